@@ -1,0 +1,33 @@
+// Function ids of the GPU parity test, shared by shaders/tests/physics_parity.comp and
+// tests/render/physics_parity_test.cpp (both include this file).
+#define PARITY_ISOTROPIC 0u
+#define PARITY_HG 1u
+#define PARITY_CORNETTE_SHANKS 2u
+#define PARITY_SCHLICK 3u
+#define PARITY_RAYLEIGH 4u
+#define PARITY_DRAINE 5u
+#define PARITY_DUAL_HG 6u
+#define PARITY_MIE_PARAMS 7u
+#define PARITY_MIE_PHASE 8u
+#define PARITY_MIE_MEAN_COSINE 9u
+#define PARITY_HG_SAMPLE_MU 10u
+#define PARITY_SAMPLE_HG 11u
+#define PARITY_SAMPLE_DRAINE 12u
+#define PARITY_SAMPLE_MIE 13u
+#define PARITY_SAMPLE_DUAL_HG 14u
+#define PARITY_SEGMENT_FACTOR 15u
+#define PARITY_SEGMENT_INTEGRAL 16u
+#define PARITY_TRANSMITTANCE 17u
+#define PARITY_OCTAVES_HG 18u
+#define PARITY_OCTAVES_MIE 19u
+#define PARITY_RAY_SPHERE_REL 20u
+#define PARITY_RAY_SHELL_REL 21u
+#define PARITY_RAY_SPHERE 22u
+#define PARITY_SPHERE_TO_ECEF 23u
+#define PARITY_ECEF_TO_SPHERE 24u
+#define PARITY_ENU_FRAME 25u
+#define PARITY_GEOPOTENTIAL 26u
+#define PARITY_PCG_HASH 27u
+#define PARITY_TWO_PROD 28u
+#define PARITY_DIRECTION_AROUND 29u
+#define PARITY_FUNCTION_COUNT 30u
