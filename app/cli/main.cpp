@@ -81,7 +81,7 @@ int cmd_phase(const std::vector<std::string>& args) {
   }
   const auto p = cv::physics::f64::mie_params(d_um);
   std::printf("droplet diameter %.4g um: g_HG %.4f  g_D %.4f  alpha %.4f  w_D %.4f  mean cosine %.4f\n", d_um,
-              p.x, p.y, p.z, p.w, cv::physics::f64::mie_mean_cosine(p));
+              p.g_hg, p.g_d, p.alpha, p.w_d, cv::physics::f64::mie_mean_cosine(p));
   return 0;
 }
 

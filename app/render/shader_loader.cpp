@@ -32,6 +32,16 @@ std::string ShaderFeatures::defines() const {
   return out;
 }
 
+namespace {
+// Mesa (22.x) ignores the source-string number of `#line` in its messages, so the file index also
+// goes into the line number itself: line n of file k is reported as k * kLineBase + n.
+constexpr long kLineBase = 100000;
+
+std::string line_directive(int file_index, int line) {
+  return "#line " + std::to_string(file_index * kLineBase + line) + " " + std::to_string(file_index) + "\n";
+}
+}  // namespace
+
 ShaderLoader::ShaderLoader(std::vector<fs::path> include_dirs) : include_dirs_(std::move(include_dirs)) {}
 
 fs::path ShaderLoader::default_shader_dir() {
@@ -79,7 +89,7 @@ void ShaderLoader::append(const fs::path& file, ShaderSource& out, std::vector<s
 
   static const std::regex include_re(R"(^\s*#\s*include\s*[<"]([^">]+)[">]\s*(//.*)?$)");
   static const std::regex version_re(R"(^\s*#\s*version\b)");
-  out.text += "#line 1 " + std::to_string(index) + "\n";
+  out.text += line_directive(index, 1);
   std::string line;
   int lineno = 0;
   while (std::getline(in, line)) {
@@ -96,7 +106,7 @@ void ShaderLoader::append(const fs::path& file, ShaderSource& out, std::vector<s
       }
       append(inc, out, stack);
       // Back in this file: the next line is lineno + 1.
-      out.text += "#line " + std::to_string(lineno + 1) + " " + std::to_string(index) + "\n";
+      out.text += line_directive(index, lineno + 1);
       continue;
     }
     out.text += line;
@@ -124,14 +134,21 @@ std::string ShaderSource::remap_log(const std::string& log) const {
   std::string line, out;
   while (std::getline(in, line)) {
     std::smatch m;
-    auto file_of = [&](const std::string& idx) {
-      const size_t i = static_cast<size_t>(std::stoul(idx));
-      return i < files.size() ? files[i] : "source " + idx;
+    // "file:line" from the reported source number and line, preferring the index encoded in the line.
+    auto locate = [&](const std::string& src, const std::string& ln) {
+      long idx = std::stol(src), l = std::stol(ln);
+      if (l >= kLineBase) {
+        idx = l / kLineBase;
+        l %= kLineBase;
+      }
+      const std::string file =
+          idx >= 0 && static_cast<size_t>(idx) < files.size() ? files[static_cast<size_t>(idx)] : "source " + src;
+      return file + ":" + std::to_string(l);
     };
     if (std::regex_search(line, m, mesa_re)) {
-      line = file_of(m[1]) + ":" + m[2].str() + "(" + m[3].str() + "):" + m.suffix().str();
+      line = locate(m[1], m[2]) + "(" + m[3].str() + "):" + m.suffix().str();
     } else if (std::regex_search(line, m, nvidia_re)) {
-      line = file_of(m[1]) + ":" + m[2].str() + ":" + m.suffix().str();
+      line = locate(m[1], m[2]) + ":" + m.suffix().str();
     }
     out += line + "\n";
   }

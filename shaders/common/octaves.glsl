@@ -18,14 +18,13 @@ CV_FN real ms_octaves_hg(real sigma_s_per_m, real mu, real g, real tau_sun, int 
 }
 
 // The same with the approximate Mie phase: both lobes' asymmetries are scaled by c^i.
-CV_FN real ms_octaves_mie(real sigma_s_per_m, real mu, real4 p, real tau_sun, int n, real a, real b, real c) {
+CV_FN real ms_octaves_mie(real sigma_s_per_m, real mu, MieParams p, real tau_sun, int n, real a, real b, real c) {
   real sum = real(0);
   real ai = real(1);
   real bi = real(1);
   real ci = real(1);
   for (int i = 0; i < n; ++i) {
-    real4 pi = real4(ci * p.x, ci * p.y, p.z, p.w);
-    sum += bi * phase_mie(mu, pi) * exp(-ai * tau_sun);
+    sum += bi * phase_mie(mu, mie_scale_g(p, ci)) * exp(-ai * tau_sun);
     ai *= a;
     bi *= b;
     ci *= c;

@@ -3,26 +3,28 @@
 
 CV_FN real phase_isotropic() { return CV_INV_4PI; }
 
-// 1 + g^2 - 2 g mu, written as (1 - |g|)^2 + 2 |g| (1 - sign(g) mu) so it keeps its relative
-// accuracy in the forward peak (|g| and sign(g) mu both near 1), where the plain form cancels.
-CV_FN real hg_denominator(real mu, real g) {
-  real ga = abs(g);
+// 1 + g^2 - 2 g mu, written as c^2 + 2 |g| (1 - sign(g) mu) with c = 1 - |g|, so it keeps its
+// relative accuracy in the forward peak (|g| and sign(g) mu both near 1), where the plain form cancels.
+CV_FN real hg_denominator(real mu, real g, real c) {
   real m = g < real(0) ? -mu : mu;
-  return (real(1) - ga) * (real(1) - ga) + real(2) * ga * (real(1) - m);
+  return c * c + real(2) * abs(g) * (real(1) - m);
+}
+
+// Henyey-Greenstein with the complement c = 1 - |g| supplied by a caller that knows it to more
+// digits than 1 - |g| would give (the peak scales as 1/c^2, so a float g near 1 alone loses them).
+CV_FN real phase_hg_c(real mu, real g, real c) {
+  real d = hg_denominator(mu, g, c);
+  return CV_INV_4PI * c * (real(2) - c) / (d * sqrt(d));
 }
 
 // Henyey-Greenstein; mean cosine g.
-CV_FN real phase_hg(real mu, real g) {
-  real ga = abs(g);
-  real d = hg_denominator(mu, g);
-  return CV_INV_4PI * (real(1) - ga) * (real(1) + ga) / (d * sqrt(d));
-}
+CV_FN real phase_hg(real mu, real g) { return phase_hg_c(mu, g, real(1) - abs(g)); }
 
 // Cornette-Shanks (1992); mean cosine 3 g (4 + g^2) / (5 (2 + g^2)).
 CV_FN real phase_cornette_shanks(real mu, real g) {
-  real ga = abs(g);
-  real d = hg_denominator(mu, g);
-  return real(3) / (real(8) * CV_PI) * (real(1) - ga) * (real(1) + ga) * (real(1) + mu * mu) /
+  real c = real(1) - abs(g);
+  real d = hg_denominator(mu, g, c);
+  return real(3) / (real(8) * CV_PI) * c * (real(2) - c) * (real(1) + mu * mu) /
          ((real(2) + g * g) * d * sqrt(d));
 }
 
@@ -32,8 +34,11 @@ CV_FN real phase_schlick(real mu, real k) {
   return CV_INV_4PI * (real(1) - k * k) / (d * d);
 }
 
-// The usual mapping from an HG asymmetry g to Schlick's k (k ~ 1.55 g - 0.55 g^3).
-CV_FN real schlick_k_from_g(real g) { return real(1.55) * g - real(0.55) * g * g * g; }
+// The usual mapping from an HG asymmetry g to Schlick's k (k ~ 1.55 g - 0.55 g^3). It passes 1 for
+// g above ~0.92, where Schlick's function would turn negative, so k is held inside (-1, 1).
+CV_FN real schlick_k_from_g(real g) {
+  return clamp(real(1.55) * g - real(0.55) * g * g * g, real(-0.999), real(0.999));
+}
 
 // Rayleigh scattering (unpolarised); mean cosine 0.
 CV_FN real phase_rayleigh(real mu) { return real(3) / (real(16) * CV_PI) * (real(1) + mu * mu); }

@@ -36,8 +36,8 @@ CV_FN real3 sample_draine(real3 wi, real g, real alpha, CV_INOUT(uint) rng, CV_O
 }
 
 // The Mie blend: pick a lobe with its weight, sample it; the pdf is the whole blend.
-CV_FN real3 sample_mie(real3 wi, real4 p, CV_INOUT(uint) rng, CV_OUT(real) pdf) {
-  real mu = rng_next(rng) < p.w ? draine_sample_mu(p.y, p.z, rng) : hg_sample_mu(p.x, rng_next(rng));
+CV_FN real3 sample_mie(real3 wi, MieParams p, CV_INOUT(uint) rng, CV_OUT(real) pdf) {
+  real mu = rng_next(rng) < p.w_d ? draine_sample_mu(p.g_d, p.alpha, rng) : hg_sample_mu(p.g_hg, rng_next(rng));
   pdf = phase_mie(mu, p);
   return direction_around(wi, mu, CV_TWO_PI * rng_next(rng));
 }

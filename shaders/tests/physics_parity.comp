@@ -45,17 +45,34 @@ void main() {
     case PARITY_RAYLEIGH: r.a.x = phase_rayleigh(c.in0.x); break;
     case PARITY_DRAINE: r.a.x = phase_draine(c.in0.x, c.in0.y, c.in0.z); break;
     case PARITY_DUAL_HG: r.a.x = phase_dual_hg(c.in0.x, c.in0.y, c.in0.z, c.in0.w); break;
-    case PARITY_MIE_PARAMS: r.a = mie_params(c.in0.x); break;
+    case PARITY_MIE_PARAMS: {
+      MieParams p = mie_params(c.in0.x);
+      r.a = vec4(p.g_hg, p.g_d, p.alpha, p.w_d);
+      r.b.x = p.c_hg;
+      break;
+    }
     case PARITY_MIE_PHASE: r.a.x = phase_mie(c.in0.x, mie_params(c.in0.y)); break;
     case PARITY_MIE_MEAN_COSINE: r.a.x = mie_mean_cosine(mie_params(c.in0.x)); break;
     case PARITY_HG_SAMPLE_MU: r.a.x = hg_sample_mu(c.in0.x, c.in0.y); break;
-    case PARITY_SAMPLE_HG: r.a.xyz = sample_hg(c.in0.xyz, c.in0.w, c.in1.xy, pdf); r.a.w = pdf; break;
+    case PARITY_SAMPLE_HG:
+      r.a.xyz = sample_hg(c.in0.xyz, c.in0.w, c.in1.xy, pdf);
+      r.a.w = pdf;
+      break;
     case PARITY_SAMPLE_DRAINE:
-      r.a.xyz = sample_draine(c.in0.xyz, c.in0.w, c.in1.x, rng, pdf); r.a.w = pdf; r.u.x = rng; break;
+      r.a.xyz = sample_draine(c.in0.xyz, c.in0.w, c.in1.x, rng, pdf);
+      r.a.w = pdf;
+      r.u.x = rng;
+      break;
     case PARITY_SAMPLE_MIE:
-      r.a.xyz = sample_mie(c.in0.xyz, mie_params(c.in0.w), rng, pdf); r.a.w = pdf; r.u.x = rng; break;
+      r.a.xyz = sample_mie(c.in0.xyz, mie_params(c.in0.w), rng, pdf);
+      r.a.w = pdf;
+      r.u.x = rng;
+      break;
     case PARITY_SAMPLE_DUAL_HG:
-      r.a.xyz = sample_dual_hg(c.in0.xyz, c.in0.w, c.in1.x, c.in1.y, rng, pdf); r.a.w = pdf; r.u.x = rng; break;
+      r.a.xyz = sample_dual_hg(c.in0.xyz, c.in0.w, c.in1.x, c.in1.y, rng, pdf);
+      r.a.w = pdf;
+      r.u.x = rng;
+      break;
     case PARITY_SEGMENT_FACTOR: r.a.x = segment_factor(c.in0.x); break;
     case PARITY_SEGMENT_INTEGRAL: r.a.x = segment_integral(c.in0.x, c.in0.y, c.in0.z); break;
     case PARITY_TRANSMITTANCE: r.a.x = transmittance(c.in0.x); break;
@@ -66,14 +83,24 @@ void main() {
                              c.in1.z);
       break;
     case PARITY_RAY_SPHERE_REL:
-      r.u.x = ray_sphere_rel(c.in0.x, c.in0.y, c.in0.z, c.in0.w, t0, t1) ? 1u : 0u; r.a.xy = vec2(t0, t1); break;
+      r.u.x = ray_sphere_rel(c.in0.x, c.in0.y, c.in0.z, c.in0.w, t0, t1) ? 1u : 0u;
+      r.a.xy = vec2(t0, t1);
+      break;
     case PARITY_RAY_SHELL_REL:
-      r.u.x = uint(ray_shell_rel(c.in0.x, c.in0.y, c.in0.z, c.in0.w, c.in1.x, seg)); r.a = seg; break;
+      r.u.x = uint(ray_shell_rel(c.in0.x, c.in0.y, c.in0.z, c.in0.w, c.in1.x, seg));
+      r.a = seg;
+      break;
     case PARITY_RAY_SPHERE:
-      r.u.x = ray_sphere(c.in0.xyz, c.in1.xyz, c.in0.w, t0, t1) ? 1u : 0u; r.a.xy = vec2(t0, t1); break;
+      r.u.x = ray_sphere(c.in0.xyz, c.in1.xyz, c.in0.w, t0, t1) ? 1u : 0u;
+      r.a.xy = vec2(t0, t1);
+      break;
     case PARITY_SPHERE_TO_ECEF: r.a.xyz = sphere_to_ecef(c.in0.x, c.in0.y, c.in0.z, c.in0.w); break;
     case PARITY_ECEF_TO_SPHERE: r.a.xyz = ecef_to_sphere(c.in0.xyz, c.in0.w); break;
-    case PARITY_ENU_FRAME: enu_frame(c.in0.x, c.in0.y, e, n, up); r.a.xyz = e; r.b.xyz = n; break;
+    case PARITY_ENU_FRAME:
+      enu_frame(c.in0.x, c.in0.y, e, n, up);
+      r.a.xyz = e;
+      r.b.xyz = n;
+      break;
     case PARITY_GEOPOTENTIAL: r.a.x = geopotential_to_height_m(c.in0.x, c.in0.y); break;
     case PARITY_PCG_HASH: r.u.x = pcg_hash(c.meta.y); break;
     case PARITY_TWO_PROD: r.a.xy = two_prod(c.in0.x, c.in0.y); break;
