@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "importer.hpp"
 #include "physics/physics.hpp"
+#include "volume/volume_io.hpp"
 #include "render/context.hpp"
 #include "render/shader_loader.hpp"
 
@@ -25,6 +27,10 @@ void print_usage() {
   std::printf(
       "usage: cloudviewer <command> [options]\n"
       "commands:\n"
+      "  info FILE                what the importer understands of a NetCDF file\n"
+      "  import FILE -o OUT [--region W,E,S,N] [--times FIRST:LAST[:STRIDE]] [--levels MIN_HPA:MAX_HPA]\n"
+      "         [--stride N] [--dz M] [--reff-liquid UM] [--reff-ice UM] [--vti]\n"
+      "                           import into OUT.cvvol (+ OUT.report.json, and OUT_tNNN.vti with --vti)\n"
       "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"
       "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"
       "  render --dry-run [-o OUT.png] [--size WxH]\n"
@@ -85,6 +91,104 @@ int cmd_phase(const std::vector<std::string>& args) {
   return 0;
 }
 
+std::vector<double> parse_list(const std::string& option, const std::string& text, char sep, std::size_t min_n,
+                               std::size_t max_n, const char* expected) {
+  std::vector<double> out;
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    const std::size_t end = text.find(sep, pos);
+    const std::string item = text.substr(pos, end == std::string::npos ? std::string::npos : end - pos);
+    try {
+      out.push_back(parse_number(option, item));
+    } catch (const UsageError&) {
+      throw UsageError{"cloudviewer: " + option + ": found '" + text + "', expected " + expected};
+    }
+    if (end == std::string::npos) break;
+    pos = end + 1;
+  }
+  if (out.size() < min_n || out.size() > max_n) {
+    throw UsageError{"cloudviewer: " + option + ": found '" + text + "', expected " + expected};
+  }
+  return out;
+}
+
+int cmd_info(const std::vector<std::string>& args) {
+  if (args.size() != 1) throw UsageError{"cloudviewer info: expected one FILE argument"};
+  std::printf("%s", cv::importers::describe_file(args[0]).c_str());
+  return 0;
+}
+
+int cmd_import(const std::vector<std::string>& args) {
+  cv::importers::ImportOptions o;
+  std::string input, out;
+  bool vti = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto next = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw UsageError{"cloudviewer import: " + a + ": expected a value after it"};
+      return args[++i];
+    };
+    if (a == "-o") out = next();
+    else if (a == "--vti") vti = true;
+    else if (a == "--region") {
+      const auto r = parse_list("--region", next(), ',', 4, 4, "W,E,S,N in degrees");
+      if (r[2] > r[3] || r[2] < -90 || r[3] > 90) throw UsageError{"cloudviewer import: --region: expected S <= N within -90..90"};
+      o.region = cv::importers::Region{r[0], r[1], r[2], r[3]};
+    } else if (a == "--times") {
+      const auto t = parse_list("--times", next(), ':', 2, 3, "FIRST:LAST[:STRIDE] as step indices");
+      o.time_first = static_cast<int>(t[0]);
+      o.time_last = static_cast<int>(t[1]);
+      o.time_stride = t.size() > 2 ? static_cast<int>(t[2]) : 1;
+      if (o.time_first < 0 || o.time_stride < 1) throw UsageError{"cloudviewer import: --times: expected FIRST >= 0 and STRIDE >= 1"};
+    } else if (a == "--levels") {
+      const auto l = parse_list("--levels", next(), ':', 2, 2, "MIN_HPA:MAX_HPA");
+      o.level_min_hpa = l[0];
+      o.level_max_hpa = l[1];
+    } else if (a == "--stride") {
+      o.horizontal_stride = static_cast<int>(parse_number("--stride", next()));
+      if (o.horizontal_stride < 1) throw UsageError{"cloudviewer import: --stride: expected an integer >= 1"};
+    } else if (a == "--dz") {
+      o.dz_m = parse_number("--dz", next());
+      if (!(o.dz_m > 0)) throw UsageError{"cloudviewer import: --dz: expected a spacing in metres > 0"};
+    } else if (a == "--reff-liquid") {
+      o.r_eff_liquid_um = parse_number("--reff-liquid", next());
+      if (!(o.r_eff_liquid_um >= 1 && o.r_eff_liquid_um <= 50)) throw UsageError{"cloudviewer import: --reff-liquid: expected 1..50 um"};
+    } else if (a == "--reff-ice") {
+      o.r_eff_ice_um = parse_number("--reff-ice", next());
+      if (!(o.r_eff_ice_um >= 5 && o.r_eff_ice_um <= 200)) throw UsageError{"cloudviewer import: --reff-ice: expected 5..200 um"};
+    } else if (!a.empty() && a[0] == '-') {
+      throw UsageError{"cloudviewer import: unknown option '" + a + "'"};
+    } else if (input.empty()) {
+      input = a;
+    } else {
+      throw UsageError{"cloudviewer import: unexpected argument '" + a + "', expected one FILE"};
+    }
+  }
+  if (input.empty() || out.empty()) throw UsageError{"cloudviewer import: expected FILE and -o OUT"};
+  if (out.size() > 6 && out.substr(out.size() - 6) == ".cvvol") out.resize(out.size() - 6);
+  cv::core::CloudVolume vol = cv::importers::import_file(input, o);
+  std::printf("grid: %d x %d x %d (lon %.4g..%.4g, lat %.4g..%.4g, alt %.0f..%.0f m), %zu time step(s)\n",
+              vol.grid.lon_deg.count, vol.grid.lat_deg.count, vol.grid.alt_m.count, vol.grid.lon_deg.start,
+              vol.grid.lon_deg.last(), vol.grid.lat_deg.start, vol.grid.lat_deg.last(), vol.grid.alt_m.start,
+              vol.grid.alt_m.last(), vol.times.size());
+  cv::core::write_cvvol(out + ".cvvol", vol, [&](std::size_t t, std::size_t n) {
+    std::printf("importing time step %zu/%zu (%s)\n", t + 1, n, vol.times[t].iso_utc.c_str());
+    std::fflush(stdout);
+    if (vti) {
+      char name[32];
+      std::snprintf(name, sizeof name, "_t%03zu.vti", t);
+      cv::core::write_vti(out + name, vol.grid, vol.step(t), vol.has_field);
+    }
+  });
+  cv::core::write_file_atomically(out + ".report.json", [&](std::FILE* f) {
+    const std::string j = vol.report.to_json();
+    std::fwrite(j.data(), 1, j.size(), f);
+  });
+  std::printf("%s", vol.report.to_text().c_str());
+  std::printf("wrote %s.cvvol and %s.report.json%s\n", out.c_str(), out.c_str(), vti ? " and .vti files" : "");
+  return 0;
+}
+
 int cmd_render(const std::vector<std::string>& args) {
   bool dry_run = false;
   std::string out = "cloudviewer.png";
@@ -136,11 +240,17 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (cmd == "gpu-info") return check_gpu(true) > 0 ? 0 : 1;
+    if (cmd == "info") return cmd_info(args);
+    if (cmd == "import") return cmd_import(args);
     if (cmd == "phase") return cmd_phase(args);
     if (cmd == "render") return cmd_render(args);
-    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected gpu-info, phase or render"};
+    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase or render"};
   } catch (const UsageError& e) {
     std::fprintf(stderr, "%s\n", e.message.c_str());
+    return kExitBadInput;
+  } catch (const cv::importers::ImportError& e) {
+    // Bad input files: one line naming the file and variable, exit code 2.
+    std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "cloudviewer %s: %s\n", cmd.c_str(), e.what());

@@ -1,0 +1,135 @@
+// CloudVolume: grid helpers, derived maps, and the lazy time-step cache.
+#include "volume/cloud_volume.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace cv::core {
+
+bool VolumeGrid::wraps_lon() const {
+  return lon_deg.count > 1 && std::abs(lon_deg.step * lon_deg.count - 360.0) < 1e-6 * 360.0;
+}
+
+const char* field_name(Field f) {
+  static const char* names[kFieldCount] = {"extinction_liquid", "extinction_ice", "cloud_fraction", "wind_u",
+                                           "wind_v", "wind_w", "temperature"};
+  return names[static_cast<int>(f)];
+}
+
+const char* field_units(Field f) {
+  static const char* units[kFieldCount] = {"1/m", "1/m", "1", "m/s", "m/s", "m/s", "K"};
+  return units[static_cast<int>(f)];
+}
+
+std::size_t TimeStepData::bytes() const {
+  std::size_t b = 0;
+  for (const auto& f : fields) b += f.size() * sizeof(float);
+  for (const auto* m : {&maps.cloud_cover, &maps.cloud_base_m, &maps.cloud_top_m, &maps.optical_depth,
+                        &maps.low_cover, &maps.mid_cover, &maps.high_cover}) {
+    b += m->size() * sizeof(float);
+  }
+  return b;
+}
+
+namespace {
+// Maximum-random overlap (Geleyn & Hollingsworth 1979): adjacent cloudy layers overlap maximally,
+// layers separated by clear air randomly. Walks the column from the top with the layer's fractions.
+struct Overlap {
+  double clear = 1.0;  // probability of a clear line of sight so far
+  double prev = 0.0;   // fraction of the layer above
+  void add(double c) {
+    c = std::clamp(c, 0.0, 1.0);
+    if (prev < 1.0) clear *= (1.0 - std::max(c, prev)) / (1.0 - prev);
+    else clear = c >= 1.0 ? 0.0 : clear;  // an overcast layer above already hides everything
+    prev = c;
+  }
+  void gap() { prev = 0.0; }
+  double cover() const { return std::clamp(1.0 - clear, 0.0, 1.0); }
+};
+}  // namespace
+
+void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& options) {
+  const std::size_t ncol = grid.columns();
+  const auto& cf = data[Field::CloudFraction];
+  const auto& el = data[Field::ExtinctionLiquid];
+  const auto& ei = data[Field::ExtinctionIce];
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  Maps2D& m = data.maps;
+  for (auto* v : {&m.cloud_cover, &m.cloud_base_m, &m.cloud_top_m, &m.optical_depth, &m.low_cover, &m.mid_cover,
+                  &m.high_cover}) {
+    v->assign(ncol, nan);
+  }
+  const double dz = grid.alt_m.step;
+  for (int j = 0; j < grid.lat_deg.count; ++j) {
+    for (int i = 0; i < grid.lon_deg.count; ++i) {
+      Overlap all, low, mid, high;
+      double tau = 0.0, base = nan, top = nan;
+      bool any_data = false;
+      for (int k = grid.alt_m.count - 1; k >= 0; --k) {
+        const std::size_t p = grid.index(i, j, k);
+        const double ext = (el.empty() || std::isnan(el[p]) ? 0.0 : el[p]) + (ei.empty() || std::isnan(ei[p]) ? 0.0 : ei[p]);
+        const bool have = (!cf.empty() && !std::isnan(cf[p])) || (!el.empty() && !std::isnan(el[p])) ||
+                          (!ei.empty() && !std::isnan(ei[p]));
+        if (!have) continue;
+        any_data = true;
+        // Without a cloud-fraction field, a point with water counts as fully cloudy.
+        const double frac = cf.empty() || std::isnan(cf[p]) ? (ext > 0.0 ? 1.0 : 0.0) : cf[p];
+        const bool cloudy = frac >= options.min_cloud_fraction && ext >= options.min_extinction_per_m;
+        const double c = cloudy ? frac : 0.0;
+        const double alt = grid.alt_m.at(k);
+        Overlap& layer = alt < options.low_top_m ? low : alt < options.mid_top_m ? mid : high;
+        if (cloudy) {
+          all.add(c);
+          layer.add(c);
+          tau += c * ext * dz;
+          top = std::isnan(top) ? alt : top;
+          base = alt;
+        } else {
+          all.gap();
+          layer.gap();
+        }
+      }
+      if (!any_data) continue;
+      const std::size_t col = grid.column(i, j);
+      m.cloud_cover[col] = static_cast<float>(all.cover());
+      m.low_cover[col] = static_cast<float>(low.cover());
+      m.mid_cover[col] = static_cast<float>(mid.cover());
+      m.high_cover[col] = static_cast<float>(high.cover());
+      m.optical_depth[col] = static_cast<float>(tau);
+      m.cloud_base_m[col] = static_cast<float>(base);
+      m.cloud_top_m[col] = static_cast<float>(top);
+    }
+  }
+}
+
+void CloudVolume::set_loader(Loader loader, std::size_t cache_steps) {
+  loader_ = std::move(loader);
+  cache_steps_ = std::max<std::size_t>(1, cache_steps);
+}
+
+void CloudVolume::put(std::size_t index, TimeStepData data) { pinned_[index] = std::move(data); }
+
+const TimeStepData& CloudVolume::step(std::size_t index) {
+  if (index >= times.size()) {
+    throw std::out_of_range("time step " + std::to_string(index) + " of " + std::to_string(times.size()));
+  }
+  if (auto it = pinned_.find(index); it != pinned_.end()) return it->second;
+  if (auto it = cache_.find(index); it != cache_.end()) {
+    lru_.remove(index);
+    lru_.push_front(index);
+    return it->second;
+  }
+  if (!loader_) throw std::logic_error("time step " + std::to_string(index) + " is not loaded and no loader is set");
+  // Evict before loading so peak memory holds at most cache_steps steps.
+  while (cache_.size() >= cache_steps_) {
+    cache_.erase(lru_.back());
+    lru_.pop_back();
+  }
+  TimeStepData data = loader_(index, report);
+  derive_maps(grid, data);
+  lru_.push_front(index);
+  return cache_.emplace(index, std::move(data)).first->second;
+}
+
+}  // namespace cv::core

@@ -1,0 +1,126 @@
+// A cloud volume on a spherical-Earth shell: a regular longitude/latitude/altitude grid, SI fields
+// per valid time (loaded lazily, evicted), 2-D maps derived from them, and the import report.
+// Plain data: nothing here knows NetCDF, GL or VTK.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <list>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "volume/import_report.hpp"
+
+namespace cv::core {
+
+// start + i * step for i in [0, count).
+struct RegularAxis {
+  double start = 0.0;
+  double step = 1.0;
+  int count = 0;
+  double at(int i) const { return start + step * i; }
+  double last() const { return at(count - 1); }
+};
+
+struct VolumeGrid {
+  RegularAxis lon_deg;  // ascending; may run past 180 across the date line
+  RegularAxis lat_deg;  // ascending, south to north
+  RegularAxis alt_m;    // geometric altitude above the sphere, ascending
+  double earth_radius_m = 6371000.0;
+
+  std::size_t columns() const { return std::size_t(lon_deg.count) * std::size_t(lat_deg.count); }
+  std::size_t points() const { return columns() * std::size_t(alt_m.count); }
+  // Longitude varies fastest, then latitude, then altitude: a 3-D texture of (nlon, nlat, nalt).
+  std::size_t index(int i_lon, int j_lat, int k_alt) const {
+    return (std::size_t(k_alt) * std::size_t(lat_deg.count) + std::size_t(j_lat)) * std::size_t(lon_deg.count) +
+           std::size_t(i_lon);
+  }
+  std::size_t column(int i_lon, int j_lat) const {
+    return std::size_t(j_lat) * std::size_t(lon_deg.count) + std::size_t(i_lon);
+  }
+  // True when the longitudes cover the whole circle (the last column's neighbour is the first).
+  bool wraps_lon() const;
+};
+
+// 3-D fields in SI units. A field a file does not provide is absent (an empty vector); a point
+// with no data (outside the model domain, below the lowest level) is NaN, never an invented value.
+enum class Field : int {
+  ExtinctionLiquid = 0,  // 1/m, in-cloud
+  ExtinctionIce,         // 1/m, in-cloud
+  CloudFraction,         // 0..1
+  WindU,                 // m/s, eastward
+  WindV,                 // m/s, northward
+  WindW,                 // m/s, upward
+  Temperature,           // K
+};
+inline constexpr int kFieldCount = 7;
+const char* field_name(Field f);
+const char* field_units(Field f);
+
+// Per-column maps derived from the 3-D fields (NaN where a column has no data or no cloud).
+struct Maps2D {
+  std::vector<float> cloud_cover;        // 0..1, maximum-random overlap
+  std::vector<float> cloud_base_m;       // lowest cloudy altitude
+  std::vector<float> cloud_top_m;        // highest cloudy altitude
+  std::vector<float> optical_depth;      // column integral of cloud fraction x in-cloud extinction
+  std::vector<float> low_cover;          // below 2 km
+  std::vector<float> mid_cover;          // 2 to 6 km
+  std::vector<float> high_cover;         // above 6 km
+};
+
+// Thresholds for the derived maps.
+struct MapOptions {
+  float min_cloud_fraction = 0.01f;       // a point counts as cloudy from here...
+  float min_extinction_per_m = 1e-6f;     // ...when its extinction also reaches this
+  double low_top_m = 2000.0;
+  double mid_top_m = 6000.0;
+};
+
+struct TimeStepData {
+  std::array<std::vector<float>, kFieldCount> fields;
+  Maps2D maps;
+  std::vector<float>& operator[](Field f) { return fields[static_cast<std::size_t>(f)]; }
+  const std::vector<float>& operator[](Field f) const { return fields[static_cast<std::size_t>(f)]; }
+  std::size_t bytes() const;
+};
+
+// Fills data.maps from data's fields.
+void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& options = {});
+
+struct ValidTime {
+  std::int64_t unix_s = 0;      // seconds since 1970-01-01 UTC (for non-standard calendars, the
+                                // nearest real date; the report says so)
+  std::string iso_utc;          // e.g. "2024-01-15T03:00:00Z", in the file's own calendar
+};
+
+// The volume: grid, times, which fields exist, report; time steps come from a loader on demand and
+// at most `cache_steps` stay in memory.
+class CloudVolume {
+ public:
+  using Loader = std::function<TimeStepData(std::size_t step, ImportReport& report)>;
+
+  VolumeGrid grid;
+  std::vector<ValidTime> times;
+  std::array<bool, kFieldCount> has_field{};
+  ImportReport report;
+
+  void set_loader(Loader loader, std::size_t cache_steps = 2);
+  // Stores a step directly (eager importers, tests); it is never evicted.
+  void put(std::size_t step, TimeStepData data);
+  // The step's data, loading it if needed and evicting the least recently used beyond the cache.
+  const TimeStepData& step(std::size_t index);
+  bool is_loaded(std::size_t index) const { return pinned_.count(index) || cache_.count(index); }
+  std::size_t loaded_steps() const { return pinned_.size() + cache_.size(); }
+
+ private:
+  Loader loader_;
+  std::size_t cache_steps_ = 2;
+  std::map<std::size_t, TimeStepData> pinned_;
+  std::map<std::size_t, TimeStepData> cache_;
+  std::list<std::size_t> lru_;  // most recent first
+};
+
+}  // namespace cv::core

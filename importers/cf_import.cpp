@@ -1,0 +1,552 @@
+// CF / ERA5 pressure-level files to a CloudVolume: horizontal mapping (wrap, date line, descending
+// and uneven latitudes, subsetting), heights from geopotential, the physics of the conversion, and
+// the consistency checks of the import report.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <numeric>
+
+#include "cf_layout.hpp"
+#include "importer.hpp"
+#include "physics/physics.hpp"
+
+namespace cv::importers {
+namespace {
+
+constexpr double kRd = 287.05;        // dry-air gas constant, J/(kg K)
+constexpr double kG0 = 9.80665;       // m/s2
+constexpr double kRhoWater = 1000.0;  // kg/m3
+constexpr double kRhoIce = 917.0;     // kg/m3
+constexpr double kMinCloudFraction = 0.01;
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string fmt(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+// Output longitude columns: source index for each, and the regular output axis.
+struct LonMap {
+  std::vector<int> src;
+  core::RegularAxis axis;
+};
+
+LonMap map_longitudes(const std::vector<double>& raw, const std::optional<Region>& region, int stride,
+                      const std::string& where, std::vector<std::string>& notes) {
+  const int n = static_cast<int>(raw.size());
+  if (n < 2) throw ImportError(where + ": " + std::to_string(n) + " longitude(s), expected at least 2");
+  // Sort the longitudes on the circle, dropping a duplicated wrap column (x and x + 360).
+  std::vector<std::pair<double, int>> s;
+  for (int i = 0; i < n; ++i) s.push_back({std::fmod(std::fmod(raw[static_cast<std::size_t>(i)], 360.0) + 360.0, 360.0), i});
+  std::sort(s.begin(), s.end());
+  std::vector<std::pair<double, int>> u;
+  for (const auto& p : s) {
+    if (!u.empty() && std::abs(p.first - u.back().first) < 1e-6) {
+      notes.push_back("longitude column " + std::to_string(p.second) + " repeats column " + std::to_string(u.back().second) +
+                      " (wrap column): dropped");
+      continue;
+    }
+    u.push_back(p);
+  }
+  if (u.size() > 1 && 360.0 - u.back().first + u.front().first < 1e-6) u.pop_back();
+  const int m = static_cast<int>(u.size());
+  // The largest gap on the circle separates the domain's east edge from its west edge.
+  int start = 0;
+  double gap = 360.0 - u.back().first + u.front().first;
+  for (int i = 1; i < m; ++i) {
+    if (u[static_cast<std::size_t>(i)].first - u[static_cast<std::size_t>(i - 1)].first > gap) {
+      gap = u[static_cast<std::size_t>(i)].first - u[static_cast<std::size_t>(i - 1)].first;
+      start = i;
+    }
+  }
+  std::vector<double> lon;
+  std::vector<int> idx;
+  for (int k = 0; k < m; ++k) {
+    const auto& p = u[static_cast<std::size_t>((start + k) % m)];
+    double x = p.first;
+    if (!lon.empty()) {
+      while (x < lon.back()) x += 360.0;
+    }
+    lon.push_back(x);
+    idx.push_back(p.second);
+  }
+  const double step = (lon.back() - lon.front()) / (m - 1);
+  for (int k = 1; k < m; ++k) {
+    const double d = lon[static_cast<std::size_t>(k)] - lon[static_cast<std::size_t>(k - 1)];
+    if (std::abs(d - step) > 1e-3 * step) {
+      throw ImportError(where + ": longitudes are not evenly spaced (step " + fmt(d) + " after " + fmt(lon[static_cast<std::size_t>(k - 1)]) +
+                        ", expected " + fmt(step) + ")");
+    }
+  }
+  const bool global = std::abs(step * m - 360.0) < 1e-3 * step;
+  // Express longitudes in -180..540 starting at the western edge (a box across 180 stays contiguous).
+  double west = lon.front();
+  if (west >= 180.0) west -= 360.0;
+  for (auto& x : lon) x += west - lon.front();
+  std::vector<int> keep;
+  double first = 0.0;
+  if (region) {
+    const double w = std::fmod(std::fmod(region->lon_west_deg, 360.0) + 360.0, 360.0);
+    double width = std::fmod(std::fmod(region->lon_east_deg - region->lon_west_deg, 360.0) + 360.0, 360.0);
+    if (width == 0.0) width = 360.0;
+    auto inside = [&](int k) {
+      return std::fmod(std::fmod(lon[static_cast<std::size_t>(k)] - w, 360.0) + 360.0, 360.0) <= width + 1e-9;
+    };
+    // Start at the box's western edge: the first column inside whose western neighbour is outside
+    // (on a global grid the neighbour of column 0 is the last column).
+    int s0 = -1;
+    for (int k = 0; k < m && s0 < 0; ++k) {
+      const bool prev_in = k > 0 ? inside(k - 1) : (global && inside(m - 1));
+      if (inside(k) && !prev_in) s0 = k;
+    }
+    if (s0 < 0 && inside(0)) s0 = 0;  // the box covers every column
+    for (int k = s0; s0 >= 0 && k < s0 + m && (global || k < m) && inside(k % m); ++k) keep.push_back(k);
+    if (!keep.empty()) first = lon[static_cast<std::size_t>(s0)];
+    if (keep.empty()) throw ImportError(where + ": the region's longitudes hold no grid column of the file");
+  } else {
+    for (int k = 0; k < m; ++k) keep.push_back(k);
+    first = lon.front();
+  }
+  LonMap out;
+  for (std::size_t k = 0; k < keep.size(); k += static_cast<std::size_t>(stride)) {
+    out.src.push_back(idx[static_cast<std::size_t>(keep[k] % m)]);
+  }
+  out.axis = {first, step * stride, static_cast<int>(out.src.size())};
+  return out;
+}
+
+// Output latitude rows: a regular ascending axis; each row interpolates two source rows.
+struct LatMap {
+  std::vector<int> j0, j1;
+  std::vector<double> w;  // weight of j1
+  core::RegularAxis axis;
+};
+
+LatMap map_latitudes(const std::vector<double>& raw, const std::optional<Region>& region, int stride,
+                     const std::string& where, std::vector<std::string>& notes) {
+  const int n = static_cast<int>(raw.size());
+  if (n < 2) throw ImportError(where + ": " + std::to_string(n) + " latitude(s), expected at least 2");
+  std::vector<int> order(static_cast<std::size_t>(n));
+  std::iota(order.begin(), order.end(), 0);
+  const bool descending = raw.front() > raw.back();
+  if (descending) std::reverse(order.begin(), order.end());
+  std::vector<double> lat;
+  for (int i : order) lat.push_back(raw[static_cast<std::size_t>(i)]);
+  for (int k = 1; k < n; ++k) {
+    if (!(lat[static_cast<std::size_t>(k)] > lat[static_cast<std::size_t>(k - 1)])) {
+      throw ImportError(where + ": latitudes are not monotonic (at index " + std::to_string(k) + ")");
+    }
+  }
+  if (lat.front() < -90.0 - 1e-9 || lat.back() > 90.0 + 1e-9) {
+    throw ImportError(where + ": latitudes run from " + fmt(lat.front()) + " to " + fmt(lat.back()) + ", expected within -90..90");
+  }
+  if (descending) notes.push_back("latitudes run north to south in the file; flipped to ascending");
+  const double step0 = (lat.back() - lat.front()) / (n - 1);
+  bool even = true;
+  for (int k = 1; k < n; ++k) {
+    even &= std::abs(lat[static_cast<std::size_t>(k)] - lat[static_cast<std::size_t>(k - 1)] - step0) < 1e-3 * step0;
+  }
+  if (!even) notes.push_back("latitudes are unevenly spaced (Gaussian grid): resampled linearly onto an even grid");
+  double lo = lat.front(), hi = lat.back();
+  if (region) {
+    lo = std::max(lo, region->lat_south_deg);
+    hi = std::min(hi, region->lat_north_deg);
+    if (lo > hi) throw ImportError(where + ": the region's latitudes hold no grid row of the file");
+    // Snap to the file's rows so an even grid keeps exactly its own values.
+    lo = lat.front() + std::ceil((lo - lat.front()) / step0 - 1e-9) * step0;
+    hi = lat.front() + std::floor((hi - lat.front()) / step0 + 1e-9) * step0;
+  }
+  const int count = static_cast<int>(std::floor((hi - lo) / (step0 * stride) + 1e-9)) + 1;
+  LatMap out;
+  out.axis = {lo, step0 * stride, count};
+  for (int r = 0; r < count; ++r) {
+    const double y = out.axis.at(r);
+    const auto it = std::lower_bound(lat.begin(), lat.end(), y - 1e-9 * step0);
+    int k = static_cast<int>(it - lat.begin());
+    k = std::clamp(k, 1, n - 1);
+    const double a = lat[static_cast<std::size_t>(k - 1)], b = lat[static_cast<std::size_t>(k)];
+    double w = std::clamp((y - a) / (b - a), 0.0, 1.0);
+    if (std::abs(w - 1.0) < 1e-9) w = 1.0;
+    if (std::abs(w) < 1e-9) w = 0.0;
+    out.j0.push_back(order[static_cast<std::size_t>(k - 1)]);
+    out.j1.push_back(order[static_cast<std::size_t>(k)]);
+    out.w.push_back(w);
+  }
+  return out;
+}
+
+// Strides of one variable's per-time-step slab, in source index space.
+struct Slab {
+  std::vector<double> data;
+  std::size_t s_lon = 0, s_lat = 0, s_lev = 0;
+  double at(int i, int j, int k) const { return data[i * s_lon + j * s_lat + k * s_lev]; }
+};
+
+}  // namespace
+
+double ice_effective_radius_um(double temperature_k) {
+  const double t_c = temperature_k - 273.15;
+  return std::clamp(50.0 + 0.5 * t_c, 20.0, 50.0);
+}
+
+double isa_altitude_m(double p_pa) {
+  constexpr double p0 = 101325.0, t0 = 288.15, lapse = 0.0065, p11 = 22632.06, t11 = 216.65;
+  if (p_pa >= p11) return t0 / lapse * (1.0 - std::pow(p_pa / p0, kRd * lapse / kG0));
+  return 11000.0 + kRd * t11 / kG0 * std::log(p11 / p_pa);
+}
+
+double isa_temperature_k(double altitude_m) { return altitude_m < 11000.0 ? 288.15 - 0.0065 * altitude_m : 216.65; }
+
+struct Era5Source {
+  std::unique_ptr<NcFile> file;
+  CfLayout layout;
+  LonMap lon;
+  LatMap lat;
+  std::vector<int> levels;            // source level indices kept, bottom (highest pressure) first
+  std::vector<double> level_pa;
+  std::vector<int> steps;             // source time indices, in output order
+  ImportOptions options;
+};
+
+namespace {
+
+Slab read_slab(const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* info) {
+  const NcFile& f = *S.file;
+  const CfLayout& L = S.layout;
+  std::vector<std::size_t> start(v.dims.size(), 0), count(v.dims.size(), 0);
+  Slab s;
+  std::size_t stride = 1;
+  for (int a = static_cast<int>(v.dims.size()) - 1; a >= 0; --a) {
+    const int d = v.dims[static_cast<std::size_t>(a)];
+    const std::size_t len = f.dims()[static_cast<std::size_t>(d)].length;
+    std::size_t c = len;
+    if (d == L.time.dim) {
+      start[static_cast<std::size_t>(a)] = static_cast<std::size_t>(time_index);
+      c = 1;
+    }
+    count[static_cast<std::size_t>(a)] = c;
+    if (d == L.lon.dim) s.s_lon = stride;
+    if (d == L.lat.dim) s.s_lat = stride;
+    if (d == L.vertical.dim) s.s_lev = stride;
+    stride *= c;
+  }
+  s.data = f.read(v, start, count, info);
+  return s;
+}
+
+}  // namespace
+
+core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size_t step,
+                                  core::ImportReport& report) {
+  const CfLayout& L = S.layout;
+  const std::string& path = S.file->path();
+  const int t = S.steps[step];
+  Slab slab[kRoleCount];
+  bool have[kRoleCount] = {};
+  for (int r = 0; r < kRoleCount; ++r) {
+    if (!L.roles[r]) continue;
+    UnpackInfo info;
+    slab[r] = read_slab(S, *L.roles[r], t, &info);
+    have[r] = true;
+    auto& use = report.use(role_name(static_cast<Role>(r)));
+    use.variable = L.roles[r]->name;
+    use.units = L.roles[r]->text("units");
+    for (double x : slab[r].data) use.before.add(x);
+    if (info.packed && use.conversion.empty()) {
+      use.conversion = "unpacked x * " + fmt(info.scale) + " + " + fmt(info.offset) + "; ";
+    }
+  }
+  const int nlev = static_cast<int>(S.levels.size());
+  const int nx = grid.lon_deg.count, ny = grid.lat_deg.count, nz = grid.alt_m.count;
+  core::TimeStepData out;
+  const bool has_cf = have[static_cast<int>(Role::CloudFraction)];
+  auto alloc = [&](core::Field f, bool on) {
+    if (on) out[f].assign(grid.points(), std::numeric_limits<float>::quiet_NaN());
+  };
+  alloc(core::Field::ExtinctionLiquid, have[static_cast<int>(Role::Liquid)]);
+  alloc(core::Field::ExtinctionIce, have[static_cast<int>(Role::Ice)]);
+  alloc(core::Field::CloudFraction, has_cf);
+  alloc(core::Field::WindU, have[static_cast<int>(Role::U)]);
+  alloc(core::Field::WindV, have[static_cast<int>(Role::V)]);
+  alloc(core::Field::WindW, have[static_cast<int>(Role::Omega)]);
+  alloc(core::Field::Temperature, true);
+
+  std::size_t water_without_cf = 0, cf_without_water = 0, negative_water = 0, nonmonotonic = 0, clamped_cf = 0;
+  double worst_negative = 0.0;
+  // Per column: native-level quantities, then interpolation onto the altitude grid.
+  std::vector<double> h(static_cast<std::size_t>(nlev)), q[core::kFieldCount];
+  for (auto& v : q) v.resize(static_cast<std::size_t>(nlev));
+  auto value = [&](Role r, int i, int j0, int j1, double w, int k) {
+    const Slab& s = slab[static_cast<int>(r)];
+    const double a = s.at(i, j0, k), b = s.at(i, j1, k);
+    return w == 0.0 ? a : w == 1.0 ? b : (1.0 - w) * a + w * b;
+  };
+  auto bad = [&](Role r, double v, const char* expected) {
+    throw ImportError(path + ": variable '" + L.roles[static_cast<int>(r)]->name + "' has value " + fmt(v) +
+                      " at time step " + std::to_string(t) + ", expected " + expected);
+  };
+  for (int y = 0; y < ny; ++y) {
+    for (int x = 0; x < nx; ++x) {
+      const int i = S.lon.src[static_cast<std::size_t>(x)];
+      const int j0 = S.lat.j0[static_cast<std::size_t>(y)], j1 = S.lat.j1[static_cast<std::size_t>(y)];
+      const double w = S.lat.w[static_cast<std::size_t>(y)];
+      for (int l = 0; l < nlev; ++l) {
+        const int k = S.levels[static_cast<std::size_t>(l)];
+        const double p = S.level_pa[static_cast<std::size_t>(l)];
+        // Height: geopotential -> geometric height on the sphere; else the standard atmosphere.
+        double z = kNaN;
+        if (have[static_cast<int>(Role::Geopotential)]) {
+          z = physics::f64::geopotential_to_height_m(value(Role::Geopotential, i, j0, j1, w, k), grid.earth_radius_m);
+        } else if (have[static_cast<int>(Role::GeopotentialHeight)]) {
+          z = physics::f64::geopotential_to_height_m(kG0 * value(Role::GeopotentialHeight, i, j0, j1, w, k), grid.earth_radius_m);
+        } else {
+          z = isa_altitude_m(p);
+        }
+        if (!std::isnan(z) && (z < -1000.0 || z > 1.0e5)) {
+          bad(have[static_cast<int>(Role::Geopotential)] ? Role::Geopotential : Role::GeopotentialHeight, z,
+              "a height between -1 km and 100 km");
+        }
+        h[static_cast<std::size_t>(l)] = z;
+        double T = have[static_cast<int>(Role::Temperature)] ? value(Role::Temperature, i, j0, j1, w, k) : isa_temperature_k(z);
+        if (!std::isnan(T) && (T < 100.0 || T > 400.0)) bad(Role::Temperature, T, "a temperature between 100 and 400 K");
+        double qv = have[static_cast<int>(Role::Humidity)] ? value(Role::Humidity, i, j0, j1, w, k) : 0.0;
+        if (std::isnan(qv)) qv = 0.0;
+        const double rho = p / (kRd * T * (1.0 + 0.608 * qv));
+        // Cloud fraction: tiny excursions from unpacking are clamped and counted; absurd values stop.
+        double cf = has_cf ? value(Role::CloudFraction, i, j0, j1, w, k) : kNaN;
+        if (has_cf && !std::isnan(cf)) {
+          if (cf < -0.01 || cf > 1.01) bad(Role::CloudFraction, cf, "a fraction between 0 and 1");
+          if (cf < 0.0 || cf > 1.0) {
+            ++clamped_cf;
+            cf = std::clamp(cf, 0.0, 1.0);
+          }
+        }
+        double water[2] = {kNaN, kNaN};
+        const Role water_role[2] = {Role::Liquid, Role::Ice};
+        for (int ph = 0; ph < 2; ++ph) {
+          if (!have[static_cast<int>(water_role[ph])]) continue;
+          double qw = value(water_role[ph], i, j0, j1, w, k);
+          if (std::isnan(qw)) continue;
+          if (qw < -1e-5 || qw > 0.05) bad(water_role[ph], qw, "a mixing ratio between 0 and 0.05 kg/kg");
+          if (qw < 0.0) {
+            ++negative_water;
+            worst_negative = std::min(worst_negative, qw);
+            qw = 0.0;
+          }
+          water[ph] = qw;
+        }
+        const double total = (std::isnan(water[0]) ? 0.0 : water[0]) + (std::isnan(water[1]) ? 0.0 : water[1]);
+        // Grid-box mean to in-cloud: divide by the cloud fraction where it is non-zero.
+        double div = 1.0;
+        if (has_cf && !std::isnan(cf)) {
+          if (total > 1e-9 && cf < kMinCloudFraction) {
+            ++water_without_cf;
+            cf = kMinCloudFraction;  // keeps the grid-box mean water (and optical depth) of the box
+          }
+          if (cf > 0.1 && total <= 1e-9) ++cf_without_water;
+          div = std::max(cf, kMinCloudFraction);
+        }
+        const double r_liq_m = S.options.r_eff_liquid_um * 1e-6;
+        const double r_ice_m = (S.options.r_eff_ice_um > 0 ? S.options.r_eff_ice_um : ice_effective_radius_um(T)) * 1e-6;
+        const std::size_t L_ = static_cast<std::size_t>(l);
+        q[static_cast<int>(core::Field::ExtinctionLiquid)][L_] =
+            std::isnan(water[0]) ? kNaN : 3.0 * rho * water[0] / div / (2.0 * kRhoWater * r_liq_m);
+        q[static_cast<int>(core::Field::ExtinctionIce)][L_] =
+            std::isnan(water[1]) ? kNaN : 3.0 * rho * water[1] / div / (2.0 * kRhoIce * r_ice_m);
+        q[static_cast<int>(core::Field::CloudFraction)][L_] = cf;
+        q[static_cast<int>(core::Field::WindU)][L_] = have[static_cast<int>(Role::U)] ? value(Role::U, i, j0, j1, w, k) : kNaN;
+        q[static_cast<int>(core::Field::WindV)][L_] = have[static_cast<int>(Role::V)] ? value(Role::V, i, j0, j1, w, k) : kNaN;
+        // Omega (Pa/s) to w (m/s) by hydrostatics: w = -omega / (rho g).
+        q[static_cast<int>(core::Field::WindW)][L_] =
+            have[static_cast<int>(Role::Omega)] ? -value(Role::Omega, i, j0, j1, w, k) / (rho * kG0) : kNaN;
+        q[static_cast<int>(core::Field::Temperature)][L_] = T;
+      }
+      // Levels run bottom to top; heights must rise with them.
+      for (int l = 1; l < nlev; ++l) {
+        if (!(h[static_cast<std::size_t>(l)] > h[static_cast<std::size_t>(l - 1)])) ++nonmonotonic;
+      }
+      // Linear interpolation in altitude; outside the column's levels: no data.
+      for (int z = 0; z < nz; ++z) {
+        const double alt = grid.alt_m.at(z);
+        int l = 1;
+        while (l < nlev && !(h[static_cast<std::size_t>(l)] >= alt)) ++l;
+        if (l >= nlev || !(h[static_cast<std::size_t>(l - 1)] <= alt) || !(h[static_cast<std::size_t>(l)] > h[static_cast<std::size_t>(l - 1)])) continue;
+        const double a = (alt - h[static_cast<std::size_t>(l - 1)]) / (h[static_cast<std::size_t>(l)] - h[static_cast<std::size_t>(l - 1)]);
+        const std::size_t p = grid.index(x, y, z);
+        for (int f = 0; f < core::kFieldCount; ++f) {
+          auto& dst = out.fields[static_cast<std::size_t>(f)];
+          if (dst.empty()) continue;
+          const double lo = q[f][static_cast<std::size_t>(l - 1)], hi = q[f][static_cast<std::size_t>(l)];
+          dst[p] = static_cast<float>(lo + a * (hi - lo));
+        }
+      }
+    }
+  }
+  // Report: SI ranges, conversions, consistency.
+  const double r_l = S.options.r_eff_liquid_um;
+  auto after = [&](Role r, core::Field f, const std::string& conv) {
+    if (!have[static_cast<int>(r)]) return;
+    auto& use = report.use(role_name(r));
+    if (use.conversion.find(conv) == std::string::npos) use.conversion += conv;
+    for (float v : out[f]) use.after.add(v);
+  };
+  after(Role::Liquid, core::Field::ExtinctionLiquid,
+        "in-cloud = q / cloud fraction; LWC = rho q, rho = p / (287.05 T (1 + 0.608 q_v)); sigma = 3 LWC / (2 rho_w r_eff), r_eff " +
+            fmt(r_l) + " um -> liquid extinction 1/m");
+  after(Role::Ice, core::Field::ExtinctionIce,
+        std::string("in-cloud = q / cloud fraction; IWC = rho q; sigma = 3 IWC / (2 917 kg/m3 r_eff), r_eff ") +
+            (S.options.r_eff_ice_um > 0 ? fmt(S.options.r_eff_ice_um) + " um" : "50 + 0.5 T[C] um in 20..50") +
+            " -> ice extinction 1/m");
+  after(Role::CloudFraction, core::Field::CloudFraction, "clamped to 0..1");
+  after(Role::U, core::Field::WindU, "interpolated in altitude");
+  after(Role::V, core::Field::WindV, "interpolated in altitude");
+  after(Role::Omega, core::Field::WindW, "w = -omega / (rho g0)");
+  after(Role::Temperature, core::Field::Temperature, "interpolated in altitude");
+  auto used_for = [&](Role r, const std::string& what) {
+    if (!have[static_cast<int>(r)]) return;
+    auto& use = report.use(role_name(r));
+    if (use.conversion.find(what) == std::string::npos) use.conversion += what;
+  };
+  used_for(Role::Geopotential, "level heights z = Phi R / (g0 R - Phi) (not stored)");
+  used_for(Role::GeopotentialHeight, "level heights from Phi = g0 gh, z = Phi R / (g0 R - Phi) (not stored)");
+  used_for(Role::Humidity, "virtual temperature for air density (not stored)");
+  if (have[static_cast<int>(Role::CloudFraction)]) report.use(role_name(Role::CloudFraction)).clamped += clamped_cf;
+  const std::string at = " at time step " + std::to_string(t);
+  if (negative_water) {
+    report.warn(std::to_string(negative_water) + " negative mixing ratios (down to " + fmt(worst_negative) + " kg/kg) set to 0" + at);
+  }
+  if (water_without_cf) {
+    report.warn(std::to_string(water_without_cf) + " points with cloud water but cloud fraction below 0.01" + at +
+                ": fraction raised to 0.01, grid-box water kept");
+  }
+  if (cf_without_water) report.warn(std::to_string(cf_without_water) + " points with cloud fraction above 0.1 but no cloud water" + at);
+  if (nonmonotonic) report.warn(std::to_string(nonmonotonic) + " level pairs whose heights do not rise with the level" + at);
+  return out;
+}
+
+core::CloudVolume import_file(const std::string& path, const ImportOptions& options) {
+  auto S = std::make_shared<Era5Source>();
+  S->file = std::make_unique<NcFile>(path);
+  S->options = options;
+  const NcFile& f = *S->file;
+  if (!f.global_text("DX").empty() || f.global_number("DX") || f.find("XLAT")) {
+    throw ImportError(path + ": this is a WRF file; the WRF reader is not built yet (expected a CF pressure-level file)");
+  }
+  S->layout = detect_cf_layout(f);
+  CfLayout& L = S->layout;
+  core::CloudVolume vol;
+  vol.report.file = path;
+  vol.report.format = "CF pressure levels";
+  for (const auto& n : L.notes) vol.report.notes.push_back(n);
+  vol.report.notes.push_back("longitude '" + L.lon.var->name + "' recognised " + L.lon.how);
+  vol.report.notes.push_back("latitude '" + L.lat.var->name + "' recognised " + L.lat.how);
+  const bool any_cloud = L.roles[static_cast<int>(Role::CloudFraction)] || L.roles[static_cast<int>(Role::Liquid)] ||
+                         L.roles[static_cast<int>(Role::Ice)];
+  if (!any_cloud) {
+    throw ImportError(path + ": no cloud variable; expected at least one of cc / fraction_of_cloud_cover, "
+                      "clwc / specific_cloud_liquid_water_content, ciwc / specific_cloud_ice_water_content");
+  }
+  // Horizontal grid.
+  S->lon = map_longitudes(L.lon.values, options.region, std::max(1, options.horizontal_stride),
+                          path + ": coordinate '" + L.lon.var->name + "'", vol.report.notes);
+  S->lat = map_latitudes(L.lat.values, options.region, std::max(1, options.horizontal_stride),
+                         path + ": coordinate '" + L.lat.var->name + "'", vol.report.notes);
+  vol.grid.lon_deg = S->lon.axis;
+  vol.grid.lat_deg = S->lat.axis;
+  // Levels: kept by pressure range, ordered bottom (highest pressure) to top.
+  std::vector<std::pair<double, int>> lev;
+  for (std::size_t k = 0; k < L.vertical.values.size(); ++k) {
+    const double pa = L.vertical.values[k] * L.pressure_scale_to_pa;
+    if (!(pa > 0.0) || pa > 1.2e5) {
+      throw ImportError(path + ": level " + fmt(L.vertical.values[k]) + " " + L.vertical.var->text("units") +
+                        " is not a pressure between 0 and 1200 hPa");
+    }
+    if (pa >= options.level_min_hpa * 100.0 && pa <= options.level_max_hpa * 100.0) lev.push_back({pa, static_cast<int>(k)});
+  }
+  if (lev.size() < 2) throw ImportError(path + ": fewer than 2 pressure levels in the requested range");
+  std::sort(lev.begin(), lev.end(), [](auto a, auto b) { return a.first > b.first; });
+  if (L.vertical.values.size() > 1 && L.vertical.values.front() * L.pressure_scale_to_pa < L.vertical.values.back() * L.pressure_scale_to_pa) {
+    vol.report.notes.push_back("levels are stored top first; ordered bottom to top");
+  }
+  for (auto& [pa, k] : lev) {
+    S->level_pa.push_back(pa);
+    S->levels.push_back(k);
+  }
+  // Time steps.
+  const int nt = static_cast<int>(L.times.size());
+  const int last = options.time_last < 0 ? nt - 1 : std::min(options.time_last, nt - 1);
+  for (int t = std::max(0, options.time_first); t <= last; t += std::max(1, options.time_stride)) S->steps.push_back(t);
+  if (S->steps.empty()) throw ImportError(path + ": no time step in the requested range (the file has " + std::to_string(nt) + ")");
+  for (int t : S->steps) vol.times.push_back(L.times[static_cast<std::size_t>(t)]);
+  if (L.times_uneven) vol.report.warn("time steps are unevenly spaced");
+  if (!L.roles[static_cast<int>(Role::Geopotential)] && !L.roles[static_cast<int>(Role::GeopotentialHeight)]) {
+    vol.report.warn("no geopotential: level heights come from the standard atmosphere (errors of a few hundred metres)");
+  }
+  if (!L.roles[static_cast<int>(Role::Temperature)]) vol.report.warn("no temperature: the standard atmosphere's is used");
+  // Altitude grid from the first step's level heights (geometric, above the sphere).
+  double zmin = 1e30, zmax = -1e30;
+  {
+    core::VolumeGrid probe = vol.grid;
+    probe.alt_m = {0.0, 1.0, 0};  // heights only
+    const NcVar* zv = L.roles[static_cast<int>(Role::Geopotential)];
+    const NcVar* ghv = L.roles[static_cast<int>(Role::GeopotentialHeight)];
+    std::vector<double> thick;
+    if (zv || ghv) {
+      const Slab s = read_slab(*S, zv ? *zv : *ghv, S->steps.front(), nullptr);
+      for (int y = 0; y < probe.lat_deg.count; ++y) {
+        for (int x = 0; x < probe.lon_deg.count; ++x) {
+          double prev = kNaN;
+          for (std::size_t l = 0; l < S->levels.size(); ++l) {
+            const double raw = s.at(S->lon.src[static_cast<std::size_t>(x)], S->lat.j0[static_cast<std::size_t>(y)], S->levels[l]);
+            const double zz = physics::f64::geopotential_to_height_m(zv ? raw : kG0 * raw, vol.grid.earth_radius_m);
+            if (std::isnan(zz)) continue;
+            zmin = std::min(zmin, zz);
+            zmax = std::max(zmax, zz);
+            if (!std::isnan(prev) && zz > prev) thick.push_back(zz - prev);
+            prev = zz;
+          }
+        }
+      }
+    } else {
+      for (std::size_t l = 0; l < S->levels.size(); ++l) {
+        const double zz = isa_altitude_m(S->level_pa[l]);
+        zmin = std::min(zmin, zz);
+        zmax = std::max(zmax, zz);
+        if (l) thick.push_back(zz - isa_altitude_m(S->level_pa[l - 1]));
+      }
+    }
+    if (!(zmax > zmin)) throw ImportError(path + ": the levels' heights span no altitude range");
+    double dz = options.dz_m;
+    if (dz <= 0.0) {
+      std::sort(thick.begin(), thick.end());
+      const double median = thick.empty() ? 500.0 : thick[thick.size() / 2];
+      dz = std::clamp(median / 2.0, 50.0, 500.0);
+    }
+    zmin = std::max(zmin, -500.0);
+    const int nz = static_cast<int>(std::floor((zmax - zmin) / dz)) + 1;
+    vol.grid.alt_m = {zmin, dz, nz};
+  }
+  const double bytes = static_cast<double>(vol.grid.points()) * core::kFieldCount * sizeof(float);
+  if (bytes > options.max_volume_bytes) {
+    throw ImportError(path + ": the volume would take " + fmt(bytes / 1e9) + " GB per time step (limit " +
+                      fmt(options.max_volume_bytes / 1e9) + " GB); subset the region, levels or stride, or raise --dz");
+  }
+  vol.has_field[static_cast<int>(core::Field::ExtinctionLiquid)] = L.roles[static_cast<int>(Role::Liquid)] != nullptr;
+  vol.has_field[static_cast<int>(core::Field::ExtinctionIce)] = L.roles[static_cast<int>(Role::Ice)] != nullptr;
+  vol.has_field[static_cast<int>(core::Field::CloudFraction)] = L.roles[static_cast<int>(Role::CloudFraction)] != nullptr;
+  vol.has_field[static_cast<int>(core::Field::WindU)] = L.roles[static_cast<int>(Role::U)] != nullptr;
+  vol.has_field[static_cast<int>(core::Field::WindV)] = L.roles[static_cast<int>(Role::V)] != nullptr;
+  vol.has_field[static_cast<int>(core::Field::WindW)] = L.roles[static_cast<int>(Role::Omega)] != nullptr;
+  vol.has_field[static_cast<int>(core::Field::Temperature)] = true;
+  if (!L.roles[static_cast<int>(Role::CloudFraction)]) {
+    vol.report.notes.push_back("no cloud fraction: water is taken as covering whole grid boxes");
+  }
+  const core::VolumeGrid grid = vol.grid;
+  vol.set_loader([S, grid](std::size_t step, core::ImportReport& report) { return load_era5_step(*S, grid, step, report); },
+                 options.cache_steps);
+  return vol;
+}
+
+}  // namespace cv::importers

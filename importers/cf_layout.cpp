@@ -1,0 +1,209 @@
+// CF layout detection: axes and role variables.
+#include "cf_layout.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+namespace cv::importers {
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+bool in(const std::string& s, std::initializer_list<const char*> list) {
+  for (const char* x : list) {
+    if (s == x) return true;
+  }
+  return false;
+}
+
+// Multiplier from a pressure unit to Pa, or 0 when the unit is not a pressure.
+double pressure_scale(const std::string& units) {
+  const std::string u = lower(units);
+  if (in(u, {"pa", "pascal", "pascals"})) return 1.0;
+  if (in(u, {"hpa", "mb", "mbar", "millibar", "millibars", "hectopascal", "hectopascals"})) return 100.0;
+  if (in(u, {"kpa"})) return 1000.0;
+  return 0.0;
+}
+
+enum class Kind { None, Lon, Lat, Vertical, Time };
+
+Kind classify(const NcVar& v, std::string& how, const std::vector<double>* values) {
+  const std::string units = lower(v.text("units"));
+  const std::string sn = lower(v.text("standard_name"));
+  const std::string axis = lower(v.text("axis"));
+  const std::string name = lower(v.name);
+  if (sn == "longitude" || in(units, {"degrees_east", "degree_east", "degree_e", "degrees_e", "degreee", "degreese"}) ||
+      (axis == "x" && units.find("degree") != std::string::npos)) {
+    how = "by attributes (units '" + v.text("units") + "', standard_name '" + v.text("standard_name") + "')";
+    return Kind::Lon;
+  }
+  if (sn == "latitude" || in(units, {"degrees_north", "degree_north", "degree_n", "degrees_n", "degreen", "degreesn"}) ||
+      (axis == "y" && units.find("degree") != std::string::npos)) {
+    how = "by attributes (units '" + v.text("units") + "')";
+    return Kind::Lat;
+  }
+  if (sn == "time" || axis == "t" || units.find(" since ") != std::string::npos) {
+    how = "by attributes (units '" + v.text("units") + "')";
+    return Kind::Time;
+  }
+  if (in(sn, {"air_pressure", "height", "altitude", "model_level_number", "atmosphere_hybrid_sigma_pressure_coordinate"}) ||
+      axis == "z" || !v.text("positive").empty() || pressure_scale(units) > 0) {
+    how = "by attributes (units '" + v.text("units") + "', positive '" + v.text("positive") + "')";
+    return Kind::Vertical;
+  }
+  // Name alone is not enough; a conventional name whose values fit the axis is accepted, noted.
+  if (values && !values->empty()) {
+    const auto [mn, mx] = std::minmax_element(values->begin(), values->end());
+    if (in(name, {"lon", "long", "longitude"}) && *mn >= -360.0 && *mx <= 720.0) {
+      how = "by its name and values (" + v.name + " has no units attribute; values within -360..720)";
+      return Kind::Lon;
+    }
+    if (in(name, {"lat", "latitude"}) && *mn >= -90.0 && *mx <= 90.0) {
+      how = "by its name and values (" + v.name + " has no units attribute; values within -90..90)";
+      return Kind::Lat;
+    }
+  }
+  return Kind::None;
+}
+
+struct RoleSpec {
+  Role role;
+  std::initializer_list<const char*> standard_names;
+  std::initializer_list<const char*> names;
+};
+
+const RoleSpec kRoles[] = {
+    {Role::CloudFraction, {"cloud_area_fraction_in_atmosphere_layer", "fraction_of_cloud_cover"}, {"cc", "fraction_of_cloud_cover", "cloud_fraction"}},
+    {Role::Liquid, {"mass_fraction_of_cloud_liquid_water_in_air", "specific_cloud_liquid_water_content"}, {"clwc", "specific_cloud_liquid_water_content"}},
+    {Role::Ice, {"mass_fraction_of_cloud_ice_in_air", "specific_cloud_ice_water_content"}, {"ciwc", "specific_cloud_ice_water_content"}},
+    {Role::Geopotential, {"geopotential"}, {"z", "geopotential"}},
+    {Role::GeopotentialHeight, {"geopotential_height"}, {"gh", "geopotential_height", "Geopotential_height_isobaric"}},
+    {Role::Temperature, {"air_temperature"}, {"t", "air_temperature", "Temperature_isobaric"}},
+    {Role::Humidity, {"specific_humidity"}, {"q", "specific_humidity"}},
+    {Role::U, {"eastward_wind"}, {"u", "eastward_wind"}},
+    {Role::V, {"northward_wind"}, {"v", "northward_wind"}},
+    {Role::Omega, {"lagrangian_tendency_of_air_pressure"}, {"w", "lagrangian_tendency_of_air_pressure"}},
+};
+}  // namespace
+
+const char* role_name(Role r) {
+  static const char* names[kRoleCount] = {"cloud fraction", "cloud liquid water", "cloud ice water", "geopotential",
+                                          "geopotential height", "temperature", "specific humidity", "eastward wind",
+                                          "northward wind", "vertical velocity (omega)"};
+  return names[static_cast<int>(r)];
+}
+
+CfLayout detect_cf_layout(const NcFile& f) {
+  CfLayout L;
+  const std::string& path = f.path();
+  // Coordinate variables: 1-D, named like their dimension.
+  for (const auto& v : f.vars()) {
+    if (v.dims.size() != 1 || f.dims()[static_cast<std::size_t>(v.dims[0])].name != v.name) continue;
+    if (f.size(v) > (1u << 24)) throw ImportError(path + ": coordinate '" + v.name + "' has an implausible length");
+    std::vector<double> values;
+    if (v.type != 2 /* NC_CHAR */) values = f.read(v);
+    std::string how;
+    const Kind k = classify(v, how, &values);
+    Axis* target = k == Kind::Lon ? &L.lon : k == Kind::Lat ? &L.lat : k == Kind::Vertical ? &L.vertical
+                 : k == Kind::Time ? &L.time : nullptr;
+    if (!target) continue;
+    if (target->var) {
+      throw ImportError(path + ": both '" + target->var->name + "' and '" + v.name +
+                        "' look like the same axis; expected one coordinate per axis");
+    }
+    target->dim = v.dims[0];
+    target->var = &v;
+    target->values = std::move(values);
+    target->how = how;
+    for (double x : target->values) {
+      if (std::isnan(x)) throw ImportError(path + ": coordinate '" + v.name + "' has missing values; expected every value set");
+    }
+  }
+  if (!L.lon.var) throw ImportError(path + ": no longitude coordinate (expected units degrees_east or standard_name longitude)");
+  if (!L.lat.var) throw ImportError(path + ": no latitude coordinate (expected units degrees_north or standard_name latitude)");
+  if (!L.vertical.var) {
+    throw ImportError(path + ": no vertical coordinate (expected pressure levels in Pa/hPa/mb, or standard_name air_pressure)");
+  }
+  L.pressure_scale_to_pa = pressure_scale(L.vertical.var->text("units"));
+  if (L.pressure_scale_to_pa == 0.0) {
+    throw ImportError(path + ": vertical coordinate '" + L.vertical.var->name + "' has units '" +
+                      L.vertical.var->text("units") +
+                      "'; this reader handles pressure levels (Pa, hPa, mb, millibars); WRF files have their own reader");
+  }
+  // Roles: standard_name first, then the known short and long names.
+  for (const RoleSpec& spec : kRoles) {
+    const NcVar* found = nullptr;
+    for (const auto& v : f.vars()) {
+      for (const char* sn : spec.standard_names) {
+        if (v.text("standard_name") == sn) found = found ? found : &v;
+      }
+    }
+    for (const char* n : spec.names) {
+      if (!found) found = f.find(n);
+    }
+    if (found && found->dims.size() < 3) found = nullptr;  // a 2-D field of that name is not the 3-D one
+    L.roles[static_cast<int>(spec.role)] = found;
+  }
+  // Time: a time dimension without a coordinate variable still orders the steps.
+  int time_dim = L.time.dim;
+  if (!L.time.var) {
+    for (std::size_t d = 0; d < f.dims().size(); ++d) {
+      const std::string n = lower(f.dims()[d].name);
+      if (n == "time" || n.rfind("time", 0) == 0 || f.dims()[d].unlimited) {
+        time_dim = static_cast<int>(d);
+        break;
+      }
+    }
+    L.time.dim = time_dim;
+  }
+  // Every 3-D+ role variable must span exactly lon, lat, vertical and (optionally) time, in any order.
+  for (int r = 0; r < kRoleCount; ++r) {
+    const NcVar* v = L.roles[r];
+    if (!v) continue;
+    for (int d : v->dims) {
+      if (d != L.lon.dim && d != L.lat.dim && d != L.vertical.dim && d != time_dim) {
+        throw ImportError(path + ": variable '" + v->name + "' has dimension '" + f.dims()[static_cast<std::size_t>(d)].name +
+                          "'; expected only " + f.dims()[static_cast<std::size_t>(L.lon.dim)].name + ", " +
+                          f.dims()[static_cast<std::size_t>(L.lat.dim)].name + ", " +
+                          f.dims()[static_cast<std::size_t>(L.vertical.dim)].name +
+                          (time_dim >= 0 ? ", " + f.dims()[static_cast<std::size_t>(time_dim)].name : std::string()));
+      }
+    }
+    const bool has_all = std::count(v->dims.begin(), v->dims.end(), L.lon.dim) == 1 &&
+                         std::count(v->dims.begin(), v->dims.end(), L.lat.dim) == 1 &&
+                         std::count(v->dims.begin(), v->dims.end(), L.vertical.dim) == 1;
+    if (!has_all) {
+      throw ImportError(path + ": variable '" + v->name + "' does not span longitude, latitude and the vertical axis once each");
+    }
+  }
+  // Valid times.
+  const std::size_t nt = time_dim >= 0 ? f.dims()[static_cast<std::size_t>(time_dim)].length : 1;
+  if (L.time.var) {
+    const TimeUnits u = parse_time_units(L.time.var->text("units"), L.time.var->text("calendar"),
+                                         path + ": variable '" + L.time.var->name + "'");
+    bool approx_any = false;
+    for (double x : L.time.values) {
+      bool approx = false;
+      L.times.push_back(valid_time(u, x, &approx));
+      approx_any |= approx;
+    }
+    if (approx_any) {
+      L.notes.push_back("calendar '" + L.time.var->text("calendar") +
+                        "': dates are kept as written; the sun uses the nearest real date");
+    }
+    for (std::size_t i = 2; i < L.times.size(); ++i) {
+      const auto d1 = L.times[i].unix_s - L.times[i - 1].unix_s, d0 = L.times[1].unix_s - L.times[0].unix_s;
+      if (d1 != d0) L.times_uneven = true;
+    }
+  } else {
+    for (std::size_t i = 0; i < nt; ++i) L.times.push_back({0, "step " + std::to_string(i) + " (no time coordinate)"});
+    L.notes.push_back("no time coordinate: steps are numbered, valid times unknown");
+  }
+  return L;
+}
+
+}  // namespace cv::importers

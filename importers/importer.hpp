@@ -1,0 +1,53 @@
+// Importers: NetCDF model output to a CloudVolume. netCDF stays inside this target; callers see
+// only core types, ImportError, and these options.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "import_error.hpp"
+#include "volume/cloud_volume.hpp"
+
+namespace cv::importers {
+
+// A longitude/latitude box. Longitudes run east from lon_west_deg to lon_east_deg, so a box across
+// the date line is e.g. west 170, east -170 (or 190).
+struct Region {
+  double lon_west_deg = -180.0;
+  double lon_east_deg = 180.0;
+  double lat_south_deg = -90.0;
+  double lat_north_deg = 90.0;
+};
+
+struct ImportOptions {
+  std::optional<Region> region;
+  // Time steps by index (inclusive; -1 = last) and stride.
+  int time_first = 0;
+  int time_last = -1;
+  int time_stride = 1;
+  // Pressure levels kept, hPa (inclusive).
+  double level_min_hpa = 0.0;
+  double level_max_hpa = 1e9;
+  int horizontal_stride = 1;
+  double dz_m = 0.0;               // altitude spacing of the volume; 0 = from the data's levels
+  double r_eff_liquid_um = 10.0;   // droplet effective radius
+  double r_eff_ice_um = 0.0;       // 0 = temperature-dependent (see docs/importers.md)
+  std::size_t cache_steps = 2;     // time steps kept in memory
+  double max_volume_bytes = 8e9;   // refuse volumes larger than this per time step
+};
+
+// What the importer understands of a file (grid, axes, variables it will use, times), as text.
+std::string describe_file(const std::string& path);
+
+// Opens the file, checks it, fixes the grid, and returns a volume whose time steps load lazily.
+core::CloudVolume import_file(const std::string& path, const ImportOptions& options = {});
+
+// Effective radius of ice crystals (um) used when none is set: grows from 20 um at -60 C to 50 um
+// at 0 C, clamped to 20..50 um outside.
+double ice_effective_radius_um(double temperature_k);
+
+// International Standard Atmosphere altitude (m) of a pressure (Pa), troposphere and lower stratosphere.
+double isa_altitude_m(double pressure_pa);
+double isa_temperature_k(double altitude_m);
+
+}  // namespace cv::importers

@@ -1,0 +1,263 @@
+// NcFile: netCDF-C behind one-line errors, unpacking and missing-value handling.
+#include "nc_file.hpp"
+
+#include <netcdf.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+namespace cv::importers {
+namespace {
+
+std::vector<NcAtt> read_atts(int ncid, int varid, int natts, const std::string& path) {
+  std::vector<NcAtt> out;
+  for (int a = 0; a < natts; ++a) {
+    char name[NC_MAX_NAME + 1] = {0};
+    nc_type type;
+    size_t len = 0;
+    if (nc_inq_attname(ncid, varid, a, name) != NC_NOERR || nc_inq_att(ncid, varid, name, &type, &len) != NC_NOERR) {
+      throw ImportError(path + ": cannot read attribute " + std::to_string(a) + " (file corrupted?)");
+    }
+    NcAtt att;
+    att.name = name;
+    if (type == NC_CHAR) {
+      att.is_text = true;
+      att.text.resize(len);
+      if (len && nc_get_att_text(ncid, varid, name, att.text.data()) != NC_NOERR) {
+        throw ImportError(path + ": cannot read text attribute '" + att.name + "'");
+      }
+      while (!att.text.empty() && att.text.back() == '\0') att.text.pop_back();
+    } else if (type == NC_STRING) {
+      att.is_text = true;
+      std::vector<char*> strs(len, nullptr);
+      if (len && nc_get_att_string(ncid, varid, name, strs.data()) == NC_NOERR) {
+        att.text = strs[0] ? strs[0] : "";
+        nc_free_string(len, strs.data());
+      }
+    } else if (len > 0 && len < (1u << 20)) {
+      att.values.resize(len);
+      if (nc_get_att_double(ncid, varid, name, att.values.data()) != NC_NOERR) att.values.clear();
+    }
+    out.push_back(std::move(att));
+  }
+  return out;
+}
+
+bool is_integer_type(int t) {
+  return t == NC_BYTE || t == NC_SHORT || t == NC_INT || t == NC_UBYTE || t == NC_USHORT || t == NC_UINT ||
+         t == NC_INT64 || t == NC_UINT64;
+}
+
+std::size_t type_bytes(int t) {
+  switch (t) {
+    case NC_BYTE: case NC_UBYTE: case NC_CHAR: return 1;
+    case NC_SHORT: case NC_USHORT: return 2;
+    case NC_INT: case NC_UINT: case NC_FLOAT: return 4;
+    default: return 8;
+  }
+}
+}  // namespace
+
+const NcAtt* NcVar::att(const std::string& n) const {
+  for (const auto& a : atts) {
+    if (a.name == n) return &a;
+  }
+  return nullptr;
+}
+
+std::string NcVar::text(const std::string& n) const {
+  const NcAtt* a = att(n);
+  return a && a->is_text ? a->text : std::string();
+}
+
+std::optional<double> NcVar::number(const std::string& n) const {
+  const NcAtt* a = att(n);
+  if (!a || a->is_text || a->values.empty()) return std::nullopt;
+  return a->values[0];
+}
+
+void NcFile::fail(int status, const std::string& what) const {
+  throw ImportError(path_ + ": " + what + ": " + nc_strerror(status));
+}
+
+NcFile::NcFile(const std::string& path) : path_(path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw ImportError(path + ": no such file");
+  file_bytes_ = static_cast<long long>(std::filesystem::file_size(path, ec));
+  const int st = nc_open(path.c_str(), NC_NOWRITE, &id_);
+  if (st != NC_NOERR) {
+    throw ImportError(path + ": not a readable NetCDF file (" + nc_strerror(st) +
+                      "); expected NetCDF-3 classic/64-bit or NetCDF-4/HDF5");
+  }
+  int format = 0;
+  nc_inq_format(id_, &format);
+  compressed_format_ = format == NC_FORMAT_NETCDF4 || format == NC_FORMAT_NETCDF4_CLASSIC;
+  int ndims = 0, nvars = 0, ngatts = 0, unlimdim = -1;
+  if (const int s = nc_inq(id_, &ndims, &nvars, &ngatts, &unlimdim); s != NC_NOERR) fail(s, "cannot read the header");
+  for (int d = 0; d < ndims; ++d) {
+    char name[NC_MAX_NAME + 1] = {0};
+    size_t len = 0;
+    if (const int s = nc_inq_dim(id_, d, name, &len); s != NC_NOERR) fail(s, "cannot read dimension " + std::to_string(d));
+    dims_.push_back({name, len, d == unlimdim});
+  }
+  for (int v = 0; v < nvars; ++v) {
+    char name[NC_MAX_NAME + 1] = {0};
+    nc_type type;
+    int nd = 0, natts = 0;
+    int dimids[NC_MAX_VAR_DIMS];
+    if (const int s = nc_inq_var(id_, v, name, &type, &nd, dimids, &natts); s != NC_NOERR) {
+      fail(s, "cannot read variable " + std::to_string(v));
+    }
+    NcVar var;
+    var.id = v;
+    var.name = name;
+    var.type = type;
+    for (int i = 0; i < nd; ++i) {
+      if (dimids[i] < 0 || dimids[i] >= ndims) throw ImportError(path + ": variable '" + var.name + "' has a bad dimension id");
+      var.dims.push_back(dimids[i]);
+    }
+    var.atts = read_atts(id_, v, natts, path);
+    vars_.push_back(std::move(var));
+  }
+  global_atts_ = read_atts(id_, NC_GLOBAL, ngatts, path);
+}
+
+NcFile::~NcFile() {
+  if (id_ >= 0) nc_close(id_);
+}
+
+const NcVar* NcFile::find(const std::string& name) const {
+  for (const auto& v : vars_) {
+    if (v.name == name) return &v;
+  }
+  return nullptr;
+}
+
+const NcVar& NcFile::var(const std::string& name) const {
+  if (const NcVar* v = find(name)) return *v;
+  throw ImportError(path_ + ": variable '" + name + "' is missing");
+}
+
+std::size_t NcFile::size(const NcVar& v) const {
+  std::size_t n = 1;
+  for (int d : v.dims) {
+    const std::size_t len = dims_[static_cast<std::size_t>(d)].length;
+    if (len != 0 && n > std::numeric_limits<std::size_t>::max() / len) return std::numeric_limits<std::size_t>::max();
+    n *= len;
+  }
+  return n;
+}
+
+std::string NcFile::global_text(const std::string& name) const {
+  for (const auto& a : global_atts_) {
+    if (a.name == name && a.is_text) return a.text;
+  }
+  return "";
+}
+
+std::optional<double> NcFile::global_number(const std::string& name) const {
+  for (const auto& a : global_atts_) {
+    if (a.name == name && !a.is_text && !a.values.empty()) return a.values[0];
+  }
+  return std::nullopt;
+}
+
+std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start, std::vector<std::size_t> count,
+                                 UnpackInfo* info) const {
+  const std::size_t nd = v.dims.size();
+  if (start.empty()) start.assign(nd, 0);
+  if (count.empty()) {
+    for (std::size_t i = 0; i < nd; ++i) count.push_back(dim_length(v, i));
+  }
+  if (start.size() != nd || count.size() != nd) {
+    throw ImportError(path_ + ": variable '" + v.name + "': read with " + std::to_string(start.size()) +
+                      " indices, expected " + std::to_string(nd));
+  }
+  std::size_t n = 1;
+  for (std::size_t i = 0; i < nd; ++i) {
+    if (start[i] + count[i] > dim_length(v, i)) {
+      throw ImportError(path_ + ": variable '" + v.name + "': read beyond dimension '" + dim_name(v, i) + "'");
+    }
+    if (count[i] != 0 && n > kMaxReadValues / count[i]) n = kMaxReadValues + 1;
+    else n *= count[i];
+  }
+  if (n > kMaxReadValues) {
+    throw ImportError(path_ + ": variable '" + v.name + "': a read of more than " + std::to_string(kMaxReadValues) +
+                      " values was asked for; subset the region, levels or times");
+  }
+  // A classic-format file stores every value uncompressed: a header claiming more than the file
+  // holds is corrupt or truncated, and must not make us allocate for it.
+  if (!compressed_format_ && static_cast<long double>(size(v)) * type_bytes(v.type) > 2.0L * file_bytes_ + 65536) {
+    throw ImportError(path_ + ": variable '" + v.name + "' claims " + std::to_string(size(v)) + " values but the file has " +
+                      std::to_string(file_bytes_) + " bytes (truncated or corrupted)");
+  }
+  if (v.type == NC_CHAR || v.type == NC_STRING) {
+    throw ImportError(path_ + ": variable '" + v.name + "' holds text, expected numbers");
+  }
+  std::vector<double> out(n);
+  if (n == 0) return out;
+  if (const int s = nc_get_vara_double(id_, v.id, start.data(), count.data(), out.data()); s != NC_NOERR) {
+    fail(s, "variable '" + v.name + "': cannot read values");
+  }
+  // Fill and missing values are compared in the packed (raw) domain, as CF says.
+  std::vector<double> missing;
+  for (const char* a : {"_FillValue", "missing_value"}) {
+    if (const NcAtt* att = v.att(a); att && !att->is_text) {
+      for (double x : att->values) missing.push_back(x);
+    }
+  }
+  if (!v.att("_FillValue") && v.type != NC_BYTE && v.type != NC_CHAR) {
+    // netCDF's default fill for the type marks never-written values.
+    double def = v.type == NC_SHORT ? NC_FILL_SHORT : v.type == NC_INT ? NC_FILL_INT
+               : v.type == NC_FLOAT ? static_cast<double>(NC_FILL_FLOAT) : v.type == NC_DOUBLE ? NC_FILL_DOUBLE : NAN;
+    if (!std::isnan(def)) missing.push_back(def);
+  }
+  std::optional<double> vmin, vmax;
+  if (const NcAtt* vr = v.att("valid_range"); vr && vr->values.size() == 2) vmin = vr->values[0], vmax = vr->values[1];
+  if (auto x = v.number("valid_min")) vmin = x;
+  if (auto x = v.number("valid_max")) vmax = x;
+  const double scale = v.number("scale_factor").value_or(1.0);
+  const double offset = v.number("add_offset").value_or(0.0);
+  const bool packed = v.att("scale_factor") || v.att("add_offset");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::size_t nmissing = 0;
+  const bool integer = is_integer_type(v.type);
+  for (double& x : out) {
+    bool miss = std::isnan(x);
+    for (double m : missing) {
+      // Float fill values are matched with a relative tolerance (1e30-style fills lose digits).
+      if (std::isnan(m) ? std::isnan(x) : integer ? x == m : std::abs(x - m) <= 1e-6 * std::abs(m)) miss = true;
+    }
+    if (!miss && ((vmin && x < *vmin) || (vmax && x > *vmax))) miss = true;
+    if (miss) {
+      x = nan;
+      ++nmissing;
+    } else if (packed) {
+      x = x * scale + offset;
+    }
+  }
+  if (info) *info = {scale, offset, packed, nmissing};
+  return out;
+}
+
+std::vector<std::string> NcFile::read_strings(const NcVar& v) const {
+  if (v.type != NC_CHAR || v.dims.size() != 2) {
+    throw ImportError(path_ + ": variable '" + v.name + "': expected a 2-D character array");
+  }
+  const std::size_t rows = dim_length(v, 0), cols = dim_length(v, 1);
+  if (rows * cols > (1u << 24)) throw ImportError(path_ + ": variable '" + v.name + "' is implausibly large");
+  std::vector<char> buf(rows * cols);
+  if (!buf.empty()) {
+    if (const int s = nc_get_var_text(id_, v.id, buf.data()); s != NC_NOERR) fail(s, "variable '" + v.name + "'");
+  }
+  std::vector<std::string> out;
+  for (std::size_t r = 0; r < rows; ++r) {
+    std::string s(buf.data() + r * cols, cols);
+    while (!s.empty() && (s.back() == '\0' || s.back() == ' ')) s.pop_back();
+    out.push_back(s);
+  }
+  return out;
+}
+
+}  // namespace cv::importers

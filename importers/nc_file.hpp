@@ -1,0 +1,87 @@
+// A thin, safe view of a NetCDF file (netCDF-C): dimensions, variables, attributes, and reads that
+// unpack scale_factor/add_offset, turn _FillValue, missing_value and valid-range violations into NaN,
+// and refuse sizes the file cannot hold. Private to the importers target.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "import_error.hpp"
+
+namespace cv::importers {
+
+struct NcDim {
+  std::string name;
+  std::size_t length = 0;
+  bool unlimited = false;
+};
+
+struct NcAtt {
+  std::string name;
+  bool is_text = false;
+  std::string text;
+  std::vector<double> values;  // numeric attributes as double (NaN kept)
+};
+
+struct NcVar {
+  int id = -1;
+  std::string name;
+  int type = 0;               // nc_type
+  std::vector<int> dims;      // indices into NcFile::dims()
+  std::vector<NcAtt> atts;
+  const NcAtt* att(const std::string& name) const;
+  std::string text(const std::string& name) const;           // "" when absent or not text
+  std::optional<double> number(const std::string& name) const;
+};
+
+// How a variable's raw values were turned into numbers, for the import report.
+struct UnpackInfo {
+  double scale = 1.0;
+  double offset = 0.0;
+  bool packed = false;
+  std::size_t missing = 0;  // values that became NaN
+};
+
+class NcFile {
+ public:
+  explicit NcFile(const std::string& path);
+  ~NcFile();
+  NcFile(const NcFile&) = delete;
+  NcFile& operator=(const NcFile&) = delete;
+
+  const std::string& path() const { return path_; }
+  const std::vector<NcDim>& dims() const { return dims_; }
+  const std::vector<NcVar>& vars() const { return vars_; }
+  const std::vector<NcAtt>& global_atts() const { return global_atts_; }
+  const NcVar* find(const std::string& name) const;
+  const NcVar& var(const std::string& name) const;  // throws ImportError when absent
+  std::size_t dim_length(const NcVar& v, std::size_t axis) const { return dims_[v.dims[axis]].length; }
+  std::string dim_name(const NcVar& v, std::size_t axis) const { return dims_[v.dims[axis]].name; }
+  std::size_t size(const NcVar& v) const;  // number of values
+  std::string global_text(const std::string& name) const;
+  std::optional<double> global_number(const std::string& name) const;
+
+  // Reads a hyperslab as double with unpacking and missing values as NaN. start/count have one
+  // entry per dimension (empty: the whole variable).
+  std::vector<double> read(const NcVar& v, std::vector<std::size_t> start = {}, std::vector<std::size_t> count = {},
+                           UnpackInfo* info = nullptr) const;
+  // A text variable (e.g. WRF's Times) as one string per leading index.
+  std::vector<std::string> read_strings(const NcVar& v) const;
+
+  // The largest read, in values, this importer allows (guards against absurd headers).
+  static constexpr std::size_t kMaxReadValues = std::size_t(1) << 31;
+
+ private:
+  [[noreturn]] void fail(int status, const std::string& what) const;
+  std::string path_;
+  int id_ = -1;
+  long long file_bytes_ = 0;
+  bool compressed_format_ = false;
+  std::vector<NcDim> dims_;
+  std::vector<NcVar> vars_;
+  std::vector<NcAtt> global_atts_;
+};
+
+}  // namespace cv::importers
