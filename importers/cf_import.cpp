@@ -103,7 +103,10 @@ LonMap map_longitudes(const std::vector<double>& raw, const std::optional<Region
     }
     if (s0 < 0 && inside(0)) s0 = 0;  // the box covers every column
     for (int k = s0; s0 >= 0 && k < s0 + m && (global || k < m) && inside(k % m); ++k) keep.push_back(k);
-    if (!keep.empty()) first = lon[static_cast<std::size_t>(s0)];
+    if (!keep.empty()) {
+      first = lon[static_cast<std::size_t>(s0)];
+      if (first >= 180.0) first -= 360.0;  // the box's western edge, in -180..180
+    }
     if (keep.empty()) throw ImportError(where + ": the region's longitudes hold no grid column of the file");
   } else {
     for (int k = 0; k < m; ++k) keep.push_back(k);
@@ -502,6 +505,10 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
             const double raw = s.at(S->lon.src[static_cast<std::size_t>(x)], S->lat.j0[static_cast<std::size_t>(y)], S->levels[l]);
             const double zz = physics::f64::geopotential_to_height_m(zv ? raw : kG0 * raw, vol.grid.earth_radius_m);
             if (std::isnan(zz)) continue;
+            if (zz < -1000.0 || zz > 1.0e5) {
+              throw ImportError(path + ": variable '" + (zv ? zv : ghv)->name + "' has value " + fmt(raw) +
+                                " (a height of " + fmt(zz) + " m), expected a height between -1 km and 100 km");
+            }
             zmin = std::min(zmin, zz);
             zmax = std::max(zmax, zz);
             if (!std::isnan(prev) && zz > prev) thick.push_back(zz - prev);

@@ -119,7 +119,7 @@ TimeUnits parse_time_units(const std::string& units, const std::string& calendar
   }
   if (u.month < 1 || u.month > 12 || u.day < 1 || u.day > month_days(u.calendar, u.year, u.month) || u.hour > 24 ||
       u.minute > 59 || u.second >= 61) {
-    throw ImportError(where + ": time units '" + units + "' hold an impossible reference date");
+    throw ImportError(where + ": time units '" + units + "' hold an impossible reference date, expected a real date and time of day");
   }
   return u;
 }

@@ -1,0 +1,115 @@
+// Real model output from ../shared/data/real (see its SOURCES.md), with values checked by hand.
+// Skipped with a message when the folder is absent (a user's clone); a failure under CI.
+#include <gtest/gtest.h>
+#include <netcdf.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "importer.hpp"
+#include "nc_file.hpp"
+
+namespace {
+using namespace cv;
+
+std::string real(const std::string& name) {
+  const std::string p = std::string(CV_REAL_DATA_DIR) + "/" + name;
+  if (!std::filesystem::exists(p)) {
+    const char* ci = std::getenv("CI");
+    if (ci && std::string(ci) == "true") ADD_FAILURE() << p << " is missing under CI";
+    return "";
+  }
+  return p;
+}
+#define REAL_FILE(var, name)                                                   \
+  const std::string var = real(name);                                          \
+  if (var.empty()) GTEST_SKIP() << name << " not found beside the checkout";
+
+TEST(RealFiles, Era5PackedValueAgainstTheUnpackedNumberByHand) {
+  REAL_FILE(path, "met-era5-cocip1.nc");
+  // Raw int16 and attributes straight from netCDF-C, unpacked by hand.
+  int id, var;
+  ASSERT_EQ(nc_open(path.c_str(), NC_NOWRITE, &id), NC_NOERR);
+  ASSERT_EQ(nc_inq_varid(id, "air_temperature", &var), NC_NOERR);
+  double scale, offset;
+  nc_get_att_double(id, var, "scale_factor", &scale);
+  nc_get_att_double(id, var, "add_offset", &offset);
+  const std::size_t idx[4] = {3, 2, 1, 5};  // (longitude, latitude, level, time)
+  short raw;
+  ASSERT_EQ(nc_get_var1_short(id, var, idx, &raw), NC_NOERR);
+  nc_close(id);
+  const double by_hand = raw * scale + offset;
+  importers::NcFile f(path);
+  const auto& v = f.var("air_temperature");
+  const auto got = f.read(v, {3, 2, 1, 5}, {1, 1, 1, 1});
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_DOUBLE_EQ(got[0], by_hand);
+  EXPECT_GT(by_hand, 200.0);
+  EXPECT_LT(by_hand, 240.0);  // upper-troposphere temperature in January
+}
+
+TEST(RealFiles, Era5ImportHeightsComeFromGeopotentialByHand) {
+  REAL_FILE(path, "met-era5-cocip1.nc");
+  importers::NcFile f(path);
+  const auto z = f.read(f.var("geopotential"), {0, 0, 0, 0}, {16, 8, 4, 1});  // first time step
+  double zmin = 1e30, zmax = -1e30;
+  for (double phi : z) {
+    const double h = phi * 6371000.0 / (9.80665 * 6371000.0 - phi);  // geometric height by hand
+    zmin = std::min(zmin, h);
+    zmax = std::max(zmax, h);
+  }
+  auto vol = importers::import_file(path);
+  EXPECT_NEAR(vol.grid.alt_m.start, zmin, 1e-6);
+  EXPECT_GE(vol.grid.alt_m.last(), zmax - vol.grid.alt_m.step);
+  EXPECT_LE(vol.grid.alt_m.last(), zmax + 1e-6);
+  // 200-300 hPa in January over the North Atlantic: roughly 8.5 to 12 km.
+  EXPECT_GT(zmin, 8000.0);
+  EXPECT_LT(zmax, 12500.0);
+  EXPECT_EQ(vol.times.size(), 13u);
+  EXPECT_EQ(vol.times[12].iso_utc, "2019-01-01T12:00:00Z");
+  // Ice only, no liquid, and the report knows the longitude had no units.
+  EXPECT_TRUE(vol.has_field[static_cast<int>(core::Field::ExtinctionIce)]);
+  EXPECT_FALSE(vol.has_field[static_cast<int>(core::Field::ExtinctionLiquid)]);
+  const auto& d = vol.step(0);
+  float max_ext = 0.0f;
+  for (float x : d[core::Field::ExtinctionIce]) {
+    if (!std::isnan(x)) max_ext = std::max(max_ext, x);
+  }
+  // Cirrus: in-cloud extinction of order 1e-4 to 1e-2 per metre.
+  EXPECT_GT(max_ext, 1e-5f);
+  EXPECT_LT(max_ext, 5e-2f);
+  bool noted = false;
+  for (const auto& n : vol.report.notes) noted |= n.find("no units attribute") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
+TEST(RealFiles, Era5DescendingLatitudeAndMillibarsDescribed) {
+  REAL_FILE(path, "met-accf-pl.nc");
+  const std::string info = importers::describe_file(path);
+  EXPECT_NE(info.find("millibars"), std::string::npos) << info;
+  EXPECT_NE(info.find("2022-11-11T00:00:00Z"), std::string::npos) << info;  // hours since 1900 by hand: 1076976 h
+  EXPECT_NE(info.find("importable: no"), std::string::npos) << info;
+}
+
+TEST(RealFiles, FilesWithoutCloudVariablesSayWhatIsMissing) {
+  for (const char* name : {"met-accf-pl.nc", "GFS_global.nc"}) {
+    REAL_FILE(path, name);
+    try {
+      importers::import_file(path);
+      ADD_FAILURE() << name;
+    } catch (const importers::ImportError& e) {
+      EXPECT_NE(std::string(e.what()).find("no cloud variable"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(RealFiles, GfsTimeUnitsAndSeamAreUnderstood) {
+  REAL_FILE(path, "GFS_global.nc");
+  const std::string info = importers::describe_file(path);
+  EXPECT_NE(info.find("2021-01-30T18:00:00Z"), std::string::npos) << info;  // "Hour since ...T12:00:00Z" + 6
+  EXPECT_NE(info.find("gpm"), std::string::npos) << info;
+}
+
+}  // namespace

@@ -1,0 +1,139 @@
+// CloudVolume: derived maps (maximum-random overlap), the lazy cache, and the writers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "support/nc_builder.hpp"
+#include "volume/cloud_volume.hpp"
+#include "volume/volume_io.hpp"
+
+namespace {
+using namespace cv::core;
+
+VolumeGrid column_grid(int nz) {
+  VolumeGrid g;
+  g.lon_deg = {0.0, 1.0, 1};
+  g.lat_deg = {0.0, 1.0, 1};
+  g.alt_m = {0.0, 1000.0, nz};
+  return g;
+}
+
+TimeStepData column(const VolumeGrid& g, const std::vector<float>& cf, float ext) {
+  TimeStepData d;
+  d[Field::CloudFraction] = cf;
+  d[Field::ExtinctionLiquid].assign(g.points(), ext);
+  return d;
+}
+
+TEST(Maps, MaximumRandomOverlap) {
+  const VolumeGrid g = column_grid(6);
+  // Two adjacent layers of 0.5 overlap fully: cover 0.5.
+  auto d = column(g, {0, 0.5f, 0.5f, 0, 0, 0}, 1e-3f);
+  derive_maps(g, d);
+  EXPECT_NEAR(d.maps.cloud_cover[0], 0.5, 1e-6);
+  // Two layers of 0.5 separated by clear air overlap randomly: 1 - 0.5 * 0.5.
+  d = column(g, {0.5f, 0, 0, 0.5f, 0, 0}, 1e-3f);
+  derive_maps(g, d);
+  EXPECT_NEAR(d.maps.cloud_cover[0], 0.75, 1e-6);
+  EXPECT_EQ(d.maps.cloud_base_m[0], 0.0f);
+  EXPECT_EQ(d.maps.cloud_top_m[0], 3000.0f);
+  // Adjacent 0.3 then 0.6: max overlap gives 0.6.
+  d = column(g, {0, 0, 0.3f, 0.6f, 0, 0}, 1e-3f);
+  derive_maps(g, d);
+  EXPECT_NEAR(d.maps.cloud_cover[0], 0.6, 1e-6);
+  // Optical depth = sum of fraction x extinction x dz: (0.3 + 0.6) * 1e-3 * 1000.
+  EXPECT_NEAR(d.maps.optical_depth[0], 0.9, 1e-6);
+  // Low (< 2 km), mid (2-6 km), high: the layers at 2 and 3 km are mid.
+  EXPECT_EQ(d.maps.low_cover[0], 0.0f);
+  EXPECT_NEAR(d.maps.mid_cover[0], 0.6, 1e-6);
+  // An overcast layer hides everything.
+  d = column(g, {0.2f, 0, 1.0f, 0, 0.4f, 0}, 1e-3f);
+  derive_maps(g, d);
+  EXPECT_NEAR(d.maps.cloud_cover[0], 1.0, 1e-6);
+  // No cloud at all: cover 0 and no base or top (NaN), never a crash.
+  d = column(g, {0, 0, 0, 0, 0, 0}, 0.0f);
+  derive_maps(g, d);
+  EXPECT_EQ(d.maps.cloud_cover[0], 0.0f);
+  EXPECT_TRUE(std::isnan(d.maps.cloud_base_m[0]));
+}
+
+TEST(Volume, CacheLoadsOnDemandAndEvictsTheLeastRecentlyUsed) {
+  CloudVolume v;
+  v.grid = column_grid(2);
+  v.times.resize(4);
+  int loads = 0;
+  v.set_loader(
+      [&](std::size_t t, ImportReport&) {
+        ++loads;
+        TimeStepData d;
+        d[Field::CloudFraction].assign(2, static_cast<float>(t) / 10.0f);
+        return d;
+      },
+      2);
+  EXPECT_EQ(v.step(0)[Field::CloudFraction][0], 0.0f);
+  EXPECT_EQ(v.step(1)[Field::CloudFraction][0], 0.1f);
+  v.step(0);                                   // 0 is now the most recent
+  EXPECT_EQ(v.step(2)[Field::CloudFraction][0], 0.2f);  // evicts 1
+  EXPECT_TRUE(v.is_loaded(0));
+  EXPECT_FALSE(v.is_loaded(1));
+  EXPECT_EQ(loads, 3);
+  EXPECT_EQ(v.loaded_steps(), 2u);
+  EXPECT_THROW(v.step(4), std::out_of_range);
+}
+
+TEST(VolumeIo, CvvolHeaderAndPayloadAndVti) {
+  const auto dir = cv::test::temp_dir("volume_io");
+  CloudVolume v;
+  v.grid = column_grid(3);
+  v.times = {{0, "1970-01-01T00:00:00Z"}, {3600, "1970-01-01T01:00:00Z"}};
+  v.has_field[static_cast<int>(Field::CloudFraction)] = true;
+  v.set_loader([](std::size_t t, ImportReport&) {
+    TimeStepData d;
+    d[Field::CloudFraction] = {0.1f * static_cast<float>(t), 0.5f, NAN};
+    return d;
+  });
+  const std::string path = (dir / "v.cvvol").string();
+  write_cvvol(path, v);
+  std::ifstream in(path, std::ios::binary);
+  std::string magic(8, '\0');
+  in.read(magic.data(), 8);
+  EXPECT_EQ(magic, "CVVOL01\n");
+  std::uint64_t len = 0;
+  in.read(reinterpret_cast<char*>(&len), 8);
+  std::string header(len, '\0');
+  in.read(header.data(), static_cast<std::streamsize>(len));
+  EXPECT_NE(header.find("\"cloud_fraction\""), std::string::npos) << header;
+  EXPECT_NE(header.find("1970-01-01T01:00:00Z"), std::string::npos);
+  float first[3];
+  in.read(reinterpret_cast<char*>(first), sizeof first);
+  EXPECT_EQ(first[1], 0.5f);
+  EXPECT_TRUE(std::isnan(first[2]));
+  // Per step: 3 field values and 7 one-column maps.
+  in.seekg(0, std::ios::end);
+  EXPECT_EQ(static_cast<std::uint64_t>(in.tellg()), 16 + len + 2 * (3 + 7) * sizeof(float));
+  // No temporary file left behind.
+  int files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) files += e.is_regular_file();
+  EXPECT_EQ(files, 1);
+  write_vti((dir / "v.vti").string(), v.grid, v.step(1), v.has_field);
+  std::ifstream vti(dir / "v.vti", std::ios::binary);
+  std::stringstream ss;
+  ss << vti.rdbuf();
+  EXPECT_NE(ss.str().find("WholeExtent=\"0 0 0 0 0 2\""), std::string::npos);
+  EXPECT_NE(ss.str().find("Name=\"cloud_fraction\""), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(VolumeIo, AFailedWriteLeavesNoFile) {
+  const auto dir = cv::test::temp_dir("volume_io_fail");
+  const std::string path = (dir / "out.bin").string();
+  EXPECT_THROW(write_file_atomically(path, [](std::FILE*) { throw std::runtime_error("disk full"); }), std::runtime_error);
+  EXPECT_FALSE(std::filesystem::exists(path));
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
