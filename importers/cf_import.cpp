@@ -18,7 +18,13 @@ constexpr double kRd = 287.05;        // dry-air gas constant, J/(kg K)
 constexpr double kG0 = 9.80665;       // m/s2
 constexpr double kRhoWater = 1000.0;  // kg/m3
 constexpr double kRhoIce = 917.0;     // kg/m3
-constexpr double kMinCloudFraction = 0.01;
+// A cloud fraction below this is zero to within int16 packing (whose step is ~1.5e-5 over 0..1).
+constexpr double kZeroCloudFraction = 1e-4;
+// Water below this counts as none for the consistency checks: int16 packing leaves a step or two
+// (~5e-8 kg/kg) where there is none, and 1e-7 kg/kg gives an optical depth of ~0.015 per km.
+constexpr double kZeroWater = 1e-7;
+// Water in a box whose fraction is zero gets this fraction, keeping the box's mean water.
+constexpr double kRaisedCloudFraction = 0.01;
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string fmt(double v) {
@@ -277,7 +283,7 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
   alloc(core::Field::Temperature, true);
 
   std::size_t water_without_cf = 0, cf_without_water = 0, negative_water = 0, nonmonotonic = 0, clamped_cf = 0;
-  double worst_negative = 0.0;
+  double worst_negative = 0.0, most_water_without_cf = 0.0;
   // Per column: native-level quantities, then interpolation onto the altitude grid.
   std::vector<double> h(static_cast<std::size_t>(nlev)), q[core::kFieldCount];
   for (auto& v : q) v.resize(static_cast<std::size_t>(nlev));
@@ -344,12 +350,13 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
         // Grid-box mean to in-cloud: divide by the cloud fraction where it is non-zero.
         double div = 1.0;
         if (has_cf && !std::isnan(cf)) {
-          if (total > 1e-9 && cf < kMinCloudFraction) {
+          if (total > kZeroWater && cf < kZeroCloudFraction) {
             ++water_without_cf;
-            cf = kMinCloudFraction;  // keeps the grid-box mean water (and optical depth) of the box
+            most_water_without_cf = std::max(most_water_without_cf, total);
+            cf = kRaisedCloudFraction;  // keeps the grid-box mean water (and optical depth) of the box
           }
-          if (cf > 0.1 && total <= 1e-9) ++cf_without_water;
-          div = std::max(cf, kMinCloudFraction);
+          if (cf > 0.1 && total <= kZeroWater) ++cf_without_water;
+          div = std::max(cf, kZeroCloudFraction);
         }
         const double r_liq_m = S.options.r_eff_liquid_um * 1e-6;
         const double r_ice_m = (S.options.r_eff_ice_um > 0 ? S.options.r_eff_ice_um : ice_effective_radius_um(T)) * 1e-6;
@@ -421,8 +428,8 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
     report.warn(std::to_string(negative_water) + " negative mixing ratios (down to " + fmt(worst_negative) + " kg/kg) set to 0" + at);
   }
   if (water_without_cf) {
-    report.warn(std::to_string(water_without_cf) + " points with cloud water but cloud fraction below 0.01" + at +
-                ": fraction raised to 0.01, grid-box water kept");
+    report.warn(std::to_string(water_without_cf) + " points with cloud water (up to " + fmt(most_water_without_cf) +
+                " kg/kg) but zero cloud fraction" + at + ": fraction raised to 0.01, grid-box mean water kept");
   }
   if (cf_without_water) report.warn(std::to_string(cf_without_water) + " points with cloud fraction above 0.1 but no cloud water" + at);
   if (nonmonotonic) report.warn(std::to_string(nonmonotonic) + " level pairs whose heights do not rise with the level" + at);
