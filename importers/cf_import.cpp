@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "cf_layout.hpp"
+#include "column.hpp"
 #include "importer.hpp"
 #include "physics/physics.hpp"
 
@@ -16,15 +17,6 @@ namespace {
 
 constexpr double kRd = 287.05;        // dry-air gas constant, J/(kg K)
 constexpr double kG0 = 9.80665;       // m/s2
-constexpr double kRhoWater = 1000.0;  // kg/m3
-constexpr double kRhoIce = 917.0;     // kg/m3
-// A cloud fraction below this is zero to within int16 packing (whose step is ~1.5e-5 over 0..1).
-constexpr double kZeroCloudFraction = 1e-4;
-// Water below this counts as none for the consistency checks: int16 packing leaves a step or two
-// (~5e-8 kg/kg) where there is none, and 1e-7 kg/kg gives an optical depth of ~0.015 per km.
-constexpr double kZeroWater = 1e-7;
-// Water in a box whose fraction is zero gets this fraction, keeping the box's mean water.
-constexpr double kRaisedCloudFraction = 0.01;
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string fmt(double v) {
@@ -268,7 +260,7 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
     }
   }
   const int nlev = static_cast<int>(S.levels.size());
-  const int nx = grid.lon_deg.count, ny = grid.lat_deg.count, nz = grid.alt_m.count;
+  const int nx = grid.lon_deg.count, ny = grid.lat_deg.count;
   core::TimeStepData out;
   const bool has_cf = have[static_cast<int>(Role::CloudFraction)];
   auto alloc = [&](core::Field f, bool on) {
@@ -282,11 +274,11 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
   alloc(core::Field::WindW, have[static_cast<int>(Role::Omega)]);
   alloc(core::Field::Temperature, true);
 
-  std::size_t water_without_cf = 0, cf_without_water = 0, negative_water = 0, nonmonotonic = 0, clamped_cf = 0;
-  double worst_negative = 0.0, most_water_without_cf = 0.0;
-  // Per column: native-level quantities, then interpolation onto the altitude grid.
-  std::vector<double> h(static_cast<std::size_t>(nlev)), q[core::kFieldCount];
-  for (auto& v : q) v.resize(static_cast<std::size_t>(nlev));
+  std::size_t negative_water = 0, clamped_cf = 0;
+  double worst_negative = 0.0;
+  ColumnCounts counts;
+  ConversionOptions conv{S.options.r_eff_liquid_um, S.options.r_eff_ice_um};
+  std::vector<LevelSample> column(static_cast<std::size_t>(nlev));
   auto value = [&](Role r, int i, int j0, int j1, double w, int k) {
     const Slab& s = slab[static_cast<int>(r)];
     const double a = s.at(i, j0, k), b = s.at(i, j1, k);
@@ -296,6 +288,7 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
     throw ImportError(path + ": variable '" + L.roles[static_cast<int>(r)]->name + "' has value " + fmt(v) +
                       " at time step " + std::to_string(t) + ", expected " + expected);
   };
+  auto has = [&](Role r) { return have[static_cast<int>(r)]; };
   for (int y = 0; y < ny; ++y) {
     for (int x = 0; x < nx; ++x) {
       const int i = S.lon.src[static_cast<std::size_t>(x)];
@@ -303,39 +296,41 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
       const double w = S.lat.w[static_cast<std::size_t>(y)];
       for (int l = 0; l < nlev; ++l) {
         const int k = S.levels[static_cast<std::size_t>(l)];
-        const double p = S.level_pa[static_cast<std::size_t>(l)];
+        LevelSample& c = column[static_cast<std::size_t>(l)];
+        c = LevelSample{};
+        c.p_pa = S.level_pa[static_cast<std::size_t>(l)];
         // Height: geopotential -> geometric height on the sphere; else the standard atmosphere.
-        double z = kNaN;
-        if (have[static_cast<int>(Role::Geopotential)]) {
-          z = physics::f64::geopotential_to_height_m(value(Role::Geopotential, i, j0, j1, w, k), grid.earth_radius_m);
-        } else if (have[static_cast<int>(Role::GeopotentialHeight)]) {
-          z = physics::f64::geopotential_to_height_m(kG0 * value(Role::GeopotentialHeight, i, j0, j1, w, k), grid.earth_radius_m);
+        if (has(Role::Geopotential)) {
+          c.z_m = physics::f64::geopotential_to_height_m(value(Role::Geopotential, i, j0, j1, w, k), grid.earth_radius_m);
+        } else if (has(Role::GeopotentialHeight)) {
+          c.z_m = physics::f64::geopotential_to_height_m(kG0 * value(Role::GeopotentialHeight, i, j0, j1, w, k),
+                                                         grid.earth_radius_m);
         } else {
-          z = isa_altitude_m(p);
+          c.z_m = isa_altitude_m(c.p_pa);
         }
-        if (!std::isnan(z) && (z < -1000.0 || z > 1.0e5)) {
-          bad(have[static_cast<int>(Role::Geopotential)] ? Role::Geopotential : Role::GeopotentialHeight, z,
+        if (!std::isnan(c.z_m) && (c.z_m < -1000.0 || c.z_m > 1.0e5)) {
+          bad(has(Role::Geopotential) ? Role::Geopotential : Role::GeopotentialHeight, c.z_m,
               "a height between -1 km and 100 km");
         }
-        h[static_cast<std::size_t>(l)] = z;
-        double T = have[static_cast<int>(Role::Temperature)] ? value(Role::Temperature, i, j0, j1, w, k) : isa_temperature_k(z);
-        if (!std::isnan(T) && (T < 100.0 || T > 400.0)) bad(Role::Temperature, T, "a temperature between 100 and 400 K");
-        double qv = have[static_cast<int>(Role::Humidity)] ? value(Role::Humidity, i, j0, j1, w, k) : 0.0;
-        if (std::isnan(qv)) qv = 0.0;
-        const double rho = p / (kRd * T * (1.0 + 0.608 * qv));
+        c.t_k = has(Role::Temperature) ? value(Role::Temperature, i, j0, j1, w, k) : isa_temperature_k(c.z_m);
+        if (!std::isnan(c.t_k) && (c.t_k < 100.0 || c.t_k > 400.0)) bad(Role::Temperature, c.t_k, "a temperature between 100 and 400 K");
+        c.qv = has(Role::Humidity) ? value(Role::Humidity, i, j0, j1, w, k) : 0.0;
+        if (std::isnan(c.qv)) c.qv = 0.0;
         // Cloud fraction: tiny excursions from unpacking are clamped and counted; absurd values stop.
-        double cf = has_cf ? value(Role::CloudFraction, i, j0, j1, w, k) : kNaN;
-        if (has_cf && !std::isnan(cf)) {
-          if (cf < -0.01 || cf > 1.01) bad(Role::CloudFraction, cf, "a fraction between 0 and 1");
-          if (cf < 0.0 || cf > 1.0) {
-            ++clamped_cf;
-            cf = std::clamp(cf, 0.0, 1.0);
+        if (has(Role::CloudFraction)) {
+          c.cf = value(Role::CloudFraction, i, j0, j1, w, k);
+          if (!std::isnan(c.cf)) {
+            if (c.cf < -0.01 || c.cf > 1.01) bad(Role::CloudFraction, c.cf, "a fraction between 0 and 1");
+            if (c.cf < 0.0 || c.cf > 1.0) {
+              ++clamped_cf;
+              c.cf = std::clamp(c.cf, 0.0, 1.0);
+            }
           }
         }
-        double water[2] = {kNaN, kNaN};
         const Role water_role[2] = {Role::Liquid, Role::Ice};
+        double* water[2] = {&c.q_liquid, &c.q_ice};
         for (int ph = 0; ph < 2; ++ph) {
-          if (!have[static_cast<int>(water_role[ph])]) continue;
+          if (!has(water_role[ph])) continue;
           double qw = value(water_role[ph], i, j0, j1, w, k);
           if (std::isnan(qw)) continue;
           if (qw < -1e-5 || qw > 0.05) bad(water_role[ph], qw, "a mixing ratio between 0 and 0.05 kg/kg");
@@ -344,54 +339,17 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
             worst_negative = std::min(worst_negative, qw);
             qw = 0.0;
           }
-          water[ph] = qw;
+          *water[ph] = qw;
         }
-        const double total = (std::isnan(water[0]) ? 0.0 : water[0]) + (std::isnan(water[1]) ? 0.0 : water[1]);
-        // Grid-box mean to in-cloud: divide by the cloud fraction where it is non-zero.
-        double div = 1.0;
-        if (has_cf && !std::isnan(cf)) {
-          if (total > kZeroWater && cf < kZeroCloudFraction) {
-            ++water_without_cf;
-            most_water_without_cf = std::max(most_water_without_cf, total);
-            cf = kRaisedCloudFraction;  // keeps the grid-box mean water (and optical depth) of the box
-          }
-          if (cf > 0.1 && total <= kZeroWater) ++cf_without_water;
-          div = std::max(cf, kZeroCloudFraction);
-        }
-        const double r_liq_m = S.options.r_eff_liquid_um * 1e-6;
-        const double r_ice_m = (S.options.r_eff_ice_um > 0 ? S.options.r_eff_ice_um : ice_effective_radius_um(T)) * 1e-6;
-        const std::size_t L_ = static_cast<std::size_t>(l);
-        q[static_cast<int>(core::Field::ExtinctionLiquid)][L_] =
-            std::isnan(water[0]) ? kNaN : 3.0 * rho * water[0] / div / (2.0 * kRhoWater * r_liq_m);
-        q[static_cast<int>(core::Field::ExtinctionIce)][L_] =
-            std::isnan(water[1]) ? kNaN : 3.0 * rho * water[1] / div / (2.0 * kRhoIce * r_ice_m);
-        q[static_cast<int>(core::Field::CloudFraction)][L_] = cf;
-        q[static_cast<int>(core::Field::WindU)][L_] = have[static_cast<int>(Role::U)] ? value(Role::U, i, j0, j1, w, k) : kNaN;
-        q[static_cast<int>(core::Field::WindV)][L_] = have[static_cast<int>(Role::V)] ? value(Role::V, i, j0, j1, w, k) : kNaN;
+        if (has(Role::U)) c.u = value(Role::U, i, j0, j1, w, k);
+        if (has(Role::V)) c.v = value(Role::V, i, j0, j1, w, k);
         // Omega (Pa/s) to w (m/s) by hydrostatics: w = -omega / (rho g).
-        q[static_cast<int>(core::Field::WindW)][L_] =
-            have[static_cast<int>(Role::Omega)] ? -value(Role::Omega, i, j0, j1, w, k) / (rho * kG0) : kNaN;
-        q[static_cast<int>(core::Field::Temperature)][L_] = T;
-      }
-      // Levels run bottom to top; heights must rise with them.
-      for (int l = 1; l < nlev; ++l) {
-        if (!(h[static_cast<std::size_t>(l)] > h[static_cast<std::size_t>(l - 1)])) ++nonmonotonic;
-      }
-      // Linear interpolation in altitude; outside the column's levels: no data.
-      for (int z = 0; z < nz; ++z) {
-        const double alt = grid.alt_m.at(z);
-        int l = 1;
-        while (l < nlev && !(h[static_cast<std::size_t>(l)] >= alt)) ++l;
-        if (l >= nlev || !(h[static_cast<std::size_t>(l - 1)] <= alt) || !(h[static_cast<std::size_t>(l)] > h[static_cast<std::size_t>(l - 1)])) continue;
-        const double a = (alt - h[static_cast<std::size_t>(l - 1)]) / (h[static_cast<std::size_t>(l)] - h[static_cast<std::size_t>(l - 1)]);
-        const std::size_t p = grid.index(x, y, z);
-        for (int f = 0; f < core::kFieldCount; ++f) {
-          auto& dst = out.fields[static_cast<std::size_t>(f)];
-          if (dst.empty()) continue;
-          const double lo = q[f][static_cast<std::size_t>(l - 1)], hi = q[f][static_cast<std::size_t>(l)];
-          dst[p] = static_cast<float>(lo + a * (hi - lo));
+        if (has(Role::Omega)) {
+          const double rho = c.p_pa / (kRd * c.t_k * (1.0 + 0.608 * c.qv));
+          c.w = -value(Role::Omega, i, j0, j1, w, k) / (rho * kG0);
         }
       }
+      place_column(column, grid, x, y, conv, out, counts);
     }
   }
   // Report: SI ranges, conversions, consistency.
@@ -423,16 +381,11 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
   used_for(Role::GeopotentialHeight, "level heights from Phi = g0 gh, z = Phi R / (g0 R - Phi) (not stored)");
   used_for(Role::Humidity, "virtual temperature for air density (not stored)");
   if (have[static_cast<int>(Role::CloudFraction)]) report.use(role_name(Role::CloudFraction)).clamped += clamped_cf;
-  const std::string at = " at time step " + std::to_string(t);
   if (negative_water) {
-    report.warn(std::to_string(negative_water) + " negative mixing ratios (down to " + fmt(worst_negative) + " kg/kg) set to 0" + at);
+    report.warn(std::to_string(negative_water) + " negative mixing ratios (down to " + fmt(worst_negative) +
+                " kg/kg) set to 0 at time step " + std::to_string(t));
   }
-  if (water_without_cf) {
-    report.warn(std::to_string(water_without_cf) + " points with cloud water (up to " + fmt(most_water_without_cf) +
-                " kg/kg) but zero cloud fraction" + at + ": fraction raised to 0.01, grid-box mean water kept");
-  }
-  if (cf_without_water) report.warn(std::to_string(cf_without_water) + " points with cloud fraction above 0.1 but no cloud water" + at);
-  if (nonmonotonic) report.warn(std::to_string(nonmonotonic) + " level pairs whose heights do not rise with the level" + at);
+  report_counts(counts, t, report);
   return out;
 }
 
