@@ -9,6 +9,7 @@
 
 #include "cf_layout.hpp"
 #include "column.hpp"
+#include "wrf_import.hpp"
 #include "importer.hpp"
 #include "physics/physics.hpp"
 
@@ -394,9 +395,7 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
   S->file = std::make_unique<NcFile>(path);
   S->options = options;
   const NcFile& f = *S->file;
-  if (!f.global_text("DX").empty() || f.global_number("DX") || f.find("XLAT")) {
-    throw ImportError(path + ": this is a WRF file; the WRF reader is not built yet (expected a CF pressure-level file)");
-  }
+  if (is_wrf_file(f)) return import_wrf(std::move(S->file), options);
   S->layout = detect_cf_layout(f);
   CfLayout& L = S->layout;
   core::CloudVolume vol;

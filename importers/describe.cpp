@@ -3,6 +3,7 @@
 
 #include "cf_layout.hpp"
 #include "importer.hpp"
+#include "wrf_import.hpp"
 
 namespace cv::importers {
 
@@ -10,10 +11,7 @@ std::string describe_file(const std::string& path) {
   NcFile f(path);
   std::string out = "file: " + path + "\n";
   auto line = [&](const std::string& s) { out += s + "\n"; };
-  if (f.find("XLAT") || f.global_number("MAP_PROJ")) {
-    line("format: WRF output (TITLE '" + f.global_text("TITLE") + "'); the WRF reader is not built yet");
-    return out;
-  }
+  if (is_wrf_file(f)) return out + describe_wrf(f);
   const CfLayout L = detect_cf_layout(f);
   line("format: CF-style gridded file (Conventions '" + f.global_text("Conventions") + "')");
   auto axis = [&](const char* what, const Axis& a) {

@@ -1,0 +1,111 @@
+// The WRF reader on the two real WRF files, checked by hand against the file's own numbers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include "importer.hpp"
+#include "nc_file.hpp"
+#include "wrf_import.hpp"
+
+namespace {
+using namespace cv;
+
+std::string real(const std::string& name) {
+  const std::string p = std::string(CV_REAL_DATA_DIR) + "/" + name;
+  if (!std::filesystem::exists(p)) {
+    const char* ci = std::getenv("CI");
+    if (ci && std::string(ci) == "true") ADD_FAILURE() << p << " is missing under CI";
+    return "";
+  }
+  return p;
+}
+#define REAL_FILE(var, name)                                                   \
+  const std::string var = real(name);                                          \
+  if (var.empty()) GTEST_SKIP() << name << " not found beside the checkout";
+
+// WRF's heights: geopotential over its own constant g.
+double wrf_height(double phi) { return phi / 9.81; }
+
+TEST(Wrf, LambertHeightsFromPhPhbByHand) {
+  REAL_FILE(path, "wrf_d01_allvars_cropped.nc");
+  importers::NcFile f(path);
+  const auto ph = f.read(f.var("PH"), {0, 0, 0, 0}, {1, 28, 8, 10});
+  const auto phb = f.read(f.var("PHB"), {0, 0, 0, 0}, {1, 28, 8, 10});
+  const auto hgt = f.read(f.var("HGT"));  // 2-D, no Time dimension
+  // The lowest staggered level is the ground: (PH + PHB) / 9.81 equals HGT there (with 9.80665 it
+  // would sit 1.7 m above it).
+  for (std::size_t n = 0; n < 80; ++n) EXPECT_NEAR(wrf_height(ph[n] + phb[n]), hgt[n], 0.01) << n;
+  // The lowest mass level is halfway between the two lowest staggered levels; by hand:
+  double zmin = 1e30;
+  for (std::size_t n = 0; n < 80; ++n) zmin = std::min(zmin, wrf_height(0.5 * (ph[n] + phb[n] + ph[n + 80] + phb[n + 80])));
+  auto vol = importers::import_file(path);
+  EXPECT_NEAR(vol.grid.alt_m.start, zmin, 1e-6);
+  EXPECT_GT(zmin, 4400.0);  // the Tibetan Plateau
+  ASSERT_EQ(vol.times.size(), 4u);
+  EXPECT_EQ(vol.times[3].iso_utc, "2005-09-21T09:00:00Z");
+  // Never any data below the ground: the lowest value in every column lies above the lowest terrain.
+  const double hgt_min = *std::min_element(hgt.begin(), hgt.end());
+  const auto& d = vol.step(0);
+  const auto& t = d[core::Field::Temperature];
+  int columns_with_data = 0;
+  for (int y = 0; y < vol.grid.lat_deg.count; ++y) {
+    for (int x = 0; x < vol.grid.lon_deg.count; ++x) {
+      for (int k = 0; k < vol.grid.alt_m.count; ++k) {
+        const float v = t[vol.grid.index(x, y, k)];
+        if (std::isnan(v)) continue;
+        EXPECT_GT(vol.grid.alt_m.at(k), hgt_min);
+        EXPECT_GT(v, 180.0f);
+        EXPECT_LT(v, 300.0f);
+        ++columns_with_data;
+        break;
+      }
+    }
+  }
+  EXPECT_GT(columns_with_data, 0);
+  // The tilted Lambert domain does not fill its lon/lat bounding box: some columns have no data.
+  EXPECT_LT(columns_with_data, vol.grid.lon_deg.count * vol.grid.lat_deg.count);
+  bool lie_noted = false;
+  for (const auto& n : vol.report.notes) lie_noted |= n.find("claim 200 x 200") != std::string::npos;
+  EXPECT_TRUE(lie_noted);
+}
+
+TEST(Wrf, ProjectionRotationMatchesCosalphaSinalpha) {
+  REAL_FILE(path, "wrf_d01_allvars_cropped.nc");
+  importers::NcFile f(path);
+  const auto lat = f.read(f.var("XLAT")), lon = f.read(f.var("XLONG"));
+  const auto ca = f.read(f.var("COSALPHA")), sa = f.read(f.var("SINALPHA"));
+  for (std::size_t n = 0; n < lat.size(); n += 7) {
+    const auto [c, s] = importers::wrf_rotation_from_projection(f, lat[n], lon[n]);
+    EXPECT_NEAR(c, ca[n], 1e-4) << n;
+    EXPECT_NEAR(s, sa[n], 1e-4) << n;
+  }
+  EXPECT_GT(std::abs(sa[0]), 1e-3);  // the check has something to check: the grid is rotated here
+}
+
+TEST(Wrf, MercatorFileWithoutCloudFraction) {
+  REAL_FILE(path, "ci_test_file.nc");
+  auto vol = importers::import_file(path);
+  EXPECT_FALSE(vol.has_field[static_cast<int>(core::Field::CloudFraction)]);
+  EXPECT_TRUE(vol.has_field[static_cast<int>(core::Field::ExtinctionLiquid)]);
+  EXPECT_FALSE(vol.has_field[static_cast<int>(core::Field::ExtinctionIce)]);
+  EXPECT_LT(vol.grid.alt_m.last(), 6000.0);  // cut to the lowest 14 levels (top ~5.6 km)
+  const auto& d = vol.step(0);
+  float tmax = 0, ext_max = 0;
+  for (float v : d[core::Field::Temperature]) {
+    if (!std::isnan(v)) tmax = std::max(tmax, v);
+  }
+  for (float v : d[core::Field::ExtinctionLiquid]) {
+    if (!std::isnan(v)) ext_max = std::max(ext_max, v);
+  }
+  EXPECT_GT(tmax, 295.0f);  // the Gulf of Mexico in August, near the surface
+  EXPECT_LT(tmax, 310.0f);
+  EXPECT_GT(ext_max, 1e-3f);  // Katrina has clouds
+  EXPECT_LT(ext_max, 1.0f);
+  bool noted = false;
+  for (const auto& n : vol.report.notes) noted |= n.find("no CLDFRA") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
+}  // namespace
