@@ -179,11 +179,17 @@ LatMap map_latitudes(const std::vector<double>& raw, const std::optional<Region>
   return out;
 }
 
-// Strides of one variable's per-time-step slab, in source index space.
+// One variable's per-time-step slab and its strides in source index space. Slabs are float (half
+// the memory) except the geopotential, kept in double so every step's level heights agree to the
+// last digit with the probe that fixed the altitude grid.
 struct Slab {
-  std::vector<double> data;
+  std::vector<float> f;
+  std::vector<double> d;
   std::size_t s_lon = 0, s_lat = 0, s_lev = 0;
-  double at(int i, int j, int k) const { return data[i * s_lon + j * s_lat + k * s_lev]; }
+  double at(int i, int j, int k) const {
+    const std::size_t n = i * s_lon + j * s_lat + k * s_lev;
+    return d.empty() ? f[n] : d[n];
+  }
 };
 
 }  // namespace
@@ -214,7 +220,7 @@ struct Era5Source {
 
 namespace {
 
-Slab read_slab(const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* info) {
+Slab read_slab(const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* info, bool as_double) {
   const NcFile& f = *S.file;
   const CfLayout& L = S.layout;
   std::vector<std::size_t> start(v.dims.size(), 0), count(v.dims.size(), 0);
@@ -234,7 +240,11 @@ Slab read_slab(const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* 
     if (d == L.vertical.dim) s.s_lev = stride;
     stride *= c;
   }
-  s.data = f.read(v, start, count, info);
+  if (as_double) {
+    s.d = f.read(v, start, count, info);
+  } else {
+    s.f = f.read_float(v, start, count, info);
+  }
   return s;
 }
 
@@ -250,12 +260,14 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
   for (int r = 0; r < kRoleCount; ++r) {
     if (!L.roles[r]) continue;
     UnpackInfo info;
-    slab[r] = read_slab(S, *L.roles[r], t, &info);
+    const bool heights = static_cast<Role>(r) == Role::Geopotential || static_cast<Role>(r) == Role::GeopotentialHeight;
+    slab[r] = read_slab(S, *L.roles[r], t, &info, heights);
     have[r] = true;
     auto& use = report.use(role_name(static_cast<Role>(r)));
     use.variable = L.roles[r]->name;
     use.units = L.roles[r]->text("units");
-    for (double x : slab[r].data) use.before.add(x);
+    for (float x : slab[r].f) use.before.add(x);
+    for (double x : slab[r].d) use.before.add(x);
     if (info.packed && use.conversion.empty()) {
       use.conversion = "unpacked x * " + fmt(info.scale) + " + " + fmt(info.offset) + "; ";
     }
@@ -279,7 +291,9 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
   double worst_negative = 0.0;
   ColumnCounts counts;
   ConversionOptions conv{S.options.r_eff_liquid_um, S.options.r_eff_ice_um};
-  std::vector<LevelSample> column(static_cast<std::size_t>(nlev));
+  // A latitude row at a time, levels outer and longitudes inner: the slabs are read along their
+  // contiguous axis (a column's levels lie megabytes apart in a global file).
+  std::vector<LevelSample> row(static_cast<std::size_t>(nx) * static_cast<std::size_t>(nlev));
   auto value = [&](Role r, int i, int j0, int j1, double w, int k) {
     const Slab& s = slab[static_cast<int>(r)];
     const double a = s.at(i, j0, k), b = s.at(i, j1, k);
@@ -291,13 +305,13 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
   };
   auto has = [&](Role r) { return have[static_cast<int>(r)]; };
   for (int y = 0; y < ny; ++y) {
-    for (int x = 0; x < nx; ++x) {
-      const int i = S.lon.src[static_cast<std::size_t>(x)];
-      const int j0 = S.lat.j0[static_cast<std::size_t>(y)], j1 = S.lat.j1[static_cast<std::size_t>(y)];
-      const double w = S.lat.w[static_cast<std::size_t>(y)];
-      for (int l = 0; l < nlev; ++l) {
-        const int k = S.levels[static_cast<std::size_t>(l)];
-        LevelSample& c = column[static_cast<std::size_t>(l)];
+    const int j0 = S.lat.j0[static_cast<std::size_t>(y)], j1 = S.lat.j1[static_cast<std::size_t>(y)];
+    const double w = S.lat.w[static_cast<std::size_t>(y)];
+    for (int l = 0; l < nlev; ++l) {
+      const int k = S.levels[static_cast<std::size_t>(l)];
+      for (int x = 0; x < nx; ++x) {
+        const int i = S.lon.src[static_cast<std::size_t>(x)];
+        LevelSample& c = row[static_cast<std::size_t>(x) * static_cast<std::size_t>(nlev) + static_cast<std::size_t>(l)];
         c = LevelSample{};
         c.p_pa = S.level_pa[static_cast<std::size_t>(l)];
         // Height: geopotential -> geometric height on the sphere; else the standard atmosphere.
@@ -350,7 +364,11 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
           c.w = -value(Role::Omega, i, j0, j1, w, k) / (rho * kG0);
         }
       }
-      place_column(column, grid, x, y, conv, out, counts);
+    }
+    for (int x = 0; x < nx; ++x) {
+      place_column(std::span<LevelSample>(row).subspan(static_cast<std::size_t>(x) * static_cast<std::size_t>(nlev),
+                                                       static_cast<std::size_t>(nlev)),
+                   grid, x, y, conv, out, counts);
     }
   }
   // Report: SI ranges, conversions, consistency.
@@ -456,7 +474,7 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
     const NcVar* ghv = L.roles[static_cast<int>(Role::GeopotentialHeight)];
     std::vector<double> thick;
     if (zv || ghv) {
-      const Slab s = read_slab(*S, zv ? *zv : *ghv, S->steps.front(), nullptr);
+      const Slab s = read_slab(*S, zv ? *zv : *ghv, S->steps.front(), nullptr, true);
       for (int y = 0; y < probe.lat_deg.count; ++y) {
         for (int x = 0; x < probe.lon_deg.count; ++x) {
           double prev = kNaN;

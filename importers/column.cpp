@@ -28,7 +28,7 @@ std::string fmt(double v) {
 }
 }  // namespace
 
-void place_column(std::vector<LevelSample>& levels, const core::VolumeGrid& grid, int x, int y,
+void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, int x, int y,
                   const ConversionOptions& options, core::TimeStepData& out, ColumnCounts& counts) {
   const int n = static_cast<int>(levels.size());
   // Per level: SI quantities in the order of core::Field.

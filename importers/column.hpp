@@ -4,6 +4,7 @@
 #pragma once
 
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "volume/cloud_volume.hpp"
@@ -41,7 +42,7 @@ struct ColumnCounts {
 // Converts the levels and interpolates them linearly in altitude into column (x, y) of `out`, whose
 // fields were allocated by the caller (absent fields stay empty). Outside the column's levels,
 // nothing is written (the NaN stays: no data is invented).
-void place_column(std::vector<LevelSample>& levels, const core::VolumeGrid& grid, int x, int y,
+void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, int x, int y,
                   const ConversionOptions& options, core::TimeStepData& out, ColumnCounts& counts);
 
 // Adds the report's consistency warnings for one time step.

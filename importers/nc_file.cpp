@@ -241,6 +241,36 @@ std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start,
   return out;
 }
 
+std::vector<float> NcFile::read_float(const NcVar& v, std::vector<std::size_t> start, std::vector<std::size_t> count,
+                                      UnpackInfo* info) const {
+  const std::size_t nd = v.dims.size();
+  if (start.empty()) start.assign(nd, 0);
+  if (count.empty()) {
+    for (std::size_t i = 0; i < nd; ++i) count.push_back(dim_length(v, i));
+  }
+  // Split along the first axis with more than one index; each chunk goes through read().
+  std::size_t axis = 0;
+  while (axis + 1 < nd && count[axis] == 1) ++axis;
+  std::vector<float> out;
+  UnpackInfo total;
+  const std::size_t chunks = nd ? count[axis] : 1;
+  for (std::size_t c = 0; c < chunks; ++c) {
+    std::vector<std::size_t> s = start, n = count;
+    if (nd) {
+      s[axis] = start[axis] + c;
+      n[axis] = 1;
+    }
+    UnpackInfo part;
+    const std::vector<double> d = read(v, s, n, &part);
+    if (c == 0) out.reserve(d.size() * chunks);
+    for (double x : d) out.push_back(static_cast<float>(x));
+    total.scale = part.scale, total.offset = part.offset, total.packed = part.packed;
+    total.missing += part.missing;
+  }
+  if (info) *info = total;
+  return out;
+}
+
 std::vector<std::string> NcFile::read_strings(const NcVar& v) const {
   if (v.type != NC_CHAR || v.dims.size() != 2) {
     throw ImportError(path_ + ": variable '" + v.name + "': expected a 2-D character array");

@@ -67,6 +67,10 @@ class NcFile {
   // entry per dimension (empty: the whole variable).
   std::vector<double> read(const NcVar& v, std::vector<std::size_t> start = {}, std::vector<std::size_t> count = {},
                            UnpackInfo* info = nullptr) const;
+  // The same read into float, unpacked in double a chunk at a time, so a large slab never exists in
+  // double (half the memory of read()).
+  std::vector<float> read_float(const NcVar& v, std::vector<std::size_t> start = {}, std::vector<std::size_t> count = {},
+                                UnpackInfo* info = nullptr) const;
   // A text variable (e.g. WRF's Times) as one string per leading index.
   std::vector<std::string> read_strings(const NcVar& v) const;
 

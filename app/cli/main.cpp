@@ -166,6 +166,7 @@ int cmd_import(const std::vector<std::string>& args) {
   }
   if (input.empty() || out.empty()) throw UsageError{"cloudviewer import: expected FILE and -o OUT"};
   if (out.size() > 6 && out.substr(out.size() - 6) == ".cvvol") out.resize(out.size() - 6);
+  o.cache_steps = 1;  // steps are written one after another: keep only the current one
   cv::core::CloudVolume vol = cv::importers::import_file(input, o);
   std::printf("grid: %d x %d x %d (lon %.4g..%.4g, lat %.4g..%.4g, alt %.0f..%.0f m), %zu time step(s)\n",
               vol.grid.lon_deg.count, vol.grid.lat_deg.count, vol.grid.alt_m.count, vol.grid.lon_deg.start,
