@@ -266,8 +266,8 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
     auto& use = report.use(role_name(static_cast<Role>(r)));
     use.variable = L.roles[r]->name;
     use.units = L.roles[r]->text("units");
-    for (float x : slab[r].f) use.before.add(x);
-    for (double x : slab[r].d) use.before.add(x);
+    use.before.add_all(slab[r].f.data(), slab[r].f.size());
+    use.before.add_all(slab[r].d.data(), slab[r].d.size());
     if (info.packed && use.conversion.empty()) {
       use.conversion = "unpacked x * " + fmt(info.scale) + " + " + fmt(info.offset) + "; ";
     }
@@ -377,7 +377,7 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
     if (!have[static_cast<int>(r)]) return;
     auto& use = report.use(role_name(r));
     if (use.conversion.find(conv) == std::string::npos) use.conversion += conv;
-    for (float v : out[f]) use.after.add(v);
+    use.after.add_all(out[f].data(), out[f].size());
   };
   after(Role::Liquid, core::Field::ExtinctionLiquid,
         "in-cloud = q / cloud fraction; LWC = rho q, rho = p / (287.05 T (1 + 0.608 q_v)); sigma = 3 LWC / (2 rho_w r_eff), r_eff " +

@@ -213,7 +213,7 @@ std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start,
                : v.type == NC_FLOAT ? static_cast<double>(NC_FILL_FLOAT) : v.type == NC_DOUBLE ? NC_FILL_DOUBLE : NAN;
     if (!std::isnan(def)) missing.push_back(def);
   }
-  std::optional<double> vmin, vmax;
+  std::optional<double> vmin, vmax;  // in the packed domain, as CF says
   if (const NcAtt* vr = v.att("valid_range"); vr && vr->values.size() == 2) vmin = vr->values[0], vmax = vr->values[1];
   if (auto x = v.number("valid_min")) vmin = x;
   if (auto x = v.number("valid_max")) vmax = x;
@@ -223,17 +223,22 @@ std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start,
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::size_t nmissing = 0;
   const bool integer = is_integer_type(v.type);
+  // Split the markers once: exact ones (integer types) and float ones matched to 1e-6. A NaN
+  // marker needs no entry: isnan() below catches exactly the values it marks.
+  std::vector<double> exact, approx;
+  for (double m : missing) {
+    if (!std::isnan(m)) (integer ? exact : approx).push_back(m);
+  }
+  const double lo = vmin.value_or(-std::numeric_limits<double>::infinity());
+  const double hi = vmax.value_or(std::numeric_limits<double>::infinity());
   for (double& x : out) {
-    bool miss = std::isnan(x);
-    for (double m : missing) {
-      // Float fill values are matched with a relative tolerance (1e30-style fills lose digits).
-      if (std::isnan(m) ? std::isnan(x) : integer ? x == m : std::abs(x - m) <= 1e-6 * std::abs(m)) miss = true;
-    }
-    if (!miss && ((vmin && x < *vmin) || (vmax && x > *vmax))) miss = true;
+    bool miss = std::isnan(x) || x < lo || x > hi;
+    for (double m : exact) miss |= x == m;
+    for (double m : approx) miss |= std::abs(x - m) <= 1e-6 * std::abs(m);
     if (miss) {
       x = nan;
       ++nmissing;
-    } else if (packed) {
+    } else {
       x = x * scale + offset;
     }
   }

@@ -196,7 +196,7 @@ core::TimeStepData load_wrf_step(const WrfSource& S, const core::VolumeGrid& gri
     use.variable = name;
     use.units = S.file->var(name).text("units");
     use.conversion = conv;
-    for (double x : f.v) use.before.add(x);
+    use.before.add_all(f.v.data(), f.v.size());
   };
   stats("geopotential (perturbation)", "PH", ph, "z = (PH + PHB) / 9.81 (WRF's g) on staggered levels, averaged to mass levels");
   stats("pressure (perturbation)", "P", p, "p = P + PB");
@@ -285,7 +285,7 @@ core::TimeStepData load_wrf_step(const WrfSource& S, const core::VolumeGrid& gri
   if (clamped) report.use("cloud fraction").clamped += clamped;
   report_counts(counts, t, report);
   auto after = [&](const char* role, core::Field f) {
-    for (float x : out[f]) report.use(role).after.add(x);
+    report.use(role).after.add_all(out[f].data(), out[f].size());
   };
   if (qc.present) after("cloud liquid water", core::Field::ExtinctionLiquid);
   if (qi.present) after("cloud ice water", core::Field::ExtinctionIce);

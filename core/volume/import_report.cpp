@@ -17,6 +17,31 @@ void ValueStats::add(double v) {
   ++count;
 }
 
+namespace {
+template <typename T>
+void add_range(ValueStats& s, const T* v, std::size_t n) {
+  T lo = std::numeric_limits<T>::infinity(), hi = -std::numeric_limits<T>::infinity();
+  std::size_t finite = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const T x = v[i];
+    if (std::isfinite(x)) {
+      lo = x < lo ? x : lo;
+      hi = x > hi ? x : hi;
+      ++finite;
+    }
+  }
+  if (finite) {
+    s.min = std::min(s.min, static_cast<double>(lo));
+    s.max = std::max(s.max, static_cast<double>(hi));
+  }
+  s.count += finite;
+  s.missing += n - finite;
+}
+}  // namespace
+
+void ValueStats::add_all(const float* v, std::size_t n) { add_range(*this, v, n); }
+void ValueStats::add_all(const double* v, std::size_t n) { add_range(*this, v, n); }
+
 void ValueStats::merge(const ValueStats& o) {
   min = std::min(min, o.min);
   max = std::max(max, o.max);

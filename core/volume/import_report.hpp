@@ -16,6 +16,9 @@ struct ValueStats {
   std::size_t count = 0;    // finite values seen
   std::size_t missing = 0;  // fill, missing_value or NaN
   void add(double v);
+  // The same over an array, in one pass (per-value calls cost a tenth of a global import).
+  void add_all(const float* v, std::size_t n);
+  void add_all(const double* v, std::size_t n);
   void merge(const ValueStats& o);
   bool empty() const { return count == 0; }
 };
