@@ -205,6 +205,11 @@ double isa_altitude_m(double p_pa) {
   return 11000.0 + kRd * t11 / kG0 * std::log(p11 / p_pa);
 }
 
+double isa_pressure_pa(double z) {
+  if (z <= 11000.0) return 101325.0 * std::pow(1.0 - 0.0065 * z / 288.15, kG0 / (kRd * 0.0065));
+  return 22632.06 * std::exp(-(z - 11000.0) * kG0 / (kRd * 216.65));
+}
+
 double isa_temperature_k(double altitude_m) { return altitude_m < 11000.0 ? 288.15 - 0.0065 * altitude_m : 216.65; }
 
 struct Era5Source {
@@ -213,7 +218,9 @@ struct Era5Source {
   LonMap lon;
   LatMap lat;
   std::vector<int> levels;            // source level indices kept, bottom (highest pressure) first
-  std::vector<double> level_pa;
+  std::vector<double> level_pa;       // pressure levels; the reference pressure of other kinds
+  std::vector<double> level_z;        // height levels, metres
+  std::vector<double> hyb_a, hyb_b;   // hybrid levels: p = a + b ps
   std::vector<int> steps;             // source time indices, in output order
   ImportOptions options;
 };
@@ -273,6 +280,16 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
     }
   }
   const int nlev = static_cast<int>(S.levels.size());
+  Slab ps, zs;
+  if (L.vertical_kind == Vertical::Hybrid) ps = read_slab(S, *L.surface_pressure, t, nullptr, true);
+  if (L.surface_geopotential) zs = read_slab(S, *L.surface_geopotential, t, nullptr, true);
+  auto surf = [&](const Slab& sl, int i, int j0, int j1, double w) {
+    const double a = sl.at(i, j0, 0), b = sl.at(i, j1, 0);
+    return w == 0.0 ? a : w == 1.0 ? b : (1.0 - w) * a + w * b;
+  };
+  // Hypsometric integration up each column of the row (hybrid levels without geopotential).
+  const std::size_t row_len = static_cast<std::size_t>(grid.lon_deg.count);
+  std::vector<double> z_prev(row_len), p_prev(row_len), tv_prev(row_len);
   const int nx = grid.lon_deg.count, ny = grid.lat_deg.count;
   core::TimeStepData out;
   const bool has_cf = have[static_cast<int>(Role::CloudFraction)];
@@ -313,13 +330,39 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
         const int i = S.lon.src[static_cast<std::size_t>(x)];
         LevelSample& c = row[static_cast<std::size_t>(x) * static_cast<std::size_t>(nlev) + static_cast<std::size_t>(l)];
         c = LevelSample{};
-        c.p_pa = S.level_pa[static_cast<std::size_t>(l)];
-        // Height: geopotential -> geometric height on the sphere; else the standard atmosphere.
+        const std::size_t L_ = static_cast<std::size_t>(l), X_ = static_cast<std::size_t>(x);
+        // The surface where the file gives it: as a geopotential height (hypsometric start) and as a
+        // geometric altitude (heights above ground). A surface_altitude variable is the latter already.
+        const bool given_altitude = L.surface_geopotential_scale != 1.0;
+        const double surf_raw = L.surface_geopotential ? surf(zs, i, j0, j1, w) : 0.0;
+        const double zsurf = given_altitude ? surf_raw * grid.earth_radius_m / (grid.earth_radius_m + surf_raw) : surf_raw / kG0;
+        const double zsurf_geometric =
+            given_altitude ? surf_raw : physics::f64::geopotential_to_height_m(surf_raw, grid.earth_radius_m);
+        switch (L.vertical_kind) {
+          case Vertical::Pressure: c.p_pa = S.level_pa[L_]; break;
+          case Vertical::Hybrid: c.p_pa = S.hyb_a[L_] + S.hyb_b[L_] * surf(ps, i, j0, j1, w); break;
+          case Vertical::Height:
+            c.p_pa = isa_pressure_pa(S.level_z[L_] + (L.height_above_ground ? zsurf_geometric : 0.0));
+            break;
+        }
+        const double t_read = has(Role::Temperature) ? value(Role::Temperature, i, j0, j1, w, k) : NAN;
+        c.qv = has(Role::Humidity) ? value(Role::Humidity, i, j0, j1, w, k) : 0.0;
+        if (std::isnan(c.qv)) c.qv = 0.0;
+        // Height: geopotential -> geometric height on the sphere; else from the coordinate itself.
         if (has(Role::Geopotential)) {
           c.z_m = physics::f64::geopotential_to_height_m(value(Role::Geopotential, i, j0, j1, w, k), grid.earth_radius_m);
         } else if (has(Role::GeopotentialHeight)) {
           c.z_m = physics::f64::geopotential_to_height_m(kG0 * value(Role::GeopotentialHeight, i, j0, j1, w, k),
                                                          grid.earth_radius_m);
+        } else if (L.vertical_kind == Vertical::Height) {
+          c.z_m = S.level_z[L_] + (L.height_above_ground ? zsurf_geometric : 0.0);
+        } else if (L.vertical_kind == Vertical::Hybrid) {
+          // Hypsometric equation from the surface: dZ = R_d T_v / g0 d(ln p), in geopotential metres.
+          const double tv = t_read * (1.0 + 0.608 * c.qv);
+          const double zgp = l == 0 ? zsurf + kRd * tv / kG0 * std::log(surf(ps, i, j0, j1, w) / c.p_pa)
+                                    : z_prev[X_] + kRd * 0.5 * (tv + tv_prev[X_]) / kG0 * std::log(p_prev[X_] / c.p_pa);
+          z_prev[X_] = zgp, p_prev[X_] = c.p_pa, tv_prev[X_] = tv;
+          c.z_m = physics::f64::geopotential_to_height_m(kG0 * zgp, grid.earth_radius_m);
         } else {
           c.z_m = isa_altitude_m(c.p_pa);
         }
@@ -327,10 +370,8 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
           bad(has(Role::Geopotential) ? Role::Geopotential : Role::GeopotentialHeight, c.z_m,
               "a height between -1 km and 100 km");
         }
-        c.t_k = has(Role::Temperature) ? value(Role::Temperature, i, j0, j1, w, k) : isa_temperature_k(c.z_m);
+        c.t_k = has(Role::Temperature) ? t_read : isa_temperature_k(c.z_m);
         if (!std::isnan(c.t_k) && (c.t_k < 100.0 || c.t_k > 400.0)) bad(Role::Temperature, c.t_k, "a temperature between 100 and 400 K");
-        c.qv = has(Role::Humidity) ? value(Role::Humidity, i, j0, j1, w, k) : 0.0;
-        if (std::isnan(c.qv)) c.qv = 0.0;
         // Cloud fraction: tiny excursions from unpacking are clamped and counted; absurd values stop.
         if (has(Role::CloudFraction)) {
           c.cf = value(Role::CloudFraction, i, j0, j1, w, k);
@@ -435,24 +476,62 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
                          path + ": coordinate '" + L.lat.var->name + "'", vol.report.notes);
   vol.grid.lon_deg = S->lon.axis;
   vol.grid.lat_deg = S->lat.axis;
-  // Levels: kept by pressure range, ordered bottom (highest pressure) to top.
-  std::vector<std::pair<double, int>> lev;
+  // Levels: kept by (reference) pressure range, ordered bottom to top. Height levels get the
+  // standard atmosphere's pressure as their reference; hybrid levels a + b 1013.25 hPa.
+  struct Lev {
+    double ref_pa;
+    int k;
+    double z;
+  };
+  std::vector<Lev> lev;
   for (std::size_t k = 0; k < L.vertical.values.size(); ++k) {
-    const double pa = L.vertical.values[k] * L.pressure_scale_to_pa;
-    if (!(pa > 0.0) || pa > 1.2e5) {
-      throw ImportError(path + ": level " + fmt(L.vertical.values[k]) + " " + L.vertical.var->text("units") +
-                        " is not a pressure between 0 and 1200 hPa");
+    const double value = L.vertical.values[k];
+    double pa = 0.0, z = NAN;
+    if (L.vertical_kind == Vertical::Pressure) {
+      pa = value * L.pressure_scale_to_pa;
+    } else if (L.vertical_kind == Vertical::Hybrid) {
+      pa = L.hybrid_a_pa[k] + L.hybrid_b[k] * 101325.0;
+    } else {
+      z = value * L.height_scale_to_m;
+      if (!(z > -1000.0 && z < 1.0e5)) {
+        throw ImportError(path + ": level " + fmt(value) + " " + L.vertical.var->text("units") + " is not a height between -1 and 100 km");
+      }
+      pa = isa_pressure_pa(z);
     }
-    if (pa >= options.level_min_hpa * 100.0 && pa <= options.level_max_hpa * 100.0) lev.push_back({pa, static_cast<int>(k)});
+    if (!(pa > 0.0) || pa > 1.2e5) {
+      throw ImportError(path + ": level " + fmt(value) + " of '" + L.vertical.var->name +
+                        "' is not a pressure between 0 and 1200 hPa");
+    }
+    if (pa >= options.level_min_hpa * 100.0 && pa <= options.level_max_hpa * 100.0) lev.push_back({pa, static_cast<int>(k), z});
   }
-  if (lev.size() < 2) throw ImportError(path + ": fewer than 2 pressure levels in the requested range");
-  std::sort(lev.begin(), lev.end(), [](auto a, auto b) { return a.first > b.first; });
-  if (L.vertical.values.size() > 1 && L.vertical.values.front() * L.pressure_scale_to_pa < L.vertical.values.back() * L.pressure_scale_to_pa) {
-    vol.report.notes.push_back("levels are stored top first; ordered bottom to top");
+  if (lev.size() < 2) throw ImportError(path + ": fewer than 2 levels in the requested range");
+  const bool top_first = lev.front().ref_pa < lev.back().ref_pa;
+  std::sort(lev.begin(), lev.end(), [](const Lev& a, const Lev& b) { return a.ref_pa > b.ref_pa; });
+  if (top_first) vol.report.notes.push_back("levels are stored top first; ordered bottom to top");
+  for (const Lev& l : lev) {
+    S->level_pa.push_back(l.ref_pa);
+    S->levels.push_back(l.k);
+    S->level_z.push_back(l.z);
+    if (L.vertical_kind == Vertical::Hybrid) {
+      S->hyb_a.push_back(L.hybrid_a_pa[static_cast<std::size_t>(l.k)]);
+      S->hyb_b.push_back(L.hybrid_b[static_cast<std::size_t>(l.k)]);
+    }
   }
-  for (auto& [pa, k] : lev) {
-    S->level_pa.push_back(pa);
-    S->levels.push_back(k);
+  const bool has_geo = L.roles[static_cast<int>(Role::Geopotential)] || L.roles[static_cast<int>(Role::GeopotentialHeight)];
+  if (L.vertical_kind == Vertical::Hybrid) {
+    vol.report.format = "CF hybrid sigma-pressure levels";
+    vol.report.notes.push_back("pressure p = a + b ps from formula_terms '" + L.vertical.var->text("formula_terms") + "'");
+    if (!has_geo && !L.roles[static_cast<int>(Role::Temperature)]) {
+      throw ImportError(path + ": hybrid levels without geopotential need temperature to find their heights; neither is in the file");
+    }
+    if (!has_geo) vol.report.notes.push_back("level heights from the hypsometric equation, integrated up from the surface");
+    if (!has_geo && !L.surface_geopotential) vol.report.warn("no surface geopotential: the surface is taken at sea level");
+  } else if (L.vertical_kind == Vertical::Height) {
+    vol.report.format = "CF height levels";
+    vol.report.warn("height levels: air pressure (for air density) comes from the standard atmosphere");
+    if (L.height_above_ground && !L.surface_geopotential && !has_geo) {
+      vol.report.warn("heights are above the ground but the file has no surface altitude: taken as above sea level");
+    }
   }
   // Time steps.
   const int nt = static_cast<int>(L.times.size());
@@ -461,7 +540,7 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
   if (S->steps.empty()) throw ImportError(path + ": no time step in the requested range (the file has " + std::to_string(nt) + ")");
   for (int t : S->steps) vol.times.push_back(L.times[static_cast<std::size_t>(t)]);
   if (L.times_uneven) vol.report.warn("time steps are unevenly spaced");
-  if (!L.roles[static_cast<int>(Role::Geopotential)] && !L.roles[static_cast<int>(Role::GeopotentialHeight)]) {
+  if (!has_geo && L.vertical_kind == Vertical::Pressure) {
     vol.report.warn("no geopotential: level heights come from the standard atmosphere (errors of a few hundred metres)");
   }
   if (!L.roles[static_cast<int>(Role::Temperature)]) vol.report.warn("no temperature: the standard atmosphere's is used");
@@ -494,11 +573,32 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
         }
       }
     } else {
+      // Height levels are their own heights; pressure and hybrid levels take the standard
+      // atmosphere's height of their (reference) pressure, with a margin for hybrid columns.
+      double surface_min = 0.0, surface_max = 0.0;
+      if (L.surface_geopotential && (L.vertical_kind == Vertical::Hybrid || L.height_above_ground)) {
+        const Slab sg = read_slab(*S, *L.surface_geopotential, S->steps.front(), nullptr, true);
+        surface_min = 1e30, surface_max = -1e30;
+        for (double v : sg.d) {
+          if (std::isnan(v)) continue;
+          const double h = L.surface_geopotential_scale != 1.0 ? v : physics::f64::geopotential_to_height_m(v, vol.grid.earth_radius_m);
+          surface_min = std::min(surface_min, h);
+          surface_max = std::max(surface_max, h);
+        }
+      }
       for (std::size_t l = 0; l < S->levels.size(); ++l) {
-        const double zz = isa_altitude_m(S->level_pa[l]);
-        zmin = std::min(zmin, zz);
-        zmax = std::max(zmax, zz);
-        if (l) thick.push_back(zz - isa_altitude_m(S->level_pa[l - 1]));
+        const double zz = L.vertical_kind == Vertical::Height ? S->level_z[l] : isa_altitude_m(S->level_pa[l]);
+        const double prev = l == 0 ? zz : L.vertical_kind == Vertical::Height ? S->level_z[l - 1] : isa_altitude_m(S->level_pa[l - 1]);
+        // Heights above ground sit on the surface; the other kinds' heights are already altitudes.
+        const bool agl = L.vertical_kind == Vertical::Height && L.height_above_ground;
+        zmin = std::min(zmin, zz + (agl ? surface_min : 0.0));
+        zmax = std::max(zmax, zz + (agl ? surface_max : 0.0));
+        if (l) thick.push_back(zz - prev);
+      }
+      if (L.vertical_kind == Vertical::Hybrid) {
+        zmin = std::min(zmin, surface_min);
+        zmax += 0.05 * (zmax - zmin);
+        vol.report.notes.push_back("altitude range from the standard atmosphere of the hybrid levels, with a 5 % margin");
       }
     }
     if (!(zmax > zmin)) throw ImportError(path + ": the levels' heights span no altitude range");

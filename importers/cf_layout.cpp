@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <regex>
 
 namespace cv::importers {
 namespace {
@@ -128,11 +129,62 @@ CfLayout detect_cf_layout(const NcFile& f) {
   if (!L.vertical.var) {
     throw ImportError(path + ": no vertical coordinate (expected pressure levels in Pa/hPa/mb, or standard_name air_pressure)");
   }
-  L.pressure_scale_to_pa = pressure_scale(L.vertical.var->text("units"));
-  if (L.pressure_scale_to_pa == 0.0) {
-    throw ImportError(path + ": vertical coordinate '" + L.vertical.var->name + "' has units '" +
-                      L.vertical.var->text("units") +
-                      "'; this reader handles pressure levels (Pa, hPa, mb, millibars); WRF files have their own reader");
+  const NcVar& zv = *L.vertical.var;
+  const std::string vunits = lower(zv.text("units"));
+  const std::string vsn = lower(zv.text("standard_name"));
+  L.pressure_scale_to_pa = pressure_scale(vunits);
+  if (vsn == "atmosphere_hybrid_sigma_pressure_coordinate") {
+    // formula_terms: "a: A b: B p0: P0 ps: PS" or "ap: AP b: B ps: PS".
+    L.vertical_kind = Vertical::Hybrid;
+    const std::string ft = zv.text("formula_terms");
+    auto term = [&](const std::string& key) -> const NcVar* {
+      const std::regex re("(^|\\s)" + key + ":\\s*([^\\s]+)");
+      std::smatch m;
+      if (!std::regex_search(ft, m, re)) return nullptr;
+      const NcVar* v = f.find(m[2]);
+      if (!v) throw ImportError(path + ": formula_terms of '" + zv.name + "' name '" + m[2].str() + "', which is not in the file");
+      return v;
+    };
+    const NcVar* a = term("a");
+    const NcVar* ap = term("ap");
+    const NcVar* b = term("b");
+    const NcVar* p0 = term("p0");
+    L.surface_pressure = term("ps");
+    if ((!a && !ap) || !b || !L.surface_pressure || (a && !p0)) {
+      throw ImportError(path + ": hybrid coordinate '" + zv.name + "' has formula_terms '" + ft +
+                        "', expected 'a: A b: B p0: P0 ps: PS' or 'ap: AP b: B ps: PS'");
+    }
+    const double p0v = a ? f.read(*p0).at(0) : 1.0;
+    const std::vector<double> av = f.read(a ? *a : *ap), bv = f.read(*b);
+    if (av.size() != L.vertical.values.size() || bv.size() != L.vertical.values.size()) {
+      throw ImportError(path + ": hybrid coefficients of '" + zv.name + "' do not have one value per level");
+    }
+    const double ascale = a ? p0v : std::max(1.0, pressure_scale((ap)->text("units")));
+    for (std::size_t k = 0; k < av.size(); ++k) {
+      L.hybrid_a_pa.push_back(av[k] * ascale);
+      L.hybrid_b.push_back(bv[k]);
+    }
+  } else if (L.pressure_scale_to_pa == 0.0) {
+    const double hs = in(vunits, {"m", "meter", "meters", "metre", "metres"}) ? 1.0 : in(vunits, {"km", "kilometer", "kilometers", "kilometre", "kilometres"}) ? 1000.0 : 0.0;
+    if (hs == 0.0 || lower(zv.text("positive")) == "down") {
+      throw ImportError(path + ": vertical coordinate '" + zv.name + "' has units '" + zv.text("units") +
+                        "' (standard_name '" + zv.text("standard_name") +
+                        "'); expected pressure levels (Pa, hPa, mb), heights (m, km, positive up) or hybrid "
+                        "sigma-pressure levels with formula_terms; model-level numbers need their coefficients");
+    }
+    L.vertical_kind = Vertical::Height;
+    L.height_scale_to_m = hs;
+    L.height_above_ground = vsn == "height";
+  }
+  // Surface geopotential (or altitude) for heights above ground and hybrid levels.
+  for (const auto& v : f.vars()) {
+    const std::string sn = lower(v.text("standard_name"));
+    if (v.dims.size() < 2 || v.dims.size() > 3) continue;
+    if (sn == "surface_geopotential" && !L.surface_geopotential) L.surface_geopotential = &v;
+    if (sn == "surface_altitude" && !L.surface_geopotential) {
+      L.surface_geopotential = &v;
+      L.surface_geopotential_scale = 9.80665;
+    }
   }
   // Roles: standard_name first, then the known short and long names.
   for (const RoleSpec& spec : kRoles) {
@@ -146,6 +198,7 @@ CfLayout detect_cf_layout(const NcFile& f) {
       if (!found) found = f.find(n);
     }
     if (found && found->dims.size() < 3) found = nullptr;  // a 2-D field of that name is not the 3-D one
+    if (found && found == L.surface_geopotential) found = nullptr;
     L.roles[static_cast<int>(spec.role)] = found;
   }
   // Time: a time dimension without a coordinate variable still orders the steps.

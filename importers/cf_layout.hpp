@@ -13,6 +13,9 @@ namespace cv::importers {
 
 enum class Role { CloudFraction, Liquid, Ice, Geopotential, GeopotentialHeight, Temperature, Humidity, U, V, Omega };
 inline constexpr int kRoleCount = 10;
+
+// The kinds of vertical coordinate the CF reader understands.
+enum class Vertical { Pressure, Height, Hybrid };
 const char* role_name(Role r);
 
 struct Axis {
@@ -24,7 +27,15 @@ struct Axis {
 
 struct CfLayout {
   Axis lon, lat, vertical, time;
-  double pressure_scale_to_pa = 0.0;  // 0 when the vertical axis is not pressure
+  Vertical vertical_kind = Vertical::Pressure;
+  double pressure_scale_to_pa = 0.0;  // pressure levels: file unit -> Pa
+  double height_scale_to_m = 0.0;     // height levels: file unit -> m
+  bool height_above_ground = false;   // standard_name "height" (above the surface), not "altitude"
+  // Hybrid sigma-pressure levels: p_k = a_pa[k] + b[k] ps (a_pa is a k p0, or ap k), file order.
+  std::vector<double> hybrid_a_pa, hybrid_b;
+  const NcVar* surface_pressure = nullptr;     // 2-D (or with time): Pa
+  const NcVar* surface_geopotential = nullptr; // 2-D (or with time): m2/s2, or surface altitude in m
+  double surface_geopotential_scale = 1.0;     // 9.80665 when the variable is an altitude in m
   std::vector<core::ValidTime> times;
   bool times_uneven = false;
   const NcVar* roles[kRoleCount] = {};

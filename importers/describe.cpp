@@ -6,6 +6,13 @@
 #include "wrf_import.hpp"
 
 namespace cv::importers {
+namespace {
+std::string fmt(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
+}  // namespace
 
 std::string describe_file(const std::string& path) {
   NcFile f(path);
@@ -24,7 +31,14 @@ std::string describe_file(const std::string& path) {
   axis("longitude", L.lon);
   axis("latitude", L.lat);
   axis("vertical", L.vertical);
-  line("  (pressure, " + L.vertical.var->text("units") + " -> Pa x " + std::to_string(L.pressure_scale_to_pa) + ")");
+  if (L.vertical_kind == Vertical::Pressure) {
+    line("  (pressure levels, " + L.vertical.var->text("units") + " -> Pa x " + fmt(L.pressure_scale_to_pa) + ")");
+  } else if (L.vertical_kind == Vertical::Height) {
+    line(std::string("  (height levels ") + (L.height_above_ground ? "above the ground" : "above sea level") + ", " +
+         L.vertical.var->text("units") + ")");
+  } else {
+    line("  (hybrid sigma-pressure levels, formula_terms '" + L.vertical.var->text("formula_terms") + "')");
+  }
   axis("time", L.time);
   if (!L.times.empty()) {
     line("times: " + std::to_string(L.times.size()) + ", " + L.times.front().iso_utc + " to " + L.times.back().iso_utc +
