@@ -163,13 +163,17 @@ std::optional<double> NcFile::global_number(const std::string& name) const {
   return std::nullopt;
 }
 
+void NcFile::whole_if_empty(const NcVar& v, std::vector<std::size_t>& start, std::vector<std::size_t>& count) const {
+  if (start.empty()) start.assign(v.dims.size(), 0);
+  if (count.empty()) {
+    for (std::size_t i = 0; i < v.dims.size(); ++i) count.push_back(dim_length(v, i));
+  }
+}
+
 std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start, std::vector<std::size_t> count,
                                  UnpackInfo* info) const {
   const std::size_t nd = v.dims.size();
-  if (start.empty()) start.assign(nd, 0);
-  if (count.empty()) {
-    for (std::size_t i = 0; i < nd; ++i) count.push_back(dim_length(v, i));
-  }
+  whole_if_empty(v, start, count);
   if (start.size() != nd || count.size() != nd) {
     throw ImportError(path_ + ": variable '" + v.name + "': read with " + std::to_string(start.size()) +
                       " indices, expected " + std::to_string(nd));
@@ -249,10 +253,7 @@ std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start,
 std::vector<float> NcFile::read_float(const NcVar& v, std::vector<std::size_t> start, std::vector<std::size_t> count,
                                       UnpackInfo* info) const {
   const std::size_t nd = v.dims.size();
-  if (start.empty()) start.assign(nd, 0);
-  if (count.empty()) {
-    for (std::size_t i = 0; i < nd; ++i) count.push_back(dim_length(v, i));
-  }
+  whole_if_empty(v, start, count);
   // Split along the first axis with more than one index; each chunk goes through read().
   std::size_t axis = 0;
   while (axis + 1 < nd && count[axis] == 1) ++axis;

@@ -79,6 +79,8 @@ class NcFile {
 
  private:
   [[noreturn]] void fail(int status, const std::string& what) const;
+  // An empty start means all zeros, an empty count the whole extent.
+  void whole_if_empty(const NcVar& v, std::vector<std::size_t>& start, std::vector<std::size_t>& count) const;
   std::string path_;
   int id_ = -1;
   long long file_bytes_ = 0;

@@ -1,6 +1,21 @@
 // Ray/sphere and ray/spherical-shell intersection on a spherical Earth, free of cancellation.
 // Distances in metres. A miss returns false and leaves t0 > t1.
 
+// Both roots of t^2 + 2 b t + c = 0 given sqrt of its discriminant: the far one as
+// q = -(b + sign(b) sqrt(disc)) and the near one as c / q, never a difference of near-equal terms.
+CV_FN void sphere_roots(real b, real c, real sqrt_disc, CV_OUT(real) t0, CV_OUT(real) t1) {
+  real q = -(b + (b >= real(0) ? sqrt_disc : -sqrt_disc));
+  if (q == real(0)) {  // ray tangent at its own origin
+    t0 = real(0);
+    t1 = real(0);
+    return;
+  }
+  real ta = q;
+  real tb = c / q;
+  t0 = min(ta, tb);
+  t1 = max(ta, tb);
+}
+
 // General form for a ray o + t d (|d| = 1) and a sphere of radius r_m about the origin
 // (Ray Tracing Gems ch. 7): the discriminant comes from the squared distance of the centre to the
 // ray line rather than from b^2 - c, and the near root is c / q, never a difference.
@@ -12,17 +27,7 @@ CV_FN bool ray_sphere(real3 o, real3 d, real r_m, CV_OUT(real) t0, CV_OUT(real) 
   real disc = (r_m - l) * (r_m + l);
   if (disc < real(0)) return false;
   real lo = length(o);
-  real c = (lo - r_m) * (lo + r_m);
-  real q = -(b + (b >= real(0) ? sqrt(disc) : -sqrt(disc)));
-  if (q == real(0)) {
-    t0 = real(0);
-    t1 = real(0);
-    return true;
-  }
-  real ta = q;
-  real tb = c / q;
-  t0 = min(ta, tb);
-  t1 = max(ta, tb);
+  sphere_roots(b, (lo - r_m) * (lo + r_m), sqrt(disc), t0, t1);
   return true;
 }
 
@@ -52,17 +57,7 @@ CV_FN bool ray_sphere_rel(real r0_m, real h_m, real mu, real hs_m, CV_OUT(real) 
   real2 dd = two_sum(bb.x, -cp.x);
   precise real disc = dd.x + (dd.y + (bb_lo - c_lo));
   if (disc < real(0)) return false;
-  real c = cp.x + c_lo;
-  real q = -(b.x + (b.x >= real(0) ? sqrt(disc) : -sqrt(disc)));
-  if (q == real(0)) {
-    t0 = real(0);
-    t1 = real(0);
-    return true;
-  }
-  real ta = q;
-  real tb = c / q;
-  t0 = min(ta, tb);
-  t1 = max(ta, tb);
+  sphere_roots(b.x, cp.x + c_lo, sqrt(disc), t0, t1);
   return true;
 }
 

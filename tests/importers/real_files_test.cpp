@@ -9,23 +9,11 @@
 #include <string>
 
 #include "importer.hpp"
+#include "support/real_data.hpp"
 #include "nc_file.hpp"
 
 namespace {
 using namespace cv;
-
-std::string real(const std::string& name) {
-  const std::string p = std::string(CV_REAL_DATA_DIR) + "/" + name;
-  if (!std::filesystem::exists(p)) {
-    const char* ci = std::getenv("CI");
-    if (ci && std::string(ci) == "true") ADD_FAILURE() << p << " is missing under CI";
-    return "";
-  }
-  return p;
-}
-#define REAL_FILE(var, name)                                                   \
-  const std::string var = real(name);                                          \
-  if (var.empty()) GTEST_SKIP() << name << " not found beside the checkout";
 
 TEST(RealFiles, Era5PackedValueAgainstTheUnpackedNumberByHand) {
   REAL_FILE(path, "met-era5-cocip1.nc");

@@ -6,24 +6,12 @@
 #include <filesystem>
 
 #include "importer.hpp"
+#include "support/real_data.hpp"
 #include "nc_file.hpp"
 #include "wrf_import.hpp"
 
 namespace {
 using namespace cv;
-
-std::string real(const std::string& name) {
-  const std::string p = std::string(CV_REAL_DATA_DIR) + "/" + name;
-  if (!std::filesystem::exists(p)) {
-    const char* ci = std::getenv("CI");
-    if (ci && std::string(ci) == "true") ADD_FAILURE() << p << " is missing under CI";
-    return "";
-  }
-  return p;
-}
-#define REAL_FILE(var, name)                                                   \
-  const std::string var = real(name);                                          \
-  if (var.empty()) GTEST_SKIP() << name << " not found beside the checkout";
 
 // WRF's heights: geopotential over its own constant g.
 double wrf_height(double phi) { return phi / 9.81; }
