@@ -3,9 +3,12 @@
 // the consistency checks of the import report.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <memory>
+#include <exception>
 #include <numeric>
+#include <thread>
 
 #include "cf_layout.hpp"
 #include "column.hpp"
@@ -223,15 +226,17 @@ struct Era5Source {
   std::vector<double> hyb_a, hyb_b;   // hybrid levels: p = a + b ps
   std::vector<int> steps;             // source time indices, in output order
   ImportOptions options;
+  // Per-step input slabs, kept between steps so their memory is reused (loads are sequential).
+  mutable std::vector<Slab> scratch = std::vector<Slab>(kRoleCount);
 };
 
 namespace {
 
-Slab read_slab(const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* info, bool as_double) {
+// Reads into `s`, reusing its memory.
+void read_slab_into(Slab& s, const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* info, bool as_double) {
   const NcFile& f = *S.file;
   const CfLayout& L = S.layout;
   std::vector<std::size_t> start(v.dims.size(), 0), count(v.dims.size(), 0);
-  Slab s;
   std::size_t stride = 1;
   for (int a = static_cast<int>(v.dims.size()) - 1; a >= 0; --a) {
     const int d = v.dims[static_cast<std::size_t>(a)];
@@ -248,27 +253,45 @@ Slab read_slab(const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* 
     stride *= c;
   }
   if (as_double) {
+    s.f.clear();
     s.d = f.read(v, start, count, info);
   } else {
-    s.f = f.read_float(v, start, count, info);
+    s.d.clear();
+    f.read_float_into(s.f, v, start, count, info);
   }
+}
+
+Slab read_slab(const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* info, bool as_double) {
+  Slab s;
+  read_slab_into(s, S, v, time_index, info, as_double);
   return s;
 }
 
 }  // namespace
 
-core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size_t step,
-                                  core::ImportReport& report) {
+// What one conversion worker owns: a row of level samples, the running state of the hypsometric
+// integration up each column, its consistency counts, and the error that stopped it, if any.
+struct RowWork {
+  std::vector<LevelSample> row;
+  std::vector<double> z_prev, p_prev, tv_prev;
+  std::size_t negative_water = 0, clamped_cf = 0;
+  double worst_negative = 0.0;
+  ColumnCounts counts;
+  std::exception_ptr error;
+};
+
+void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size_t step, core::ImportReport& report,
+                    core::TimeStepData& out) {
   const CfLayout& L = S.layout;
   const std::string& path = S.file->path();
   const int t = S.steps[step];
-  Slab slab[kRoleCount];
+  std::vector<Slab>& slab = S.scratch;
   bool have[kRoleCount] = {};
   for (int r = 0; r < kRoleCount; ++r) {
     if (!L.roles[r]) continue;
     UnpackInfo info;
     const bool heights = static_cast<Role>(r) == Role::Geopotential || static_cast<Role>(r) == Role::GeopotentialHeight;
-    slab[r] = read_slab(S, *L.roles[r], t, &info, heights);
+    read_slab_into(slab[static_cast<std::size_t>(r)], S, *L.roles[r], t, &info, heights);
     have[r] = true;
     auto& use = report.use(role_name(static_cast<Role>(r)));
     use.variable = L.roles[r]->name;
@@ -287,14 +310,12 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
     const double a = sl.at(i, j0, 0), b = sl.at(i, j1, 0);
     return w == 0.0 ? a : w == 1.0 ? b : (1.0 - w) * a + w * b;
   };
-  // Hypsometric integration up each column of the row (hybrid levels without geopotential).
   const std::size_t row_len = static_cast<std::size_t>(grid.lon_deg.count);
-  std::vector<double> z_prev(row_len), p_prev(row_len), tv_prev(row_len);
   const int nx = grid.lon_deg.count, ny = grid.lat_deg.count;
-  core::TimeStepData out;
   const bool has_cf = have[static_cast<int>(Role::CloudFraction)];
   auto alloc = [&](core::Field f, bool on) {
     if (on) out[f].assign(grid.points(), std::numeric_limits<float>::quiet_NaN());
+    else out[f].clear();
   };
   alloc(core::Field::ExtinctionLiquid, have[static_cast<int>(Role::Liquid)]);
   alloc(core::Field::ExtinctionIce, have[static_cast<int>(Role::Ice)]);
@@ -304,13 +325,9 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
   alloc(core::Field::WindW, have[static_cast<int>(Role::Omega)]);
   alloc(core::Field::Temperature, true);
 
-  std::size_t negative_water = 0, clamped_cf = 0;
-  double worst_negative = 0.0;
-  ColumnCounts counts;
   ConversionOptions conv{S.options.r_eff_liquid_um, S.options.r_eff_ice_um};
   // A latitude row at a time, levels outer and longitudes inner: the slabs are read along their
   // contiguous axis (a column's levels lie megabytes apart in a global file).
-  std::vector<LevelSample> row(static_cast<std::size_t>(nx) * static_cast<std::size_t>(nlev));
   auto value = [&](Role r, int i, int j0, int j1, double w, int k) {
     const Slab& s = slab[static_cast<int>(r)];
     const double a = s.at(i, j0, k), b = s.at(i, j1, k);
@@ -321,14 +338,16 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
                       " at time step " + std::to_string(t) + ", expected " + expected);
   };
   auto has = [&](Role r) { return have[static_cast<int>(r)]; };
-  for (int y = 0; y < ny; ++y) {
+  // Rows are independent: workers take every n-th row, each with its own buffers and counts; an
+  // error in any row stops the step with that row's message.
+  auto do_row = [&](int y, RowWork& W) {
     const int j0 = S.lat.j0[static_cast<std::size_t>(y)], j1 = S.lat.j1[static_cast<std::size_t>(y)];
     const double w = S.lat.w[static_cast<std::size_t>(y)];
     for (int l = 0; l < nlev; ++l) {
       const int k = S.levels[static_cast<std::size_t>(l)];
       for (int x = 0; x < nx; ++x) {
         const int i = S.lon.src[static_cast<std::size_t>(x)];
-        LevelSample& c = row[static_cast<std::size_t>(x) * static_cast<std::size_t>(nlev) + static_cast<std::size_t>(l)];
+        LevelSample& c = W.row[static_cast<std::size_t>(x) * static_cast<std::size_t>(nlev) + static_cast<std::size_t>(l)];
         c = LevelSample{};
         const std::size_t L_ = static_cast<std::size_t>(l), X_ = static_cast<std::size_t>(x);
         // The surface where the file gives it: as a geopotential height (hypsometric start) and as a
@@ -360,8 +379,8 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
           // Hypsometric equation from the surface: dZ = R_d T_v / g0 d(ln p), in geopotential metres.
           const double tv = t_read * (1.0 + 0.608 * c.qv);
           const double zgp = l == 0 ? zsurf + kRd * tv / kG0 * std::log(surf(ps, i, j0, j1, w) / c.p_pa)
-                                    : z_prev[X_] + kRd * 0.5 * (tv + tv_prev[X_]) / kG0 * std::log(p_prev[X_] / c.p_pa);
-          z_prev[X_] = zgp, p_prev[X_] = c.p_pa, tv_prev[X_] = tv;
+                                    : W.z_prev[X_] + kRd * 0.5 * (tv + W.tv_prev[X_]) / kG0 * std::log(W.p_prev[X_] / c.p_pa);
+          W.z_prev[X_] = zgp, W.p_prev[X_] = c.p_pa, W.tv_prev[X_] = tv;
           c.z_m = physics::f64::geopotential_to_height_m(kG0 * zgp, grid.earth_radius_m);
         } else {
           c.z_m = isa_altitude_m(c.p_pa);
@@ -378,7 +397,7 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
           if (!std::isnan(c.cf)) {
             if (c.cf < -0.01 || c.cf > 1.01) bad(Role::CloudFraction, c.cf, "a fraction between 0 and 1");
             if (c.cf < 0.0 || c.cf > 1.0) {
-              ++clamped_cf;
+              ++W.clamped_cf;
               c.cf = std::clamp(c.cf, 0.0, 1.0);
             }
           }
@@ -391,8 +410,8 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
           if (std::isnan(qw)) continue;
           if (qw < -1e-5 || qw > 0.05) bad(water_role[ph], qw, "a mixing ratio between 0 and 0.05 kg/kg");
           if (qw < 0.0) {
-            ++negative_water;
-            worst_negative = std::min(worst_negative, qw);
+            ++W.negative_water;
+            W.worst_negative = std::min(W.worst_negative, qw);
             qw = 0.0;
           }
           *water[ph] = qw;
@@ -407,10 +426,43 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
       }
     }
     for (int x = 0; x < nx; ++x) {
-      place_column(std::span<LevelSample>(row).subspan(static_cast<std::size_t>(x) * static_cast<std::size_t>(nlev),
+      place_column(std::span<LevelSample>(W.row).subspan(static_cast<std::size_t>(x) * static_cast<std::size_t>(nlev),
                                                        static_cast<std::size_t>(nlev)),
-                   grid, x, y, conv, out, counts);
+                   grid, x, y, conv, out, W.counts);
     }
+    };
+  unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  if (const char* env = std::getenv("CLOUDVIEWER_THREADS"); env && std::atoi(env) > 0) hw = static_cast<unsigned>(std::atoi(env));
+  const int workers = static_cast<int>(std::min<unsigned>(std::min(hw, 8u), static_cast<unsigned>(std::max(1, ny / 4))));
+  std::vector<RowWork> work(static_cast<std::size_t>(workers));
+  for (auto& W : work) {
+    W.row.resize(static_cast<std::size_t>(nx) * static_cast<std::size_t>(nlev));
+    W.z_prev.resize(row_len), W.p_prev.resize(row_len), W.tv_prev.resize(row_len);
+  }
+  auto run = [&](int wid) {
+    RowWork& W = work[static_cast<std::size_t>(wid)];
+    try {
+      for (int y = wid; y < ny; y += workers) do_row(y, W);
+    } catch (...) {
+      W.error = std::current_exception();
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int wid = 1; wid < workers; ++wid) threads.emplace_back(run, wid);
+  run(0);
+  for (auto& th : threads) th.join();
+  std::size_t negative_water = 0, clamped_cf = 0;
+  double worst_negative = 0.0;
+  ColumnCounts counts;
+  for (auto& W : work) {
+    if (W.error) std::rethrow_exception(W.error);
+    negative_water += W.negative_water;
+    clamped_cf += W.clamped_cf;
+    worst_negative = std::min(worst_negative, W.worst_negative);
+    counts.water_without_cf += W.counts.water_without_cf;
+    counts.cf_without_water += W.counts.cf_without_water;
+    counts.nonmonotonic += W.counts.nonmonotonic;
+    counts.most_water_without_cf = std::max(counts.most_water_without_cf, W.counts.most_water_without_cf);
   }
   // Report: SI ranges, conversions, consistency.
   const double r_l = S.options.r_eff_liquid_um;
@@ -446,7 +498,6 @@ core::TimeStepData load_era5_step(const Era5Source& S, const core::VolumeGrid& g
                 " kg/kg) set to 0 at time step " + std::to_string(t));
   }
   report_counts(counts, t, report);
-  return out;
 }
 
 core::CloudVolume import_file(const std::string& path, const ImportOptions& options) {
@@ -628,8 +679,9 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
     vol.report.notes.push_back("no cloud fraction: water is taken as covering whole grid boxes");
   }
   const core::VolumeGrid grid = vol.grid;
-  vol.set_loader([S, grid](std::size_t step, core::ImportReport& report) { return load_era5_step(*S, grid, step, report); },
-                 options.cache_steps);
+  vol.set_loader([S, grid](std::size_t step, core::ImportReport& report, core::TimeStepData& out) {
+    load_era5_step(*S, grid, step, report, out);
+  }, options.cache_steps);
   return vol;
 }
 

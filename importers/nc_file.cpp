@@ -252,12 +252,19 @@ std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start,
 
 std::vector<float> NcFile::read_float(const NcVar& v, std::vector<std::size_t> start, std::vector<std::size_t> count,
                                       UnpackInfo* info) const {
+  std::vector<float> out;
+  read_float_into(out, v, std::move(start), std::move(count), info);
+  return out;
+}
+
+void NcFile::read_float_into(std::vector<float>& out, const NcVar& v, std::vector<std::size_t> start,
+                             std::vector<std::size_t> count, UnpackInfo* info) const {
   const std::size_t nd = v.dims.size();
   whole_if_empty(v, start, count);
   // Split along the first axis with more than one index; each chunk goes through read().
   std::size_t axis = 0;
   while (axis + 1 < nd && count[axis] == 1) ++axis;
-  std::vector<float> out;
+  out.clear();
   UnpackInfo total;
   const std::size_t chunks = nd ? count[axis] : 1;
   for (std::size_t c = 0; c < chunks; ++c) {
@@ -274,7 +281,6 @@ std::vector<float> NcFile::read_float(const NcVar& v, std::vector<std::size_t> s
     total.missing += part.missing;
   }
   if (info) *info = total;
-  return out;
 }
 
 std::vector<std::string> NcFile::read_strings(const NcVar& v) const {

@@ -71,6 +71,9 @@ class NcFile {
   // double (half the memory of read()).
   std::vector<float> read_float(const NcVar& v, std::vector<std::size_t> start = {}, std::vector<std::size_t> count = {},
                                 UnpackInfo* info = nullptr) const;
+  // The same into `out`, reusing its memory.
+  void read_float_into(std::vector<float>& out, const NcVar& v, std::vector<std::size_t> start,
+                       std::vector<std::size_t> count, UnpackInfo* info = nullptr) const;
   // A text variable (e.g. WRF's Times) as one string per leading index.
   std::vector<std::string> read_strings(const NcVar& v) const;
 

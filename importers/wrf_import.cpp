@@ -181,8 +181,8 @@ std::pair<double, double> wrf_rotation_from_projection(const NcFile& f, double l
   return {std::cos(-gamma * kDeg), std::sin(-gamma * kDeg)};
 }
 
-core::TimeStepData load_wrf_step(const WrfSource& S, const core::VolumeGrid& grid, std::size_t step,
-                                 core::ImportReport& report) {
+void load_wrf_step(const WrfSource& S, const core::VolumeGrid& grid, std::size_t step, core::ImportReport& report,
+                   core::TimeStepData& out) {
   const int t = S.steps[step];
   const std::string& path = S.file->path();
   const Field3 ph = read3(S, "PH", t, true), phb = read3(S, "PHB", t, true);
@@ -214,9 +214,9 @@ core::TimeStepData load_wrf_step(const WrfSource& S, const core::VolumeGrid& gri
     if (f->nz != S.nz + 1) throw ImportError(path + ": PH/PHB have " + std::to_string(f->nz) + " levels, expected " + std::to_string(S.nz + 1));
   }
 
-  core::TimeStepData out;
   auto alloc = [&](core::Field fld, bool on) {
     if (on) out[fld].assign(grid.points(), std::numeric_limits<float>::quiet_NaN());
+    else out[fld].clear();
   };
   alloc(core::Field::ExtinctionLiquid, qc.present);
   alloc(core::Field::ExtinctionIce, qi.present || qs.present);
@@ -293,7 +293,6 @@ core::TimeStepData load_wrf_step(const WrfSource& S, const core::VolumeGrid& gri
   if (u.present && v.present) after("grid-relative u", core::Field::WindU), after("grid-relative v", core::Field::WindV);
   if (w.present) after("vertical wind", core::Field::WindW);
   after("potential temperature perturbation", core::Field::Temperature);
-  return out;
 }
 
 core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& options) {
@@ -468,8 +467,9 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
   if (f.find("QRAIN") || f.find("QGRAUP")) vol.report.notes.push_back("QRAIN and QGRAUP (precipitation) are not part of the cloud volume");
   if (cosa) vol.report.notes.push_back("winds rotated to earth-relative with COSALPHA/SINALPHA");
   const core::VolumeGrid grid = vol.grid;
-  vol.set_loader([S, grid](std::size_t step, core::ImportReport& report) { return load_wrf_step(*S, grid, step, report); },
-                 options.cache_steps);
+  vol.set_loader([S, grid](std::size_t step, core::ImportReport& report, core::TimeStepData& out) {
+    load_wrf_step(*S, grid, step, report, out);
+  }, options.cache_steps);
   return vol;
 }
 

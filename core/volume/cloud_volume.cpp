@@ -121,12 +121,16 @@ const TimeStepData& CloudVolume::step(std::size_t index) {
     return it->second;
   }
   if (!loader_) throw std::logic_error("time step " + std::to_string(index) + " is not loaded and no loader is set");
-  // Evict before loading so peak memory holds at most cache_steps steps.
+  // Evict before loading so peak memory holds at most cache_steps steps; keep the evicted arrays.
   while (cache_.size() >= cache_steps_) {
-    cache_.erase(lru_.back());
+    auto it = cache_.find(lru_.back());
+    spare_ = std::move(it->second);
+    cache_.erase(it);
     lru_.pop_back();
   }
-  TimeStepData data = loader_(index, report);
+  TimeStepData data = std::move(spare_);
+  spare_ = TimeStepData{};
+  loader_(index, report, data);
   derive_maps(grid, data);
   lru_.push_front(index);
   return cache_.emplace(index, std::move(data)).first->second;

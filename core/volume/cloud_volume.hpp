@@ -100,7 +100,10 @@ struct ValidTime {
 // at most `cache_steps` stay in memory.
 class CloudVolume {
  public:
-  using Loader = std::function<TimeStepData(std::size_t step, ImportReport& report)>;
+  // Fills `out` with a step's fields. `out` may arrive holding an evicted step's arrays, so their
+  // memory is reused (a global step is gigabytes: fresh pages cost more than the conversion); the
+  // loader must assign every field it provides and clear() the others.
+  using Loader = std::function<void(std::size_t step, ImportReport& report, TimeStepData& out)>;
 
   VolumeGrid grid;
   std::vector<ValidTime> times;
@@ -121,6 +124,7 @@ class CloudVolume {
   std::map<std::size_t, TimeStepData> pinned_;
   std::map<std::size_t, TimeStepData> cache_;
   std::list<std::size_t> lru_;  // most recent first
+  TimeStepData spare_;           // the last evicted step's arrays, for reuse
 };
 
 }  // namespace cv::core

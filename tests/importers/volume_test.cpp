@@ -66,11 +66,9 @@ TEST(Volume, CacheLoadsOnDemandAndEvictsTheLeastRecentlyUsed) {
   v.times.resize(4);
   int loads = 0;
   v.set_loader(
-      [&](std::size_t t, ImportReport&) {
+      [&](std::size_t t, ImportReport&, TimeStepData& d) {
         ++loads;
-        TimeStepData d;
         d[Field::CloudFraction].assign(2, static_cast<float>(t) / 10.0f);
-        return d;
       },
       2);
   EXPECT_EQ(v.step(0)[Field::CloudFraction][0], 0.0f);
@@ -90,11 +88,7 @@ TEST(VolumeIo, CvvolHeaderAndPayloadAndVti) {
   v.grid = column_grid(3);
   v.times = {{0, "1970-01-01T00:00:00Z"}, {3600, "1970-01-01T01:00:00Z"}};
   v.has_field[static_cast<int>(Field::CloudFraction)] = true;
-  v.set_loader([](std::size_t t, ImportReport&) {
-    TimeStepData d;
-    d[Field::CloudFraction] = {0.1f * static_cast<float>(t), 0.5f, NAN};
-    return d;
-  });
+  v.set_loader([](std::size_t t, ImportReport&, TimeStepData& d) { d[Field::CloudFraction] = {0.1f * static_cast<float>(t), 0.5f, NAN}; });
   const std::string path = (dir / "v.cvvol").string();
   write_cvvol(path, v);
   std::ifstream in(path, std::ios::binary);
