@@ -164,6 +164,9 @@ LatMap map_latitudes(const std::vector<double>& raw, const std::optional<Region>
     hi = lat.front() + std::floor((hi - lat.front()) / step0 + 1e-9) * step0;
   }
   const int count = static_cast<int>(std::floor((hi - lo) / (step0 * stride) + 1e-9)) + 1;
+  if (hi < lo || count < 1) {
+    throw ImportError(where + ": the region's latitudes fall between two grid rows; expected at least one row");
+  }
   LatMap out;
   out.axis = {lo, step0 * stride, count};
   for (int r = 0; r < count; ++r) {
@@ -189,8 +192,10 @@ struct Slab {
   std::vector<float> f;
   std::vector<double> d;
   std::size_t s_lon = 0, s_lat = 0, s_lev = 0;
+  int i_off = 0, j_off = 0, k_off = 0;  // the read starts here in the file's index space
   double at(int i, int j, int k) const {
-    const std::size_t n = i * s_lon + j * s_lat + k * s_lev;
+    const std::size_t n = static_cast<std::size_t>(i - i_off) * s_lon + static_cast<std::size_t>(j - j_off) * s_lat +
+                          (s_lev ? static_cast<std::size_t>(k - k_off) * s_lev : 0);
     return d.empty() ? f[n] : d[n];
   }
 };
@@ -226,6 +231,9 @@ struct Era5Source {
   std::vector<double> hyb_a, hyb_b;   // hybrid levels: p = a + b ps
   std::vector<int> steps;             // source time indices, in output order
   ImportOptions options;
+  // The index ranges of the file that the region, stride and levels need (inclusive): reads cover
+  // only these.
+  int lon_lo = 0, lon_hi = 0, lat_lo = 0, lat_hi = 0, lev_lo = 0, lev_hi = 0;
   // Per-step input slabs, kept between steps so their memory is reused (loads are sequential).
   mutable std::vector<Slab> scratch = std::vector<Slab>(kRoleCount);
 };
@@ -241,15 +249,18 @@ void read_slab_into(Slab& s, const Era5Source& S, const NcVar& v, int time_index
   for (int a = static_cast<int>(v.dims.size()) - 1; a >= 0; --a) {
     const int d = v.dims[static_cast<std::size_t>(a)];
     const std::size_t len = f.dims()[static_cast<std::size_t>(d)].length;
-    std::size_t c = len;
-    if (d == L.time.dim) {
-      start[static_cast<std::size_t>(a)] = static_cast<std::size_t>(time_index);
-      c = 1;
-    }
+    std::size_t c = len, first = 0;
+    auto range = [&](int lo, int hi, int& off) {
+      first = static_cast<std::size_t>(lo);
+      c = static_cast<std::size_t>(hi - lo + 1);
+      off = lo;
+    };
+    if (d == L.time.dim) first = static_cast<std::size_t>(time_index), c = 1;
+    if (d == L.lon.dim) range(S.lon_lo, S.lon_hi, s.i_off), s.s_lon = stride;
+    if (d == L.lat.dim) range(S.lat_lo, S.lat_hi, s.j_off), s.s_lat = stride;
+    if (d == L.vertical.dim) range(S.lev_lo, S.lev_hi, s.k_off), s.s_lev = stride;
+    start[static_cast<std::size_t>(a)] = first;
     count[static_cast<std::size_t>(a)] = c;
-    if (d == L.lon.dim) s.s_lon = stride;
-    if (d == L.lat.dim) s.s_lat = stride;
-    if (d == L.vertical.dim) s.s_lev = stride;
     stride *= c;
   }
   if (as_double) {
@@ -307,8 +318,9 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   if (L.vertical_kind == Vertical::Hybrid) ps = read_slab(S, *L.surface_pressure, t, nullptr, true);
   if (L.surface_geopotential) zs = read_slab(S, *L.surface_geopotential, t, nullptr, true);
   auto surf = [&](const Slab& sl, int i, int j0, int j1, double w) {
-    const double a = sl.at(i, j0, 0), b = sl.at(i, j1, 0);
-    return w == 0.0 ? a : w == 1.0 ? b : (1.0 - w) * a + w * b;
+    if (w == 0.0) return sl.at(i, j0, 0);
+    if (w == 1.0) return sl.at(i, j1, 0);
+    return (1.0 - w) * sl.at(i, j0, 0) + w * sl.at(i, j1, 0);
   };
   const std::size_t row_len = static_cast<std::size_t>(grid.lon_deg.count);
   const int nx = grid.lon_deg.count, ny = grid.lat_deg.count;
@@ -322,16 +334,18 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   alloc(core::Field::CloudFraction, has_cf);
   alloc(core::Field::WindU, have[static_cast<int>(Role::U)]);
   alloc(core::Field::WindV, have[static_cast<int>(Role::V)]);
-  alloc(core::Field::WindW, have[static_cast<int>(Role::Omega)]);
+  alloc(core::Field::WindW, have[static_cast<int>(Role::Omega)] || have[static_cast<int>(Role::UpwardVelocity)]);
   alloc(core::Field::Temperature, true);
 
   ConversionOptions conv{S.options.r_eff_liquid_um, S.options.r_eff_ice_um};
   // A latitude row at a time, levels outer and longitudes inner: the slabs are read along their
   // contiguous axis (a column's levels lie megabytes apart in a global file).
   auto value = [&](Role r, int i, int j0, int j1, double w, int k) {
-    const Slab& s = slab[static_cast<int>(r)];
-    const double a = s.at(i, j0, k), b = s.at(i, j1, k);
-    return w == 0.0 ? a : w == 1.0 ? b : (1.0 - w) * a + w * b;
+    // Only rows with weight are read: the slab may hold no more than those.
+    const Slab& s = slab[static_cast<std::size_t>(r)];
+    if (w == 0.0) return s.at(i, j0, k);
+    if (w == 1.0) return s.at(i, j1, k);
+    return (1.0 - w) * s.at(i, j0, k) + w * s.at(i, j1, k);
   };
   auto bad = [&](Role r, double v, const char* expected) {
     throw ImportError(path + ": variable '" + L.roles[static_cast<int>(r)]->name + "' has value " + fmt(v) +
@@ -418,6 +432,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
         }
         if (has(Role::U)) c.u = value(Role::U, i, j0, j1, w, k);
         if (has(Role::V)) c.v = value(Role::V, i, j0, j1, w, k);
+        if (has(Role::UpwardVelocity)) c.w = value(Role::UpwardVelocity, i, j0, j1, w, k);
         // Omega (Pa/s) to w (m/s) by hydrostatics: w = -omega / (rho g).
         if (has(Role::Omega)) {
           const double rho = c.p_pa / (kRd * c.t_k * (1.0 + 0.608 * c.qv));
@@ -483,6 +498,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   after(Role::U, core::Field::WindU, "interpolated in altitude");
   after(Role::V, core::Field::WindV, "interpolated in altitude");
   after(Role::Omega, core::Field::WindW, "w = -omega / (rho g0)");
+  after(Role::UpwardVelocity, core::Field::WindW, "interpolated in altitude");
   after(Role::Temperature, core::Field::Temperature, "interpolated in altitude");
   auto used_for = [&](Role r, const std::string& what) {
     if (!have[static_cast<int>(r)]) return;
@@ -584,6 +600,18 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
       vol.report.warn("heights are above the ground but the file has no surface altitude: taken as above sea level");
     }
   }
+  // What the reads must cover: the bounding ranges of the columns, rows and levels kept.
+  S->lon_lo = *std::min_element(S->lon.src.begin(), S->lon.src.end());
+  S->lon_hi = *std::max_element(S->lon.src.begin(), S->lon.src.end());
+  S->lat_lo = std::numeric_limits<int>::max();
+  S->lat_hi = std::numeric_limits<int>::min();
+  for (std::size_t r = 0; r < S->lat.w.size(); ++r) {  // rows that carry weight
+    for (const auto& [j, used] : {std::pair{S->lat.j0[r], S->lat.w[r] < 1.0}, std::pair{S->lat.j1[r], S->lat.w[r] > 0.0}}) {
+      if (used) S->lat_lo = std::min(S->lat_lo, j), S->lat_hi = std::max(S->lat_hi, j);
+    }
+  }
+  S->lev_lo = *std::min_element(S->levels.begin(), S->levels.end());
+  S->lev_hi = *std::max_element(S->levels.begin(), S->levels.end());
   // Time steps.
   const int nt = static_cast<int>(L.times.size());
   const int last = options.time_last < 0 ? nt - 1 : std::min(options.time_last, nt - 1);
@@ -609,7 +637,9 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
         for (int x = 0; x < probe.lon_deg.count; ++x) {
           double prev = kNaN;
           for (std::size_t l = 0; l < S->levels.size(); ++l) {
-            const double raw = s.at(S->lon.src[static_cast<std::size_t>(x)], S->lat.j0[static_cast<std::size_t>(y)], S->levels[l]);
+            const std::size_t yy = static_cast<std::size_t>(y);
+            const int row = S->lat.w[yy] == 1.0 ? S->lat.j1[yy] : S->lat.j0[yy];  // a row the read holds
+            const double raw = s.at(S->lon.src[static_cast<std::size_t>(x)], row, S->levels[l]);
             const double zz = physics::f64::geopotential_to_height_m(zv ? raw : kG0 * raw, vol.grid.earth_radius_m);
             if (std::isnan(zz)) continue;
             if (zz < -1000.0 || zz > 1.0e5) {
@@ -673,7 +703,8 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
   vol.has_field[static_cast<int>(core::Field::CloudFraction)] = L.roles[static_cast<int>(Role::CloudFraction)] != nullptr;
   vol.has_field[static_cast<int>(core::Field::WindU)] = L.roles[static_cast<int>(Role::U)] != nullptr;
   vol.has_field[static_cast<int>(core::Field::WindV)] = L.roles[static_cast<int>(Role::V)] != nullptr;
-  vol.has_field[static_cast<int>(core::Field::WindW)] = L.roles[static_cast<int>(Role::Omega)] != nullptr;
+  vol.has_field[static_cast<int>(core::Field::WindW)] =
+      L.roles[static_cast<int>(Role::Omega)] != nullptr || L.roles[static_cast<int>(Role::UpwardVelocity)] != nullptr;
   vol.has_field[static_cast<int>(core::Field::Temperature)] = true;
   if (!L.roles[static_cast<int>(Role::CloudFraction)]) {
     vol.report.notes.push_back("no cloud fraction: water is taken as covering whole grid boxes");

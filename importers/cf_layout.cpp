@@ -88,13 +88,14 @@ const RoleSpec kRoles[] = {
     {Role::U, {"eastward_wind"}, {"u", "eastward_wind"}},
     {Role::V, {"northward_wind"}, {"v", "northward_wind"}},
     {Role::Omega, {"lagrangian_tendency_of_air_pressure"}, {"w", "lagrangian_tendency_of_air_pressure"}},
+    {Role::UpwardVelocity, {"upward_air_velocity"}, {}},
 };
 }  // namespace
 
 const char* role_name(Role r) {
   static const char* names[kRoleCount] = {"cloud fraction", "cloud liquid water", "cloud ice water", "geopotential",
                                           "geopotential height", "temperature", "specific humidity", "eastward wind",
-                                          "northward wind", "vertical velocity (omega)"};
+                                          "northward wind", "vertical velocity (omega)", "upward air velocity"};
   return names[static_cast<int>(r)];
 }
 
@@ -121,7 +122,19 @@ CfLayout detect_cf_layout(const NcFile& f) {
     target->values = std::move(values);
     target->how = how;
     for (double x : target->values) {
-      if (std::isnan(x)) throw ImportError(path + ": coordinate '" + v.name + "' has missing values; expected every value set");
+      if (!std::isfinite(x)) {
+        throw ImportError(path + ": coordinate '" + v.name + "' has a missing or infinite value; expected every value set and finite");
+      }
+    }
+  }
+  // Rotated-pole and projected grids are not longitude/latitude grids, whatever their units say.
+  for (const auto& v : f.vars()) {
+    const std::string sn = lower(v.text("standard_name"));
+    const std::string mapping = v.text("grid_mapping_name");
+    if (sn == "grid_longitude" || sn == "grid_latitude" || sn == "projection_x_coordinate" ||
+        (!mapping.empty() && mapping != "latitude_longitude")) {
+      throw ImportError(path + ": variable '" + v.name + "' describes a " + (mapping.empty() ? sn : mapping) +
+                        " grid; expected a plain longitude/latitude grid (rotated-pole and projected CF grids are not supported yet)");
     }
   }
   if (!L.lon.var) throw ImportError(path + ": no longitude coordinate (expected units degrees_east or standard_name longitude)");
@@ -201,6 +214,31 @@ CfLayout detect_cf_layout(const NcFile& f) {
     if (found && found == L.surface_geopotential) found = nullptr;
     L.roles[static_cast<int>(spec.role)] = found;
   }
+  // Names are not units: a "z" in metres is a geopotential height, a "w" in m/s an upward velocity.
+  auto units_of = [](const NcVar* v) { return lower(v->text("units")); };
+  if (const NcVar* z = L.roles[static_cast<int>(Role::Geopotential)]) {
+    const std::string u = units_of(z);
+    if (in(u, {"m", "gpm", "meter", "meters", "metre", "metres"})) {
+      if (!L.roles[static_cast<int>(Role::GeopotentialHeight)]) L.roles[static_cast<int>(Role::GeopotentialHeight)] = z;
+      L.roles[static_cast<int>(Role::Geopotential)] = nullptr;
+      L.notes.push_back("'" + z->name + "' has units '" + z->text("units") + "': read as geopotential height");
+    } else if (!u.empty() && u.find('s') == std::string::npos) {  // m2 s-2, m**2 s**-2, m^2/s^2 all name seconds
+      throw ImportError(path + ": variable '" + z->name + "' has units '" + z->text("units") +
+                        "', expected geopotential (m2 s-2) or geopotential height (m, gpm)");
+    }
+  }
+  if (const NcVar* w = L.roles[static_cast<int>(Role::Omega)]) {
+    const std::string u = units_of(w);
+    const bool pressure_rate = u.rfind("pa", 0) == 0 || u.rfind("hpa", 0) == 0;
+    if (!pressure_rate) {
+      L.roles[static_cast<int>(Role::Omega)] = nullptr;
+      if (lower(w->text("standard_name")) == "upward_air_velocity" || u == "m s-1" || u == "m s**-1" || u == "m/s") {
+        L.roles[static_cast<int>(Role::UpwardVelocity)] = w;
+      } else {
+        L.notes.push_back("'" + w->name + "' has units '" + w->text("units") + "' (neither Pa/s nor m/s): not used");
+      }
+    }
+  }
   // Time: a time dimension without a coordinate variable still orders the steps.
   int time_dim = L.time.dim;
   if (!L.time.var) {
@@ -240,6 +278,10 @@ CfLayout detect_cf_layout(const NcFile& f) {
                                          path + ": variable '" + L.time.var->name + "'");
     bool approx_any = false;
     for (double x : L.time.values) {
+      if (!std::isfinite(x) || std::abs(x * u.seconds_per_unit) > 3.2e11) {
+        throw ImportError(path + ": variable '" + L.time.var->name + "' has value " + std::to_string(x) +
+                          ", expected a time within 10 000 years of its reference date");
+      }
       bool approx = false;
       L.times.push_back(valid_time(u, x, &approx));
       approx_any |= approx;

@@ -11,8 +11,8 @@
 
 namespace cv::importers {
 
-enum class Role { CloudFraction, Liquid, Ice, Geopotential, GeopotentialHeight, Temperature, Humidity, U, V, Omega };
-inline constexpr int kRoleCount = 10;
+enum class Role { CloudFraction, Liquid, Ice, Geopotential, GeopotentialHeight, Temperature, Humidity, U, V, Omega, UpwardVelocity };
+inline constexpr int kRoleCount = 11;
 
 // The kinds of vertical coordinate the CF reader understands.
 enum class Vertical { Pressure, Height, Hybrid };

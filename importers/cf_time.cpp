@@ -125,6 +125,10 @@ TimeUnits parse_time_units(const std::string& units, const std::string& calendar
 }
 
 core::ValidTime valid_time(const TimeUnits& u, double value, bool* approximated) {
+  // Beyond +-10 000 years from the reference the date arithmetic would overflow: no file means that.
+  if (!std::isfinite(value) || std::abs(value * u.seconds_per_unit) > 3.2e11) {
+    throw ImportError("time value " + std::to_string(value) + " is not within 10 000 years of the reference date");
+  }
   // Offset from the reference instant in whole days plus seconds of day, exact to the second for
   // any value a file can hold.
   const double total_s = value * u.seconds_per_unit + u.hour * 3600.0 + u.minute * 60.0 + u.second - u.utc_offset_s;

@@ -31,9 +31,10 @@ std::string fmt(double v) {
 void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, int x, int y,
                   const ConversionOptions& options, core::TimeStepData& out, ColumnCounts& counts) {
   const int n = static_cast<int>(levels.size());
-  // Per level: SI quantities in the order of core::Field.
-  double q[core::kFieldCount][256];
-  if (n > 256) return;
+  // Per level: SI quantities in the order of core::Field (a per-thread buffer, reused).
+  thread_local std::vector<double> buffer;
+  buffer.resize(static_cast<std::size_t>(core::kFieldCount) * static_cast<std::size_t>(n));
+  auto q = [&](int f) { return buffer.data() + static_cast<std::size_t>(f) * static_cast<std::size_t>(n); };
   for (int l = 0; l < n; ++l) {
     LevelSample& s = levels[static_cast<std::size_t>(l)];
     const double rho = s.p_pa / (kRdJPerKgK * s.t_k * (1.0 + 0.608 * s.qv));
@@ -51,15 +52,15 @@ void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, i
     }
     const double r_liq_m = options.r_eff_liquid_um * 1e-6;
     const double r_ice_m = (options.r_eff_ice_um > 0 ? options.r_eff_ice_um : ice_effective_radius_um(s.t_k)) * 1e-6;
-    q[static_cast<int>(core::Field::ExtinctionLiquid)][l] =
+    q(static_cast<int>(core::Field::ExtinctionLiquid))[l] =
         std::isnan(s.q_liquid) ? kNaN : 3.0 * rho * s.q_liquid / div / (2.0 * kRhoWater * r_liq_m);
-    q[static_cast<int>(core::Field::ExtinctionIce)][l] =
+    q(static_cast<int>(core::Field::ExtinctionIce))[l] =
         std::isnan(s.q_ice) ? kNaN : 3.0 * rho * s.q_ice / div / (2.0 * kRhoIce * r_ice_m);
-    q[static_cast<int>(core::Field::CloudFraction)][l] = s.cf;
-    q[static_cast<int>(core::Field::WindU)][l] = s.u;
-    q[static_cast<int>(core::Field::WindV)][l] = s.v;
-    q[static_cast<int>(core::Field::WindW)][l] = s.w;
-    q[static_cast<int>(core::Field::Temperature)][l] = s.t_k;
+    q(static_cast<int>(core::Field::CloudFraction))[l] = s.cf;
+    q(static_cast<int>(core::Field::WindU))[l] = s.u;
+    q(static_cast<int>(core::Field::WindV))[l] = s.v;
+    q(static_cast<int>(core::Field::WindW))[l] = s.w;
+    q(static_cast<int>(core::Field::Temperature))[l] = s.t_k;
   }
   for (int l = 1; l < n; ++l) {
     if (!(levels[static_cast<std::size_t>(l)].z_m > levels[static_cast<std::size_t>(l - 1)].z_m)) ++counts.nonmonotonic;
@@ -77,7 +78,8 @@ void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, i
     for (int f = 0; f < core::kFieldCount; ++f) {
       auto& dst = out.fields[static_cast<std::size_t>(f)];
       if (dst.empty()) continue;
-      dst[p] = static_cast<float>(q[f][l - 1] + a * (q[f][l] - q[f][l - 1]));
+      const double* qf = q(f);
+      dst[p] = static_cast<float>(qf[l - 1] + a * (qf[l] - qf[l - 1]));
     }
   }
 }

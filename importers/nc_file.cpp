@@ -121,6 +121,16 @@ NcFile::NcFile(const std::string& path) : path_(path) {
     vars_.push_back(std::move(var));
   }
   global_atts_ = read_atts(id_, NC_GLOBAL, ngatts, path);
+  // A classic-format file stores every value uncompressed: if its variables need more bytes than
+  // the file has, it was cut short (netCDF would read the missing part as zeros).
+  if (!compressed_format_) {
+    long double need = 0;
+    for (const auto& v : vars_) need += static_cast<long double>(size(v)) * type_bytes(v.type);
+    if (need > static_cast<long double>(file_bytes_)) {
+      throw ImportError(path + ": its variables need " + std::to_string(static_cast<long long>(need)) + " bytes but the file has " +
+                        std::to_string(file_bytes_) + " (truncated); expected a complete file");
+    }
+  }
 }
 
 NcFile::~NcFile() {
@@ -189,12 +199,6 @@ std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start,
   if (n > kMaxReadValues) {
     throw ImportError(path_ + ": variable '" + v.name + "': a read of more than " + std::to_string(kMaxReadValues) +
                       " values was asked for; subset the region, levels or times");
-  }
-  // A classic-format file stores every value uncompressed: a header claiming more than the file
-  // holds is corrupt or truncated, and must not make us allocate for it.
-  if (!compressed_format_ && static_cast<long double>(size(v)) * type_bytes(v.type) > 2.0L * file_bytes_ + 65536) {
-    throw ImportError(path_ + ": variable '" + v.name + "' claims " + std::to_string(size(v)) + " values but the file has " +
-                      std::to_string(file_bytes_) + " bytes (truncated or corrupted)");
   }
   if (v.type == NC_CHAR || v.type == NC_STRING) {
     throw ImportError(path_ + ": variable '" + v.name + "' holds text, expected numbers");

@@ -56,7 +56,7 @@ class WrfProjection {
     } else if (proj_ == 2) {
       ps_ = std::make_unique<GeographicLib::PolarStereographic>(kWrfEarthRadiusM, 0.0, 1.0);
       north_ = truelat1_ >= 0.0;
-      ps_->SetScale(truelat1_, 1.0);
+      ps_->SetScale(std::abs(truelat1_), 1.0);  // GeographicLib takes the latitude in the projection's own hemisphere
     } else if (proj_ == 3) {
       mercator_k_ = std::cos(truelat1_ * kDeg);
     } else {
@@ -325,6 +325,35 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
                                " (cropped?): its dimensions are used");
   }
   if (S->nx < 2 || S->ny < 2 || S->nz < 2) throw ImportError(path + ": the WRF grid is smaller than 2 x 2 x 2");
+  // Every 3-D variable used must have the shape WRF gives it (staggered ones one longer), so no
+  // read can run past an array.
+  {
+    struct Shape {
+      const char* name;
+      int dz, dy, dx;  // extra length over nz, ny, nx
+    };
+    const Shape shapes[] = {{"PH", 1, 0, 0}, {"PHB", 1, 0, 0}, {"W", 1, 0, 0},      {"P", 0, 0, 0},
+                            {"PB", 0, 0, 0}, {"T", 0, 0, 0},   {"QVAPOR", 0, 0, 0}, {"QCLOUD", 0, 0, 0},
+                            {"QICE", 0, 0, 0}, {"QSNOW", 0, 0, 0}, {"CLDFRA", 0, 0, 0}, {"U", 0, 0, 1}, {"V", 0, 1, 0}};
+    for (const Shape& sh : shapes) {
+      const NcVar* v = f.find(sh.name);
+      if (!v) continue;
+      const std::size_t want[3] = {static_cast<std::size_t>(S->nz + sh.dz), static_cast<std::size_t>(S->ny + sh.dy),
+                                   static_cast<std::size_t>(S->nx + sh.dx)};
+      const std::size_t r = v->dims.size();
+      bool ok = r == 4 && v->dims[0] == S->dim_time;
+      for (std::size_t a = 0; ok && a < 3; ++a) ok = f.dim_length(*v, a + 1) == want[a];
+      if (!ok) {
+        std::string got;
+        for (std::size_t a = 0; a < r; ++a) got += (a ? " x " : "") + std::to_string(f.dim_length(*v, a));
+        throw ImportError(path + ": variable '" + sh.name + "' has shape (" + got + "), expected (Time x " +
+                          std::to_string(want[0]) + " x " + std::to_string(want[1]) + " x " + std::to_string(want[2]) + ")");
+      }
+    }
+  }
+  if (options.level_min_hpa > 0.0 || options.level_max_hpa < 1e9) {
+    vol.report.warn("--levels applies to pressure-level files; a WRF file is read on all its model levels");
+  }
   // XLAT/XLONG, with or without a Time dimension.
   auto read2 = [&](const char* name) {
     const NcVar& v = f.var(name);

@@ -10,8 +10,13 @@
 namespace cv::core {
 namespace {
 
+// A failure of the file itself (disk full, I/O error), as opposed to one of the data being written.
+struct WriteFailure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 void put(std::FILE* f, const void* p, std::size_t n) {
-  if (n && std::fwrite(p, 1, n, f) != n) throw std::runtime_error("write failed");
+  if (n && std::fwrite(p, 1, n, f) != n) throw WriteFailure(std::string("write failed (") + std::strerror(errno) + ")");
 }
 void put(std::FILE* f, const std::string& s) { put(f, s.data(), s.size()); }
 
@@ -35,11 +40,16 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   if (!f) throw std::runtime_error(path + ": cannot create (" + std::strerror(errno) + ")");
   try {
     write(f);
-    if (std::fflush(f) != 0 || ::fsync(::fileno(f)) != 0) throw std::runtime_error("flush failed");
-  } catch (const std::exception& e) {
+    if (std::fflush(f) != 0 || ::fsync(::fileno(f)) != 0) throw WriteFailure(std::string("flush failed (") + std::strerror(errno) + ")");
+  } catch (const WriteFailure& e) {
     std::fclose(f);
     std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": " + e.what() + " (" + std::strerror(errno) + ")");
+    throw std::runtime_error(path + ": " + e.what());
+  } catch (...) {
+    // Anything else (bad data found while loading a step) leaves no file and keeps its own message.
+    std::fclose(f);
+    std::remove(tmp.c_str());
+    throw;
   }
   std::fclose(f);
   std::error_code ec;

@@ -356,8 +356,8 @@ TEST_F(CfImport, BrokenAndUnsupportedFiles) {
     b.put(v, std::vector<double>(100000, 1.0));
     b.close();
   }
-  std::filesystem::resize_file(classic, 4096);
-  expect_import_error(classic, {});
+  std::filesystem::resize_file(classic, 700000);  // 100 000 doubles need 800 000 bytes
+  expect_import_error(classic, {"truncated"});
   // No cloud variable.
   SynthOptions o;
   o.with_cloud = false;
@@ -411,6 +411,109 @@ TEST_F(CfImport, ReportJsonNamesEveryVariableItUsed) {
     EXPECT_NE(j.find(name), std::string::npos) << name << "\n" << j;
   }
   EXPECT_NE(v.report.to_text().find("liquid extinction"), std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+// Findings of a review, each a file the importer once took silently or read past.
+TEST_F(CfImport, GeopotentialInMetresIsReadAsGeopotentialHeight) {
+  SynthOptions o;
+  o.packed = false;
+  const std::string p = write(o);
+  {
+    int id, var;
+    cv::test::nc_check(nc_open(p.c_str(), NC_WRITE, &id), "open");
+    cv::test::nc_check(nc_inq_varid(id, "z", &var), "z");
+    nc_redef(id);
+    cv::test::nc_check(nc_put_att_text(id, var, "units", 1, "m"), "units");
+    nc_enddef(id);
+    // Overwrite z with the heights themselves (metres), as a "z" in m would hold.
+    std::size_t n = 2 * 5 * 4 * 6;
+    std::vector<double> zv(n);
+    nc_get_var_double(id, var, zv.data());
+    for (double& x : zv) x /= 9.80665;
+    nc_put_var_double(id, var, zv.data());
+    nc_close(id);
+  }
+  auto v = import(p);
+  expect_synthetic_values(v, 1e-5);
+}
+
+TEST_F(CfImport, UpwardVelocityInMetresPerSecondIsNotOmega) {
+  SynthOptions o;
+  o.packed = false;
+  const std::string p = write(o);
+  {
+    int id, dims[4], var;
+    cv::test::nc_check(nc_open(p.c_str(), NC_WRITE, &id), "open");
+    int u;
+    nc_inq_varid(id, "u", &u);
+    nc_inq_vardimid(id, u, dims);
+    nc_redef(id);
+    cv::test::nc_check(nc_def_var(id, "w", NC_FLOAT, 4, dims, &var), "w");
+    nc_put_att_text(id, var, "units", 5, "m s-1");
+    nc_put_att_text(id, var, "standard_name", 19, "upward_air_velocity");
+    nc_enddef(id);
+    std::vector<float> w(2 * 5 * 4 * 6, 1.0f);
+    nc_put_var_float(id, var, w.data());
+    nc_close(id);
+  }
+  auto v = import(p);
+  const auto& d = v.step(0)[core::Field::WindW];
+  ASSERT_FALSE(d.empty());
+  EXPECT_NEAR(d[v.grid.index(0, 0, 1)], 1.0f, 1e-6f);
+}
+
+TEST_F(CfImport, RotatedPoleGridsAreRefused) {
+  const std::string p = (dir_ / "rot.nc").string();
+  {
+    cv::test::NcBuilder b(p);
+    const int dx = b.dim("rlon", 3), dy = b.dim("rlat", 2), dz = b.dim("level", 2);
+    const int vx = b.var("rlon", NC_DOUBLE, {dx}), vy = b.var("rlat", NC_DOUBLE, {dy}), vz = b.var("level", NC_DOUBLE, {dz});
+    b.text(vx, "standard_name", "grid_longitude");
+    b.text(vx, "units", "degrees");
+    b.text(vy, "standard_name", "grid_latitude");
+    b.text(vy, "units", "degrees");
+    b.text(vz, "units", "hPa");
+    b.text(b.var("cc", NC_FLOAT, {dz, dy, dx}), "units", "1");
+    b.put(vx, {0, 1, 2});
+    b.put(vy, {0, 1});
+    b.put(vz, {1000, 500});
+    b.close();
+  }
+  expect_import_error(p, {"'rlon'", "expected a plain longitude/latitude grid"});
+}
+
+TEST_F(CfImport, ARegionBetweenTwoRowsAndInfiniteCoordinatesAreRefused) {
+  SynthOptions o;
+  importers::ImportOptions r;
+  r.region = importers::Region{170.0, 190.0, 46.0, 48.0};  // rows are at 45 and 50
+  try {
+    import(write(o), r);
+    FAIL();
+  } catch (const importers::ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("between two grid rows"), std::string::npos) << e.what();
+  }
+  SynthOptions inf;
+  inf.lons = {170, 175, INFINITY, 185, 190, 195};
+  inf.coord_type = NC_DOUBLE;
+  expect_import_error(write(inf, "inf.nc"), {"'longitude'", "infinite"});
+}
+
+TEST_F(CfImport, ARegionReadsOnlyItsPartOfTheFile) {
+  SynthOptions o;
+  o.lons.clear();
+  for (int k = 0; k <= 12; ++k) o.lons.push_back(160.0 + 5.0 * k);
+  importers::ImportOptions r;
+  r.region = importers::Region{170.0, 190.0, 45.0, 55.0};
+  r.level_min_hpa = 500.0;
+  auto v = import(write(o), r);
+  v.step(0);
+  // 13 longitudes x 4 latitudes x 5 levels in the file; the box needs 5 x 3 x 4.
+  const auto& before = v.report.use("cloud fraction").before;
+  EXPECT_EQ(before.count + before.missing, 5u * 3u * 4u);
 }
 
 }  // namespace

@@ -186,3 +186,31 @@ TEST(Vertical, ModelLevelNumbersWithoutCoefficientsSayWhatIsNeeded) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Vertical, ColumnsWithHundredsOfLevels) {
+  const auto dir = cv::test::temp_dir("vertical_many");
+  const std::string p = (dir / "many.nc").string();
+  const std::size_t nz = 300;
+  {
+    Columns c(p, nz);
+    c.horizontal();
+    const int vz = c.b.var("lev", NC_DOUBLE, {c.dz});
+    c.b.text(vz, "units", "m");
+    c.b.text(vz, "positive", "up");
+    std::vector<double> z;
+    for (std::size_t k = 0; k < nz; ++k) z.push_back(100.0 + 50.0 * static_cast<double>(k));
+    c.b.put(vz, z);
+    c.fields(nz, 150);  // cloud at 7600 m
+    c.b.close();
+  }
+  importers::ImportOptions o;
+  o.dz_m = 50.0;
+  auto v = importers::import_file(p, o);
+  EXPECT_EQ(v.grid.alt_m.count, 300);
+  EXPECT_NEAR(v.step(0)[core::Field::CloudFraction][v.grid.index(1, 1, 150)], 0.5, 1e-6);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace

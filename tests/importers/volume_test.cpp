@@ -121,6 +121,29 @@ TEST(VolumeIo, CvvolHeaderAndPayloadAndVti) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(VolumeIo, AnErrorWhileLoadingKeepsItsTypeAndMessageAndLeavesNoFile) {
+  struct BadData : std::runtime_error {
+    using std::runtime_error::runtime_error;
+  };
+  const auto dir = cv::test::temp_dir("volume_io_bad");
+  CloudVolume v;
+  v.grid = column_grid(1);
+  v.times.resize(2);
+  v.set_loader([](std::size_t t, ImportReport&, TimeStepData& d) {
+    if (t == 1) throw BadData("f.nc: variable 'cc' has value 7, expected a fraction between 0 and 1");
+    d[Field::CloudFraction] = {0.5f};
+  });
+  v.has_field[static_cast<int>(Field::CloudFraction)] = true;
+  try {
+    write_cvvol((dir / "v.cvvol").string(), v);
+    FAIL();
+  } catch (const BadData& e) {
+    EXPECT_STREQ(e.what(), "f.nc: variable 'cc' has value 7, expected a fraction between 0 and 1");
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+  std::filesystem::remove_all(dir);
+}
+
 TEST(VolumeIo, AFailedWriteLeavesNoFile) {
   const auto dir = cv::test::temp_dir("volume_io_fail");
   const std::string path = (dir / "out.bin").string();

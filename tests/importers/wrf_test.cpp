@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "importer.hpp"
+#include "support/nc_builder.hpp"
 #include "support/real_data.hpp"
 #include "nc_file.hpp"
 #include "wrf_import.hpp"
@@ -94,6 +95,37 @@ TEST(Wrf, MercatorFileWithoutCloudFraction) {
   bool noted = false;
   for (const auto& n : vol.report.notes) noted |= n.find("no CLDFRA") != std::string::npos;
   EXPECT_TRUE(noted);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(Wrf, AVariableOfTheWrongShapeIsRefusedBeforeAnyRead) {
+  const auto dir = cv::test::temp_dir("wrf_shape");
+  const std::string p = (dir / "wrf.nc").string();
+  {
+    cv::test::NcBuilder b(p);
+    const int dt = b.dim("Time", 1), dx = b.dim("west_east", 3), dy = b.dim("south_north", 3), dz = b.dim("bottom_top", 2);
+    const int dzs = b.dim("bottom_top_stag", 3);
+    for (const char* a : {"MAP_PROJ"}) b.number(NC_GLOBAL, a, NC_INT, {3});
+    for (const char* a : {"TRUELAT1", "TRUELAT2", "STAND_LON"}) b.number(NC_GLOBAL, a, NC_FLOAT, {0});
+    for (const char* a : {"DX", "DY"}) b.number(NC_GLOBAL, a, NC_FLOAT, {100000});
+    b.var("XLAT", NC_FLOAT, {dy, dx});
+    b.var("XLONG", NC_FLOAT, {dy, dx});
+    b.var("PH", NC_FLOAT, {dt, dzs, dy, dx});
+    b.var("PHB", NC_FLOAT, {dt, dzs, dy, dx});
+    b.var("P", NC_FLOAT, {dt, dz, dy});  // one dimension short
+    b.var("QCLOUD", NC_FLOAT, {dt, dz, dy, dx});
+    b.close();
+  }
+  try {
+    importers::import_file(p);
+    FAIL();
+  } catch (const importers::ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("variable 'P' has shape (1 x 2 x 3)"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

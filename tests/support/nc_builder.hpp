@@ -89,6 +89,7 @@ struct SynthOptions {
   double z_override = NAN;       // when set, every geopotential value
   double clwc_noise = 0.0;       // subtract this from the clear points (tiny negatives after unpacking)
   bool with_cloud = true;
+  nc_type coord_type = NC_FLOAT;  // of longitude and latitude
 };
 
 inline double isa_height_m(double p_pa) {
@@ -104,9 +105,9 @@ inline void write_synth(const std::string& path, const SynthOptions& o) {
             nz = static_cast<int>(o.levels_hpa.size()), nt = o.times;
   const int dt = b.dim("time", static_cast<std::size_t>(nt)), dz = b.dim("level", static_cast<std::size_t>(nz));
   const int dy = b.dim("latitude", static_cast<std::size_t>(ny)), dx = b.dim("longitude", static_cast<std::size_t>(nx));
-  const int vlon = b.var("longitude", NC_FLOAT, {dx});
+  const int vlon = b.var("longitude", o.coord_type, {dx});
   b.text(vlon, "units", "degrees_east");
-  const int vlat = b.var("latitude", NC_FLOAT, {dy});
+  const int vlat = b.var("latitude", o.coord_type, {dy});
   b.text(vlat, "units", "degrees_north");
   const int vlev = b.var("level", NC_INT, {dz});
   b.text(vlev, "units", o.level_units);
