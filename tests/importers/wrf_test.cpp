@@ -129,3 +129,84 @@ TEST(Wrf, AVariableOfTheWrongShapeIsRefusedBeforeAnyRead) {
 }
 
 }  // namespace
+
+#include <GeographicLib/PolarStereographic.hpp>
+
+namespace {
+
+// A small polar stereographic WRF domain whose XLAT/XLONG come from the inverse projection (WRF's
+// 6370 km sphere, true latitude +-60), in the given hemisphere.
+std::string write_polar_wrf(const std::filesystem::path& dir, bool north) {
+  const std::string p = (dir / (north ? "north.nc" : "south.nc")).string();
+  const int nx = 6, ny = 5, nz = 3;
+  const double dx = 50000.0, stand_lon = -45.0, truelat = north ? 60.0 : -60.0;
+  GeographicLib::PolarStereographic ps(6370000.0, 0.0, 1.0);
+  ps.SetScale(std::abs(truelat), 1.0);
+  double x0, y0;
+  ps.Forward(north, north ? 70.0 : -70.0, 10.0, x0, y0);  // the domain's first mass point, 10 degrees east of STAND_LON
+  std::vector<double> lat, lon;
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      double la, lo;
+      ps.Reverse(north, x0 + i * dx, y0 + j * dx, la, lo);
+      lat.push_back(la);
+      lon.push_back(lo + stand_lon);
+    }
+  }
+  cv::test::NcBuilder b(p);
+  const int dt = b.dim("Time", 1), dxd = b.dim("west_east", nx), dyd = b.dim("south_north", ny), dzd = b.dim("bottom_top", nz);
+  const int dzs = b.dim("bottom_top_stag", nz + 1);
+  b.number(NC_GLOBAL, "MAP_PROJ", NC_INT, {2});
+  b.number(NC_GLOBAL, "TRUELAT1", NC_FLOAT, {truelat});
+  b.number(NC_GLOBAL, "TRUELAT2", NC_FLOAT, {truelat});
+  b.number(NC_GLOBAL, "STAND_LON", NC_FLOAT, {stand_lon});
+  b.number(NC_GLOBAL, "DX", NC_FLOAT, {dx});
+  b.number(NC_GLOBAL, "DY", NC_FLOAT, {dx});
+  const int vlat = b.var("XLAT", NC_DOUBLE, {dyd, dxd}), vlon = b.var("XLONG", NC_DOUBLE, {dyd, dxd});
+  const int ph = b.var("PH", NC_FLOAT, {dt, dzs, dyd, dxd}), phb = b.var("PHB", NC_FLOAT, {dt, dzs, dyd, dxd});
+  const int pp = b.var("P", NC_FLOAT, {dt, dzd, dyd, dxd}), pb = b.var("PB", NC_FLOAT, {dt, dzd, dyd, dxd});
+  const int th = b.var("T", NC_FLOAT, {dt, dzd, dyd, dxd}), qc = b.var("QCLOUD", NC_FLOAT, {dt, dzd, dyd, dxd});
+  const std::size_t n2 = static_cast<std::size_t>(nx) * ny;
+  std::vector<double> vph(n2 * (nz + 1), 0.0), vphb, vp(n2 * nz, 0.0), vpb, vth(n2 * nz, 0.0), vqc;
+  for (int k = 0; k <= nz; ++k) vphb.insert(vphb.end(), n2, 9.81 * 1000.0 * k);  // staggered levels at 0, 1, 2, 3 km
+  for (int k = 0; k < nz; ++k) vpb.insert(vpb.end(), n2, 95000.0 - 10000.0 * k), vqc.insert(vqc.end(), n2, k == 1 ? 1e-4 : 0.0);
+  b.put(vlat, lat);
+  b.put(vlon, lon);
+  b.put(ph, vph);
+  b.put(phb, vphb);
+  b.put(pp, vp);
+  b.put(pb, vpb);
+  b.put(th, vth);
+  b.put(qc, vqc);
+  b.close();
+  return p;
+}
+
+TEST(Wrf, PolarStereographicInBothHemispheres) {
+  const auto dir = cv::test::temp_dir("wrf_polar");
+  for (bool north : {true, false}) {
+    auto vol = importers::import_file(write_polar_wrf(dir, north));
+    bool checked = false;
+    for (const auto& n : vol.report.notes) {
+      if (n.find("projection checked") != std::string::npos) {
+        checked = true;
+        const double off = std::stod(n.substr(n.find("lies ") + 5));
+        EXPECT_LT(off, 1.0) << (north ? "north: " : "south: ") << n;
+      }
+    }
+    EXPECT_TRUE(checked);
+    // Mass levels at 0.5, 1.5 and 2.5 km; the cloud on the middle one.
+    EXPECT_NEAR(vol.grid.alt_m.start, 500.0, 1e-3);
+    const auto& d = vol.step(0);
+    float most = 0.0f;
+    for (float v : d[core::Field::ExtinctionLiquid]) {
+      if (!std::isnan(v)) most = std::max(most, v);
+    }
+    // sigma = 3 rho q / (2 rho_w r_eff) at p = 850 hPa, T = 300 (p / 1e5)^(R_d / c_p), no vapour.
+    const double t = 300.0 * std::pow(0.85, 287.05 / 1004.6), rho = 85000.0 / (287.05 * t);
+    EXPECT_NEAR(most, 3.0 * rho * 1e-4 / (2.0 * 1000.0 * 10e-6), 1e-4) << (north ? "north" : "south");
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
