@@ -615,8 +615,13 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
   // Time steps.
   const int nt = static_cast<int>(L.times.size());
   const int last = options.time_last < 0 ? nt - 1 : std::min(options.time_last, nt - 1);
-  for (int t = std::max(0, options.time_first); t <= last; t += std::max(1, options.time_stride)) S->steps.push_back(t);
-  if (S->steps.empty()) throw ImportError(path + ": no time step in the requested range (the file has " + std::to_string(nt) + ")");
+  for (int t = std::max(0, options.time_first); t <= last; t += std::max(1, options.time_stride)) {
+    if (in_time_range(L.times[static_cast<std::size_t>(t)], options)) S->steps.push_back(t);
+  }
+  if (S->steps.empty()) {
+    throw ImportError(path + ": no time step in the requested range; the file has " + std::to_string(nt) +
+                      (nt ? ", from " + L.times.front().iso_utc + " to " + L.times.back().iso_utc : std::string()));
+  }
   for (int t : S->steps) vol.times.push_back(L.times[static_cast<std::size_t>(t)]);
   if (L.times_uneven) vol.report.warn("time steps are unevenly spaced");
   if (!has_geo && L.vertical_kind == Vertical::Pressure) {

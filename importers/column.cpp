@@ -84,6 +84,10 @@ void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, i
   }
 }
 
+bool in_time_range(const core::ValidTime& t, const ImportOptions& o) {
+  return (o.time_from_iso.empty() || t.iso_utc >= o.time_from_iso) && (o.time_to_iso.empty() || t.iso_utc <= o.time_to_iso);
+}
+
 void report_counts(const ColumnCounts& c, int t, core::ImportReport& report) {
   const std::string at = " at time step " + std::to_string(t);
   if (c.water_without_cf) {

@@ -45,6 +45,11 @@ struct ColumnCounts {
 void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, int x, int y,
                   const ConversionOptions& options, core::TimeStepData& out, ColumnCounts& counts);
 
+// True when a valid time lies in the options' ISO range (ISO 8601 UTC strings of one format order
+// as the times they name).
+struct ImportOptions;
+bool in_time_range(const core::ValidTime& t, const ImportOptions& options);
+
 // Adds the report's consistency warnings for one time step.
 void report_counts(const ColumnCounts& c, int time_index, core::ImportReport& report);
 

@@ -25,6 +25,8 @@ struct ImportOptions {
   int time_first = 0;
   int time_last = -1;
   int time_stride = 1;
+  // And/or by valid time, ISO 8601 UTC ("2024-01-15T03:00:00Z"), inclusive; empty = open.
+  std::string time_from_iso, time_to_iso;
   // Pressure levels kept, hPa (inclusive).
   double level_min_hpa = 0.0;
   double level_max_hpa = 1e9;

@@ -446,9 +446,12 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
   const int nt = S->dim_time >= 0 ? static_cast<int>(f.dims()[static_cast<std::size_t>(S->dim_time)].length) : 1;
   const int last = options.time_last < 0 ? nt - 1 : std::min(options.time_last, nt - 1);
   for (int t = std::max(0, options.time_first); t <= last; t += std::max(1, options.time_stride)) {
+    const core::ValidTime vt = static_cast<std::size_t>(t) < times.size()
+                                   ? wrf_time(times[static_cast<std::size_t>(t)], path + ": variable 'Times'")
+                                   : core::ValidTime{0, "step " + std::to_string(t)};
+    if (!in_time_range(vt, options)) continue;
     S->steps.push_back(t);
-    vol.times.push_back(static_cast<std::size_t>(t) < times.size() ? wrf_time(times[static_cast<std::size_t>(t)], path + ": variable 'Times'")
-                                                                   : core::ValidTime{0, "step " + std::to_string(t)});
+    vol.times.push_back(vt);
   }
   if (S->steps.empty()) throw ImportError(path + ": no time step in the requested range (the file has " + std::to_string(nt) + ")");
   // Altitude grid from the first step's mass-level heights over the domain.

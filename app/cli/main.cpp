@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -28,7 +29,8 @@ void print_usage() {
       "usage: cloudviewer <command> [options]\n"
       "commands:\n"
       "  info FILE                what the importer understands of a NetCDF file\n"
-      "  import FILE -o OUT [--region W,E,S,N] [--times FIRST:LAST[:STRIDE]] [--levels MIN_HPA:MAX_HPA]\n"
+      "  import FILE -o OUT [--region W,E,S,N] [--times FIRST:LAST[:STRIDE] | --times START..END]\n"
+      "         [--levels MIN_HPA:MAX_HPA]\n"
       "         [--stride N] [--dz M] [--reff-liquid UM] [--reff-ice UM] [--vti]\n"
       "                           import into OUT.cvvol (+ OUT.report.json, and OUT_tNNN.vti with --vti)\n"
       "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"
@@ -134,8 +136,18 @@ int cmd_import(const std::vector<std::string>& args) {
       const auto r = parse_list("--region", next(), ',', 4, 4, "W,E,S,N in degrees");
       if (r[2] > r[3] || r[2] < -90 || r[3] > 90) throw UsageError{"cloudviewer import: --region: expected S <= N within -90..90"};
       o.region = cv::importers::Region{r[0], r[1], r[2], r[3]};
+    } else if (a == "--times" && i + 1 < args.size() && args[i + 1].find("..") != std::string::npos) {
+      // A valid-time range: START..END in ISO 8601 UTC, either end may be empty.
+      const std::string r = next();
+      static const std::regex iso(R"(^(\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}Z)?$)");
+      const std::string from = r.substr(0, r.find("..")), to = r.substr(r.find("..") + 2);
+      if (!std::regex_match(from, iso) || !std::regex_match(to, iso)) {
+        throw UsageError{"cloudviewer import: --times: found '" + r + "', expected START..END as YYYY-MM-DDThh:mm:ssZ"};
+      }
+      o.time_from_iso = from;
+      o.time_to_iso = to;
     } else if (a == "--times") {
-      const auto t = parse_list("--times", next(), ':', 2, 3, "FIRST:LAST[:STRIDE] as step indices");
+      const auto t = parse_list("--times", next(), ':', 2, 3, "FIRST:LAST[:STRIDE] as step indices, or START..END as ISO times");
       o.time_first = static_cast<int>(t[0]);
       o.time_last = static_cast<int>(t[1]);
       o.time_stride = t.size() > 2 ? static_cast<int>(t[2]) : 1;

@@ -315,6 +315,21 @@ TEST_F(CfImport, LazyLoadingEvictsBeyondTheCache) {
   auto w = import(write(o, "t.nc"), io);
   ASSERT_EQ(w.times.size(), 2u);
   EXPECT_EQ(w.times[1].iso_utc, "2024-01-15T09:00:00Z");
+  // By valid time: 03:00 to 06:00 inclusive.
+  importers::ImportOptions by_time;
+  by_time.time_from_iso = "2024-01-15T03:00:00Z";
+  by_time.time_to_iso = "2024-01-15T06:00:00Z";
+  auto z = import(write(o, "t2.nc"), by_time);
+  ASSERT_EQ(z.times.size(), 2u);
+  EXPECT_EQ(z.times[0].iso_utc, "2024-01-15T03:00:00Z");
+  by_time.time_from_iso = "2030-01-01T00:00:00Z";
+  by_time.time_to_iso.clear();
+  try {
+    import(write(o, "t3.nc"), by_time);
+    FAIL();
+  } catch (const importers::ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("from 2024-01-15T00:00:00Z to 2024-01-15T09:00:00Z"), std::string::npos) << e.what();
+  }
 }
 
 // Bad input: one line naming the file, the variable and what was expected; never a crash.
