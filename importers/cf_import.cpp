@@ -322,6 +322,10 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     if (w == 1.0) return sl.at(i, j1, 0);
     return (1.0 - w) * sl.at(i, j0, 0) + w * sl.at(i, j1, 0);
   };
+  auto surface_pressure = [&](int i, int j0, int j1, double w) {
+    const double v = surf(ps, i, j0, j1, w);
+    return L.surface_pressure_is_log ? std::exp(v) : v;
+  };
   const std::size_t row_len = static_cast<std::size_t>(grid.lon_deg.count);
   const int nx = grid.lon_deg.count, ny = grid.lat_deg.count;
   const bool has_cf = have[static_cast<int>(Role::CloudFraction)];
@@ -373,7 +377,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
             given_altitude ? surf_raw : physics::f64::geopotential_to_height_m(surf_raw, grid.earth_radius_m);
         switch (L.vertical_kind) {
           case Vertical::Pressure: c.p_pa = S.level_pa[L_]; break;
-          case Vertical::Hybrid: c.p_pa = S.hyb_a[L_] + S.hyb_b[L_] * surf(ps, i, j0, j1, w); break;
+          case Vertical::Hybrid: c.p_pa = S.hyb_a[L_] + S.hyb_b[L_] * surface_pressure(i, j0, j1, w); break;
           case Vertical::Height:
             c.p_pa = isa_pressure_pa(S.level_z[L_] + (L.height_above_ground ? zsurf_geometric : 0.0));
             break;
@@ -392,7 +396,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
         } else if (L.vertical_kind == Vertical::Hybrid) {
           // Hypsometric equation from the surface: dZ = R_d T_v / g0 d(ln p), in geopotential metres.
           const double tv = t_read * (1.0 + 0.608 * c.qv);
-          const double zgp = l == 0 ? zsurf + kRd * tv / kG0 * std::log(surf(ps, i, j0, j1, w) / c.p_pa)
+          const double zgp = l == 0 ? zsurf + kRd * tv / kG0 * std::log(surface_pressure(i, j0, j1, w) / c.p_pa)
                                     : W.z_prev[X_] + kRd * 0.5 * (tv + W.tv_prev[X_]) / kG0 * std::log(W.p_prev[X_] / c.p_pa);
           W.z_prev[X_] = zgp, W.p_prev[X_] = c.p_pa, W.tv_prev[X_] = tv;
           c.z_m = physics::f64::geopotential_to_height_m(kG0 * zgp, grid.earth_radius_m);
@@ -587,7 +591,9 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
   const bool has_geo = L.roles[static_cast<int>(Role::Geopotential)] || L.roles[static_cast<int>(Role::GeopotentialHeight)];
   if (L.vertical_kind == Vertical::Hybrid) {
     vol.report.format = "CF hybrid sigma-pressure levels";
-    vol.report.notes.push_back("pressure p = a + b ps from formula_terms '" + L.vertical.var->text("formula_terms") + "'");
+    if (!L.vertical.var->text("formula_terms").empty()) {
+      vol.report.notes.push_back("pressure p = a + b ps from formula_terms '" + L.vertical.var->text("formula_terms") + "'");
+    }
     if (!has_geo && !L.roles[static_cast<int>(Role::Temperature)]) {
       throw ImportError(path + ": hybrid levels without geopotential need temperature to find their heights; neither is in the file");
     }

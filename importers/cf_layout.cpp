@@ -51,8 +51,11 @@ Kind classify(const NcVar& v, std::string& how, const std::vector<double>* value
     how = "by attributes (units '" + v.text("units") + "')";
     return Kind::Time;
   }
-  if (in(sn, {"air_pressure", "height", "altitude", "model_level_number", "atmosphere_hybrid_sigma_pressure_coordinate"}) ||
-      axis == "z" || !v.text("positive").empty() || pressure_scale(units) > 0) {
+  const std::string long_name = lower(v.text("long_name"));
+  if (in(sn, {"air_pressure", "height", "altitude", "model_level_number", "atmosphere_hybrid_sigma_pressure_coordinate",
+              "hybrid_sigma_pressure"}) ||
+      axis == "z" || !v.text("positive").empty() || pressure_scale(units) > 0 ||
+      long_name == "model_level_number" || long_name.rfind("hybrid level", 0) == 0) {
     how = "by attributes (units '" + v.text("units") + "', positive '" + v.text("positive") + "')";
     return Kind::Vertical;
   }
@@ -146,7 +149,8 @@ CfLayout detect_cf_layout(const NcFile& f) {
   const std::string vunits = lower(zv.text("units"));
   const std::string vsn = lower(zv.text("standard_name"));
   L.pressure_scale_to_pa = pressure_scale(vunits);
-  if (vsn == "atmosphere_hybrid_sigma_pressure_coordinate") {
+  // CF's name, and the one cdo writes.
+  if ((vsn == "atmosphere_hybrid_sigma_pressure_coordinate" || vsn == "hybrid_sigma_pressure") && !zv.text("formula_terms").empty()) {
     // formula_terms: "a: A b: B p0: P0 ps: PS" or "ap: AP b: B ps: PS".
     L.vertical_kind = Vertical::Hybrid;
     const std::string ft = zv.text("formula_terms");
@@ -177,6 +181,28 @@ CfLayout detect_cf_layout(const NcFile& f) {
       L.hybrid_a_pa.push_back(av[k] * ascale);
       L.hybrid_b.push_back(bv[k]);
     }
+  } else if (L.pressure_scale_to_pa == 0.0 && (vsn == "model_level_number" || lower(zv.text("long_name")) == "model_level_number" ||
+                                               vunits.empty() || vunits == "1" || vunits == "level")) {
+    // IFS model levels as cdo writes them: no formula_terms, but coefficient tables hyam/hybm (Pa
+    // and 1) and the surface pressure as ps, sp or lnsp (its logarithm).
+    const NcVar* a = f.find("hyam");
+    const NcVar* b = f.find("hybm");
+    const NcVar* sp = f.find("lnsp") ? f.find("lnsp") : f.find("ps") ? f.find("ps") : f.find("sp");
+    const std::size_t n = L.vertical.values.size();
+    if (!a || !b || !sp || f.size(*a) != n || f.size(*b) != n) {
+      throw ImportError(path + ": vertical coordinate '" + zv.name + "' numbers model levels; model-level numbers need "
+                        "their coefficients: expected formula_terms, or hyam (Pa) and hybm with one value per level and "
+                        "a surface pressure (ps, sp or lnsp)");
+    }
+    L.vertical_kind = Vertical::Hybrid;
+    L.surface_pressure = sp;
+    L.surface_pressure_is_log = sp->name == "lnsp";
+    const std::vector<double> av = f.read(*a), bv = f.read(*b);
+    for (std::size_t k = 0; k < n; ++k) {
+      L.hybrid_a_pa.push_back(av[k] * std::max(1.0, pressure_scale(lower(a->text("units")))));
+      L.hybrid_b.push_back(bv[k]);
+    }
+    L.notes.push_back("model levels: p = hyam + hybm ps from '" + a->name + "', '" + b->name + "' and '" + sp->name + "'");
   } else if (L.pressure_scale_to_pa == 0.0) {
     const double hs = in(vunits, {"m", "meter", "meters", "metre", "metres"}) ? 1.0 : in(vunits, {"km", "kilometer", "kilometers", "kilometre", "kilometres"}) ? 1000.0 : 0.0;
     if (hs == 0.0 || lower(zv.text("positive")) == "down") {

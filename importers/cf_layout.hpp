@@ -34,6 +34,7 @@ struct CfLayout {
   // Hybrid sigma-pressure levels: p_k = a_pa[k] + b[k] ps (a_pa is a k p0, or ap k), file order.
   std::vector<double> hybrid_a_pa, hybrid_b;
   const NcVar* surface_pressure = nullptr;     // 2-D (or with time): Pa
+  bool surface_pressure_is_log = false;        // IFS lnsp: ln(ps / Pa)
   const NcVar* surface_geopotential = nullptr; // 2-D (or with time): m2/s2, or surface altitude in m
   double surface_geopotential_scale = 1.0;     // 9.80665 when the variable is an altitude in m
   std::vector<core::ValidTime> times;

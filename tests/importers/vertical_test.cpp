@@ -164,6 +164,42 @@ void hybrid_case(bool ap_form) {
 TEST(Vertical, HybridLevelsApForm) { hybrid_case(true); }
 TEST(Vertical, HybridLevelsAP0Form) { hybrid_case(false); }
 
+TEST(Vertical, IfsModelLevelsWithHyamHybmAndLnsp) {
+  // The same isothermal columns as above, written as cdo writes IFS model levels.
+  const auto dir = cv::test::temp_dir("vertical_ifs");
+  const std::string p = (dir / "ml.nc").string();
+  {
+    Columns c(p, 5);
+    c.horizontal();
+    const int vz = c.b.var("lev", NC_DOUBLE, {c.dz});
+    c.b.text(vz, "long_name", "model_level_number");
+    c.b.put(vz, {1.0, 2.0, 3.0, 4.0, 5.0});
+    const int va = c.b.var("hyam", NC_DOUBLE, {c.dz}), vb = c.b.var("hybm", NC_DOUBLE, {c.dz});
+    c.b.text(va, "units", "Pa");
+    c.b.put(va, {30000.0, 20000.0, 7000.0, 0.0, 0.0});
+    c.b.put(vb, {0.0, 0.3, 0.63, 0.85, 0.95});
+    const int ls = c.b.var("lnsp", NC_DOUBLE, {c.dt, c.dy, c.dx});
+    c.b.put(ls, std::vector<double>(6, std::log(1e5)));
+    c.fields(5, 2);
+    c.b.close();
+  }
+  importers::ImportOptions o;
+  o.dz_m = 100.0;
+  auto v = importers::import_file(p, o);
+  auto zgp = [](double pa) { return 287.05 * 260.0 / 9.80665 * std::log(1e5 / pa); };
+  const double z850 = geometric(zgp(85000.0)), z700 = geometric(zgp(70000.0));
+  const auto& d = v.step(0);
+  int checked = 0;
+  for (int z = 0; z < v.grid.alt_m.count; ++z) {
+    const double alt = v.grid.alt_m.at(z);
+    if (alt <= z850 || alt >= z700) continue;
+    EXPECT_NEAR(d[core::Field::CloudFraction][v.grid.index(0, 0, z)], 0.5 * (alt - z850) / (z700 - z850), 1e-5) << alt;
+    ++checked;
+  }
+  EXPECT_GT(checked, 10);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Vertical, ModelLevelNumbersWithoutCoefficientsSayWhatIsNeeded) {
   const auto dir = cv::test::temp_dir("vertical_ml");
   const std::string p = (dir / "ml.nc").string();
