@@ -28,7 +28,7 @@ void print_usage() {
   std::printf(
       "usage: cloudviewer <command> [options]\n"
       "commands:\n"
-      "  info FILE                what the importer understands of a NetCDF file\n"
+      "  info FILE                what the importer understands of a NetCDF file (or a .cvvol volume)\n"
       "  import FILE -o OUT [--region W,E,S,N] [--times FIRST:LAST[:STRIDE] | --times START..END]\n"
       "         [--levels MIN_HPA:MAX_HPA]\n"
       "         [--stride N] [--dz M] [--reff-liquid UM] [--reff-ice UM] [--vti]\n"
@@ -116,7 +116,28 @@ std::vector<double> parse_list(const std::string& option, const std::string& tex
 
 int cmd_info(const std::vector<std::string>& args) {
   if (args.size() != 1) throw UsageError{"cloudviewer info: expected one FILE argument"};
-  std::printf("%s", cv::importers::describe_file(args[0]).c_str());
+  const std::string& path = args[0];
+  if (path.size() > 6 && path.substr(path.size() - 6) == ".cvvol") {
+    const cv::core::CloudVolume v = cv::core::read_cvvol(path);
+    const auto& g = v.grid;
+    std::printf("file: %s\nformat: cloud volume (.cvvol)\ngrid: %d x %d x %d, lon %.6g..%.6g step %.6g, lat %.6g..%.6g step "
+                "%.6g, altitude %.6g..%.6g m step %.6g, Earth radius %.0f m\n",
+                path.c_str(), g.lon_deg.count, g.lat_deg.count, g.alt_m.count, g.lon_deg.start, g.lon_deg.last(),
+                g.lon_deg.step, g.lat_deg.start, g.lat_deg.last(), g.lat_deg.step, g.alt_m.start, g.alt_m.last(),
+                g.alt_m.step, g.earth_radius_m);
+    std::printf("times: %zu", v.times.size());
+    if (!v.times.empty()) std::printf(", %s to %s", v.times.front().iso_utc.c_str(), v.times.back().iso_utc.c_str());
+    std::printf("\nfields:");
+    for (int i = 0; i < cv::core::kFieldCount; ++i) {
+      if (v.has_field[static_cast<std::size_t>(i)]) {
+        std::printf(" %s [%s]", cv::core::field_name(static_cast<cv::core::Field>(i)),
+                    cv::core::field_units(static_cast<cv::core::Field>(i)));
+      }
+    }
+    std::printf("\n");
+    return 0;
+  }
+  std::printf("%s", cv::importers::describe_file(path).c_str());
   return 0;
 }
 
@@ -260,6 +281,9 @@ int main(int argc, char** argv) {
     throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase or render"};
   } catch (const UsageError& e) {
     std::fprintf(stderr, "%s\n", e.message.c_str());
+    return kExitBadInput;
+  } catch (const cv::core::VolumeFileError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
   } catch (const cv::importers::ImportError& e) {
     // Bad input files: one line naming the file and variable, exit code 2.

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <stdexcept>
 #include <unistd.h>
 
@@ -96,6 +97,103 @@ void write_cvvol(const std::string& path, CloudVolume& v, const std::function<vo
       for (const auto& [name, arr] : map_arrays(d.maps)) put(f, arr->data(), arr->size() * sizeof(float));
     }
   });
+}
+
+namespace {
+// Minimal readers for the header this file writes (not a general JSON parser).
+double json_number(const std::string& j, const std::string& key, std::size_t from, const std::string& path) {
+  const std::size_t k = j.find("\"" + key + "\":", from);
+  if (k == std::string::npos) throw VolumeFileError(path + ": header has no '" + key + "'");
+  return std::stod(j.substr(k + key.size() + 3));
+}
+RegularAxis json_axis(const std::string& j, const std::string& key, const std::string& path) {
+  const std::size_t k = j.find("\"" + key + "\":");
+  if (k == std::string::npos) throw VolumeFileError(path + ": header has no axis '" + key + "'");
+  RegularAxis a;
+  a.start = json_number(j, "start", k, path);
+  a.step = json_number(j, "step", k, path);
+  a.count = static_cast<int>(json_number(j, "count", k, path));
+  if (a.count < 1 || a.count > 1000000) throw VolumeFileError(path + ": axis '" + key + "' has an implausible count");
+  return a;
+}
+std::vector<std::string> json_strings(const std::string& j, const std::string& key, const std::string& path) {
+  const std::size_t k = j.find("\"" + key + "\":");
+  if (k == std::string::npos) throw VolumeFileError(path + ": header has no '" + key + "'");
+  const std::size_t open = j.find('[', k), close = j.find(']', k);
+  std::vector<std::string> out;
+  for (std::size_t q = j.find('"', open); q < close; q = j.find('"', q + 1)) {
+    const std::size_t e = j.find('"', q + 1);
+    out.push_back(j.substr(q + 1, e - q - 1));
+    q = e;
+  }
+  return out;
+}
+}  // namespace
+
+CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw VolumeFileError(path + ": cannot open (" + std::strerror(errno) + ")");
+  std::shared_ptr<std::FILE> file(f, [](std::FILE* p) { std::fclose(p); });
+  char magic[8];
+  std::uint64_t len = 0;
+  if (std::fread(magic, 1, 8, f) != 8 || std::memcmp(magic, "CVVOL01\n", 8) != 0) {
+    throw VolumeFileError(path + ": not a cloud volume (expected the CVVOL01 header of a .cvvol file)");
+  }
+  if (std::fread(&len, sizeof len, 1, f) != 1 || len > (1u << 26)) throw VolumeFileError(path + ": truncated or corrupt header");
+  std::string header(len, '\0');
+  if (std::fread(header.data(), 1, len, f) != len) throw VolumeFileError(path + ": truncated header");
+  CloudVolume v;
+  v.grid.lon_deg = json_axis(header, "lon_deg", path);
+  v.grid.lat_deg = json_axis(header, "lat_deg", path);
+  v.grid.alt_m = json_axis(header, "alt_m", path);
+  v.grid.earth_radius_m = json_number(header, "earth_radius_m", 0, path);
+  const std::vector<std::string> fields = json_strings(header, "fields", path);
+  std::vector<int> order;
+  for (const auto& name : fields) {
+    int found = -1;
+    for (int i = 0; i < kFieldCount; ++i) {
+      if (name == field_name(static_cast<Field>(i))) found = i;
+    }
+    if (found < 0) throw VolumeFileError(path + ": unknown field '" + name + "' in the header");
+    v.has_field[static_cast<std::size_t>(found)] = true;
+    order.push_back(found);
+  }
+  // Times: pairs of iso_utc and unix_s, in order.
+  for (std::size_t k = header.find("\"iso_utc\":"); k != std::string::npos; k = header.find("\"iso_utc\":", k + 1)) {
+    const std::size_t q = header.find('"', k + 10);
+    ValidTime t;
+    t.iso_utc = header.substr(q + 1, header.find('"', q + 1) - q - 1);
+    t.unix_s = static_cast<std::int64_t>(json_number(header, "unix_s", k, path));
+    v.times.push_back(t);
+  }
+  const std::size_t points = v.grid.points(), cols = v.grid.columns();
+  const std::uint64_t step_bytes = (order.size() * points + 7 * cols) * sizeof(float);
+  const std::uint64_t data0 = 16 + len;
+  std::fseek(f, 0, SEEK_END);
+  const long long size = std::ftell(f);
+  if (static_cast<std::uint64_t>(size) != data0 + step_bytes * v.times.size()) {
+    throw VolumeFileError(path + ": holds " + std::to_string(size) + " bytes, expected " +
+                             std::to_string(data0 + step_bytes * v.times.size()) + " for its header (truncated?)");
+  }
+  v.report.file = path;
+  v.report.format = "cloud volume (.cvvol)";
+  v.set_loader(
+      [file, order, data0, step_bytes, points, path](std::size_t t, ImportReport&, TimeStepData& out) {
+        if (std::fseek(file.get(), static_cast<long>(data0 + step_bytes * t), SEEK_SET) != 0) {
+          throw VolumeFileError(path + ": cannot seek to time step " + std::to_string(t));
+        }
+        for (auto& fld : out.fields) fld.clear();
+        for (int i : order) {
+          auto& a = out.fields[static_cast<std::size_t>(i)];
+          a.resize(points);
+          if (std::fread(a.data(), sizeof(float), points, file.get()) != points) {
+            throw VolumeFileError(path + ": truncated at time step " + std::to_string(t));
+          }
+        }
+        // The maps that follow are derived again from the fields by CloudVolume::step.
+      },
+      cache_steps);
+  return v;
 }
 
 void write_vti(const std::string& path, const VolumeGrid& g, const TimeStepData& d, const std::array<bool, kFieldCount>& has) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <stdexcept>
 #include <string>
 
 #include "volume/cloud_volume.hpp"
@@ -16,6 +17,17 @@ void write_file_atomically(const std::string& path, const std::function<void(std
 // Writes every time step (loading each in turn); progress(step, count) is called before each.
 void write_cvvol(const std::string& path, CloudVolume& volume,
                  const std::function<void(std::size_t, std::size_t)>& progress = {});
+// A .cvvol that cannot be read: missing, of another kind, truncated or corrupt (bad input).
+class VolumeFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Opens a .cvvol written by write_cvvol: grid, times and fields come from its header; time steps
+// are read lazily from the file (one seek each). Throws std::runtime_error naming the file and what
+// is wrong (bad magic, truncated header or payload, unknown field) as a VolumeFileError.
+CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps = 2);
+
 void write_vti(const std::string& path, const VolumeGrid& grid, const TimeStepData& data,
                const std::array<bool, kFieldCount>& has_field);
 

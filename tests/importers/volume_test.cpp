@@ -121,6 +121,49 @@ TEST(VolumeIo, CvvolHeaderAndPayloadAndVti) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(VolumeIo, CvvolRoundTrip) {
+  const auto dir = cv::test::temp_dir("volume_roundtrip");
+  CloudVolume v;
+  v.grid.lon_deg = {170.0, 5.0, 3};
+  v.grid.lat_deg = {40.0, 5.0, 2};
+  v.grid.alt_m = {100.0, 500.0, 4};
+  v.times = {{1705276800, "2024-01-15T00:00:00Z"}, {1705287600, "2024-01-15T03:00:00Z"}};
+  for (Field f : {Field::CloudFraction, Field::ExtinctionLiquid, Field::Temperature}) v.has_field[static_cast<int>(f)] = true;
+  v.set_loader([&](std::size_t t, ImportReport&, TimeStepData& d) {
+    for (Field f : {Field::CloudFraction, Field::ExtinctionLiquid, Field::Temperature}) {
+      d[f].resize(v.grid.points());
+      for (std::size_t p = 0; p < d[f].size(); ++p) d[f][p] = static_cast<float>(p * 0.01 + t + static_cast<int>(f));
+    }
+    d[Field::ExtinctionLiquid][3] = NAN;
+  });
+  const std::string path = (dir / "rt.cvvol").string();
+  write_cvvol(path, v);
+  CloudVolume r = read_cvvol(path);
+  EXPECT_EQ(r.grid.lon_deg.start, 170.0);
+  EXPECT_EQ(r.grid.alt_m.count, 4);
+  ASSERT_EQ(r.times.size(), 2u);
+  EXPECT_EQ(r.times[1].iso_utc, "2024-01-15T03:00:00Z");
+  EXPECT_EQ(r.times[1].unix_s, 1705287600);
+  EXPECT_TRUE(r.has_field[static_cast<int>(Field::Temperature)]);
+  EXPECT_FALSE(r.has_field[static_cast<int>(Field::WindU)]);
+  for (std::size_t t = 0; t < 2; ++t) {
+    for (Field f : {Field::CloudFraction, Field::Temperature}) EXPECT_EQ(r.step(t)[f], v.step(t)[f]);
+    EXPECT_TRUE(std::isnan(r.step(t)[Field::ExtinctionLiquid][3]));
+    EXPECT_EQ(r.step(t).maps.cloud_cover, v.step(t).maps.cloud_cover);
+  }
+  // A cut file and a file of another kind are refused with the reason.
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 4);
+  EXPECT_THROW(read_cvvol(path), std::runtime_error);
+  std::ofstream(dir / "other.cvvol") << "not a volume";
+  try {
+    read_cvvol((dir / "other.cvvol").string());
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("not a cloud volume"), std::string::npos);
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(VolumeIo, AnErrorWhileLoadingKeepsItsTypeAndMessageAndLeavesNoFile) {
   struct BadData : std::runtime_error {
     using std::runtime_error::runtime_error;
