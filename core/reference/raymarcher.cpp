@@ -1,0 +1,118 @@
+// The CPU reference raymarcher.
+#include "reference/raymarcher.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "geo/geodesy.hpp"
+#include "physics/physics.hpp"
+#include "volume/sampler.hpp"
+
+namespace cv::core {
+namespace {
+namespace p64 = cv::physics::f64;
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+// Grid-box-mean extinction of liquid and of ice at an Earth-centred point.
+struct Medium {
+  const VolumeGrid& grid;
+  VolumeSampler liquid, ice, fraction;
+  bool has_fraction;
+  void at(const glm::dvec3& p, double& sigma_liquid, double& sigma_ice) const {
+    const glm::dvec3 g = p64::ecef_to_sphere(p, grid.earth_radius_m);
+    const double lat = g.x / kDeg, lon = g.y / kDeg, alt = g.z;
+    const double cf = has_fraction ? fraction.sample(lat, lon, alt, 0.0) : 1.0;
+    sigma_liquid = std::max(0.0, cf * liquid.sample(lat, lon, alt, 0.0));
+    sigma_ice = std::max(0.0, cf * ice.sample(lat, lon, alt, 0.0));
+  }
+};
+}  // namespace
+
+glm::dvec3 camera_ray(const Camera& cam, int px, int py) {
+  const geo::EnuFrame f = geo::sphere_enu(cam.lat_deg, cam.lon_deg);
+  const double h = cam.heading_deg * kDeg, pitch = cam.pitch_deg * kDeg;
+  const glm::dvec3 forward = std::cos(pitch) * (std::sin(h) * f.east + std::cos(h) * f.north) + std::sin(pitch) * f.up;
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, f.up) + (std::abs(std::cos(pitch)) < 1e-12 ? f.east : glm::dvec3(0.0)));
+  const glm::dvec3 up = glm::cross(right, forward);
+  const double tan_half = std::tan(0.5 * cam.fov_deg * kDeg);
+  const double x = (2.0 * (px + 0.5) / cam.width - 1.0) * tan_half;
+  const double y = (1.0 - 2.0 * (py + 0.5) / cam.height) * tan_half * cam.height / cam.width;
+  return glm::normalize(forward + x * right + y * up);
+}
+
+ReferenceImage render_reference(const VolumeGrid& grid, const TimeStepData& data, const Camera& cam, const Sun& sun,
+                                const MarchSettings& s) {
+  ReferenceImage img;
+  img.width = cam.width;
+  img.height = cam.height;
+  img.radiance.assign(static_cast<std::size_t>(cam.width) * cam.height, glm::dvec3(0.0));
+  img.transmittance.assign(img.radiance.size(), 1.0);
+  const Medium medium{grid, VolumeSampler(grid, data[Field::ExtinctionLiquid]), VolumeSampler(grid, data[Field::ExtinctionIce]),
+                      VolumeSampler(grid, data[Field::CloudFraction]), !data[Field::CloudFraction].empty()};
+  const double r0 = grid.earth_radius_m;
+  const double hb = grid.alt_m.start, ht = grid.alt_m.last();
+  const glm::dvec3 o = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);
+  const glm::dvec3 to_sun = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0));
+  const p64::MieParams mie = p64::mie_params(s.droplet_diameter_um);
+  const glm::dvec3 up_cam = glm::normalize(o);
+  for (int py = 0; py < cam.height; ++py) {
+    for (int px = 0; px < cam.width; ++px) {
+      const glm::dvec3 d = camera_ray(cam, px, py);
+      // The shell, from the camera's altitude (computed in double) and the ray's cosine with up.
+      glm::dvec4 seg;
+      const int n = p64::ray_shell_rel(r0, cam.alt_m, glm::dot(d, up_cam), hb, ht, seg);
+      // The ground ends the ray.
+      double tg0, tg1;
+      const double t_ground = p64::ray_sphere_rel(r0, cam.alt_m, glm::dot(d, up_cam), 0.0, tg0, tg1) && tg1 > 0.0
+                                  ? std::max(tg0, 0.0) : 1e300;
+      // Sunlight propagates along -to_sun and leaves toward the camera along -d: the scattering
+      // cosine between the two propagation directions is dot(to_sun, d).
+      const double mu = glm::dot(d, to_sun);
+      glm::dvec3 radiance(0.0);
+      double transmittance = 1.0;
+      for (int k = 0; k < n && transmittance > 1e-6; ++k) {
+        const double t_start = seg[2 * k], t_end = std::min(seg[2 * k + 1], t_ground);
+        if (!(t_end > t_start)) continue;
+        const int steps = std::max(1, static_cast<int>(std::ceil((t_end - t_start) / s.view_step_m)));
+        const double dt = (t_end - t_start) / steps;
+        for (int i = 0; i < steps && transmittance > 1e-6; ++i) {
+          const glm::dvec3 p = o + (t_start + (i + 0.5) * dt) * d;
+          double sl, si;
+          medium.at(p, sl, si);
+          const double sigma = sl + si;
+          if (sigma <= 0.0) continue;
+          // Optical depth toward the sun, unless the Earth is in the way.
+          const glm::dvec3 up_p = glm::normalize(p);
+          const double alt_p = glm::length(p) - r0;
+          const double mu_sun = glm::dot(to_sun, up_p);
+          double e0, e1, tau_sun = 0.0;
+          bool lit = !(p64::ray_sphere_rel(r0, alt_p, mu_sun, 0.0, e0, e1) && e1 > 0.0);
+          if (lit) {
+            glm::dvec4 sseg;
+            const int sn = p64::ray_shell_rel(r0, alt_p, mu_sun, hb, ht, sseg);
+            for (int q = 0; q < sn; ++q) {
+              const double ds = (sseg[2 * q + 1] - sseg[2 * q]) / s.sun_steps;
+              for (int j = 0; j < s.sun_steps; ++j) {
+                double a, b;
+                medium.at(p + (sseg[2 * q] + (j + 0.5) * ds) * to_sun, a, b);
+                tau_sun += (a + b) * ds;
+              }
+            }
+          }
+          // In-scattered radiance per metre: the octave sums of both phases (clouds do not absorb).
+          const double scatter = lit ? p64::ms_octaves_mie(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c) +
+                                           p64::ms_octaves_hg(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c)
+                                     : 0.0;
+          radiance += transmittance * p64::segment_integral(sun.irradiance * scatter, sigma, dt);
+          transmittance *= p64::transmittance(sigma * dt);
+        }
+      }
+      const std::size_t idx = static_cast<std::size_t>(py) * cam.width + px;
+      img.radiance[idx] = radiance;
+      img.transmittance[idx] = transmittance;
+    }
+  }
+  return img;
+}
+
+}  // namespace cv::core

@@ -1,0 +1,52 @@
+// The CPU reference raymarcher: double precision, through the same physics functions
+// (shaders/common) and the same sampling of the data (volume/sampler) as the GPU will use, so
+// tests can hold the GPU image against it. Single scattering toward the sun with the
+// multiple-scattering octaves; no sky, ground or ambient term yet (the renderer issue adds them).
+#pragma once
+
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "volume/cloud_volume.hpp"
+
+namespace cv::core {
+
+// A pinhole camera on the spherical Earth. Heading is clockwise from north, pitch up from the
+// horizon, fov the horizontal field of view; all in degrees.
+struct Camera {
+  double lat_deg = 0.0, lon_deg = 0.0, alt_m = 0.0;
+  double heading_deg = 0.0, pitch_deg = 0.0, fov_deg = 60.0;
+  int width = 64, height = 36;
+};
+
+// The sun by its subsolar point (where it stands at the zenith) and the irradiance it delivers
+// perpendicular to its rays at the top of the cloud layer (per channel, W/m2 or relative units).
+struct Sun {
+  double subsolar_lat_deg = 0.0, subsolar_lon_deg = 0.0;
+  glm::dvec3 irradiance{1.0, 1.0, 1.0};
+};
+
+struct MarchSettings {
+  double view_step_m = 100.0;  // march step along view rays
+  int sun_steps = 32;          // steps of the secondary march toward the sun
+  int octaves = 1;             // 1 = single scattering
+  double octave_a = 0.5, octave_b = 0.5, octave_c = 0.5;
+  double droplet_diameter_um = 20.0;  // approximate Mie phase for liquid
+  double ice_g = 0.75;                // Henyey-Greenstein for ice
+};
+
+struct ReferenceImage {
+  int width = 0, height = 0;
+  std::vector<glm::dvec3> radiance;    // scattered toward the camera, per pixel
+  std::vector<double> transmittance;   // of the view ray through the clouds
+};
+
+// The direction of a pixel's ray in Earth-centred coordinates.
+glm::dvec3 camera_ray(const Camera& cam, int px, int py);
+
+// Renders one time step of a volume (its extinction and cloud-fraction fields).
+ReferenceImage render_reference(const VolumeGrid& grid, const TimeStepData& data, const Camera& cam, const Sun& sun,
+                                const MarchSettings& settings);
+
+}  // namespace cv::core
