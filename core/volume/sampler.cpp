@@ -1,48 +1,35 @@
 // Trilinear sampling of volume fields.
 #include "volume/sampler.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include "physics/physics.hpp"
 
 namespace cv::core {
 
 VolumeSampler::VolumeSampler(const VolumeGrid& grid, const std::vector<float>& field)
     : grid_(grid), field_(field), wraps_(grid.wraps_lon()) {}
 
-double VolumeSampler::lon_index(double lon_deg) const {
-  const auto& a = grid_.lon_deg;
-  // Degrees east of the first column, in [0, 360).
-  double east = std::fmod(lon_deg - a.start, 360.0);
-  if (east < 0.0) east += 360.0;
-  const double f = east / a.step;
-  if (wraps_) return f >= a.count ? f - a.count : f;
-  const double last = a.count - 1;
-  if (f <= last + 1e-9) return std::min(f, last);
-  return -1.0;
+bool VolumeSampler::global_lat() const {
+  const auto& la = grid_.lat_deg;
+  return wraps_ && la.start - la.step < -90.0 + 1e-9 && la.last() + la.step > 90.0 - 1e-9;
 }
 
 double VolumeSampler::sample(double lat_deg, double lon_deg, double alt_m, double nodata) const {
   if (field_.empty() || !std::isfinite(lat_deg) || !std::isfinite(lon_deg) || !std::isfinite(alt_m)) return nodata;
-  const auto& la = grid_.lat_deg;
-  const auto& al = grid_.alt_m;
-  const double fx = lon_index(lon_deg);
-  if (fx < 0.0) return nodata;
-  double fy = (lat_deg - la.start) / la.step;
-  const double fz = (alt_m - al.start) / al.step;
-  const double ny = la.count - 1, nz = al.count - 1;
-  // A global grid's rows end at or near the poles: beyond its first and last rows the edge row
-  // holds (no data is missing there); a regional grid has nothing beyond its rows.
-  const bool global_lat = wraps_ && la.start - la.step < -90.0 + 1e-9 && la.last() + la.step > 90.0 - 1e-9;
-  if (fy < 0.0 || fy > ny) {
-    if (!global_lat) return nodata;
-    fy = std::min(std::max(fy, 0.0), ny);
-  }
-  if (fz < -1e-9 || fz > nz + 1e-9) return nodata;
-  const int x0 = static_cast<int>(std::floor(fx));
-  const int y0 = std::min(static_cast<int>(std::floor(fy)), std::max(0, la.count - 2));
-  const int z0 = std::min(static_cast<int>(std::floor(std::max(fz, 0.0))), std::max(0, al.count - 2));
-  const int x1 = wraps_ ? (x0 + 1) % grid_.lon_deg.count : std::min(x0 + 1, grid_.lon_deg.count - 1);
-  const int y1 = std::min(y0 + 1, la.count - 1), z1 = std::min(z0 + 1, al.count - 1);
-  const double wx = fx - x0, wy = std::min(std::max(fy - y0, 0.0), 1.0), wz = std::min(std::max(fz - z0, 0.0), 1.0);
+  const glm::dvec3 start(grid_.lon_deg.start, grid_.lat_deg.start, grid_.alt_m.start);
+  const glm::dvec3 step(grid_.lon_deg.step, grid_.lat_deg.step, grid_.alt_m.step);
+  const glm::dvec3 count(grid_.lon_deg.count, grid_.lat_deg.count, grid_.alt_m.count);
+  glm::dvec3 f;
+  if (!physics::f64::volume_coords(lat_deg, lon_deg, alt_m, start, step, count, wraps_, global_lat(), f)) return nodata;
+  const int nx = grid_.lon_deg.count, ny = grid_.lat_deg.count, nz = grid_.alt_m.count;
+  const int x0 = std::min(static_cast<int>(std::floor(f.x)), nx - 1);
+  const int y0 = std::min(static_cast<int>(std::floor(f.y)), std::max(0, ny - 2));
+  const int z0 = std::min(static_cast<int>(std::floor(f.z)), std::max(0, nz - 2));
+  const int x1 = wraps_ ? (x0 + 1) % nx : std::min(x0 + 1, nx - 1);
+  const int y1 = std::min(y0 + 1, ny - 1), z1 = std::min(z0 + 1, nz - 1);
+  const double wx = f.x - x0, wy = std::min(std::max(f.y - y0, 0.0), 1.0), wz = std::min(std::max(f.z - z0, 0.0), 1.0);
   auto at = [&](int x, int y, int z) {
     const double v = field_[grid_.index(x, y, z)];
     return std::isnan(v) ? nodata : v;

@@ -18,9 +18,8 @@ class VolumeSampler {
   // used: 0 for extinction (no cloud known), NaN to see the gaps.
   double sample(double lat_deg, double lon_deg, double alt_m, double nodata) const;
 
-  // Fractional index of a longitude: in [0, count - 1] inside a regional grid, in [0, count) on a
-  // global one (where count wraps to 0), or negative when outside.
-  double lon_index(double lon_deg) const;
+  // Whether the grid's rows reach the poles (then latitude clamps to the edge rows).
+  bool global_lat() const;
 
  private:
   const VolumeGrid& grid_;

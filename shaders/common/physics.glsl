@@ -12,3 +12,4 @@
 #include "octaves.glsl"
 #include "intersect.glsl"
 #include "geodesy.glsl"
+#include "volume_coords.glsl"
