@@ -16,17 +16,32 @@ constexpr double kDeg = 3.14159265358979323846 / 180.0;
 // Grid-box-mean extinction of liquid and of ice at an Earth-centred point.
 struct Medium {
   const VolumeGrid& grid;
-  VolumeSampler liquid, ice, fraction;
-  bool has_fraction;
+  VolumeSampler liquid, ice;
   void at(const glm::dvec3& p, double& sigma_liquid, double& sigma_ice) const {
     const glm::dvec3 g = p64::ecef_to_sphere(p, grid.earth_radius_m);
     const double lat = g.x / kDeg, lon = g.y / kDeg, alt = g.z;
-    const double cf = has_fraction ? fraction.sample(lat, lon, alt, 0.0) : 1.0;
-    sigma_liquid = std::max(0.0, cf * liquid.sample(lat, lon, alt, 0.0));
-    sigma_ice = std::max(0.0, cf * ice.sample(lat, lon, alt, 0.0));
+    sigma_liquid = liquid.sample(lat, lon, alt, 0.0);
+    sigma_ice = ice.sample(lat, lon, alt, 0.0);
   }
 };
 }  // namespace
+
+GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepData& data) {
+  GridMeanExtinction m;
+  const auto& cf = data[Field::CloudFraction];
+  auto product = [&](const std::vector<float>& ext, std::vector<float>& out) {
+    out.assign(grid.points(), 0.0f);
+    if (ext.empty()) return;
+    for (std::size_t p = 0; p < out.size(); ++p) {
+      const float c = cf.empty() ? 1.0f : cf[p];
+      const float v = c * ext[p];
+      out[p] = std::isnan(v) || v < 0.0f ? 0.0f : v;
+    }
+  };
+  product(data[Field::ExtinctionLiquid], m.liquid_per_m);
+  product(data[Field::ExtinctionIce], m.ice_per_m);
+  return m;
+}
 
 glm::dvec3 camera_ray(const Camera& cam, int px, int py) {
   const geo::EnuFrame f = geo::sphere_enu(cam.lat_deg, cam.lon_deg);
@@ -40,15 +55,14 @@ glm::dvec3 camera_ray(const Camera& cam, int px, int py) {
   return glm::normalize(forward + x * right + y * up);
 }
 
-ReferenceImage render_reference(const VolumeGrid& grid, const TimeStepData& data, const Camera& cam, const Sun& sun,
+ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction& ext, const Camera& cam, const Sun& sun,
                                 const MarchSettings& s) {
   ReferenceImage img;
   img.width = cam.width;
   img.height = cam.height;
   img.radiance.assign(static_cast<std::size_t>(cam.width) * cam.height, glm::dvec3(0.0));
   img.transmittance.assign(img.radiance.size(), 1.0);
-  const Medium medium{grid, VolumeSampler(grid, data[Field::ExtinctionLiquid]), VolumeSampler(grid, data[Field::ExtinctionIce]),
-                      VolumeSampler(grid, data[Field::CloudFraction]), !data[Field::CloudFraction].empty()};
+  const Medium medium{grid, VolumeSampler(grid, ext.liquid_per_m), VolumeSampler(grid, ext.ice_per_m)};
   const double r0 = grid.earth_radius_m;
   const double hb = grid.alt_m.start, ht = grid.alt_m.last();
   const glm::dvec3 o = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);

@@ -42,11 +42,23 @@ struct ReferenceImage {
   std::vector<double> transmittance;   // of the view ray through the clouds
 };
 
+// The renderer's medium: grid-box-mean extinction (cloud fraction x in-cloud extinction) of
+// liquid and of ice per grid node, no data as 0. Both the CPU reference and the GPU interpolate
+// these products, never the factors separately.
+struct GridMeanExtinction {
+  std::vector<float> liquid_per_m, ice_per_m;
+};
+GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepData& data);
+
 // The direction of a pixel's ray in Earth-centred coordinates.
 glm::dvec3 camera_ray(const Camera& cam, int px, int py);
 
-// Renders one time step of a volume (its extinction and cloud-fraction fields).
-ReferenceImage render_reference(const VolumeGrid& grid, const TimeStepData& data, const Camera& cam, const Sun& sun,
+// Renders one time step of a volume.
+ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction& medium, const Camera& cam, const Sun& sun,
                                 const MarchSettings& settings);
+inline ReferenceImage render_reference(const VolumeGrid& grid, const TimeStepData& data, const Camera& cam, const Sun& sun,
+                                       const MarchSettings& settings) {
+  return render_reference(grid, grid_mean_extinction(grid, data), cam, sun, settings);
+}
 
 }  // namespace cv::core
