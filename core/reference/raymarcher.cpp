@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/glm.hpp>
+
 #include "geo/geodesy.hpp"
 #include "physics/physics.hpp"
 #include "volume/sampler.hpp"
@@ -43,16 +45,24 @@ GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepDa
   return m;
 }
 
-glm::dvec3 camera_ray(const Camera& cam, int px, int py) {
+CameraFrame camera_frame(const Camera& cam) {
   const geo::EnuFrame f = geo::sphere_enu(cam.lat_deg, cam.lon_deg);
   const double h = cam.heading_deg * kDeg, pitch = cam.pitch_deg * kDeg;
-  const glm::dvec3 forward = std::cos(pitch) * (std::sin(h) * f.east + std::cos(h) * f.north) + std::sin(pitch) * f.up;
-  const glm::dvec3 right = glm::normalize(glm::cross(forward, f.up) + (std::abs(std::cos(pitch)) < 1e-12 ? f.east : glm::dvec3(0.0)));
-  const glm::dvec3 up = glm::cross(right, forward);
-  const double tan_half = std::tan(0.5 * cam.fov_deg * kDeg);
-  const double x = (2.0 * (px + 0.5) / cam.width - 1.0) * tan_half;
-  const double y = (1.0 - 2.0 * (py + 0.5) / cam.height) * tan_half * cam.height / cam.width;
-  return glm::normalize(forward + x * right + y * up);
+  CameraFrame c;
+  c.forward = std::cos(pitch) * (std::sin(h) * f.east + std::cos(h) * f.north) + std::sin(pitch) * f.up;
+  // Looking straight up or down the heading is undefined: east is then "right".
+  const glm::dvec3 side = glm::cross(c.forward, f.up);
+  c.right = glm::length(side) < 1e-12 ? f.east : glm::normalize(side);
+  c.up = glm::cross(c.right, c.forward);
+  c.tan_half = std::tan(0.5 * cam.fov_deg * kDeg);
+  return c;
+}
+
+glm::dvec3 camera_ray(const Camera& cam, int px, int py) {
+  const CameraFrame c = camera_frame(cam);
+  const double x = (2.0 * (px + 0.5) / cam.width - 1.0) * c.tan_half;
+  const double y = (1.0 - 2.0 * (py + 0.5) / cam.height) * c.tan_half * cam.height / cam.width;
+  return glm::normalize(c.forward + x * c.right + y * c.up);
 }
 
 ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction& ext, const Camera& cam, const Sun& sun,

@@ -50,6 +50,14 @@ struct GridMeanExtinction {
 };
 GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepData& data);
 
+// A camera's orientation in Earth-centred coordinates, and its half-width: pixel (px, py) looks
+// along forward + x right + y up with x, y in [-tan_half, tan_half] (y scaled by the aspect).
+struct CameraFrame {
+  glm::dvec3 forward, right, up;
+  double tan_half = 0.0;
+};
+CameraFrame camera_frame(const Camera& cam);
+
 // The direction of a pixel's ray in Earth-centred coordinates.
 glm::dvec3 camera_ray(const Camera& cam, int px, int py);
 

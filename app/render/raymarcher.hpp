@@ -1,0 +1,35 @@
+// The GPU raymarcher (shaders/render/raymarch.comp): uploads a volume's grid-mean extinction as 3-D
+// textures and renders a camera's view into linear radiance and transmittance, the same quantities
+// as the CPU reference (core/reference/raymarcher).
+#pragma once
+
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "reference/raymarcher.hpp"
+#include "render/shader_loader.hpp"
+
+namespace cv::render {
+
+class GpuRaymarcher {
+ public:
+  // Needs a current OpenGL 4.5 context; compiles the raymarcher.
+  explicit GpuRaymarcher(const ShaderLoader& loader);
+  ~GpuRaymarcher();
+  GpuRaymarcher(const GpuRaymarcher&) = delete;
+  GpuRaymarcher& operator=(const GpuRaymarcher&) = delete;
+
+  // Uploads one time step (replacing the previous one).
+  void upload(const core::VolumeGrid& grid, const core::GridMeanExtinction& medium);
+
+  // Renders: rgb = radiance, a = view transmittance, rows top to bottom.
+  std::vector<glm::vec4> render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings);
+
+ private:
+  GlProgram program_;
+  GLuint textures_[2] = {0, 0};
+  core::VolumeGrid grid_;
+};
+
+}  // namespace cv::render

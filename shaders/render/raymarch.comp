@@ -1,0 +1,128 @@
+// The volumetric raymarcher on the spherical shell, in the form of the CPU reference
+// (core/reference/raymarcher.cpp): shell intersection from the camera's altitude, the segment
+// integral per step, a secondary march toward the sun with the Earth's shadow, and the octave sum
+// with the approximate Mie phase for liquid and Henyey-Greenstein for ice. Output: rgb radiance,
+// a = view transmittance.
+#include "../common/physics.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(rgba32f, binding = 0) writeonly uniform image2D u_out;
+layout(binding = 1) uniform sampler3D u_liquid;  // grid-mean extinction, 1/m (cf x in-cloud)
+layout(binding = 2) uniform sampler3D u_ice;
+
+uniform ivec2 u_size;
+uniform vec3 u_cam_ecef;      // metres (float: 0.5 m at the Earth's radius, enough to sample clouds)
+uniform float u_cam_alt;      // metres, from double on the CPU
+uniform vec3 u_cam_up;        // local vertical at the camera
+uniform vec3 u_forward;
+uniform vec3 u_right;
+uniform vec3 u_upv;
+uniform float u_tan_half;     // of the horizontal field of view
+uniform vec3 u_to_sun;
+uniform vec3 u_irradiance;
+uniform float u_r0;           // the sphere's radius
+uniform vec3 u_grid_start;    // (lon deg, lat deg, alt m)
+uniform vec3 u_grid_step;
+uniform vec3 u_grid_count;
+uniform bool u_wraps;
+uniform bool u_global_lat;
+uniform float u_view_step;
+uniform int u_sun_steps;
+uniform int u_octaves;
+uniform vec3 u_octave_abc;
+uniform float u_droplet_um;
+uniform float u_ice_g;
+
+const float kDeg = 0.017453292519943295;
+
+// Trilinear over texel centres, exactly as core/volume/sampler.cpp: no data reads as 0.
+float fetch(sampler3D tex, vec3 f) {
+  ivec3 n = ivec3(u_grid_count);
+  int x0 = min(int(floor(f.x)), n.x - 1);
+  int y0 = min(int(floor(f.y)), max(0, n.y - 2));
+  int z0 = min(int(floor(f.z)), max(0, n.z - 2));
+  int x1 = u_wraps ? (x0 + 1) % n.x : min(x0 + 1, n.x - 1);
+  int y1 = min(y0 + 1, n.y - 1);
+  int z1 = min(z0 + 1, n.z - 1);
+  float wx = f.x - float(x0);
+  float wy = clamp(f.y - float(y0), 0.0, 1.0);
+  float wz = clamp(f.z - float(z0), 0.0, 1.0);
+  float c00 = mix(texelFetch(tex, ivec3(x0, y0, z0), 0).r, texelFetch(tex, ivec3(x1, y0, z0), 0).r, wx);
+  float c10 = mix(texelFetch(tex, ivec3(x0, y1, z0), 0).r, texelFetch(tex, ivec3(x1, y1, z0), 0).r, wx);
+  float c01 = mix(texelFetch(tex, ivec3(x0, y0, z1), 0).r, texelFetch(tex, ivec3(x1, y0, z1), 0).r, wx);
+  float c11 = mix(texelFetch(tex, ivec3(x0, y1, z1), 0).r, texelFetch(tex, ivec3(x1, y1, z1), 0).r, wx);
+  return mix(mix(c00, c10, wy), mix(c01, c11, wy), wz);
+}
+
+void medium_at(vec3 p, out float sl, out float si) {
+  sl = 0.0;
+  si = 0.0;
+  vec3 g = ecef_to_sphere(p, u_r0);
+  vec3 f;
+  if (!volume_coords(g.x / kDeg, g.y / kDeg, g.z, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
+  sl = fetch(u_liquid, f);
+  si = fetch(u_ice, f);
+}
+
+void main() {
+  ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+  if (px.x >= u_size.x || px.y >= u_size.y) return;
+  float x = (2.0 * (float(px.x) + 0.5) / float(u_size.x) - 1.0) * u_tan_half;
+  float y = (1.0 - 2.0 * (float(px.y) + 0.5) / float(u_size.y)) * u_tan_half * float(u_size.y) / float(u_size.x);
+  vec3 d = normalize(u_forward + x * u_right + y * u_upv);
+  float hb = u_grid_start.z;
+  float ht = u_grid_start.z + u_grid_step.z * (u_grid_count.z - 1.0);
+  float mu_up = dot(d, u_cam_up);
+  vec4 seg;
+  int n = ray_shell_rel(u_r0, u_cam_alt, mu_up, hb, ht, seg);
+  float tg0;
+  float tg1;
+  float t_ground = ray_sphere_rel(u_r0, u_cam_alt, mu_up, 0.0, tg0, tg1) && tg1 > 0.0 ? max(tg0, 0.0) : 3.0e38;
+  float mu = dot(d, u_to_sun);
+  MieParams mie = mie_params(u_droplet_um);
+  vec3 radiance = vec3(0.0);
+  float t_view = 1.0;
+  for (int k = 0; k < n && t_view > 1e-6; ++k) {
+    float t_start = k == 0 ? seg.x : seg.z;
+    float t_end = min(k == 0 ? seg.y : seg.w, t_ground);
+    if (!(t_end > t_start)) continue;
+    int steps = max(1, int(ceil((t_end - t_start) / u_view_step)));
+    float dt = (t_end - t_start) / float(steps);
+    for (int i = 0; i < steps && t_view > 1e-6; ++i) {
+      vec3 p = u_cam_ecef + (t_start + (float(i) + 0.5) * dt) * d;
+      float sl;
+      float si;
+      medium_at(p, sl, si);
+      float sigma = sl + si;
+      if (sigma <= 0.0) continue;
+      vec3 up_p = normalize(p);
+      float alt_p = length(p) - u_r0;
+      float mu_sun = dot(u_to_sun, up_p);
+      float e0;
+      float e1;
+      bool lit = !(ray_sphere_rel(u_r0, alt_p, mu_sun, 0.0, e0, e1) && e1 > 0.0);
+      float tau_sun = 0.0;
+      if (lit) {
+        vec4 sseg;
+        int sn = ray_shell_rel(u_r0, alt_p, mu_sun, hb, ht, sseg);
+        for (int q = 0; q < sn; ++q) {
+          float s0 = q == 0 ? sseg.x : sseg.z;
+          float s1 = q == 0 ? sseg.y : sseg.w;
+          float ds = (s1 - s0) / float(u_sun_steps);
+          for (int j = 0; j < u_sun_steps; ++j) {
+            float a;
+            float b;
+            medium_at(p + (s0 + (float(j) + 0.5) * ds) * u_to_sun, a, b);
+            tau_sun += (a + b) * ds;
+          }
+        }
+      }
+      float scatter = lit ? ms_octaves_mie(sl, mu, mie, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z) +
+                                ms_octaves_hg(si, mu, u_ice_g, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
+                          : 0.0;
+      radiance += t_view * segment_integral(u_irradiance * scatter, sigma, dt);
+      t_view *= transmittance(sigma * dt);
+    }
+  }
+  imageStore(u_out, px, vec4(radiance, t_view));
+}
