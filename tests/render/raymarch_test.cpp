@@ -77,3 +77,43 @@ TEST(Raymarch, GpuMatchesTheCpuReference) {
 }
 
 }  // namespace
+
+#include "importer.hpp"
+
+namespace {
+
+TEST(Raymarch, TheBundledSampleRendersWithCloudAndWithoutNaN) {
+  auto ctx = render::make_headless_context();
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::GpuRaymarcher gpu(loader);
+  auto vol = importers::import_file(CV_SAMPLE_FILE);
+  const auto& g = vol.grid;
+  gpu.upload(g, core::grid_mean_extinction(g, vol.step(3)));
+  core::Camera cam;  // from 5000 km above the middle of the domain, straight down
+  cam.lat_deg = 45.0;
+  cam.lon_deg = 190.0;
+  cam.alt_m = 5.0e6;
+  cam.pitch_deg = -90.0;
+  cam.fov_deg = 60.0;
+  cam.width = 64;
+  cam.height = 36;
+  core::Sun sun;
+  sun.subsolar_lat_deg = -21.0;
+  sun.subsolar_lon_deg = 190.0;
+  core::MarchSettings s;
+  s.view_step_m = 500.0;
+  s.octaves = 4;
+  const auto img = gpu.render(cam, sun, s);
+  int cloudy = 0, clear = 0;
+  for (const auto& p : img) {
+    ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w));
+    ASSERT_GE(p.w, 0.0f);
+    ASSERT_LE(p.w, 1.0f);
+    (p.w < 0.5f ? cloudy : clear)++;
+  }
+  // The domain fills part of the view; part of it is cloud, part of the view is clear.
+  EXPECT_GT(cloudy, 100);
+  EXPECT_GT(clear, 100);
+}
+
+}  // namespace
