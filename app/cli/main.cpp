@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "geo/geodesy.hpp"
+#include "geo/solar.hpp"
 #include "importer.hpp"
 #include <glm/glm.hpp>
 #include "physics/physics.hpp"
@@ -45,6 +46,7 @@ void print_usage() {
       "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"
       "  render INPUT -o OUT.png [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov]\n"
       "         [--sun LAT,LON] [--steps M] [--sun-steps N] [--octaves N] [--exposure E] [--pfm OUT.pfm]\n"
+      "                           (the sun stands where it stood at the valid time unless --sun is given)\n"
       "                           render a NetCDF file or .cvvol volume headlessly (EGL) to a PNG\n"
       "  --version                print the version\n");
 }
@@ -321,9 +323,23 @@ int cmd_render(const std::vector<std::string>& args) {
     cam.heading_deg = std::atan2(glm::dot(dir, f.east), glm::dot(dir, f.north)) * 180.0 / 3.14159265358979323846;
     cam.fov_deg = 60.0;
   }
+  // The sun where it stood at the valid time, unless set by hand or the time is unknown.
   cv::core::Sun s;
-  s.subsolar_lat_deg = sun ? (*sun)[0] : -20.0;
-  s.subsolar_lon_deg = sun ? (*sun)[1] : cam.lon_deg - 50.0;
+  const cv::core::ValidTime& vt = vol.times[static_cast<std::size_t>(step)];
+  const bool known_time = vt.iso_utc.find('T') != std::string::npos;
+  if (sun) {
+    s.subsolar_lat_deg = (*sun)[0];
+    s.subsolar_lon_deg = (*sun)[1];
+  } else if (known_time) {
+    const cv::geo::SubsolarPoint sp = cv::geo::subsolar_point(vt.unix_s);
+    s.subsolar_lat_deg = sp.lat_deg;
+    s.subsolar_lon_deg = sp.lon_deg;
+  } else {
+    s.subsolar_lon_deg = cam.lon_deg;  // noon over the camera
+    std::printf("the input has no valid times: the sun is put at noon over the camera (set it with --sun)\n");
+  }
+  std::printf("sun overhead at %.2f, %.2f (%s)\n", s.subsolar_lat_deg, s.subsolar_lon_deg,
+              sun ? "--sun" : known_time ? "from the valid time" : "default");
   if (march.view_step_m <= 0.0) march.view_step_m = std::max(50.0, g.alt_m.step);
   std::printf("rendering %s, time step %d (%s), %dx%d, view step %.0f m, %d sun steps, %d octaves\n", input.c_str(), step,
               vol.times[static_cast<std::size_t>(step)].iso_utc.c_str(), w, h, march.view_step_m, march.sun_steps,

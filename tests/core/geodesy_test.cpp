@@ -87,3 +87,34 @@ TEST(Geodesy, GeopotentialToHeight) {
 }
 
 }  // namespace
+
+#include "geo/solar.hpp"
+
+namespace {
+
+std::int64_t utc(int y, int m, int d, int h, int mi) {
+  // Days from 1970-01-01 to y-m-d (proleptic Gregorian), then the time of day.
+  const int yy = y - (m <= 2);
+  const long era = (yy >= 0 ? yy : yy - 399) / 400;
+  const long yoe = yy - era * 400;
+  const long doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const long days = era * 146097 + yoe * 365 + yoe / 4 - yoe / 100 + doy - 719468;
+  return static_cast<std::int64_t>(days) * 86400 + h * 3600 + mi * 60;
+}
+
+TEST(Solar, SolsticesEquinoxAndLocalNoon) {
+  using cv::geo::subsolar_point;
+  // Almanac instants of 2024: June solstice 20 Jun 20:51 UTC, December solstice 21 Dec 09:21,
+  // March equinox 20 Mar 03:06.
+  EXPECT_NEAR(subsolar_point(utc(2024, 6, 20, 20, 51)).lat_deg, 23.44, 0.02);
+  EXPECT_NEAR(subsolar_point(utc(2024, 12, 21, 9, 21)).lat_deg, -23.44, 0.02);
+  EXPECT_NEAR(subsolar_point(utc(2024, 3, 20, 3, 6)).lat_deg, 0.0, 0.02);
+  // At 12:00 UTC the sun stands over Greenwich within the equation of time (at most ~16 minutes,
+  // 4 degrees): on 3 November it runs ~16 min fast, putting noon at 4.1 degrees west.
+  EXPECT_NEAR(subsolar_point(utc(2024, 11, 3, 12, 0)).lon_deg, -4.1, 0.15);
+  // And the sun moves west 15 degrees an hour.
+  const double a = subsolar_point(utc(2024, 1, 15, 0, 0)).lon_deg, b = subsolar_point(utc(2024, 1, 15, 1, 0)).lon_deg;
+  EXPECT_NEAR(cv::geo::wrap_lon_deg(a - b), 15.0, 0.01);
+}
+
+}  // namespace
