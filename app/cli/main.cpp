@@ -45,7 +45,8 @@ void print_usage() {
       "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"
       "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"
       "  render INPUT -o OUT.png [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov]\n"
-      "         [--sun LAT,LON] [--steps M] [--sun-steps N] [--octaves N] [--exposure E] [--pfm OUT.pfm]\n"
+      "         [--sun LAT,LON] [--steps M] [--sun-steps N] [--octaves N] [--accumulate N] [--exposure E]\n"
+      "         [--pfm OUT.pfm]\n"
       "                           (the sun stands where it stood at the valid time unless --sun is given)\n"
       "                           render a NetCDF file or .cvvol volume headlessly (EGL) to a PNG\n"
       "  --version                print the version\n");
@@ -238,7 +239,7 @@ int cmd_render(const std::vector<std::string>& args) {
   using clock = std::chrono::steady_clock;
   auto seconds = [](clock::time_point a) { return std::chrono::duration<double>(clock::now() - a).count(); };
   std::string input, out, pfm;
-  int w = 960, h = 540, step = 0;
+  int w = 960, h = 540, step = 0, accumulate = 1;
   std::optional<std::vector<double>> camera, sun;
   cv::core::MarchSettings march;
   march.view_step_m = 0.0;  // from the grid unless set
@@ -275,6 +276,9 @@ int cmd_render(const std::vector<std::string>& args) {
     } else if (a == "--octaves") {
       march.octaves = static_cast<int>(parse_number("--octaves", next()));
       if (march.octaves < 1 || march.octaves > 16) throw UsageError{"cloudviewer render: --octaves: expected 1..16"};
+    } else if (a == "--accumulate") {
+      accumulate = static_cast<int>(parse_number("--accumulate", next()));
+      if (accumulate < 1 || accumulate > 4096) throw UsageError{"cloudviewer render: --accumulate: expected 1..4096 frames"};
     } else if (a == "--exposure") {
       tone.exposure = parse_number("--exposure", next());
       if (!(tone.exposure > 0)) throw UsageError{"cloudviewer render: --exposure: expected a number > 0"};
@@ -341,9 +345,9 @@ int cmd_render(const std::vector<std::string>& args) {
   std::printf("sun overhead at %.2f, %.2f (%s)\n", s.subsolar_lat_deg, s.subsolar_lon_deg,
               sun ? "--sun" : known_time ? "from the valid time" : "default");
   if (march.view_step_m <= 0.0) march.view_step_m = std::max(50.0, g.alt_m.step);
-  std::printf("rendering %s, time step %d (%s), %dx%d, view step %.0f m, %d sun steps, %d octaves\n", input.c_str(), step,
-              vol.times[static_cast<std::size_t>(step)].iso_utc.c_str(), w, h, march.view_step_m, march.sun_steps,
-              march.octaves);
+  std::printf("rendering %s, time step %d (%s), %dx%d, view step %.0f m, %d sun steps, %d octaves, %d frame(s)\n",
+              input.c_str(), step, vol.times[static_cast<std::size_t>(step)].iso_utc.c_str(), w, h, march.view_step_m,
+              march.sun_steps, march.octaves, accumulate);
   auto ctx = cv::render::make_headless_context();
   const cv::render::ShaderLoader loader({cv::render::ShaderLoader::default_shader_dir()});
   cv::render::GpuRaymarcher gpu(loader);
@@ -352,7 +356,21 @@ int cmd_render(const std::vector<std::string>& args) {
   glFinish();
   const double t_upload = seconds(t0);
   t0 = clock::now();
-  const std::vector<glm::vec4> pixels = gpu.render(cam, s, march);
+  // One frame at step middles, or the mean of jittered frames (banding averages away).
+  std::vector<glm::vec4> pixels;
+  if (accumulate == 1) {
+    pixels = gpu.render(cam, s, march);
+  } else {
+    pixels.assign(static_cast<std::size_t>(w) * h, glm::vec4(0.0f));
+    for (int f = 0; f < accumulate; ++f) {
+      march.frame = f;
+      const std::vector<glm::vec4> frame = gpu.render(cam, s, march);
+      for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] += (frame[i] - pixels[i]) / static_cast<float>(f + 1);
+      std::printf("\raccumulated %d/%d frames", f + 1, accumulate);
+      std::fflush(stdout);
+    }
+    std::printf("\n");
+  }
   const double t_march = seconds(t0);
   t0 = clock::now();
   std::size_t bad = 0;

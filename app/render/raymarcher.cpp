@@ -64,6 +64,7 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   set3(p, "u_octave_abc", {s.octave_a, s.octave_b, s.octave_c});
   glProgramUniform1f(p, loc(p, "u_droplet_um"), static_cast<float>(s.droplet_diameter_um));
   glProgramUniform1f(p, loc(p, "u_ice_g"), static_cast<float>(s.ice_g));
+  glProgramUniform1i(p, loc(p, "u_frame"), s.frame);
   GLuint out = 0;
   glCreateTextures(GL_TEXTURE_2D, 1, &out);
   glTextureStorage2D(out, 1, GL_RGBA32F, cam.width, cam.height);

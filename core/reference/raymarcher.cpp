@@ -99,8 +99,11 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
         if (!(t_end > t_start)) continue;
         const int steps = std::max(1, static_cast<int>(std::ceil((t_end - t_start) / s.view_step_m)));
         const double dt = (t_end - t_start) / steps;
+        const double offset = s.frame < 0 ? 0.5
+                                          : p64::step_jitter(static_cast<p64::uint>(px), static_cast<p64::uint>(py),
+                                                             static_cast<p64::uint>(s.frame));
         for (int i = 0; i < steps && transmittance > 1e-6; ++i) {
-          const glm::dvec3 p = o + (t_start + (i + 0.5) * dt) * d;
+          const glm::dvec3 p = o + (t_start + (i + offset) * dt) * d;
           double sl, si;
           medium.at(p, sl, si);
           const double sigma = sl + si;

@@ -34,6 +34,9 @@ struct MarchSettings {
   double octave_a = 0.5, octave_b = 0.5, octave_c = 0.5;
   double droplet_diameter_um = 20.0;  // approximate Mie phase for liquid
   double ice_g = 0.75;                // Henyey-Greenstein for ice
+  // -1: sample each step at its middle; otherwise the accumulation frame whose jittered offsets
+  // (shaders/common/rng.glsl step_jitter) place the samples, so banding averages away over frames.
+  int frame = -1;
 };
 
 struct ReferenceImage {

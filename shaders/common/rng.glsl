@@ -11,3 +11,10 @@ CV_FN real rng_next(CV_INOUT(uint) state) {
   state = pcg_hash(state);
   return real(state >> 8u) * real(5.9604644775390625e-8);
 }
+
+// The offset within a march step for pixel (px, py) in accumulation frame `frame`: a hash, so the
+// GPU and the CPU reference march through the same points; frames decorrelate the offsets.
+CV_FN real step_jitter(uint px, uint py, uint frame) {
+  uint seed = pcg_hash(px * 1973u + py * 9277u + frame * 26699u + 1u);
+  return real(seed >> 8u) * real(5.9604644775390625e-8);
+}

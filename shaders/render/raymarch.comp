@@ -32,6 +32,7 @@ uniform int u_octaves;
 uniform vec3 u_octave_abc;
 uniform float u_droplet_um;
 uniform float u_ice_g;
+uniform int u_frame;  // -1: step middles; else the accumulation frame (step_jitter)
 
 const float kDeg = 0.017453292519943295;
 
@@ -88,8 +89,9 @@ void main() {
     if (!(t_end > t_start)) continue;
     int steps = max(1, int(ceil((t_end - t_start) / u_view_step)));
     float dt = (t_end - t_start) / float(steps);
+    float offset = u_frame < 0 ? 0.5 : step_jitter(uint(px.x), uint(px.y), uint(u_frame));
     for (int i = 0; i < steps && t_view > 1e-6; ++i) {
-      vec3 p = u_cam_ecef + (t_start + (float(i) + 0.5) * dt) * d;
+      vec3 p = u_cam_ecef + (t_start + (float(i) + offset) * dt) * d;
       float sl;
       float si;
       medium_at(p, sl, si);

@@ -74,6 +74,18 @@ TEST(Raymarch, GpuMatchesTheCpuReference) {
               "transmittance worst %.3g\n", cam.width, cam.height, mean, worst, worst_t);
   EXPECT_LT(worst, 1e-3);
   EXPECT_LT(worst_t, 1e-3);
+  // With jittered steps (an accumulation frame) both march through the same points.
+  s.frame = 7;
+  const auto cpu_j = core::render_reference(sc.grid, medium, cam, sun, s);
+  const auto gpu_j = gpu.render(cam, sun, s);
+  double worst_j = 0.0, changed = 0.0;
+  for (std::size_t i = 0; i < gpu_j.size(); ++i) {
+    worst_j = std::max(worst_j, std::abs(gpu_j[i].x - cpu_j.radiance[i].x) / max_l);
+    changed = std::max(changed, std::abs(cpu_j.radiance[i].x - cpu.radiance[i].x) / max_l);
+  }
+  std::printf("with jitter (frame 7): worst %.3g; jitter moved pixels by up to %.3g\n", worst_j, changed);
+  EXPECT_LT(worst_j, 1e-3);
+  EXPECT_GT(changed, 1e-4);  // the jitter does move the samples
 }
 
 }  // namespace
