@@ -105,6 +105,16 @@ void main() {
     case PARITY_PCG_HASH: r.u.x = pcg_hash(c.meta.y); break;
     case PARITY_TWO_PROD: r.a.xy = two_prod(c.in0.x, c.in0.y); break;
     case PARITY_DIRECTION_AROUND: r.a.xyz = direction_around(c.in0.xyz, c.in1.x, c.in1.y); break;
+    case PARITY_VOLUME_COORDS: {
+      // in0 = (lat, lon, alt, wraps); in1 = grid start x/y/z and count x packed below by the test.
+      vec3 f;
+      bool wraps = c.in0.w > 0.5;
+      r.u.x = volume_coords(c.in0.x, c.in0.y, c.in0.z, vec3(160.0, 25.0, 0.0), vec3(0.5, 0.5, 500.0),
+                            wraps ? vec3(720.0, 81.0, 33.0) : vec3(121.0, 81.0, 33.0), wraps, false, f) ? 1u : 0u;
+      r.a.xyz = f;
+      break;
+    }
+    case PARITY_STEP_JITTER: r.a.x = step_jitter(uint(c.in0.x), uint(c.in0.y), c.meta.y); break;
     default: r.u.w = 1u; break;
   }
   results[i] = r;

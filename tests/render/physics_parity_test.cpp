@@ -119,6 +119,16 @@ Result eval(const Case& c) {
       break;
     }
     case PARITY_DIRECTION_AROUND: r.a = vec4(f32::direction_around(vec3(c.in0), c.in1.x, c.in1.y), 0); break;
+    case PARITY_VOLUME_COORDS: {
+      glm::vec3 f;
+      const bool wraps = c.in0.w > 0.5f;
+      r.u.x = f32::volume_coords(c.in0.x, c.in0.y, c.in0.z, vec3(160.0f, 25.0f, 0.0f), vec3(0.5f, 0.5f, 500.0f),
+                                 wraps ? vec3(720.0f, 81.0f, 33.0f) : vec3(121.0f, 81.0f, 33.0f), wraps, false, f)
+                  ? 1u : 0u;
+      r.a = vec4(f, 0.0f);
+      break;
+    }
+    case PARITY_STEP_JITTER: r.a.x = f32::step_jitter(static_cast<f32::uint>(c.in0.x), static_cast<f32::uint>(c.in0.y), c.meta.y); break;
     default: r.u.w = 1u; break;
   }
   return r;
@@ -209,6 +219,18 @@ std::vector<Case> build_cases() {
   for (float a : {6371000.0f, 0.3333333f, -12345.678f}) {
     for (float b : {0.9999999f, -7.0e-5f, 3.1415927f}) cs.push_back(mk(PARITY_TWO_PROD, vec4(a, b, 0, 0)));
   }
+  // Grid coordinates on a regional grid (160..220E, 25..65N) and a global one, across the date line
+  // and its edges, above and below; and the step jitter of a few pixels and frames.
+  for (float lon : {-200.0f, -180.0f, -175.0f, 159.9f, 160.0f, 185.25f, 219.99f, 220.0f, 220.3f, 359.9f, 530.0f}) {
+    for (float lat : {24.0f, 25.0f, 44.3f, 65.0f}) {
+      for (float alt : {-1.0f, 0.0f, 7777.0f, 16000.0f, 16001.0f}) {
+        for (float wraps : {0.0f, 1.0f}) cs.push_back(mk(PARITY_VOLUME_COORDS, vec4(lat, lon, alt, wraps)));
+      }
+    }
+  }
+  for (unsigned f = 0; f < 4; ++f) {
+    for (float px : {0.0f, 17.0f, 1919.0f}) cs.push_back(mk(PARITY_STEP_JITTER, vec4(px, 3.0f * px + 1.0f, 0, 0), vec4(0.0f), f));
+  }
   for (int i = 0; i <= 10; ++i) {
     cs.push_back(mk(PARITY_DIRECTION_AROUND, vec4(glm::normalize(vec3(0.1f * i - 0.5f, 0.2f, -0.9f)), 0),
                     vec4(-1.0f + 0.2f * i, 0.6f * i, 0, 0)));
@@ -229,7 +251,8 @@ float floor_for(unsigned id, int component) {
     case PARITY_SAMPLE_DUAL_HG:
     case PARITY_ENU_FRAME:
     case PARITY_DIRECTION_AROUND:
-    case PARITY_ECEF_TO_SPHERE: return 1.0f;
+    case PARITY_ECEF_TO_SPHERE:
+    case PARITY_VOLUME_COORDS: return 1.0f;  // grid indices
     case PARITY_RAY_SPHERE_REL:
     case PARITY_RAY_SHELL_REL:
     case PARITY_RAY_SPHERE: return 1.0f;  // metres
@@ -246,7 +269,7 @@ const char* name_of(unsigned id) {
                                 "sample_draine", "sample_mie", "sample_dual_hg", "segment_factor",
                                 "segment_integral", "transmittance", "octaves_hg", "octaves_mie", "ray_sphere_rel",
                                 "ray_shell_rel", "ray_sphere", "sphere_to_ecef", "ecef_to_sphere", "enu_frame",
-                                "geopotential", "pcg_hash", "two_prod", "direction_around"};
+                                "geopotential", "pcg_hash", "two_prod", "direction_around", "volume_coords", "step_jitter"};
   return id < PARITY_FUNCTION_COUNT ? names[id] : "?";
 }
 
