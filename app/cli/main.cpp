@@ -56,10 +56,10 @@ double parse_number(const std::string& option, const std::string& text) {
   try {
     size_t used = 0;
     const double v = std::stod(text, &used);
-    if (used == text.size()) return v;
+    if (used == text.size() && std::isfinite(v)) return v;
   } catch (const std::exception&) {
   }
-  throw UsageError{"cloudviewer: " + option + ": found '" + text + "', expected a number"};
+  throw UsageError{"cloudviewer: " + option + ": found '" + text + "', expected a finite number"};
 }
 
 std::vector<fs::path> all_shaders(const fs::path& dir) {
@@ -303,6 +303,11 @@ int cmd_render(const std::vector<std::string>& args) {
   const cv::core::GridMeanExtinction medium = cv::core::grid_mean_extinction(vol.grid, data);
   const double t_load = seconds(t0);
   const auto& g = vol.grid;
+  if (g.lon_deg.count < 2 || g.lat_deg.count < 2 || g.alt_m.count < 2) {
+    throw UsageError{"cloudviewer render: " + input + ": the volume is " + std::to_string(g.lon_deg.count) + " x " +
+                     std::to_string(g.lat_deg.count) + " x " + std::to_string(g.alt_m.count) +
+                     " points; rendering needs at least 2 along each axis"};
+  }
   cv::core::Camera cam;
   cam.width = w;
   cam.height = h;

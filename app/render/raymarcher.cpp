@@ -24,6 +24,13 @@ GpuRaymarcher::~GpuRaymarcher() {
 }
 
 void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExtinction& medium) {
+  GLint max3d = 0;
+  glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
+  if (grid.lon_deg.count > max3d || grid.lat_deg.count > max3d || grid.alt_m.count > max3d) {
+    throw GlError("the volume is " + std::to_string(grid.lon_deg.count) + " x " + std::to_string(grid.lat_deg.count) + " x " +
+                  std::to_string(grid.alt_m.count) + " points; this OpenGL allows " + std::to_string(max3d) +
+                  " per side of a 3-D texture: import with --region or --stride");
+  }
   if (textures_[0]) glDeleteTextures(2, textures_);
   glCreateTextures(GL_TEXTURE_3D, 2, textures_);
   const std::vector<float>* fields[2] = {&medium.liquid_per_m, &medium.ice_per_m};
@@ -38,6 +45,11 @@ void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExt
 }
 
 std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s) {
+  // The read-back takes its byte count as a GLsizei.
+  if (static_cast<double>(cam.width) * cam.height * sizeof(glm::vec4) >= 2147483647.0) {
+    throw GlError("an image of " + std::to_string(cam.width) + " x " + std::to_string(cam.height) +
+                  " pixels is too large to read back at once (at most 134 million pixels)");
+  }
   const GLuint p = program_.id();
   const core::CameraFrame c = core::camera_frame(cam);
   const double r0 = grid_.earth_radius_m;

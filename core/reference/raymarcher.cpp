@@ -50,9 +50,9 @@ CameraFrame camera_frame(const Camera& cam) {
   const double h = cam.heading_deg * kDeg, pitch = cam.pitch_deg * kDeg;
   CameraFrame c;
   c.forward = std::cos(pitch) * (std::sin(h) * f.east + std::cos(h) * f.north) + std::sin(pitch) * f.up;
-  // Looking straight up or down the heading is undefined: east is then "right".
-  const glm::dvec3 side = glm::cross(c.forward, f.up);
-  c.right = glm::length(side) < 1e-12 ? f.east : glm::normalize(side);
+  // Right is the heading turned 90 degrees clockwise, level with the ground: defined also when
+  // looking straight up or down, where the heading still sets which way the image turns.
+  c.right = std::cos(h) * f.east - std::sin(h) * f.north;
   c.up = glm::cross(c.right, c.forward);
   c.tan_half = std::tan(0.5 * cam.fov_deg * kDeg);
   return c;

@@ -96,3 +96,18 @@ TEST(Reference, OctavesBrightenAThickCloudAndNothingIsNaN) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Reference, LookingStraightDownTheHeadingStillTurnsTheImage) {
+  // Heading 90 (east): "right" is south, whether the camera looks down exactly or almost.
+  for (double pitch : {-90.0, -89.999}) {
+    Camera c;
+    c.heading_deg = 90.0;
+    c.pitch_deg = pitch;
+    const CameraFrame f = camera_frame(c);
+    EXPECT_NEAR(f.right.z, -1.0, 1e-4) << pitch;  // at (0, 0) north is +z
+  }
+}
+
+}  // namespace
