@@ -82,13 +82,32 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
   for (int py = 0; py < cam.height; ++py) {
     for (int px = 0; px < cam.width; ++px) {
       const glm::dvec3 d = camera_ray(cam, px, py);
-      // The shell, from the camera's altitude (computed in double) and the ray's cosine with up.
+      // A camera above the shell marches from where its ray enters the shell, placed on the exact
+      // sphere: far cameras then sample near the Earth, where positions keep their digits (the GPU
+      // does the same, and it matters there: float positions at 4e8 m are +-32 m).
+      glm::dvec3 origin = o;
+      double h = cam.alt_m;
+      glm::dvec3 up = up_cam;
+      double mu_up = glm::dot(d, up), nu_up = glm::length(glm::cross(d, up));
+      bool skip = false;
+      if (h > ht) {
+        double e0, e1;
+        if (!p64::ray_sphere_rel_nu(r0, h, mu_up, nu_up, ht, e0, e1) || e1 < 0.0) {
+          skip = true;
+        } else if (e0 > 0.0) {
+          origin = glm::normalize(origin + e0 * d) * (r0 + ht);
+          h = ht;
+          up = glm::normalize(origin);
+          mu_up = glm::dot(d, up);
+          nu_up = glm::length(glm::cross(d, up));
+        }
+      }
+      if (skip) continue;
       glm::dvec4 seg;
-      const int n = p64::ray_shell_rel(r0, cam.alt_m, glm::dot(d, up_cam), hb, ht, seg);
+      const int n = p64::ray_shell_rel_nu(r0, h, mu_up, nu_up, hb, ht, seg);
       // The ground ends the ray.
       double tg0, tg1;
-      const double t_ground = p64::ray_sphere_rel(r0, cam.alt_m, glm::dot(d, up_cam), 0.0, tg0, tg1) && tg1 > 0.0
-                                  ? std::max(tg0, 0.0) : 1e300;
+      const double t_ground = p64::ray_sphere_rel_nu(r0, h, mu_up, nu_up, 0.0, tg0, tg1) && tg1 > 0.0 ? std::max(tg0, 0.0) : 1e300;
       // Sunlight propagates along -to_sun and leaves toward the camera along -d: the scattering
       // cosine between the two propagation directions is dot(to_sun, d).
       const double mu = glm::dot(d, to_sun);
@@ -103,7 +122,7 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
                                           : p64::step_jitter(static_cast<p64::uint>(px), static_cast<p64::uint>(py),
                                                              static_cast<p64::uint>(s.frame));
         for (int i = 0; i < steps && transmittance > 1e-6; ++i) {
-          const glm::dvec3 p = o + (t_start + (i + offset) * dt) * d;
+          const glm::dvec3 p = origin + (t_start + (i + offset) * dt) * d;
           double sl, si;
           medium.at(p, sl, si);
           const double sigma = sl + si;
@@ -111,12 +130,12 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
           // Optical depth toward the sun, unless the Earth is in the way.
           const glm::dvec3 up_p = glm::normalize(p);
           const double alt_p = glm::length(p) - r0;
-          const double mu_sun = glm::dot(to_sun, up_p);
+          const double mu_sun = glm::dot(to_sun, up_p), nu_sun = glm::length(glm::cross(to_sun, up_p));
           double e0, e1, tau_sun = 0.0;
-          bool lit = !(p64::ray_sphere_rel(r0, alt_p, mu_sun, 0.0, e0, e1) && e1 > 0.0);
+          bool lit = !(p64::ray_sphere_rel_nu(r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
           if (lit) {
             glm::dvec4 sseg;
-            const int sn = p64::ray_shell_rel(r0, alt_p, mu_sun, hb, ht, sseg);
+            const int sn = p64::ray_shell_rel_nu(r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
             for (int q = 0; q < sn; ++q) {
               const double ds = (sseg[2 * q + 1] - sseg[2 * q]) / s.sun_steps;
               for (int j = 0; j < s.sun_steps; ++j) {

@@ -61,17 +61,63 @@ CV_FN bool ray_sphere_rel(real r0_m, real h_m, real mu, real hs_m, CV_OUT(real) 
   return true;
 }
 
+// The same, given also nu = sin of the angle between the ray and the local up (>= 0). Callers
+// compute nu as |d x up| and mu as d . up: each keeps ~1e-7 relative where it is the smaller one.
+// Closer to vertical than to horizontal (a camera at 4e8 m sees the whole Earth within 1 degree of
+// its nadir, where mu rounds to +-1), the discriminant is formed from nu as
+// rs^2 - (r nu)^2 = (rs - r nu)(rs + r nu), its small factor in double-float; closer to horizontal,
+// from mu as in ray_sphere_rel.
+CV_FN bool ray_sphere_rel_nu(real r0_m, real h_m, real mu, real nu, real hs_m, CV_OUT(real) t0, CV_OUT(real) t1) {
+  if (abs(mu) < nu) return ray_sphere_rel(r0_m, h_m, mu, hs_m, t0, t1);
+  t0 = real(1);
+  t1 = real(0);
+  real2 r = two_sum(r0_m, h_m);
+  real2 rs = two_sum(r0_m, hs_m);
+  real2 rn = two_prod(r.x, nu);
+  precise real rn_lo = rn.y + r.y * nu;
+  real2 diff = two_sum(rs.x, -rn.x);
+  precise real small = diff.x + (diff.y + (rs.y - rn_lo));
+  precise real disc = small * (rs.x + rn.x);
+  if (disc < real(0)) return false;
+  // c = (h - hs)(2 r0 + h + hs), as in ray_sphere_rel.
+  real2 dh = two_sum(h_m, -hs_m);
+  real2 e1 = two_sum(real(2) * r0_m, h_m);
+  real2 e2 = two_sum(e1.x, hs_m);
+  precise real c = dh.x * e2.x + (dh.x * (e1.y + e2.y) + dh.y * e2.x);
+  sphere_roots(r.x * mu, c, sqrt(disc), t0, t1);
+  return true;
+}
+
 // The parts of a camera-relative ray with t >= 0 inside the shell between altitudes hb_m < ht_m:
 // up to two segments, (seg.x, seg.y) and (seg.z, seg.w), in order. Returns how many (0, 1 or 2).
 // Two happen when the ray dips into the shell, crosses below its base and comes out again.
+CV_FN int shell_segments(bool outer_hit, real to0, real to1, bool inner_hit, real ti0, real ti1, CV_OUT(real4) seg);
+
 CV_FN int ray_shell_rel(real r0_m, real h_m, real mu, real hb_m, real ht_m, CV_OUT(real4) seg) {
-  seg = real4(real(0));
   real to0;
   real to1;
-  if (!ray_sphere_rel(r0_m, h_m, mu, ht_m, to0, to1) || to1 < real(0)) return 0;
   real ti0;
   real ti1;
-  bool inner = ray_sphere_rel(r0_m, h_m, mu, hb_m, ti0, ti1) && ti1 >= real(0);
+  bool outer = ray_sphere_rel(r0_m, h_m, mu, ht_m, to0, to1);
+  bool inner = ray_sphere_rel(r0_m, h_m, mu, hb_m, ti0, ti1);
+  return shell_segments(outer, to0, to1, inner, ti0, ti1, seg);
+}
+
+CV_FN int ray_shell_rel_nu(real r0_m, real h_m, real mu, real nu, real hb_m, real ht_m, CV_OUT(real4) seg) {
+  real to0;
+  real to1;
+  real ti0;
+  real ti1;
+  bool outer = ray_sphere_rel_nu(r0_m, h_m, mu, nu, ht_m, to0, to1);
+  bool inner = ray_sphere_rel_nu(r0_m, h_m, mu, nu, hb_m, ti0, ti1);
+  return shell_segments(outer, to0, to1, inner, ti0, ti1, seg);
+}
+
+// The shell's segments from the outer sphere's and the inner sphere's hits.
+CV_FN int shell_segments(bool outer_hit, real to0, real to1, bool inner_hit, real ti0, real ti1, CV_OUT(real4) seg) {
+  seg = real4(real(0));
+  if (!outer_hit || to1 < real(0)) return 0;
+  bool inner = inner_hit && ti1 >= real(0);
   real start = max(to0, real(0));
   if (!inner || ti0 == ti1) {
     seg = real4(start, to1, real(0), real(0));

@@ -11,7 +11,7 @@ layout(binding = 1) uniform sampler3D u_liquid;  // grid-mean extinction, 1/m (c
 layout(binding = 2) uniform sampler3D u_ice;
 
 uniform ivec2 u_size;
-uniform vec3 u_cam_ecef;      // metres (float: 0.5 m at the Earth's radius, enough to sample clouds)
+uniform vec3 u_cam_ecef;      // metres (float: 0.5 m near the Earth, +-32 m at 4e8 m; far rays re-anchor)
 uniform float u_cam_alt;      // metres, from double on the CPU
 uniform vec3 u_cam_up;        // local vertical at the camera
 uniform vec3 u_forward;
@@ -73,12 +73,34 @@ void main() {
   vec3 d = normalize(u_forward + x * u_right + y * u_upv);
   float hb = u_grid_start.z;
   float ht = u_grid_start.z + u_grid_step.z * (u_grid_count.z - 1.0);
-  float mu_up = dot(d, u_cam_up);
+  // A camera above the shell marches from where its ray enters the shell, placed on the exact
+  // sphere: positions near the Earth keep their digits (at 4e8 m a float position is +-32 m), and
+  // nu = |d x up| keeps near-nadir and near-tangent rays right where mu rounds to +-1.
+  vec3 origin = u_cam_ecef;
+  float h = u_cam_alt;
+  vec3 up = u_cam_up;
+  float mu_up = dot(d, up);
+  float nu_up = length(cross(d, up));
+  if (h > ht) {
+    float e0;
+    float e1;
+    if (!ray_sphere_rel_nu(u_r0, h, mu_up, nu_up, ht, e0, e1) || e1 < 0.0) {
+      imageStore(u_out, px, vec4(0.0, 0.0, 0.0, 1.0));
+      return;
+    }
+    if (e0 > 0.0) {
+      origin = normalize(origin + e0 * d) * (u_r0 + ht);
+      h = ht;
+      up = normalize(origin);
+      mu_up = dot(d, up);
+      nu_up = length(cross(d, up));
+    }
+  }
   vec4 seg;
-  int n = ray_shell_rel(u_r0, u_cam_alt, mu_up, hb, ht, seg);
+  int n = ray_shell_rel_nu(u_r0, h, mu_up, nu_up, hb, ht, seg);
   float tg0;
   float tg1;
-  float t_ground = ray_sphere_rel(u_r0, u_cam_alt, mu_up, 0.0, tg0, tg1) && tg1 > 0.0 ? max(tg0, 0.0) : 3.0e38;
+  float t_ground = ray_sphere_rel_nu(u_r0, h, mu_up, nu_up, 0.0, tg0, tg1) && tg1 > 0.0 ? max(tg0, 0.0) : 3.0e38;
   float mu = dot(d, u_to_sun);
   MieParams mie = mie_params(u_droplet_um);
   vec3 radiance = vec3(0.0);
@@ -91,7 +113,7 @@ void main() {
     float dt = (t_end - t_start) / float(steps);
     float offset = u_frame < 0 ? 0.5 : step_jitter(uint(px.x), uint(px.y), uint(u_frame));
     for (int i = 0; i < steps && t_view > 1e-6; ++i) {
-      vec3 p = u_cam_ecef + (t_start + (float(i) + offset) * dt) * d;
+      vec3 p = origin + (t_start + (float(i) + offset) * dt) * d;
       float sl;
       float si;
       medium_at(p, sl, si);
@@ -100,13 +122,14 @@ void main() {
       vec3 up_p = normalize(p);
       float alt_p = length(p) - u_r0;
       float mu_sun = dot(u_to_sun, up_p);
+      float nu_sun = length(cross(u_to_sun, up_p));
       float e0;
       float e1;
-      bool lit = !(ray_sphere_rel(u_r0, alt_p, mu_sun, 0.0, e0, e1) && e1 > 0.0);
+      bool lit = !(ray_sphere_rel_nu(u_r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
       float tau_sun = 0.0;
       if (lit) {
         vec4 sseg;
-        int sn = ray_shell_rel(u_r0, alt_p, mu_sun, hb, ht, sseg);
+        int sn = ray_shell_rel_nu(u_r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
         for (int q = 0; q < sn; ++q) {
           float s0 = q == 0 ? sseg.x : sseg.z;
           float s1 = q == 0 ? sseg.y : sseg.w;

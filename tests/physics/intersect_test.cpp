@@ -79,6 +79,32 @@ TEST(Intersect, CameraRelativeSphereAgainstReference) {
               static_cast<double>(worst));
 }
 
+TEST(Intersect, SineFormAgainstReference) {
+  // A caller's mu = d . up and nu = |d x up| are each accurate where they are the smaller. The
+  // reference is the geometry the accurate one stands for: mu's near the horizontal, nu's (with
+  // mu's sign) near the vertical, where mu rounds toward +-1.
+  ld worst = 0;
+  long n = 0;
+  for (float h : altitudes()) {
+    for (float hs : {0.0f, kBase, kTop}) {
+      for (float mu : cosines(h)) {
+        const float nu = static_cast<float>(std::sqrt((1 - static_cast<ld>(mu)) * (1 + static_cast<ld>(mu))));
+        const bool vertical = std::abs(mu) >= nu;
+        const ld mu_ref = vertical ? (mu < 0 ? -1 : 1) * std::sqrt(std::max(0.0L, 1 - static_cast<ld>(nu) * nu)) : mu;
+        const Hit ref = reference(kR0, h, mu_ref, hs);
+        float t0 = 0, t1 = 0;
+        const bool hit = f32::ray_sphere_rel_nu(kR0, h, mu, nu, hs, t0, t1);
+        ASSERT_EQ(hit, ref.hit) << "h=" << h << " hs=" << hs << " mu=" << mu;
+        ++n;
+        if (!hit) continue;
+        worst = std::max({worst, std::abs(t0 - ref.t0) / tolerance(ref.t0), std::abs(t1 - ref.t1) / tolerance(ref.t1)});
+      }
+    }
+  }
+  EXPECT_LE(worst, 1.0);
+  std::printf("sine form: %ld rays, worst distance error %.3f of the tolerance\n", n, static_cast<double>(worst));
+}
+
 TEST(Intersect, TangentAndMissingRaysAreClassifiedRight) {
   // From 4e8 m the Earth spans +-0.9 degrees: a horizontal ray misses, the nadir ray hits.
   float t0, t1;

@@ -90,6 +90,47 @@ TEST(Raymarch, GpuMatchesTheCpuReference) {
   EXPECT_GT(changed, 1e-4);  // the jitter does move the samples
 }
 
+TEST(Raymarch, FarCamerasMatchTheCpuReference) {
+  // Geostationary distance and 400 000 km, looking straight down at the cloud box: the box spans
+  // 0.06 degree of the view from 4e8 m.
+  auto ctx = render::make_headless_context();
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::GpuRaymarcher gpu(loader);
+  Scene sc;
+  const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
+  gpu.upload(sc.grid, medium);
+  core::Sun sun;
+  sun.subsolar_lat_deg = 5.0;
+  sun.subsolar_lon_deg = 20.0;
+  core::MarchSettings s;
+  s.view_step_m = 200.0;
+  s.sun_steps = 16;
+  s.octaves = 4;
+  for (const auto& [alt, fov] : {std::pair{3.6e7, 0.8}, std::pair{4e8, 0.07}}) {
+    core::Camera cam;
+    cam.alt_m = alt;
+    cam.pitch_deg = -90.0;
+    cam.fov_deg = fov;
+    cam.width = 32;
+    cam.height = 32;
+    const auto cpu = core::render_reference(sc.grid, medium, cam, sun, s);
+    const auto img = gpu.render(cam, sun, s);
+    double max_l = 0.0, worst = 0.0, worst_t = 0.0;
+    int cloudy = 0;
+    for (const auto& l : cpu.radiance) max_l = std::max(max_l, l.x);
+    for (std::size_t i = 0; i < img.size(); ++i) {
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(img[i][c] - cpu.radiance[i][c]) / max_l);
+      worst_t = std::max(worst_t, std::abs(img[i].w - cpu.transmittance[i]));
+      cloudy += cpu.transmittance[i] < 0.5;
+    }
+    std::printf("camera at %.3g m: radiance worst %.3g of the brightest, transmittance worst %.3g, %d cloudy pixels\n",
+                alt, worst, worst_t, cloudy);
+    EXPECT_GT(cloudy, 50) << alt;
+    EXPECT_LT(worst, 1e-3) << alt;
+    EXPECT_LT(worst_t, 1e-3) << alt;
+  }
+}
+
 }  // namespace
 
 #include "importer.hpp"
