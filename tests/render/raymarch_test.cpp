@@ -172,3 +172,106 @@ TEST(Raymarch, TheBundledSampleRendersWithCloudAndWithoutNaN) {
 }
 
 }  // namespace
+
+namespace {
+
+// A global grid (5 degrees, the poles' rows at +-90): a stratiform layer at 2-3 km everywhere, a
+// thick blob over the north pole and one on the date line.
+struct GlobalScene {
+  core::VolumeGrid grid;
+  core::TimeStepData data;
+  GlobalScene() {
+    grid.lon_deg = {0.0, 5.0, 72};
+    grid.lat_deg = {-90.0, 5.0, 37};
+    grid.alt_m = {500.0, 500.0, 21};
+    data[core::Field::ExtinctionLiquid].assign(grid.points(), 0.0f);
+    for (int k = 0; k < grid.alt_m.count; ++k)
+      for (int j = 0; j < grid.lat_deg.count; ++j)
+        for (int i = 0; i < grid.lon_deg.count; ++i) {
+          const double lon = grid.lon_deg.at(i), lat = grid.lat_deg.at(j), z = grid.alt_m.at(k);
+          double sigma = (z >= 2000.0 && z <= 3000.0) ? 5e-4 : 0.0;
+          const double dl = std::remainder(lon - 180.0, 360.0);
+          if (lat >= 80.0 && z < 6000.0) sigma += 5e-3;
+          if (std::abs(lat) <= 10.0 && std::abs(dl) <= 10.0 && z < 8000.0) sigma += 3e-3;
+          data[core::Field::ExtinctionLiquid][grid.index(i, j, k)] = static_cast<float>(sigma);
+        }
+  }
+};
+
+struct GlobalCase {
+  const char* name;
+  core::Camera cam;
+  core::Sun sun;
+};
+
+core::Camera global_camera(double lat, double lon, double alt, double heading, double pitch, double fov, int w, int h) {
+  core::Camera c;
+  c.lat_deg = lat, c.lon_deg = lon, c.alt_m = alt, c.heading_deg = heading, c.pitch_deg = pitch, c.fov_deg = fov;
+  c.width = w, c.height = h;
+  return c;
+}
+
+core::Sun global_sun(double lat, double lon) {
+  core::Sun s;
+  s.subsolar_lat_deg = lat, s.subsolar_lon_deg = lon;
+  return s;
+}
+
+// Renders each case on the GPU and the CPU reference and holds them within 1e-3 of the brightest
+// pixel (radiance, all channels) and 1e-3 in transmittance.
+void expect_gpu_matches_cpu(std::initializer_list<GlobalCase> cases) {
+  auto ctx = render::make_headless_context();
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::GpuRaymarcher gpu(loader);
+  GlobalScene sc;
+  ASSERT_TRUE(sc.grid.wraps_lon());
+  const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
+  gpu.upload(sc.grid, medium);
+  core::MarchSettings s;
+  s.view_step_m = 250.0;
+  s.sun_steps = 16;
+  s.octaves = 4;
+  for (const GlobalCase& c : cases) {
+    const auto cpu = core::render_reference(sc.grid, medium, c.cam, c.sun, s);
+    const auto img = gpu.render(c.cam, c.sun, s);
+    double max_l = 1e-30, worst = 0.0, worst_t = 0.0;
+    int cloudy = 0;
+    for (const auto& l : cpu.radiance) max_l = std::max(max_l, l.x);
+    for (std::size_t i = 0; i < img.size(); ++i) {
+      ASSERT_TRUE(std::isfinite(img[i].x) && std::isfinite(img[i].w)) << c.name;
+      for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(img[i][k] - cpu.radiance[i][k]) / max_l);
+      worst_t = std::max(worst_t, std::abs(img[i].w - cpu.transmittance[i]));
+      cloudy += cpu.transmittance[i] < 0.99;
+    }
+    std::printf("%-28s radiance worst %.3g, transmittance worst %.3g, %d pixels with cloud\n", c.name, worst, worst_t,
+                cloudy);
+    EXPECT_GT(cloudy, 0) << c.name;
+    EXPECT_LT(worst, 1e-3) << c.name;
+    EXPECT_LT(worst_t, 1e-3) << c.name;
+  }
+}
+
+TEST(Raymarch, PoleDateLineLimbAndInsideACloud) {
+  expect_gpu_matches_cpu({
+      {"pole, looking away from sun", global_camera(80.0, 0.0, 3e5, 180.0, -30.0, 60.0, 32, 18), global_sun(20.0, 0.0)},
+      {"across the date line", global_camera(0.0, 165.0, 5000.0, 90.0, 2.0, 60.0, 32, 18), global_sun(0.0, 150.0)},
+      {"limb, two shell segments", global_camera(0.0, 0.0, 4e5, 0.0, -19.5, 20.0, 32, 18), global_sun(0.0, 0.0)},
+      {"inside a cloud", global_camera(0.0, 180.0, 2500.0, 45.0, 0.0, 90.0, 32, 18), global_sun(0.0, 170.0)},
+      {"one pixel, wide field", global_camera(30.0, 30.0, 1e6, 0.0, -90.0, 179.0, 1, 1), global_sun(30.0, 30.0)},
+  });
+}
+
+// Known open: with the sun near the horizon of the samples, the GPU differs from the reference by
+// more than 1e-3 of the brightest pixel (measured on llvmpipe: 1.07e-3 over the pole looking
+// sunward, 1.16e-3 at the terminator looking sunward and 4.7e-3 looking away). Sample altitudes
+// without cancellation did not change it; the Earth-shadow and grazing sun-path computations in
+// float are the next suspects. Run with --gtest_also_run_disabled_tests.
+TEST(Raymarch, DISABLED_GrazingSunMatchesTheReference) {
+  expect_gpu_matches_cpu({
+      {"over the pole, sunward", global_camera(80.0, 0.0, 3e5, 0.0, -30.0, 60.0, 32, 18), global_sun(20.0, 0.0)},
+      {"terminator, sunward", global_camera(0.0, 0.0, 8000.0, 90.0, -10.0, 90.0, 32, 18), global_sun(0.0, 90.0)},
+      {"terminator, away", global_camera(0.0, 0.0, 8000.0, 270.0, -10.0, 90.0, 32, 18), global_sun(0.0, 90.0)},
+  });
+}
+
+}  // namespace
