@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "reference/raymarcher.hpp"
 #include "render/context.hpp"
@@ -33,13 +34,19 @@ struct Scene {
   }
 };
 
-TEST(Raymarch, GpuMatchesTheCpuReference) {
-  auto ctx = render::make_headless_context();
-  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
-  render::GpuRaymarcher gpu(loader);
+// A headless context, the GPU raymarcher, and the bubble scene uploaded to it.
+struct BubbleOnGpu {
+  std::unique_ptr<render::GlContext> ctx = render::make_headless_context();
+  render::ShaderLoader loader{{render::ShaderLoader::default_shader_dir()}};
+  render::GpuRaymarcher gpu{loader};
   Scene sc;
-  const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
-  gpu.upload(sc.grid, medium);
+  core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
+  BubbleOnGpu() { gpu.upload(sc.grid, medium); }
+};
+
+TEST(Raymarch, GpuMatchesTheCpuReference) {
+  BubbleOnGpu g;
+  auto& [ctx, loader, gpu, sc, medium] = g;
   core::Camera cam;
   cam.lat_deg = -1.5;
   cam.lon_deg = 0.0;
@@ -93,12 +100,8 @@ TEST(Raymarch, GpuMatchesTheCpuReference) {
 TEST(Raymarch, FarCamerasMatchTheCpuReference) {
   // Geostationary distance and 400 000 km, looking straight down at the cloud box: the box spans
   // 0.06 degree of the view from 4e8 m.
-  auto ctx = render::make_headless_context();
-  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
-  render::GpuRaymarcher gpu(loader);
-  Scene sc;
-  const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
-  gpu.upload(sc.grid, medium);
+  BubbleOnGpu g;
+  auto& [ctx, loader, gpu, sc, medium] = g;
   core::Sun sun;
   sun.subsolar_lat_deg = 5.0;
   sun.subsolar_lon_deg = 20.0;
