@@ -1,0 +1,55 @@
+// A scene: everything that decides an image (data source and subset, time step, camera, sun,
+// lighting and quality settings, overlays), as one plain struct that the renderer reads, the viewer
+// edits and the scene file (JSON, versioned) stores, so every image can be reproduced.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "reference/raymarcher.hpp"
+
+namespace cv::core {
+
+// Where the clouds come from, and the part of the file the scene uses (importers read only that).
+struct DataSource {
+  std::string path;  // NetCDF or .cvvol; a relative path is taken from the scene file's folder
+  std::optional<std::array<double, 4>> region_deg;  // west, east, south, north
+  std::optional<std::array<double, 2>> levels_hpa;  // min, max pressure of the levels read
+  int horizontal_stride = 1;
+  double dz_m = 0.0;  // vertical spacing of the resampled grid; 0: the importer's default
+};
+
+// How the sun is placed: where it stood at the data's valid time, at a given UTC date/time, or by
+// hand through its subsolar point.
+enum class SunMode { ValidTime, DateTime, Manual };
+struct SunSpec {
+  SunMode mode = SunMode::ValidTime;
+  std::string datetime_utc;  // ISO 8601, for SunMode::DateTime
+  double subsolar_lat_deg = 0.0, subsolar_lon_deg = 0.0;  // for SunMode::Manual
+  double irradiance = 1.0;  // relative units at the top of the atmosphere
+};
+
+// Settings of the image as a whole (the march's own settings are in MarchSettings).
+struct RenderSettings {
+  MarchSettings march;
+  std::string quality = "default";  // the preset the march settings came from, or "custom"
+  int accumulate = 1;               // jittered frames averaged per image
+  double resolution_scale = 1.0;    // march at this fraction of the output size
+  double exposure = 4.0;            // tonemapping
+};
+
+struct Scene {
+  static constexpr int kVersion = 1;
+  DataSource data;
+  int time_step = 0;
+  // No camera: frame the volume from the south and above (auto_camera in the renderer).
+  std::optional<Camera> camera;
+  int width = 960, height = 540;
+  SunSpec sun;
+  RenderSettings render;
+  std::vector<std::string> overlays;  // none yet
+};
+
+}  // namespace cv::core
