@@ -113,6 +113,17 @@ CV_FN int ray_shell_rel_nu(real r0_m, real h_m, real mu, real nu, real hb_m, rea
   return shell_segments(outer, to0, to1, inner, ti0, ti1, seg);
 }
 
+// Altitude at distance t_m along a ray that starts at altitude h_m with cosine mu to the local up,
+// on a sphere of radius r0_m. |o + t d| - r0 loses the altitude in float32 (positions carry 0.5 m
+// near the Earth, and a grazing sun ray's samples sit in the ramp between grid levels for hundreds
+// of kilometres); the rise t (t + 2 (r0 + h) mu) / (|o + t d| + r0 + h) keeps it, because the
+// radius enters only the denominator.
+CV_FN real ray_altitude(real r0_m, real h_m, real mu, real t_m) {
+  real rh = r0_m + h_m;
+  real r_t = sqrt(max(rh * rh + t_m * (t_m + real(2) * rh * mu), real(0)));
+  return h_m + t_m * (t_m + real(2) * rh * mu) / (r_t + rh);
+}
+
 // The shell's segments from the outer sphere's and the inner sphere's hits.
 CV_FN int shell_segments(bool outer_hit, real to0, real to1, bool inner_hit, real ti0, real ti1, CV_OUT(real4) seg) {
   seg = real4(real(0));

@@ -55,12 +55,14 @@ float fetch(sampler3D tex, vec3 f) {
   return mix(mix(c00, c10, wy), mix(c01, c11, wy), wz);
 }
 
-void medium_at(vec3 p, out float sl, out float si) {
+// The medium at Earth-centred point p whose altitude alt_m the caller knows better than |p| - r0
+// (ray_altitude): latitude and longitude come from p.
+void medium_at(vec3 p, float alt_m, out float sl, out float si) {
   sl = 0.0;
   si = 0.0;
   vec3 g = ecef_to_sphere(p, u_r0);
   vec3 f;
-  if (!volume_coords(g.x / kDeg, g.y / kDeg, g.z, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
+  if (!volume_coords(g.x / kDeg, g.y / kDeg, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
   sl = fetch(u_liquid, f);
   si = fetch(u_ice, f);
 }
@@ -113,14 +115,15 @@ void main() {
     float dt = (t_end - t_start) / float(steps);
     float offset = u_frame < 0 ? 0.5 : step_jitter(uint(px.x), uint(px.y), uint(u_frame));
     for (int i = 0; i < steps && t_view > 1e-6; ++i) {
-      vec3 p = origin + (t_start + (float(i) + offset) * dt) * d;
+      float t = t_start + (float(i) + offset) * dt;
+      vec3 p = origin + t * d;
+      float alt_p = ray_altitude(u_r0, h, mu_up, t);
       float sl;
       float si;
-      medium_at(p, sl, si);
+      medium_at(p, alt_p, sl, si);
       float sigma = sl + si;
       if (sigma <= 0.0) continue;
       vec3 up_p = normalize(p);
-      float alt_p = length(p) - u_r0;
       float mu_sun = dot(u_to_sun, up_p);
       float nu_sun = length(cross(u_to_sun, up_p));
       float e0;
@@ -135,9 +138,10 @@ void main() {
           float s1 = q == 0 ? sseg.y : sseg.w;
           float ds = (s1 - s0) / float(u_sun_steps);
           for (int j = 0; j < u_sun_steps; ++j) {
+            float s = s0 + (float(j) + 0.5) * ds;
             float a;
             float b;
-            medium_at(p + (s0 + (float(j) + 0.5) * ds) * u_to_sun, a, b);
+            medium_at(p + s * u_to_sun, ray_altitude(u_r0, alt_p, mu_sun, s), a, b);
             tau_sun += (a + b) * ds;
           }
         }

@@ -115,6 +115,7 @@ void main() {
       break;
     }
     case PARITY_STEP_JITTER: r.a.x = step_jitter(uint(c.in0.x), uint(c.in0.y), c.meta.y); break;
+    case PARITY_RAY_ALTITUDE: r.a.x = ray_altitude(c.in0.x, c.in0.y, c.in0.z, c.in0.w); break;
     default: r.u.w = 1u; break;
   }
   results[i] = r;

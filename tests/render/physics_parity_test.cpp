@@ -129,6 +129,7 @@ Result eval(const Case& c) {
       break;
     }
     case PARITY_STEP_JITTER: r.a.x = f32::step_jitter(static_cast<f32::uint>(c.in0.x), static_cast<f32::uint>(c.in0.y), c.meta.y); break;
+    case PARITY_RAY_ALTITUDE: r.a.x = f32::ray_altitude(c.in0.x, c.in0.y, c.in0.z, c.in0.w); break;
     default: r.u.w = 1u; break;
   }
   return r;
@@ -231,6 +232,9 @@ std::vector<Case> build_cases() {
   for (unsigned f = 0; f < 4; ++f) {
     for (float px : {0.0f, 17.0f, 1919.0f}) cs.push_back(mk(PARITY_STEP_JITTER, vec4(px, 3.0f * px + 1.0f, 0, 0), vec4(0.0f), f));
   }
+  for (float h : {0.0f, 2500.0f, 4e8f})
+    for (float mu : {-0.9f, -0.004f, 0.0f, 0.3f, 1.0f})
+      for (float t : {0.0f, 150.0f, 4.0e5f}) cs.push_back(mk(PARITY_RAY_ALTITUDE, vec4(6371000.0f, h, mu, t)));
   for (int i = 0; i <= 10; ++i) {
     cs.push_back(mk(PARITY_DIRECTION_AROUND, vec4(glm::normalize(vec3(0.1f * i - 0.5f, 0.2f, -0.9f)), 0),
                     vec4(-1.0f + 0.2f * i, 0.6f * i, 0, 0)));
@@ -255,7 +259,8 @@ float floor_for(unsigned id, int component) {
     case PARITY_VOLUME_COORDS: return 1.0f;  // grid indices
     case PARITY_RAY_SPHERE_REL:
     case PARITY_RAY_SHELL_REL:
-    case PARITY_RAY_SPHERE: return 1.0f;  // metres
+    case PARITY_RAY_SPHERE:
+    case PARITY_RAY_ALTITUDE: return 1.0f;  // metres
     case PARITY_SPHERE_TO_ECEF: return 6.4e6f;
     case PARITY_MIE_PARAMS: return 1e-3f;
     case PARITY_TWO_PROD: return 1e-30f;
@@ -269,7 +274,8 @@ const char* name_of(unsigned id) {
                                 "sample_draine", "sample_mie", "sample_dual_hg", "segment_factor",
                                 "segment_integral", "transmittance", "octaves_hg", "octaves_mie", "ray_sphere_rel",
                                 "ray_shell_rel", "ray_sphere", "sphere_to_ecef", "ecef_to_sphere", "enu_frame",
-                                "geopotential", "pcg_hash", "two_prod", "direction_around", "volume_coords", "step_jitter"};
+                                "geopotential", "pcg_hash", "two_prod", "direction_around", "volume_coords", "step_jitter",
+                                "ray_altitude"};
   return id < PARITY_FUNCTION_COUNT ? names[id] : "?";
 }
 
