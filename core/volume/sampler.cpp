@@ -24,13 +24,15 @@ double VolumeSampler::sample(double lat_deg, double lon_deg, double alt_m, doubl
   glm::dvec3 f;
   if (!physics::f64::volume_coords(lat_deg, lon_deg, alt_m, start, step, count, wraps_, global_lat(), f)) return nodata;
   const int nx = grid_.lon_deg.count, ny = grid_.lat_deg.count, nz = grid_.alt_m.count;
-  const int x0 = std::min(static_cast<int>(std::floor(f.x)), nx - 1);
-  const int y0 = std::min(static_cast<int>(std::floor(f.y)), std::max(0, ny - 2));
-  const int z0 = std::min(static_cast<int>(std::floor(f.z)), std::max(0, nz - 2));
-  const int x1 = wraps_ ? (x0 + 1) % nx : std::min(x0 + 1, nx - 1);
-  const int y1 = std::min(y0 + 1, ny - 1), z1 = std::min(z0 + 1, nz - 1);
-  const double wx = f.x - x0, wy = std::min(std::max(f.y - y0, 0.0), 1.0), wz = std::min(std::max(f.z - z0, 0.0), 1.0);
+  double wx, wy, wz;
+  const int x0 = physics::f64::volume_fetch_index(f.x, nx, wx);
+  const int y0 = physics::f64::volume_fetch_index(f.y, ny, wy);
+  const int z0 = physics::f64::volume_fetch_index(f.z, nz, wz);
+  const int x1 = wraps_ ? (x0 + 1) % nx : x0 + 1;
+  const int y1 = y0 + 1, z1 = std::min(z0 + 1, nz - 1);
+  // Nodes beyond a regional grid's sides (index -1 or n) are its border: no data.
   auto at = [&](int x, int y, int z) {
+    if (x < 0 || x >= nx || y < 0 || y >= ny) return nodata;
     const double v = field_[grid_.index(x, y, z)];
     return std::isnan(v) ? nodata : v;
   };

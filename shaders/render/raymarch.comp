@@ -36,22 +36,28 @@ uniform int u_frame;  // -1: step middles; else the accumulation frame (step_jit
 
 const float kDeg = 0.017453292519943295;
 
-// Trilinear over texel centres, exactly as core/volume/sampler.cpp: no data reads as 0.
+// Trilinear over texel centres, exactly as core/volume/sampler.cpp: no data reads as 0, and so do
+// the border nodes (index -1 or n) a regional grid fades into.
+float node(sampler3D tex, int x, int y, int z) {
+  ivec3 n = ivec3(u_grid_count);
+  return x < 0 || x >= n.x || y < 0 || y >= n.y ? 0.0 : texelFetch(tex, ivec3(x, y, z), 0).r;
+}
+
 float fetch(sampler3D tex, vec3 f) {
   ivec3 n = ivec3(u_grid_count);
-  int x0 = min(int(floor(f.x)), n.x - 1);
-  int y0 = min(int(floor(f.y)), max(0, n.y - 2));
-  int z0 = min(int(floor(f.z)), max(0, n.z - 2));
-  int x1 = u_wraps ? (x0 + 1) % n.x : min(x0 + 1, n.x - 1);
-  int y1 = min(y0 + 1, n.y - 1);
+  float wx;
+  float wy;
+  float wz;
+  int x0 = volume_fetch_index(f.x, n.x, wx);
+  int y0 = volume_fetch_index(f.y, n.y, wy);
+  int z0 = volume_fetch_index(f.z, n.z, wz);
+  int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
+  int y1 = y0 + 1;
   int z1 = min(z0 + 1, n.z - 1);
-  float wx = f.x - float(x0);
-  float wy = clamp(f.y - float(y0), 0.0, 1.0);
-  float wz = clamp(f.z - float(z0), 0.0, 1.0);
-  float c00 = mix(texelFetch(tex, ivec3(x0, y0, z0), 0).r, texelFetch(tex, ivec3(x1, y0, z0), 0).r, wx);
-  float c10 = mix(texelFetch(tex, ivec3(x0, y1, z0), 0).r, texelFetch(tex, ivec3(x1, y1, z0), 0).r, wx);
-  float c01 = mix(texelFetch(tex, ivec3(x0, y0, z1), 0).r, texelFetch(tex, ivec3(x1, y0, z1), 0).r, wx);
-  float c11 = mix(texelFetch(tex, ivec3(x0, y1, z1), 0).r, texelFetch(tex, ivec3(x1, y1, z1), 0).r, wx);
+  float c00 = mix(node(tex, x0, y0, z0), node(tex, x1, y0, z0), wx);
+  float c10 = mix(node(tex, x0, y1, z0), node(tex, x1, y1, z0), wx);
+  float c01 = mix(node(tex, x0, y0, z1), node(tex, x1, y0, z1), wx);
+  float c11 = mix(node(tex, x0, y1, z1), node(tex, x1, y1, z1), wx);
   return mix(mix(c00, c10, wy), mix(c01, c11, wy), wz);
 }
 

@@ -80,3 +80,23 @@ TEST(Sampler, NoDataCornersTakeTheGivenValue) {
 }
 
 }  // namespace
+
+namespace {
+// A regional grid's sides fade to nothing over one grid cell, as though bordered by empty nodes:
+// a ray grazing the data's edge sees a ramp, not a cliff that float rounding decides.
+TEST(Sampler, RegionalEdgesFadeOverOneCell) {
+  VolumeGrid g;
+  g.lon_deg = {10.0, 1.0, 3};
+  g.lat_deg = {20.0, 1.0, 3};
+  g.alt_m = {0.0, 1000.0, 2};
+  const std::vector<float> f(g.points(), 2.0f);
+  const VolumeSampler s(g, f);
+  EXPECT_DOUBLE_EQ(s.sample(21.0, 12.0, 500.0, 0.0), 2.0);    // on the east edge column
+  EXPECT_NEAR(s.sample(21.0, 12.25, 500.0, 0.0), 1.5, 1e-12);  // a quarter cell beyond it
+  EXPECT_NEAR(s.sample(21.0, 9.5, 500.0, 0.0), 1.0, 1e-12);    // half a cell west
+  EXPECT_NEAR(s.sample(19.25, 11.0, 500.0, 0.0), 0.5, 1e-12);  // three quarters south
+  EXPECT_NEAR(s.sample(23.0, 11.0, 500.0, 0.0), 0.0, 1e-12);   // a whole cell north: nothing
+  EXPECT_TRUE(std::isnan(s.sample(23.5, 11.0, 500.0, NAN)));   // beyond the border
+  EXPECT_TRUE(std::isnan(s.sample(21.0, 8.5, 500.0, NAN)));
+}
+}  // namespace
