@@ -219,7 +219,7 @@ int cmd_render(const std::vector<std::string>& args) {
   auto t0 = clock::now();
   core::CloudVolume vol = load_volume(scene);
   if (static_cast<std::size_t>(scene.time_step) >= vol.times.size()) {
-    throw UsageError{"cloudviewer render: --time: found " + std::to_string(scene.time_step) + ", the input has " +
+    throw UsageError{"cloudviewer render: --time (time_step): found " + std::to_string(scene.time_step) + ", the input has " +
                      std::to_string(vol.times.size()) + " time step(s)"};
   }
   const core::TimeStepData& data = vol.step(static_cast<std::size_t>(scene.time_step));
