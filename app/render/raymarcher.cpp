@@ -1,6 +1,7 @@
 // The GPU raymarcher: texture upload, uniforms, dispatch, read-back.
 #include "render/raymarcher.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/glm.hpp>
@@ -44,7 +45,8 @@ void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExt
   grid_ = grid;
 }
 
-std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s) {
+std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
+                                             const DispatchOptions& dispatch) {
   // The read-back takes its byte count as a GLsizei.
   if (static_cast<double>(cam.width) * cam.height * sizeof(glm::vec4) >= 2147483647.0) {
     throw GlError("an image of " + std::to_string(cam.width) + " x " + std::to_string(cam.height) +
@@ -84,7 +86,26 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   glBindTextureUnit(1, textures_[0]);
   glBindTextureUnit(2, textures_[1]);
   glUseProgram(p);
-  glDispatchCompute(static_cast<GLuint>((cam.width + 7) / 8), static_cast<GLuint>((cam.height + 7) / 8), 1);
+  const int tile = dispatch.rows_per_tile > 0 ? (dispatch.rows_per_tile + 7) / 8 * 8 : cam.height;
+  GLuint query = 0;
+  if (dispatch.gpu_seconds) glCreateQueries(GL_TIME_ELAPSED, 1, &query);
+  for (int row = 0; row < cam.height; row += tile) {
+    const int rows = std::min(tile, cam.height - row);
+    glProgramUniform1i(p, loc(p, "u_row_offset"), row);
+    if (query) glBeginQuery(GL_TIME_ELAPSED, query);
+    glDispatchCompute(static_cast<GLuint>((cam.width + 7) / 8), static_cast<GLuint>((rows + 7) / 8), 1);
+    if (query) {
+      glEndQuery(GL_TIME_ELAPSED);
+      GLuint64 ns = 0;
+      glGetQueryObjectui64v(query, GL_QUERY_RESULT, &ns);  // waits for this tile
+      *dispatch.gpu_seconds += static_cast<double>(ns) * 1e-9;
+    }
+    if (dispatch.on_tile) {
+      glFinish();  // progress means finished rows, not queued ones
+      dispatch.on_tile(row + rows, cam.height);
+    }
+  }
+  if (query) glDeleteQueries(1, &query);
   glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
   std::vector<glm::vec4> pixels(static_cast<std::size_t>(cam.width) * cam.height);
   glGetTextureImage(out, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(pixels.size() * sizeof(glm::vec4)), pixels.data());

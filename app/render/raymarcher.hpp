@@ -3,6 +3,7 @@
 // as the CPU reference (core/reference/raymarcher).
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -11,6 +12,15 @@
 #include "render/shader_loader.hpp"
 
 namespace cv::render {
+
+// How a render is dispatched: in tiles of rows, so that a long frame reports progress (and no
+// single dispatch runs long enough to trip a driver's watchdog), and how long the march took on
+// the GPU. The default is one dispatch for the whole image.
+struct DispatchOptions {
+  int rows_per_tile = 0;  // 0: the whole image at once; otherwise rounded up to the 8-row workgroup
+  std::function<void(int rows_done, int rows_total)> on_tile;  // after each tile has finished
+  double* gpu_seconds = nullptr;  // if set, the dispatches' GPU time (GL_TIME_ELAPSED queries) is added
+};
 
 class GpuRaymarcher {
  public:
@@ -24,7 +34,8 @@ class GpuRaymarcher {
   void upload(const core::VolumeGrid& grid, const core::GridMeanExtinction& medium);
 
   // Renders: rgb = radiance, a = view transmittance, rows top to bottom.
-  std::vector<glm::vec4> render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings);
+  std::vector<glm::vec4> render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings,
+                                const DispatchOptions& dispatch = {});
 
  private:
   GlProgram program_;

@@ -11,6 +11,7 @@ layout(binding = 1) uniform sampler3D u_liquid;  // grid-mean extinction, 1/m (c
 layout(binding = 2) uniform sampler3D u_ice;
 
 uniform ivec2 u_size;
+uniform int u_row_offset;     // first image row of this dispatch (long renders go in tiles of rows)
 uniform vec3 u_cam_ecef;      // metres (float: 0.5 m near the Earth, +-32 m at 4e8 m; far rays re-anchor)
 uniform float u_cam_alt;      // metres, from double on the CPU
 uniform vec3 u_cam_up;        // local vertical at the camera
@@ -74,7 +75,7 @@ void medium_at(vec3 p, float alt_m, out float sl, out float si) {
 }
 
 void main() {
-  ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 px = ivec2(gl_GlobalInvocationID.xy) + ivec2(0, u_row_offset);
   if (px.x >= u_size.x || px.y >= u_size.y) return;
   float x = (2.0 * (float(px.x) + 0.5) / float(u_size.x) - 1.0) * u_tan_half;
   float y = (1.0 - 2.0 * (float(px.y) + 0.5) / float(u_size.y)) * u_tan_half * float(u_size.y) / float(u_size.x);

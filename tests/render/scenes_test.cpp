@@ -11,7 +11,7 @@
 #include "reference/raymarcher.hpp"
 #include "render/context.hpp"
 #include "render/raymarcher.hpp"
-#include "scenes/standard_scenes.hpp"
+#include "scene/standard_scenes.hpp"
 
 namespace {
 using namespace cv;

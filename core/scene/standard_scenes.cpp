@@ -1,6 +1,6 @@
 // The standard scenes (see standard_scenes.hpp): analytic cloud fields, deterministic, built in
 // milliseconds, small enough for the CPU reference at test sizes.
-#include "scenes/standard_scenes.hpp"
+#include "scene/standard_scenes.hpp"
 
 #include <algorithm>
 #include <cmath>

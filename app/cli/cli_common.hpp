@@ -1,0 +1,25 @@
+// What the `cloudviewer` subcommands share: the bad-input exception, exit codes and the parsers of
+// numbers and lists in arguments.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace cv::cli {
+
+constexpr int kExitBadInput = 2;
+
+// Bad command-line input: one line naming the argument, what was found and what was expected.
+struct UsageError {
+  std::string message;
+};
+
+// A finite number, or UsageError naming the option.
+double parse_number(const std::string& option, const std::string& text);
+
+// min_n..max_n finite numbers separated by `sep`, or UsageError naming the option and `expected`.
+std::vector<double> parse_list(const std::string& option, const std::string& text, char sep, std::size_t min_n,
+                               std::size_t max_n, const char* expected);
+
+}  // namespace cv::cli

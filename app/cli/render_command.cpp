@@ -1,0 +1,339 @@
+// `cloudviewer render`: builds the effective scene (scene file or defaults, then the options on
+// top), imports only the part of the data it needs, renders on the GPU with progress, and prints
+// where the time went per pass.
+#include "render_command.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <utility>
+
+#include <glm/glm.hpp>
+
+#include "cli_common.hpp"
+#include "importer.hpp"
+#include "render/context.hpp"
+#include "render/image_output.hpp"
+#include "render/raymarcher.hpp"
+#include "render/shader_loader.hpp"
+#include "scene/framing.hpp"
+#include "scene/quality.hpp"
+#include "scene/scene_json.hpp"
+#include "volume/volume_io.hpp"
+
+namespace cv::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using clock = std::chrono::steady_clock;
+
+// A single frame larger than this is marched in tiles of rows of about this many pixels, each
+// reported as it finishes (a 1920x1080 frame takes about 15 s on llvmpipe, see docs/BENCHMARKS.md).
+constexpr double kTilePixels = 262144.0;
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+double seconds_since(clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); }
+
+// What the options ask for, applied on top of the scene file (or the defaults) in one place.
+struct RenderArgs {
+  std::string input, out, pfm, save_scene;
+  bool march_overridden = false;  // --steps, --sun-steps, --octaves or --accumulate: quality becomes custom
+};
+
+int parse_int(const std::string& option, const std::string& text, int lo, int hi, const std::string& what) {
+  const double v = parse_number(option, text);
+  if (!(v >= lo && v <= hi) || v != std::floor(v)) {
+    throw UsageError{"cloudviewer render: " + option + ": found '" + text + "', expected " + what};
+  }
+  return static_cast<int>(v);
+}
+
+// The options, applied to `scene` in the order given (later ones win).
+RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& scene) {
+  RenderArgs r;
+  // Every option takes a value; the one argument that is no option's value is the input. It is
+  // read first so that a scene file's settings are the base the options override.
+  std::vector<std::pair<std::string, std::string>> options;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (!a.empty() && a[0] == '-') {
+      if (i + 1 >= args.size()) throw UsageError{"cloudviewer render: " + a + ": expected a value after it"};
+      options.emplace_back(a, args[++i]);
+    } else if (r.input.empty()) {
+      r.input = a;
+    } else {
+      throw UsageError{"cloudviewer render: unexpected argument '" + a + "', expected one INPUT"};
+    }
+  }
+  if (r.input.empty()) throw UsageError{"cloudviewer render: expected INPUT (.nc, .cvvol or a scene .json) and -o OUT.png"};
+  if (ends_with(r.input, ".json")) {
+    scene = core::load_scene(r.input);
+  } else {
+    scene = core::Scene{};
+    core::apply_quality("default", scene.render);
+    scene.data.path = r.input;
+  }
+  auto& m = scene.render.march;
+  for (const auto& [a, v] : options) {
+    if (a == "-o") r.out = v;
+    else if (a == "--pfm") r.pfm = v;
+    else if (a == "--save-scene") r.save_scene = v;
+    else if (a == "--size") {
+      int w = 0, h = 0;
+      char extra = 0;
+      if (std::sscanf(v.c_str(), "%dx%d%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 16384 || h > 16384) {
+        throw UsageError{"cloudviewer render: --size: found '" + v + "', expected WxH with 1..16384 each"};
+      }
+      scene.width = w, scene.height = h;
+    } else if (a == "--time") {
+      scene.time_step = parse_int(a, v, 0, 1 << 30, "a time-step index >= 0");
+    } else if (a == "--camera") {
+      const auto c = parse_list(a, v, ',', 6, 6, "lat,lon,alt_m,heading,pitch,fov in degrees and metres");
+      if (!(c[2] >= 0.0 && c[2] <= 4e8) || !(c[5] > 0.0 && c[5] < 180.0) || std::abs(c[0]) > 90.0 || std::abs(c[4]) > 90.0) {
+        throw UsageError{"cloudviewer render: --camera: found '" + v +
+                         "', expected |lat| <= 90, altitude 0..4e8 m, |pitch| <= 90 and fov in (0, 180) degrees"};
+      }
+      core::Camera cam;
+      cam.lat_deg = c[0], cam.lon_deg = c[1], cam.alt_m = c[2], cam.heading_deg = c[3], cam.pitch_deg = c[4], cam.fov_deg = c[5];
+      scene.camera = cam;
+    } else if (a == "--sun") {
+      const auto s = parse_list(a, v, ',', 2, 2, "the subsolar point lat,lon in degrees");
+      if (std::abs(s[0]) > 90.0) throw UsageError{"cloudviewer render: --sun: found '" + v + "', expected |lat| <= 90"};
+      scene.sun.mode = core::SunMode::Manual;
+      scene.sun.subsolar_lat_deg = s[0], scene.sun.subsolar_lon_deg = s[1];
+    } else if (a == "--sun-time") {
+      if (!core::parse_iso_utc(v)) {
+        throw UsageError{"cloudviewer render: --sun-time: found '" + v + "', expected a UTC date-time YYYY-MM-DDThh:mm:ssZ"};
+      }
+      scene.sun.mode = core::SunMode::DateTime;
+      scene.sun.datetime_utc = v;
+    } else if (a == "--quality") {
+      if (v == "custom") {
+        scene.render.quality = v;
+      } else if (core::find_quality(v)) {
+        core::apply_quality(v, scene.render);
+      } else {
+        throw UsageError{"cloudviewer render: --quality: found '" + v + "', expected one of " + core::quality_names()};
+      }
+    } else if (a == "--steps") {
+      m.view_step_m = parse_number(a, v);
+      if (!(m.view_step_m > 0)) throw UsageError{"cloudviewer render: --steps: found '" + v + "', expected a view step in metres > 0"};
+      r.march_overridden = true;
+    } else if (a == "--sun-steps") {
+      m.sun_steps = parse_int(a, v, 1, 1024, "an integer 1..1024");
+      r.march_overridden = true;
+    } else if (a == "--octaves") {
+      m.octaves = parse_int(a, v, 1, 16, "an integer 1..16");
+      r.march_overridden = true;
+    } else if (a == "--accumulate") {
+      scene.render.accumulate = parse_int(a, v, 1, 4096, "1..4096 frames");
+      r.march_overridden = true;
+    } else if (a == "--exposure") {
+      scene.render.exposure = parse_number(a, v);
+      if (!(scene.render.exposure > 0)) throw UsageError{"cloudviewer render: --exposure: found '" + v + "', expected a number > 0"};
+    } else if (a == "--region") {
+      const auto g = parse_list(a, v, ',', 4, 4, "W,E,S,N in degrees");
+      if (g[2] > g[3] || g[2] < -90 || g[3] > 90) {
+        throw UsageError{"cloudviewer render: --region: found '" + v + "', expected S <= N within -90..90"};
+      }
+      scene.data.region_deg = std::array<double, 4>{g[0], g[1], g[2], g[3]};
+    } else if (a == "--levels") {
+      const auto l = parse_list(a, v, ':', 2, 2, "MIN_HPA:MAX_HPA");
+      if (!(l[0] >= 0 && l[0] <= l[1])) throw UsageError{"cloudviewer render: --levels: found '" + v + "', expected 0 <= MIN <= MAX hPa"};
+      scene.data.levels_hpa = std::array<double, 2>{l[0], l[1]};
+    } else if (a == "--stride") {
+      scene.data.horizontal_stride = parse_int(a, v, 1, 1000000, "an integer >= 1");
+    } else {
+      throw UsageError{"cloudviewer render: unknown option '" + a + "'"};
+    }
+  }
+  if (r.out.empty()) throw UsageError{"cloudviewer render: expected -o OUT.png"};
+  if (scene.data.path.empty()) {
+    throw UsageError{"cloudviewer render: " + r.input + ": data.path: found nothing, expected the NetCDF or .cvvol file to render"};
+  }
+  return r;
+}
+
+// Reads the scene's data: a .cvvol as it is, NetCDF through the importer with the scene's subset,
+// so only that part of the file is read.
+core::CloudVolume load_volume(const core::Scene& scene) {
+  const core::DataSource& d = scene.data;
+  if (ends_with(d.path, ".cvvol")) {
+    if (d.region_deg || d.levels_hpa || d.horizontal_stride != 1 || d.dz_m != 0.0) {
+      throw UsageError{"cloudviewer render: " + d.path +
+                       ": found a region, levels, stride or dz for a .cvvol volume, expected them only for NetCDF input "
+                       "(a volume is subset when it is imported)"};
+    }
+    return core::read_cvvol(d.path, 1);
+  }
+  importers::ImportOptions o;
+  if (d.region_deg) o.region = importers::Region{(*d.region_deg)[0], (*d.region_deg)[1], (*d.region_deg)[2], (*d.region_deg)[3]};
+  if (d.levels_hpa) o.level_min_hpa = (*d.levels_hpa)[0], o.level_max_hpa = (*d.levels_hpa)[1];
+  o.horizontal_stride = d.horizontal_stride;
+  o.dz_m = d.dz_m;
+  o.cache_steps = 1;  // one time step is rendered
+  return importers::import_file(d.path, o);
+}
+
+// Bilinear resampling of linear pixels (radiance and transmittance) from a reduced march size to
+// the output size, pixel centres aligned.
+std::vector<glm::vec4> upscale(const std::vector<glm::vec4>& in, int iw, int ih, int ow, int oh) {
+  std::vector<glm::vec4> out(static_cast<std::size_t>(ow) * oh);
+  for (int y = 0; y < oh; ++y) {
+    const double fy = std::clamp((y + 0.5) * ih / oh - 0.5, 0.0, ih - 1.0);
+    const int y0 = static_cast<int>(fy), y1 = std::min(y0 + 1, ih - 1);
+    const float ty = static_cast<float>(fy - y0);
+    for (int x = 0; x < ow; ++x) {
+      const double fx = std::clamp((x + 0.5) * iw / ow - 0.5, 0.0, iw - 1.0);
+      const int x0 = static_cast<int>(fx), x1 = std::min(x0 + 1, iw - 1);
+      const float tx = static_cast<float>(fx - x0);
+      auto at = [&](int xx, int yy) { return in[static_cast<std::size_t>(yy) * iw + xx]; };
+      const glm::vec4 top = glm::mix(at(x0, y0), at(x1, y0), tx), bottom = glm::mix(at(x0, y1), at(x1, y1), tx);
+      out[static_cast<std::size_t>(y) * ow + x] = glm::mix(top, bottom, ty);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+const char* render_usage() {
+  return "  render INPUT -o OUT.png   INPUT: NetCDF, .cvvol or a scene .json (docs/scene.md); options override it:\n"
+         "         [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov] [--sun LAT,LON | --sun-time ISO]\n"
+         "         [--quality low|default|high|custom] [--steps M] [--sun-steps N] [--octaves N] [--accumulate N]\n"
+         "         [--exposure E] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N] [--pfm OUT.pfm]\n"
+         "         [--save-scene OUT.json]  (the effective scene, camera and sun resolved, to reproduce the image)\n"
+         "                           the sun stands where it stood at the valid time unless --sun or --sun-time\n";
+}
+
+int cmd_render(const std::vector<std::string>& args) {
+  core::Scene scene;
+  const RenderArgs ra = parse_render_args(args, scene);
+  auto t0 = clock::now();
+  core::CloudVolume vol = load_volume(scene);
+  if (static_cast<std::size_t>(scene.time_step) >= vol.times.size()) {
+    throw UsageError{"cloudviewer render: --time (time_step): found " + std::to_string(scene.time_step) + ", the input has " +
+                     std::to_string(vol.times.size()) + " time step(s)"};
+  }
+  const core::TimeStepData& data = vol.step(static_cast<std::size_t>(scene.time_step));
+  const core::GridMeanExtinction medium = core::grid_mean_extinction(vol.grid, data);
+  const double t_load = seconds_since(t0);
+  const auto& g = vol.grid;
+  if (g.lon_deg.count < 2 || g.lat_deg.count < 2 || g.alt_m.count < 2) {
+    throw UsageError{"cloudviewer render: " + scene.data.path + ": the volume is " + std::to_string(g.lon_deg.count) + " x " +
+                     std::to_string(g.lat_deg.count) + " x " + std::to_string(g.alt_m.count) +
+                     " points; rendering needs at least 2 along each axis"};
+  }
+
+  // Resolve everything the scene left automatic, so the saved scene reproduces this image exactly.
+  core::Camera cam = scene.camera ? *scene.camera : core::auto_camera(g, scene.width, scene.height);
+  cam.width = scene.width, cam.height = scene.height;
+  const core::ValidTime& vt = vol.times[static_cast<std::size_t>(scene.time_step)];
+  const bool known_time = vt.iso_utc.find('T') != std::string::npos;
+  const core::Sun sun = core::resolve_sun(scene.sun, known_time ? std::optional<std::int64_t>(vt.unix_s) : std::nullopt, cam.lon_deg);
+  if (scene.sun.mode == core::SunMode::ValidTime && !known_time) {
+    std::printf("the input has no valid times: the sun is put at noon over the camera (set it with --sun)\n");
+  }
+  std::printf("sun overhead at %.2f, %.2f (%s)\n", sun.subsolar_lat_deg, sun.subsolar_lon_deg,
+              scene.sun.mode == core::SunMode::Manual     ? "set by hand"
+              : scene.sun.mode == core::SunMode::DateTime ? scene.sun.datetime_utc.c_str()
+              : known_time                                ? "from the valid time"
+                                                          : "default");
+  scene.render.march.view_step_m = core::resolve_view_step_m(scene.render, g);
+  if (ra.march_overridden) scene.render.quality = "custom";
+  scene.camera = cam;
+  scene.sun.mode = core::SunMode::Manual;
+  scene.sun.subsolar_lat_deg = sun.subsolar_lat_deg, scene.sun.subsolar_lon_deg = sun.subsolar_lon_deg;
+  if (!ra.save_scene.empty()) {
+    core::Scene saved = scene;
+    // Data beside or below the saved scene: a path relative to its folder (as load_scene resolves
+    // it), so the two can move together; anywhere else an absolute path.
+    const fs::path folder = fs::absolute(ra.save_scene).parent_path().lexically_normal();
+    const fs::path data = fs::absolute(scene.data.path).lexically_normal();
+    const fs::path rel = data.lexically_relative(folder);
+    saved.data.path = (rel.empty() || *rel.begin() == "..") ? data.string() : rel.string();
+    core::save_scene(saved, ra.save_scene);
+    std::printf("wrote the scene %s\n", ra.save_scene.c_str());
+  }
+
+  const core::RenderSettings& rs = scene.render;
+  core::MarchSettings march = rs.march;
+  const int mw = std::max(1, static_cast<int>(std::lround(cam.width * rs.resolution_scale)));
+  const int mh = std::max(1, static_cast<int>(std::lround(cam.height * rs.resolution_scale)));
+  core::Camera march_cam = cam;
+  march_cam.width = mw, march_cam.height = mh;
+  std::printf("rendering %s, time step %d (%s), %dx%d%s, quality %s: view step %.0f m, %d sun steps, %d octaves, %d frame(s)\n",
+              scene.data.path.c_str(), scene.time_step, vt.iso_utc.c_str(), cam.width, cam.height,
+              mw != cam.width || mh != cam.height ? (" marched at " + std::to_string(mw) + "x" + std::to_string(mh)).c_str() : "",
+              rs.quality.c_str(), march.view_step_m, march.sun_steps, march.octaves, rs.accumulate);
+  auto ctx = render::make_headless_context();
+  const render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::GpuRaymarcher gpu(loader);
+  t0 = clock::now();
+  gpu.upload(g, medium);
+  glFinish();
+  const double t_upload = seconds_since(t0);
+
+  t0 = clock::now();
+  double gpu_s = 0.0;
+  render::DispatchOptions dispatch;
+  dispatch.gpu_seconds = &gpu_s;
+  const double pixels_per_frame = static_cast<double>(mw) * mh;
+  if (rs.accumulate == 1 && pixels_per_frame > kTilePixels) {
+    dispatch.rows_per_tile = std::max(8, static_cast<int>(kTilePixels / mw));
+    dispatch.on_tile = [&](int done, int total) {
+      std::printf("\rmarched %d/%d rows (%.0f%%), %.1f s", done, total, 100.0 * done / total, seconds_since(t0));
+      std::fflush(stdout);
+    };
+  }
+  // One frame at step middles (or the scene's frame), or the mean of jittered frames.
+  std::vector<glm::vec4> pixels;
+  if (rs.accumulate == 1) {
+    pixels = gpu.render(march_cam, sun, march, dispatch);
+    if (dispatch.on_tile) std::printf("\n");
+  } else {
+    pixels.assign(static_cast<std::size_t>(mw) * mh, glm::vec4(0.0f));
+    for (int f = 0; f < rs.accumulate; ++f) {
+      march.frame = f;
+      const std::vector<glm::vec4> frame = gpu.render(march_cam, sun, march, dispatch);
+      for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] += (frame[i] - pixels[i]) / static_cast<float>(f + 1);
+      std::printf("\raccumulated %d/%d frames, %.1f s", f + 1, rs.accumulate, seconds_since(t0));
+      std::fflush(stdout);
+    }
+    std::printf("\n");
+  }
+  const double t_march = seconds_since(t0);
+
+  t0 = clock::now();
+  if (mw != cam.width || mh != cam.height) pixels = upscale(pixels, mw, mh, cam.width, cam.height);
+  std::size_t bad = 0;
+  for (const auto& p : pixels) bad += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w));
+  render::ToneSettings tone;
+  tone.exposure = rs.exposure;
+  const std::vector<unsigned char> rgb8 = render::tonemap_srgb8(pixels, tone);
+  const double t_tone = seconds_since(t0);
+  t0 = clock::now();
+  render::write_png(ra.out, cam.width, cam.height, rgb8);
+  if (!ra.pfm.empty()) render::write_pfm(ra.pfm, cam.width, cam.height, pixels, tone);
+  const double t_write = seconds_since(t0);
+  char gpu_text[48];
+  // GL_TIME_ELAPSED as the driver reports it (Mesa's llvmpipe runs compute on the CPU and reports
+  // next to nothing; on a real GPU this is the march without queueing and read-back).
+  if (gpu_s > 0.0) std::snprintf(gpu_text, sizeof gpu_text, "%.3f ms (GL timer query)", gpu_s * 1e3);
+  else std::snprintf(gpu_text, sizeof gpu_text, "not reported by the driver");
+  std::printf("timings (%s):\n  load/import %.3f s\n  upload      %.3f s\n  march       %.3f s wall, GPU %s\n"
+              "  composite/tonemap %.3f s\n  write       %.3f s\n",
+              ctx->info().renderer.c_str(), t_load, t_upload, t_march, gpu_text, t_tone, t_write);
+  if (bad) std::fprintf(stderr, "cloudviewer render: %zu pixels were not finite (drawn white)\n", bad);
+  std::printf("wrote %s%s\n", ra.out.c_str(), ra.pfm.empty() ? "" : (" and " + ra.pfm).c_str());
+  return bad ? 1 : 0;
+}
+
+}  // namespace cv::cli

@@ -1,0 +1,298 @@
+// Reading and writing scene files with nlohmann-json: a strict reader that names the key path of
+// every problem, and a writer that writes every key.
+#include "scene/scene_json.hpp"
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <optional>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/framing.hpp"
+#include "scene/quality.hpp"
+#include "volume/volume_io.hpp"
+
+namespace cv::core {
+namespace {
+
+using json = nlohmann::json;
+using ojson = nlohmann::ordered_json;
+
+// What a value looked like, for messages: JSON as written (strings keep their quotes), shortened.
+std::string shown(const json& v) {
+  std::string s = v.dump();
+  if (s.size() > 40) s = s.substr(0, 37) + "...";
+  return s;
+}
+
+// Reads one object of the scene, remembering its key path for messages.
+class Reader {
+ public:
+  Reader(const std::string& source, const json& obj, std::string path) : source_(source), obj_(obj), path_(std::move(path)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& found, const std::string& expected) const {
+    throw SceneError(source_ + ": " + where(key) + ": found " + found + ", expected " + expected);
+  }
+
+  // Every key must be one of `known`: a misspelt key would otherwise be ignored without a word.
+  void only(std::initializer_list<const char*> known) const {
+    for (const auto& [key, value] : obj_.items()) {
+      bool ok = false;
+      for (const char* k : known) ok = ok || key == k;
+      if (!ok) {
+        std::string list;
+        for (const char* k : known) list += std::string(list.empty() ? "" : ", ") + k;
+        throw SceneError(source_ + ": " + where(key) + ": unknown key, expected one of " + list);
+      }
+    }
+  }
+
+  const json* find(const char* key) const {
+    const auto it = obj_.find(key);
+    return it == obj_.end() ? nullptr : &*it;
+  }
+
+  void number(const char* key, double& out, double lo, double hi, const std::string& expected) const {
+    const json* v = find(key);
+    if (!v) return;
+    if (!v->is_number() || !(v->get<double>() >= lo && v->get<double>() <= hi)) fail(key, shown(*v), expected);
+    out = v->get<double>();
+  }
+
+  void integer(const char* key, int& out, int lo, int hi) const {
+    const json* v = find(key);
+    if (!v) return;
+    const std::string expected = "an integer " + std::to_string(lo) + ".." + std::to_string(hi);
+    if (!v->is_number()) fail(key, shown(*v), expected);
+    const double d = v->get<double>();
+    if (!(d >= lo && d <= hi) || d != std::floor(d)) fail(key, shown(*v), expected);
+    out = static_cast<int>(d);
+  }
+
+  void string(const char* key, std::string& out) const {
+    const json* v = find(key);
+    if (!v) return;
+    if (!v->is_string()) fail(key, shown(*v), "a string");
+    out = v->get<std::string>();
+  }
+
+  // A nested object (nothing when absent or null), checked to be an object.
+  std::optional<Reader> child(const char* key) const {
+    const json* v = find(key);
+    if (!v || v->is_null()) return std::nullopt;
+    if (!v->is_object()) fail(key, shown(*v), "an object { ... }");
+    return Reader(source_, *v, where(key));
+  }
+
+  // A fixed-length array of numbers (nothing when absent or null).
+  template <std::size_t N>
+  std::optional<std::array<double, N>> numbers(const char* key, const std::string& expected) const {
+    const json* v = find(key);
+    if (!v || v->is_null()) return std::nullopt;
+    if (!v->is_array() || v->size() != N) fail(key, shown(*v), expected);
+    std::array<double, N> out{};
+    for (std::size_t i = 0; i < N; ++i) {
+      if (!(*v)[i].is_number()) fail(key, shown(*v), expected);
+      out[i] = (*v)[i].get<double>();
+    }
+    return out;
+  }
+
+  std::string where(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+ private:
+  const std::string& source_;
+  const json& obj_;
+  std::string path_;
+};
+
+constexpr double kHuge = 1e300;  // "any finite number" as a range
+
+void read_data(const Reader& r, DataSource& d) {
+  r.only({"path", "region_deg", "levels_hpa", "horizontal_stride", "dz_m"});
+  r.string("path", d.path);
+  d.region_deg = r.numbers<4>("region_deg", "[west, east, south, north] in degrees, or null");
+  if (d.region_deg) {
+    const auto& g = *d.region_deg;
+    if (!(g[2] <= g[3] && g[2] >= -90.0 && g[3] <= 90.0)) {
+      r.fail("region_deg", shown(json(g)), "south <= north within -90..90");
+    }
+  }
+  d.levels_hpa = r.numbers<2>("levels_hpa", "[min, max] pressure in hPa, or null");
+  if (d.levels_hpa && !((*d.levels_hpa)[0] <= (*d.levels_hpa)[1] && (*d.levels_hpa)[0] >= 0.0)) {
+    r.fail("levels_hpa", shown(json(*d.levels_hpa)), "0 <= min <= max in hPa");
+  }
+  r.integer("horizontal_stride", d.horizontal_stride, 1, 1000000);
+  r.number("dz_m", d.dz_m, 0.0, 1e5, "a vertical spacing in metres 0..100000 (0: the importer's default)");
+}
+
+void read_camera(const Reader& r, Camera& c) {
+  r.only({"lat_deg", "lon_deg", "alt_m", "heading_deg", "pitch_deg", "fov_deg"});
+  r.number("lat_deg", c.lat_deg, -90.0, 90.0, "a latitude in degrees -90..90");
+  r.number("lon_deg", c.lon_deg, -kHuge, kHuge, "a longitude in degrees");
+  r.number("alt_m", c.alt_m, 0.0, 4e8, "an altitude in metres 0..4e8");
+  r.number("heading_deg", c.heading_deg, -kHuge, kHuge, "a heading in degrees clockwise from north");
+  r.number("pitch_deg", c.pitch_deg, -90.0, 90.0, "a pitch in degrees -90..90");
+  r.number("fov_deg", c.fov_deg, 1e-6, 179.999, "a horizontal field of view in degrees, more than 0 and less than 180");
+}
+
+void read_sun(const Reader& r, SunSpec& s) {
+  r.only({"mode", "datetime_utc", "subsolar_lat_deg", "subsolar_lon_deg", "irradiance"});
+  std::string mode = s.mode == SunMode::Manual ? "manual" : s.mode == SunMode::DateTime ? "datetime" : "valid_time";
+  r.string("mode", mode);
+  if (mode == "valid_time") s.mode = SunMode::ValidTime;
+  else if (mode == "datetime") s.mode = SunMode::DateTime;
+  else if (mode == "manual") s.mode = SunMode::Manual;
+  else r.fail("mode", shown(json(mode)), "\"valid_time\", \"datetime\" or \"manual\"");
+  r.string("datetime_utc", s.datetime_utc);
+  if ((s.mode == SunMode::DateTime || !s.datetime_utc.empty()) && !parse_iso_utc(s.datetime_utc)) {
+    r.fail("datetime_utc", shown(json(s.datetime_utc)), "a UTC date-time YYYY-MM-DDThh:mm:ssZ");
+  }
+  r.number("subsolar_lat_deg", s.subsolar_lat_deg, -90.0, 90.0, "a latitude in degrees -90..90");
+  r.number("subsolar_lon_deg", s.subsolar_lon_deg, -kHuge, kHuge, "a longitude in degrees");
+  r.number("irradiance", s.irradiance, 1e-300, kHuge, "a relative irradiance > 0");
+}
+
+void read_march(const Reader& r, MarchSettings& m) {
+  r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "droplet_diameter_um", "ice_g", "frame"});
+  r.number("view_step_m", m.view_step_m, 0.0, 1e7, "a view step in metres 0..1e7 (0: from the grid)");
+  r.integer("sun_steps", m.sun_steps, 1, 1024);
+  r.integer("octaves", m.octaves, 1, 16);
+  r.number("octave_a", m.octave_a, 0.0, 1.0, "a number 0..1");
+  r.number("octave_b", m.octave_b, 0.0, 1.0, "a number 0..1");
+  r.number("octave_c", m.octave_c, 0.0, 1.0, "a number 0..1");
+  r.number("droplet_diameter_um", m.droplet_diameter_um, 0.01, 50.0, "a droplet diameter in um 0.01..50");
+  r.number("ice_g", m.ice_g, -0.999, 0.999, "an asymmetry parameter -0.999..0.999");
+  r.integer("frame", m.frame, -1, 1 << 30);
+}
+
+void read_render(const Reader& r, RenderSettings& s) {
+  r.only({"quality", "march", "accumulate", "resolution_scale", "exposure"});
+  // The preset first: march keys written in the file then override its values.
+  std::string quality = s.quality;
+  r.string("quality", quality);
+  if (quality == "custom") {
+    s.quality = quality;
+  } else if (find_quality(quality)) {
+    apply_quality(quality, s);
+  } else {
+    r.fail("quality", shown(json(quality)), "one of " + quality_names());
+  }
+  if (const auto m = r.child("march")) read_march(*m, s.march);
+  r.integer("accumulate", s.accumulate, 1, 4096);
+  r.number("resolution_scale", s.resolution_scale, 0.01, 1.0, "a fraction of the output size 0.01..1");
+  r.number("exposure", s.exposure, 1e-300, kHuge, "an exposure > 0");
+}
+
+}  // namespace
+
+Scene scene_from_json(const std::string& text, const std::string& source) {
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::parse_error& e) {
+    // nlohmann's message names the byte and what it expected; keep it on one line.
+    std::string what = e.what();
+    for (char& c : what) c = (c == '\n' ? ' ' : c);
+    throw SceneError(source + ": not valid JSON: " + what);
+  }
+  if (!root.is_object()) throw SceneError(source + ": found " + shown(root) + " at the top, expected a JSON object { ... }");
+  const Reader r(source, root, "");
+  r.only({"version", "data", "time_step", "camera", "width", "height", "sun", "render", "overlays"});
+  const json* version = r.find("version");
+  if (!version) r.fail("version", "nothing", "\"version\": " + std::to_string(Scene::kVersion));
+  if (!version->is_number_integer() || version->get<long long>() < 1) r.fail("version", shown(*version), "an integer >= 1");
+  if (version->get<long long>() > Scene::kVersion) {
+    r.fail("version", shown(*version),
+           std::to_string(Scene::kVersion) + " or lower (the file was written by a newer cloudviewer)");
+  }
+  Scene scene;
+  apply_quality(scene.render.quality, scene.render);  // a scene without render keys renders at "default"
+  if (const auto d = r.child("data")) read_data(*d, scene.data);
+  r.integer("time_step", scene.time_step, 0, 1 << 30);
+  if (const auto c = r.child("camera")) {
+    scene.camera = Camera{};
+    read_camera(*c, *scene.camera);
+  }
+  r.integer("width", scene.width, 1, 16384);
+  r.integer("height", scene.height, 1, 16384);
+  if (scene.camera) scene.camera->width = scene.width, scene.camera->height = scene.height;
+  if (const auto s = r.child("sun")) read_sun(*s, scene.sun);
+  if (const auto rs = r.child("render")) read_render(*rs, scene.render);
+  if (const json* o = r.find("overlays")) {
+    if (!o->is_array()) r.fail("overlays", shown(*o), "an array of overlay names (none exist yet)");
+    for (const auto& item : *o) {
+      if (!item.is_string()) r.fail("overlays", shown(*o), "an array of strings");
+      scene.overlays.push_back(item.get<std::string>());
+    }
+  }
+  return scene;
+}
+
+std::string scene_to_json(const Scene& s) {
+  // Keys in the order docs/scene.md lists them, not sorted, so the file reads top-down.
+  ojson root = ojson::object();
+  root["version"] = Scene::kVersion;
+  ojson data = {{"path", s.data.path}, {"horizontal_stride", s.data.horizontal_stride}, {"dz_m", s.data.dz_m}};
+  data["region_deg"] = s.data.region_deg ? ojson(*s.data.region_deg) : ojson(nullptr);
+  data["levels_hpa"] = s.data.levels_hpa ? ojson(*s.data.levels_hpa) : ojson(nullptr);
+  root["data"] = data;
+  root["time_step"] = s.time_step;
+  root["width"] = s.width;
+  root["height"] = s.height;
+  if (s.camera) {
+    const Camera& c = *s.camera;
+    root["camera"] = {{"lat_deg", c.lat_deg},         {"lon_deg", c.lon_deg},     {"alt_m", c.alt_m},
+                      {"heading_deg", c.heading_deg}, {"pitch_deg", c.pitch_deg}, {"fov_deg", c.fov_deg}};
+  } else {
+    root["camera"] = nullptr;  // automatic framing
+  }
+  const char* mode = s.sun.mode == SunMode::Manual ? "manual" : s.sun.mode == SunMode::DateTime ? "datetime" : "valid_time";
+  root["sun"] = {{"mode", mode},
+                 {"datetime_utc", s.sun.datetime_utc},
+                 {"subsolar_lat_deg", s.sun.subsolar_lat_deg},
+                 {"subsolar_lon_deg", s.sun.subsolar_lon_deg},
+                 {"irradiance", s.sun.irradiance}};
+  const MarchSettings& m = s.render.march;
+  root["render"] = {{"quality", s.render.quality},
+                    {"accumulate", s.render.accumulate},
+                    {"resolution_scale", s.render.resolution_scale},
+                    {"exposure", s.render.exposure},
+                    {"march",
+                     {{"view_step_m", m.view_step_m},
+                      {"sun_steps", m.sun_steps},
+                      {"octaves", m.octaves},
+                      {"octave_a", m.octave_a},
+                      {"octave_b", m.octave_b},
+                      {"octave_c", m.octave_c},
+                      {"droplet_diameter_um", m.droplet_diameter_um},
+                      {"ice_g", m.ice_g},
+                      {"frame", m.frame}}}};
+  root["overlays"] = s.overlays;
+  return root.dump(2) + "\n";
+}
+
+Scene load_scene(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path + ": cannot open the scene file (missing or unreadable)");
+  std::ostringstream text;
+  text << in.rdbuf();
+  Scene scene = scene_from_json(text.str(), path);
+  namespace fs = std::filesystem;
+  if (!scene.data.path.empty() && fs::path(scene.data.path).is_relative()) {
+    scene.data.path = (fs::path(path).parent_path() / scene.data.path).lexically_normal().string();
+  }
+  return scene;
+}
+
+void save_scene(const Scene& scene, const std::string& path) {
+  const std::string text = scene_to_json(scene);
+  write_file_atomically(path, [&](std::FILE* f) { std::fwrite(text.data(), 1, text.size(), f); });
+}
+
+}  // namespace cv::core

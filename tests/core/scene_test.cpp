@@ -1,0 +1,267 @@
+// Scene files (round trip, and each class of bad input named in one line), quality presets,
+// automatic framing and the scene's sun.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "geo/geodesy.hpp"
+#include "geo/solar.hpp"
+#include "scene/framing.hpp"
+#include "scene/quality.hpp"
+#include "scene/scene_json.hpp"
+
+namespace {
+using namespace cv::core;
+namespace fs = std::filesystem;
+
+// Every field set to something other than its default, with values that are not short decimals
+// so that a lossy number format would show.
+Scene full_scene() {
+  Scene s;
+  s.data.path = "/data/run 7/cyclone.nc";
+  s.data.region_deg = std::array<double, 4>{170.25, -170.125, -12.5, 33.0 / 7.0};
+  s.data.levels_hpa = std::array<double, 2>{150.0, 987.654321};
+  s.data.horizontal_stride = 3;
+  s.data.dz_m = 250.0;
+  s.time_step = 4;
+  Camera c;
+  c.lat_deg = -33.123456789012345, c.lon_deg = 151.2, c.alt_m = 3.6e6 / 3.0;
+  c.heading_deg = 12.5, c.pitch_deg = -41.0 / 3.0, c.fov_deg = 47.0;
+  s.camera = c;
+  s.width = 48, s.height = 27;
+  s.camera->width = 48, s.camera->height = 27;
+  s.sun.mode = SunMode::DateTime;
+  s.sun.datetime_utc = "2024-01-15T03:00:00Z";
+  s.sun.subsolar_lat_deg = -21.1, s.sun.subsolar_lon_deg = 134.7, s.sun.irradiance = 1.7;
+  s.render.quality = "custom";
+  s.render.march.view_step_m = 333.3;
+  s.render.march.sun_steps = 24, s.render.march.octaves = 6;
+  s.render.march.octave_a = 0.4, s.render.march.octave_b = 0.3, s.render.march.octave_c = 0.6;
+  s.render.march.droplet_diameter_um = 12.5, s.render.march.ice_g = 0.8, s.render.march.frame = 9;
+  s.render.accumulate = 8, s.render.resolution_scale = 0.5, s.render.exposure = 6.25;
+  s.overlays = {"coastlines"};
+  return s;
+}
+
+void expect_equal(const Scene& a, const Scene& b) {
+  EXPECT_EQ(a.data.path, b.data.path);
+  EXPECT_EQ(a.data.region_deg, b.data.region_deg);
+  EXPECT_EQ(a.data.levels_hpa, b.data.levels_hpa);
+  EXPECT_EQ(a.data.horizontal_stride, b.data.horizontal_stride);
+  EXPECT_EQ(a.data.dz_m, b.data.dz_m);
+  EXPECT_EQ(a.time_step, b.time_step);
+  ASSERT_EQ(a.camera.has_value(), b.camera.has_value());
+  if (a.camera) {
+    EXPECT_EQ(a.camera->lat_deg, b.camera->lat_deg);
+    EXPECT_EQ(a.camera->lon_deg, b.camera->lon_deg);
+    EXPECT_EQ(a.camera->alt_m, b.camera->alt_m);
+    EXPECT_EQ(a.camera->heading_deg, b.camera->heading_deg);
+    EXPECT_EQ(a.camera->pitch_deg, b.camera->pitch_deg);
+    EXPECT_EQ(a.camera->fov_deg, b.camera->fov_deg);
+    EXPECT_EQ(a.camera->width, b.camera->width);
+    EXPECT_EQ(a.camera->height, b.camera->height);
+  }
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_EQ(a.height, b.height);
+  EXPECT_EQ(a.sun.mode, b.sun.mode);
+  EXPECT_EQ(a.sun.datetime_utc, b.sun.datetime_utc);
+  EXPECT_EQ(a.sun.subsolar_lat_deg, b.sun.subsolar_lat_deg);
+  EXPECT_EQ(a.sun.subsolar_lon_deg, b.sun.subsolar_lon_deg);
+  EXPECT_EQ(a.sun.irradiance, b.sun.irradiance);
+  const MarchSettings &m = a.render.march, &n = b.render.march;
+  EXPECT_EQ(a.render.quality, b.render.quality);
+  EXPECT_EQ(m.view_step_m, n.view_step_m);
+  EXPECT_EQ(m.sun_steps, n.sun_steps);
+  EXPECT_EQ(m.octaves, n.octaves);
+  EXPECT_EQ(m.octave_a, n.octave_a);
+  EXPECT_EQ(m.octave_b, n.octave_b);
+  EXPECT_EQ(m.octave_c, n.octave_c);
+  EXPECT_EQ(m.droplet_diameter_um, n.droplet_diameter_um);
+  EXPECT_EQ(m.ice_g, n.ice_g);
+  EXPECT_EQ(m.frame, n.frame);
+  EXPECT_EQ(a.render.accumulate, b.render.accumulate);
+  EXPECT_EQ(a.render.resolution_scale, b.render.resolution_scale);
+  EXPECT_EQ(a.render.exposure, b.render.exposure);
+  EXPECT_EQ(a.overlays, b.overlays);
+}
+
+TEST(SceneJson, FullyPopulatedSceneRoundTripsExactly) {
+  const Scene s = full_scene();
+  const std::string text = scene_to_json(s);
+  expect_equal(scene_from_json(text), s);
+  // And through a file: save, load (an absolute data path stays as it is).
+  const fs::path file = fs::temp_directory_path() / "cv_scene_roundtrip.json";
+  save_scene(s, file.string());
+  expect_equal(load_scene(file.string()), s);
+  fs::remove(file);
+}
+
+TEST(SceneJson, AbsentCameraMeansAutomaticAndSurvivesTheRoundTrip) {
+  Scene s = full_scene();
+  s.camera.reset();
+  const Scene back = scene_from_json(scene_to_json(s));
+  EXPECT_FALSE(back.camera.has_value());
+  EXPECT_FALSE(scene_from_json(R"({"version": 1, "camera": null})").camera.has_value());
+}
+
+TEST(SceneJson, MissingKeysTakeTheDefaultsAndTheDefaultPreset) {
+  const Scene s = scene_from_json(R"({"version": 1, "data": {"path": "a.nc"}})");
+  EXPECT_EQ(s.data.path, "a.nc");
+  EXPECT_EQ(s.width, 960);
+  EXPECT_EQ(s.sun.mode, SunMode::ValidTime);
+  EXPECT_EQ(s.render.quality, "default");
+  EXPECT_EQ(s.render.march.sun_steps, 16);
+  EXPECT_EQ(s.render.march.octaves, 4);
+  EXPECT_EQ(s.render.march.view_step_m, 0.0);  // from the grid
+  // A preset named in the file sets the march, and march keys in the file override it.
+  const Scene h = scene_from_json(R"({"version": 1, "render": {"quality": "high", "march": {"octaves": 2}}})");
+  EXPECT_EQ(h.render.march.sun_steps, 32);
+  EXPECT_EQ(h.render.march.octaves, 2);
+  EXPECT_EQ(h.render.accumulate, 4);
+}
+
+TEST(SceneJson, RelativeDataPathIsTakenFromTheSceneFilesFolder) {
+  const fs::path dir = fs::temp_directory_path() / "cv_scene_rel" / "scenes";
+  fs::create_directories(dir);
+  std::ofstream(dir / "s.json") << R"({"version": 1, "data": {"path": "../data/c.nc"}})";
+  EXPECT_EQ(load_scene((dir / "s.json").string()).data.path, (dir.parent_path() / "data" / "c.nc").string());
+  fs::remove_all(dir.parent_path());
+}
+
+// The one-line message for bad input, exactly.
+std::string error_of(const std::string& text) {
+  try {
+    scene_from_json(text, "scene.json");
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(SceneJson, BadTypeNamesTheKeyPathWhatWasFoundAndWhatWasExpected) {
+  EXPECT_EQ(error_of(R"({"version": 1, "render": {"march": {"sun_steps": "abc"}}})"),
+            "scene.json: render.march.sun_steps: found \"abc\", expected an integer 1..1024");
+  EXPECT_EQ(error_of(R"({"version": 1, "camera": [1, 2]})"), "scene.json: camera: found [1,2], expected an object { ... }");
+  EXPECT_EQ(error_of(R"({"version": 1, "data": {"path": 7}})"), "scene.json: data.path: found 7, expected a string");
+  EXPECT_EQ(error_of(R"({"version": 1, "render": {"march": {"octaves": 2.5}}})"),
+            "scene.json: render.march.octaves: found 2.5, expected an integer 1..16");
+}
+
+TEST(SceneJson, OutOfRangeValuesAreRefused) {
+  EXPECT_EQ(error_of(R"({"version": 1, "camera": {"fov_deg": 180}})"),
+            "scene.json: camera.fov_deg: found 180, expected a horizontal field of view in degrees, more than 0 and less "
+            "than 180");
+  EXPECT_EQ(error_of(R"({"version": 1, "width": 0})"), "scene.json: width: found 0, expected an integer 1..16384");
+  EXPECT_EQ(error_of(R"({"version": 1, "data": {"region_deg": [0, 10, 20, -20]}})"),
+            "scene.json: data.region_deg: found [0.0,10.0,20.0,-20.0], expected south <= north within -90..90");
+  EXPECT_EQ(error_of(R"({"version": 1, "sun": {"mode": "datetime", "datetime_utc": "2024-02-30T00:00:00Z"}})"),
+            "scene.json: sun.datetime_utc: found \"2024-02-30T00:00:00Z\", expected a UTC date-time YYYY-MM-DDThh:mm:ssZ");
+  EXPECT_EQ(error_of(R"({"version": 1, "render": {"quality": "ultra"}})"),
+            "scene.json: render.quality: found \"ultra\", expected one of low, default, high, custom");
+}
+
+TEST(SceneJson, UnknownKeysAreNamedSoTyposAreCaught) {
+  EXPECT_EQ(error_of(R"({"version": 1, "render": {"march": {"sun_step": 8}}})"),
+            "scene.json: render.march.sun_step: unknown key, expected one of view_step_m, sun_steps, octaves, octave_a, "
+            "octave_b, octave_c, droplet_diameter_um, ice_g, frame");
+  EXPECT_EQ(error_of(R"({"version": 1, "camra": {}})"),
+            "scene.json: camra: unknown key, expected one of version, data, time_step, camera, width, height, sun, render, "
+            "overlays");
+}
+
+TEST(SceneJson, VersionIsRequiredAndANewerOneIsRefused) {
+  EXPECT_EQ(error_of(R"({"version": 2})"),
+            "scene.json: version: found 2, expected 1 or lower (the file was written by a newer cloudviewer)");
+  EXPECT_EQ(error_of(R"({"width": 48})"), "scene.json: version: found nothing, expected \"version\": 1");
+  EXPECT_EQ(error_of(R"({"version": "1"})"), "scene.json: version: found \"1\", expected an integer >= 1");
+}
+
+TEST(SceneJson, MalformedJsonAndAMissingFileGiveOneLine) {
+  const std::string bad = error_of("{\"version\": 1,\n \"width\": }");
+  EXPECT_EQ(bad.rfind("scene.json: not valid JSON: ", 0), 0u) << bad;
+  EXPECT_EQ(bad.find('\n'), std::string::npos) << bad;
+  EXPECT_NE(bad.find("line 2"), std::string::npos) << bad;  // where it went wrong
+  EXPECT_EQ(error_of("[1, 2]"), "scene.json: found [1,2] at the top, expected a JSON object { ... }");
+  try {
+    load_scene("/nonexistent/scene.json");
+    ADD_FAILURE() << "no error for a missing file";
+  } catch (const SceneError& e) {
+    EXPECT_STREQ(e.what(), "/nonexistent/scene.json: cannot open the scene file (missing or unreadable)");
+  }
+}
+
+TEST(Quality, PresetsSetTheMarchAndTheViewStepFollowsTheGrid) {
+  VolumeGrid g;
+  g.alt_m = {0.0, 500.0, 33};
+  RenderSettings r;
+  apply_quality("low", r);
+  EXPECT_EQ(resolve_view_step_m(r, g), 1000.0);
+  EXPECT_EQ(r.march.sun_steps, 8);
+  EXPECT_EQ(r.march.octaves, 1);
+  apply_quality("default", r);
+  EXPECT_EQ(resolve_view_step_m(r, g), 500.0);
+  EXPECT_EQ(r.march.sun_steps, 16);
+  EXPECT_EQ(r.march.octaves, 4);
+  EXPECT_EQ(r.accumulate, 1);
+  apply_quality("high", r);
+  EXPECT_EQ(resolve_view_step_m(r, g), 250.0);
+  EXPECT_EQ(r.accumulate, 4);
+  // The floor in metres: a fine grid does not make the default step finer than 50 m.
+  g.alt_m.step = 20.0;
+  apply_quality("default", r);
+  EXPECT_EQ(resolve_view_step_m(r, g), 50.0);
+  r.march.view_step_m = 123.0;  // set by hand: used as it is
+  EXPECT_EQ(resolve_view_step_m(r, g), 123.0);
+  EXPECT_THROW(apply_quality("custom", r), std::invalid_argument);
+}
+
+TEST(Framing, AutoCameraLooksAtTheBaseOfTheVolumeFromTheSouth) {
+  VolumeGrid g;
+  g.lon_deg = {100.0, 0.25, 121};  // 100..130
+  g.lat_deg = {0.0, 0.25, 81};     // 0..20
+  g.alt_m = {0.0, 500.0, 33};
+  const Camera c = auto_camera(g, 48, 27);
+  EXPECT_EQ(c.width, 48);
+  EXPECT_EQ(c.height, 27);
+  EXPECT_DOUBLE_EQ(c.lat_deg, -2.0);
+  EXPECT_DOUBLE_EQ(c.lon_deg, 115.0);
+  EXPECT_DOUBLE_EQ(c.alt_m, 1.8e6);
+  // The view axis points at the centre of the volume's base (to rounding).
+  const glm::dvec3 eye = cv::geo::sphere_to_ecef({c.lat_deg, c.lon_deg, c.alt_m}, g.earth_radius_m);
+  const glm::dvec3 target = cv::geo::sphere_to_ecef({10.0, 115.0, 0.0}, g.earth_radius_m);
+  const glm::dvec3 forward = camera_frame(c).forward;
+  const glm::dvec3 to_target = glm::normalize(target - eye);
+  EXPECT_LT(std::atan2(glm::length(glm::cross(forward, to_target)), glm::dot(forward, to_target)), 1e-9);
+  EXPECT_LT(std::abs(c.heading_deg), 1e-9);  // due north, the volume straight ahead
+}
+
+TEST(Framing, IsoDateTimesAndTheSun) {
+  EXPECT_EQ(parse_iso_utc("2024-01-15T03:00:00Z"), 1705287600);
+  EXPECT_EQ(parse_iso_utc("2000-02-29T23:59:59Z"), 951868799);
+  EXPECT_EQ(parse_iso_utc("1969-12-31T00:00"), -86400);
+  EXPECT_FALSE(parse_iso_utc("2023-02-29T00:00:00Z"));
+  EXPECT_FALSE(parse_iso_utc("yesterday"));
+  SunSpec spec;
+  spec.mode = SunMode::DateTime;
+  spec.datetime_utc = "2024-01-15T03:00:00Z";
+  const Sun at = resolve_sun(spec, std::nullopt, 0.0);
+  EXPECT_EQ(at.subsolar_lat_deg, cv::geo::subsolar_point(1705287600).lat_deg);
+  EXPECT_EQ(at.subsolar_lon_deg, cv::geo::subsolar_point(1705287600).lon_deg);
+  spec.mode = SunMode::ValidTime;
+  EXPECT_EQ(resolve_sun(spec, 1705287600, 0.0).subsolar_lon_deg, at.subsolar_lon_deg);
+  EXPECT_EQ(resolve_sun(spec, std::nullopt, 42.0).subsolar_lon_deg, 42.0);  // no time: noon over the camera
+  spec.mode = SunMode::Manual;
+  spec.subsolar_lat_deg = 5.0, spec.subsolar_lon_deg = -60.0, spec.irradiance = 2.0;
+  const Sun m = resolve_sun(spec, 1705287600, 0.0);
+  EXPECT_EQ(m.subsolar_lat_deg, 5.0);
+  EXPECT_EQ(m.subsolar_lon_deg, -60.0);
+  EXPECT_EQ(m.irradiance, glm::dvec3(2.0));
+}
+
+}  // namespace
