@@ -23,12 +23,19 @@ class GpuRaymarcher {
   // Uploads one time step (replacing the previous one).
   void upload(const core::VolumeGrid& grid, const core::GridMeanExtinction& medium);
 
-  // Renders: rgb = radiance, a = view transmittance, rows top to bottom.
+  // Uploads the erosion noise textures, needed before a render with settings.noise_amount > 0.
+  void upload_noise(const core::ErosionNoise& noise);
+
+  // Renders: rgb = radiance, a = view transmittance, rows top to bottom. With noise_amount 0 the
+  // program without the noise code runs and the noise textures are not bound.
   std::vector<glm::vec4> render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings);
 
  private:
+  const ShaderLoader& loader_;
   GlProgram program_;
+  GlProgram noise_program_;  // the NoiseDetail variant, compiled on first use
   GLuint textures_[2] = {0, 0};
+  GLuint noise_textures_[2] = {0, 0};
   core::VolumeGrid grid_;
 };
 
