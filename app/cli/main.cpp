@@ -46,7 +46,8 @@ void print_usage() {
       "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"
       "  render INPUT -o OUT.png [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov]\n"
       "         [--sun LAT,LON] [--steps M] [--sun-steps N] [--octaves N] [--accumulate N] [--exposure E]\n"
-      "         [--pfm OUT.pfm]\n"
+      "         [--pfm OUT.pfm] [--noise AMOUNT] [--noise-scale METRES]\n"
+      "                           (--noise 0..1 erodes sub-grid detail into the clouds; 0, the default, is the data)\n"
       "                           (the sun stands where it stood at the valid time unless --sun is given)\n"
       "                           render a NetCDF file or .cvvol volume headlessly (EGL) to a PNG\n"
       "  --version                print the version\n");
@@ -279,6 +280,14 @@ int cmd_render(const std::vector<std::string>& args) {
     } else if (a == "--accumulate") {
       accumulate = static_cast<int>(parse_number("--accumulate", next()));
       if (accumulate < 1 || accumulate > 4096) throw UsageError{"cloudviewer render: --accumulate: expected 1..4096 frames"};
+    } else if (a == "--noise") {
+      march.noise_amount = parse_number("--noise", next());
+      if (!(march.noise_amount >= 0 && march.noise_amount <= 1)) throw UsageError{"cloudviewer render: --noise: expected an amount in 0..1"};
+    } else if (a == "--noise-scale") {
+      march.noise_scale_m = parse_number("--noise-scale", next());
+      if (!(march.noise_scale_m >= 10 && march.noise_scale_m <= 1e7)) {
+        throw UsageError{"cloudviewer render: --noise-scale: expected the noise tile's period in metres, 10..1e7"};
+      }
     } else if (a == "--exposure") {
       tone.exposure = parse_number("--exposure", next());
       if (!(tone.exposure > 0)) throw UsageError{"cloudviewer render: --exposure: expected a number > 0"};
@@ -358,6 +367,12 @@ int cmd_render(const std::vector<std::string>& args) {
   cv::render::GpuRaymarcher gpu(loader);
   t0 = clock::now();
   gpu.upload(g, medium);
+  if (march.noise_amount > 0.0) {  // generated, compiled and bound only when used
+    const auto t_noise = clock::now();
+    gpu.upload_noise(cv::core::make_erosion_noise());
+    std::printf("erosion noise %.2f, tile %.0f m: generated and uploaded in %.2f s\n", march.noise_amount, march.noise_scale_m,
+                seconds(t_noise));
+  }
   glFinish();
   const double t_upload = seconds(t0);
   t0 = clock::now();

@@ -23,7 +23,8 @@ class GpuRaymarcher {
   // Uploads one time step (replacing the previous one).
   void upload(const core::VolumeGrid& grid, const core::GridMeanExtinction& medium);
 
-  // Uploads the erosion noise textures, needed before a render with settings.noise_amount > 0.
+  // Uploads the erosion noise textures and compiles the noise variant of the raymarcher: needed
+  // before a render with settings.noise_amount > 0, not done otherwise.
   void upload_noise(const core::ErosionNoise& noise);
 
   // Renders: rgb = radiance, a = view transmittance, rows top to bottom. With noise_amount 0 the
@@ -33,7 +34,7 @@ class GpuRaymarcher {
  private:
   const ShaderLoader& loader_;
   GlProgram program_;
-  GlProgram noise_program_;  // the NoiseDetail variant, compiled on first use
+  GlProgram noise_program_;  // the NoiseDetail variant, compiled by upload_noise
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
   core::VolumeGrid grid_;
