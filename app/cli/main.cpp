@@ -282,11 +282,13 @@ int cmd_render(const std::vector<std::string>& args) {
       if (accumulate < 1 || accumulate > 4096) throw UsageError{"cloudviewer render: --accumulate: expected 1..4096 frames"};
     } else if (a == "--noise") {
       march.noise_amount = parse_number("--noise", next());
-      if (!(march.noise_amount >= 0 && march.noise_amount <= 1)) throw UsageError{"cloudviewer render: --noise: expected an amount in 0..1"};
+      if (!(march.noise_amount >= 0 && march.noise_amount <= 1)) {
+        throw UsageError{"cloudviewer render: --noise: found " + args[i] + ", expected an amount in 0..1 (0: the data only)"};
+      }
     } else if (a == "--noise-scale") {
       march.noise_scale_m = parse_number("--noise-scale", next());
       if (!(march.noise_scale_m >= 10 && march.noise_scale_m <= 1e7)) {
-        throw UsageError{"cloudviewer render: --noise-scale: expected the noise tile's period in metres, 10..1e7"};
+        throw UsageError{"cloudviewer render: --noise-scale: found " + args[i] + ", expected the noise tile's period in metres, 10..1e7"};
       }
     } else if (a == "--exposure") {
       tone.exposure = parse_number("--exposure", next());
