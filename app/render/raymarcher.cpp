@@ -72,6 +72,7 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   }
   const bool noise = s.noise_amount > 0.0;
   if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
+  if (noise && !(s.noise_scale_m > 0.0)) throw GlError("noise_scale_m must be > 0");
   const GLuint p = noise ? noise_program_.id() : program_.id();
   const core::CameraFrame c = core::camera_frame(cam);
   const double r0 = grid_.earth_radius_m;

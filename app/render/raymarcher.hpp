@@ -14,7 +14,8 @@ namespace cv::render {
 
 class GpuRaymarcher {
  public:
-  // Needs a current OpenGL 4.5 context; compiles the raymarcher.
+  // Needs a current OpenGL 4.5 context; compiles the raymarcher. Keeps a reference to the loader
+  // (for the noise variant, compiled later), which must outlive it.
   explicit GpuRaymarcher(const ShaderLoader& loader);
   ~GpuRaymarcher();
   GpuRaymarcher(const GpuRaymarcher&) = delete;

@@ -99,6 +99,7 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
   Erosion erosion;
   if (s.noise_amount > 0.0) {
     if (!noise) throw std::invalid_argument("render_reference: noise_amount > 0 needs the erosion noise textures");
+    if (!(s.noise_scale_m > 0.0)) throw std::invalid_argument("render_reference: noise_scale_m must be > 0");
     erosion = {noise, noise_anchor(grid_centre_ecef(grid), s.noise_scale_m), s.noise_scale_m, s.noise_amount};
   }
   const Medium medium{grid, VolumeSampler(grid, ext.liquid_per_m), VolumeSampler(grid, ext.ice_per_m), erosion};
