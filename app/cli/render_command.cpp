@@ -16,6 +16,7 @@
 
 #include "cli_common.hpp"
 #include "importer.hpp"
+#include "noise/noise.hpp"
 #include "render/context.hpp"
 #include "render/image_output.hpp"
 #include "render/raymarcher.hpp"
@@ -135,6 +136,16 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
     } else if (a == "--accumulate") {
       scene.render.accumulate = parse_int(a, v, 1, 4096, "1..4096 frames");
       r.march_overridden = true;
+    } else if (a == "--noise") {
+      m.noise_amount = parse_number(a, v);
+      if (!(m.noise_amount >= 0 && m.noise_amount <= 1)) {
+        throw UsageError{"cloudviewer render: --noise: found " + v + ", expected an amount in 0..1 (0: the data only)"};
+      }
+    } else if (a == "--noise-scale") {
+      m.noise_scale_m = parse_number(a, v);
+      if (!(m.noise_scale_m >= 10 && m.noise_scale_m <= 1e7)) {
+        throw UsageError{"cloudviewer render: --noise-scale: found " + v + ", expected the noise tile's period in metres, 10..1e7"};
+      }
     } else if (a == "--exposure") {
       scene.render.exposure = parse_number(a, v);
       if (!(scene.render.exposure > 0)) throw UsageError{"cloudviewer render: --exposure: found '" + v + "', expected a number > 0"};
@@ -209,6 +220,7 @@ const char* render_usage() {
          "         [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov] [--sun LAT,LON | --sun-time ISO]\n"
          "         [--quality low|default|high|custom] [--steps M] [--sun-steps N] [--octaves N] [--accumulate N]\n"
          "         [--exposure E] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N] [--pfm OUT.pfm]\n"
+         "         [--noise AMOUNT] [--noise-scale METRES]\n"
          "         [--save-scene OUT.json]  (the effective scene, camera and sun resolved, to reproduce the image)\n"
          "                           the sun stands where it stood at the valid time unless --sun or --sun-time\n";
 }
@@ -278,6 +290,12 @@ int cmd_render(const std::vector<std::string>& args) {
   render::GpuRaymarcher gpu(loader);
   t0 = clock::now();
   gpu.upload(g, medium);
+  if (march.noise_amount > 0.0) {  // generated, compiled and bound only when used
+    const auto t_noise = clock::now();
+    gpu.upload_noise(core::make_erosion_noise());
+    std::printf("erosion noise %.2f, tile %.0f m: generated and uploaded in %.2f s\n", march.noise_amount, march.noise_scale_m,
+                seconds_since(t_noise));
+  }
   glFinish();
   const double t_upload = seconds_since(t0);
 

@@ -18,10 +18,30 @@ void set3(GLuint p, const char* n, const glm::dvec3& v) {
 }  // namespace
 
 GpuRaymarcher::GpuRaymarcher(const ShaderLoader& loader)
-    : program_(load_compute(loader, ShaderLoader::default_shader_dir() / "render" / "raymarch.comp")) {}
+    : loader_(loader), program_(load_compute(loader, ShaderLoader::default_shader_dir() / "render" / "raymarch.comp")) {}
 
 GpuRaymarcher::~GpuRaymarcher() {
   if (textures_[0]) glDeleteTextures(2, textures_);
+  if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
+}
+
+void GpuRaymarcher::upload_noise(const core::ErosionNoise& noise) {
+  // The noise variant is compiled here, not in the first render, so render timings are the march's.
+  if (!noise_program_.id()) {
+    noise_program_ = load_compute(loader_, ShaderLoader::default_shader_dir() / "render" / "raymarch.comp",
+                                  ShaderFeatures{ShaderFeature::NoiseDetail});
+  }
+  if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
+  glCreateTextures(GL_TEXTURE_3D, 2, noise_textures_);
+  const core::NoiseTexture* tex[2] = {&noise.low, &noise.high};
+  for (int i = 0; i < 2; ++i) {
+    // Fetched texel by texel (texelFetch) and interpolated with wrap-around in the shader, exactly
+    // as the CPU reference does.
+    glTextureStorage3D(noise_textures_[i], 1, GL_R32F, tex[i]->n, tex[i]->n, tex[i]->n);
+    glTextureSubImage3D(noise_textures_[i], 0, 0, 0, 0, tex[i]->n, tex[i]->n, tex[i]->n, GL_RED, GL_FLOAT,
+                        tex[i]->texels.data());
+  }
+  check_gl("uploading the erosion noise textures");
 }
 
 void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExtinction& medium) {
@@ -52,7 +72,10 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
     throw GlError("an image of " + std::to_string(cam.width) + " x " + std::to_string(cam.height) +
                   " pixels is too large to read back at once (at most 134 million pixels)");
   }
-  const GLuint p = program_.id();
+  const bool noise = s.noise_amount > 0.0;
+  if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
+  if (noise && !(s.noise_scale_m > 0.0)) throw GlError("noise_scale_m must be > 0");
+  const GLuint p = noise ? noise_program_.id() : program_.id();
   const core::CameraFrame c = core::camera_frame(cam);
   const double r0 = grid_.earth_radius_m;
   glProgramUniform2i(p, loc(p, "u_size"), cam.width, cam.height);
@@ -79,6 +102,15 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   glProgramUniform1f(p, loc(p, "u_droplet_um"), static_cast<float>(s.droplet_diameter_um));
   glProgramUniform1f(p, loc(p, "u_ice_g"), static_cast<float>(s.ice_g));
   glProgramUniform1i(p, loc(p, "u_frame"), s.frame);
+  if (noise) {
+    const core::NoiseAnchor a = core::noise_anchor(core::grid_centre_ecef(grid_), s.noise_scale_m);
+    set3(p, "u_noise_anchor", a.ecef_m);  // float-exact by construction
+    set3(p, "u_noise_anchor_frac", a.frac);
+    glProgramUniform1f(p, loc(p, "u_noise_period"), static_cast<float>(s.noise_scale_m));
+    glProgramUniform1f(p, loc(p, "u_noise_amount"), static_cast<float>(s.noise_amount));
+    glBindTextureUnit(3, noise_textures_[0]);
+    glBindTextureUnit(4, noise_textures_[1]);
+  }
   GLuint out = 0;
   glCreateTextures(GL_TEXTURE_2D, 1, &out);
   glTextureStorage2D(out, 1, GL_RGBA32F, cam.width, cam.height);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <glm/glm.hpp>
 
@@ -15,15 +16,32 @@ namespace {
 namespace p64 = cv::physics::f64;
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
-// Grid-box-mean extinction of liquid and of ice at an Earth-centred point.
+// Erosion noise as the march uses it: the textures, where they are anchored, how strong.
+struct Erosion {
+  const ErosionNoise* noise = nullptr;  // null: off
+  NoiseAnchor anchor;
+  double period_m = 0.0, amount = 0.0;
+  // Erodes both extinctions at p, as raymarch.comp's erode_at does.
+  void apply(const glm::dvec3& p, double& sigma_liquid, double& sigma_ice) const {
+    const glm::dvec3 t = p64::noise_tile_coords(p - anchor.ecef_m, anchor.frac, period_m);
+    const double e = p64::erosion_threshold(noise->low.sample(t), noise->high.sample(p64::noise_high_coords(t)), amount);
+    const double feature_m = p64::noise_feature_m(period_m);
+    sigma_liquid = p64::erode_extinction(sigma_liquid, e, feature_m);
+    sigma_ice = p64::erode_extinction(sigma_ice, e, feature_m);
+  }
+};
+
+// Grid-box-mean extinction of liquid and of ice at an Earth-centred point, eroded by the noise if on.
 struct Medium {
   const VolumeGrid& grid;
   VolumeSampler liquid, ice;
+  Erosion erosion;
   void at(const glm::dvec3& p, double& sigma_liquid, double& sigma_ice) const {
     const glm::dvec3 g = p64::ecef_to_sphere(p, grid.earth_radius_m);
     const double lat = g.x / kDeg, lon = g.y / kDeg, alt = g.z;
     sigma_liquid = liquid.sample(lat, lon, alt, 0.0);
     sigma_ice = ice.sample(lat, lon, alt, 0.0);
+    if (erosion.noise && sigma_liquid + sigma_ice > 0.0) erosion.apply(p, sigma_liquid, sigma_ice);
   }
 };
 }  // namespace
@@ -65,14 +83,26 @@ glm::dvec3 camera_ray(const Camera& cam, int px, int py) {
   return glm::normalize(c.forward + x * c.right + y * c.up);
 }
 
+glm::dvec3 grid_centre_ecef(const VolumeGrid& grid) {
+  const double lat = grid.lat_deg.start + 0.5 * (grid.lat_deg.last() - grid.lat_deg.start);
+  const double lon = grid.lon_deg.start + 0.5 * (grid.lon_deg.last() - grid.lon_deg.start);
+  return geo::sphere_to_ecef({lat, lon, 0.0}, grid.earth_radius_m);
+}
+
 ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction& ext, const Camera& cam, const Sun& sun,
-                                const MarchSettings& s) {
+                                const MarchSettings& s, const ErosionNoise* noise) {
   ReferenceImage img;
   img.width = cam.width;
   img.height = cam.height;
   img.radiance.assign(static_cast<std::size_t>(cam.width) * cam.height, glm::dvec3(0.0));
   img.transmittance.assign(img.radiance.size(), 1.0);
-  const Medium medium{grid, VolumeSampler(grid, ext.liquid_per_m), VolumeSampler(grid, ext.ice_per_m)};
+  Erosion erosion;
+  if (s.noise_amount > 0.0) {
+    if (!noise) throw std::invalid_argument("render_reference: noise_amount > 0 needs the erosion noise textures");
+    if (!(s.noise_scale_m > 0.0)) throw std::invalid_argument("render_reference: noise_scale_m must be > 0");
+    erosion = {noise, noise_anchor(grid_centre_ecef(grid), s.noise_scale_m), s.noise_scale_m, s.noise_amount};
+  }
+  const Medium medium{grid, VolumeSampler(grid, ext.liquid_per_m), VolumeSampler(grid, ext.ice_per_m), erosion};
   const double r0 = grid.earth_radius_m;
   const double hb = grid.alt_m.start, ht = grid.alt_m.last();
   const glm::dvec3 o = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);

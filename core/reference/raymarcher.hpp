@@ -8,6 +8,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "noise/noise.hpp"
 #include "volume/cloud_volume.hpp"
 
 namespace cv::core {
@@ -37,6 +38,10 @@ struct MarchSettings {
   // -1: sample each step at its middle; otherwise the accumulation frame whose jittered offsets
   // (shaders/common/rng.glsl step_jitter) place the samples, so banding averages away over frames.
   int frame = -1;
+  // Sub-grid erosion noise (core/noise, shaders/common/erosion.glsl). 0 = off: the image is the
+  // data's field exactly, and no noise is generated, bound or sampled. Up to 1 = strongest.
+  double noise_amount = 0.0;
+  double noise_scale_m = 20000.0;  // period of the low-frequency noise tile, metres
 };
 
 struct ReferenceImage {
@@ -64,9 +69,14 @@ CameraFrame camera_frame(const Camera& cam);
 // The direction of a pixel's ray in Earth-centred coordinates.
 glm::dvec3 camera_ray(const Camera& cam, int px, int py);
 
-// Renders one time step of a volume.
+// The centre of a volume on the sphere (altitude 0), Earth-centred, metres: the erosion noise's
+// anchor (noise_anchor) for this grid, the same on the CPU and the GPU.
+glm::dvec3 grid_centre_ecef(const VolumeGrid& grid);
+
+// Renders one time step of a volume. `noise` is needed when settings.noise_amount > 0
+// (std::invalid_argument otherwise) and is not read when it is 0.
 ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction& medium, const Camera& cam, const Sun& sun,
-                                const MarchSettings& settings);
+                                const MarchSettings& settings, const ErosionNoise* noise = nullptr);
 inline ReferenceImage render_reference(const VolumeGrid& grid, const TimeStepData& data, const Camera& cam, const Sun& sun,
                                        const MarchSettings& settings) {
   return render_reference(grid, grid_mean_extinction(grid, data), cam, sun, settings);

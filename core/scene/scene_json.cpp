@@ -159,7 +159,8 @@ void read_sun(const Reader& r, SunSpec& s) {
 }
 
 void read_march(const Reader& r, MarchSettings& m) {
-  r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "droplet_diameter_um", "ice_g", "frame"});
+  r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "droplet_diameter_um", "ice_g", "frame",
+          "noise_amount", "noise_scale_m"});
   r.number("view_step_m", m.view_step_m, 0.0, 1e7, "a view step in metres 0..1e7 (0: from the grid)");
   r.integer("sun_steps", m.sun_steps, 1, 1024);
   r.integer("octaves", m.octaves, 1, 16);
@@ -169,6 +170,8 @@ void read_march(const Reader& r, MarchSettings& m) {
   r.number("droplet_diameter_um", m.droplet_diameter_um, 0.01, 50.0, "a droplet diameter in um 0.01..50");
   r.number("ice_g", m.ice_g, -0.999, 0.999, "an asymmetry parameter -0.999..0.999");
   r.integer("frame", m.frame, -1, 1 << 30);
+  r.number("noise_amount", m.noise_amount, 0.0, 1.0, "an erosion amount 0..1 (0: the data only)");
+  r.number("noise_scale_m", m.noise_scale_m, 10.0, 1e7, "a noise tile period in metres 10..1e7");
 }
 
 void read_render(const Reader& r, RenderSettings& s) {
@@ -272,7 +275,9 @@ std::string scene_to_json(const Scene& s) {
                       {"octave_c", m.octave_c},
                       {"droplet_diameter_um", m.droplet_diameter_um},
                       {"ice_g", m.ice_g},
-                      {"frame", m.frame}}}};
+                      {"frame", m.frame},
+                      {"noise_amount", m.noise_amount},
+                      {"noise_scale_m", m.noise_scale_m}}}};
   root["overlays"] = s.overlays;
   return root.dump(2) + "\n";
 }

@@ -62,6 +62,41 @@ float fetch(sampler3D tex, vec3 f) {
   return mix(mix(c00, c10, wy), mix(c01, c11, wy), wz);
 }
 
+#ifdef CV_FEATURE_NOISE_DETAIL
+// Sub-grid erosion (shaders/common/erosion.glsl), compiled in only when the amount is above 0.
+layout(binding = 3) uniform sampler3D u_noise_low;   // Perlin-Worley, periodic, [0, 1]
+layout(binding = 4) uniform sampler3D u_noise_high;  // Worley fBm, periodic, [0, 1]
+uniform vec3 u_noise_anchor;       // metres, Earth-centred, a float-exact point near the data
+uniform vec3 u_noise_anchor_frac;  // the anchor's position in tiles, from double on the CPU
+uniform float u_noise_period;      // metres, the low-frequency tile
+uniform float u_noise_amount;
+
+// Trilinear with wrap-around, as NoiseTexture::sample in core/noise (x, then y, then z).
+float fetch_noise(sampler3D tex, vec3 t) {
+  int n = textureSize(tex, 0).x;
+  ivec3 i0;
+  ivec3 i1;
+  vec3 w;
+  noise_texel_pair(t.x, n, i0.x, i1.x, w.x);
+  noise_texel_pair(t.y, n, i0.y, i1.y, w.y);
+  noise_texel_pair(t.z, n, i0.z, i1.z, w.z);
+  float c00 = mix(texelFetch(tex, ivec3(i0.x, i0.y, i0.z), 0).r, texelFetch(tex, ivec3(i1.x, i0.y, i0.z), 0).r, w.x);
+  float c10 = mix(texelFetch(tex, ivec3(i0.x, i1.y, i0.z), 0).r, texelFetch(tex, ivec3(i1.x, i1.y, i0.z), 0).r, w.x);
+  float c01 = mix(texelFetch(tex, ivec3(i0.x, i0.y, i1.z), 0).r, texelFetch(tex, ivec3(i1.x, i0.y, i1.z), 0).r, w.x);
+  float c11 = mix(texelFetch(tex, ivec3(i0.x, i1.y, i1.z), 0).r, texelFetch(tex, ivec3(i1.x, i1.y, i1.z), 0).r, w.x);
+  return mix(mix(c00, c10, w.y), mix(c01, c11, w.y), w.z);
+}
+
+// Erodes both extinctions at p, as Erosion::apply in core/reference/raymarcher.cpp does.
+void erode_at(vec3 p, inout float sl, inout float si) {
+  vec3 t = noise_tile_coords(p - u_noise_anchor, u_noise_anchor_frac, u_noise_period);
+  float e = erosion_threshold(fetch_noise(u_noise_low, t), fetch_noise(u_noise_high, noise_high_coords(t)), u_noise_amount);
+  float feature_m = noise_feature_m(u_noise_period);
+  sl = erode_extinction(sl, e, feature_m);
+  si = erode_extinction(si, e, feature_m);
+}
+#endif
+
 // The medium at Earth-centred point p whose altitude alt_m the caller knows better than |p| - r0
 // (ray_altitude): latitude and longitude come from p.
 void medium_at(vec3 p, float alt_m, out float sl, out float si) {
@@ -72,6 +107,9 @@ void medium_at(vec3 p, float alt_m, out float sl, out float si) {
   if (!volume_coords(g.x / kDeg, g.y / kDeg, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
   sl = fetch(u_liquid, f);
   si = fetch(u_ice, f);
+#ifdef CV_FEATURE_NOISE_DETAIL
+  if (sl + si > 0.0) erode_at(p, sl, si);
+#endif
 }
 
 void main() {

@@ -116,6 +116,19 @@ void main() {
     }
     case PARITY_STEP_JITTER: r.a.x = step_jitter(uint(c.in0.x), uint(c.in0.y), c.meta.y); break;
     case PARITY_RAY_ALTITUDE: r.a.x = ray_altitude(c.in0.x, c.in0.y, c.in0.z, c.in0.w); break;
+    case PARITY_NOISE_TILE_COORDS: r.a.xyz = noise_tile_coords(c.in0.xyz, c.in1.xyz, c.in0.w); break;
+    case PARITY_NOISE_TEXEL_PAIR: {
+      int i0;
+      int i1;
+      noise_texel_pair(c.in0.x, int(c.meta.y), i0, i1, r.a.x);
+      r.u.xy = uvec2(i0, i1);
+      break;
+    }
+    case PARITY_EROSION:
+      // in0 = (sigma, n_low, n_high, amount), in1.x = feature metres: the threshold and the fraction kept.
+      r.a.x = erosion_threshold(c.in0.y, c.in0.z, c.in0.w);
+      r.a.y = erode_extinction(c.in0.x, r.a.x, c.in1.x) / c.in0.x;
+      break;
     default: r.u.w = 1u; break;
   }
   results[i] = r;

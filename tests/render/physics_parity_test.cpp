@@ -130,6 +130,18 @@ Result eval(const Case& c) {
     }
     case PARITY_STEP_JITTER: r.a.x = f32::step_jitter(static_cast<f32::uint>(c.in0.x), static_cast<f32::uint>(c.in0.y), c.meta.y); break;
     case PARITY_RAY_ALTITUDE: r.a.x = f32::ray_altitude(c.in0.x, c.in0.y, c.in0.z, c.in0.w); break;
+    case PARITY_NOISE_TILE_COORDS: r.a = vec4(f32::noise_tile_coords(vec3(c.in0), vec3(c.in1), c.in0.w), 0); break;
+    case PARITY_NOISE_TEXEL_PAIR: {
+      int i0, i1;
+      f32::noise_texel_pair(c.in0.x, static_cast<int>(c.meta.y), i0, i1, r.a.x);
+      r.u.x = static_cast<unsigned>(i0);
+      r.u.y = static_cast<unsigned>(i1);
+      break;
+    }
+    case PARITY_EROSION:
+      r.a.x = f32::erosion_threshold(c.in0.y, c.in0.z, c.in0.w);
+      r.a.y = f32::erode_extinction(c.in0.x, r.a.x, c.in1.x) / c.in0.x;
+      break;
     default: r.u.w = 1u; break;
   }
   return r;
@@ -235,6 +247,22 @@ std::vector<Case> build_cases() {
   for (float h : {0.0f, 2500.0f, 4e8f})
     for (float mu : {-0.9f, -0.004f, 0.0f, 0.3f, 1.0f})
       for (float t : {0.0f, 150.0f, 4.0e5f}) cs.push_back(mk(PARITY_RAY_ALTITUDE, vec4(6371000.0f, h, mu, t)));
+  // Erosion noise: tile coordinates of offsets up to 1e6 m (away from the wrap at 0/1, where a
+  // last-bit difference would read as a whole tile), texel addressing across the seam, and the
+  // erosion from thin to thick extinction.
+  for (float x : {-987654.3f, -2500.0f, 0.0f, 123.456f, 7777.7f, 300001.0f}) {
+    cs.push_back(mk(PARITY_NOISE_TILE_COORDS, vec4(x, 0.5f * x + 1000.0f, -x - 3000.0f, 20000.0f), vec4(0.3f, 0.71f, 0.05f, 0)));
+  }
+  for (float t : {0.0f, 0.2f, 0.5f / 64.0f, 0.49f, 63.5f / 64.0f, 0.9999f, 1.0f}) {
+    for (unsigned n : {32u, 64u}) cs.push_back(mk(PARITY_NOISE_TEXEL_PAIR, vec4(t, 0, 0, 0), vec4(0.0f), n));
+  }
+  for (float sigma : {1e-7f, 1e-4f, 1e-3f, 2e-2f, 5.0f}) {
+    for (float nl : {0.0f, 0.3f, 0.8f, 1.0f}) {
+      for (float nh : {0.0f, 0.6f, 1.0f}) {
+        for (float amount : {0.0f, 0.5f, 1.0f}) cs.push_back(mk(PARITY_EROSION, vec4(sigma, nl, nh, amount), vec4(2500.0f, 0, 0, 0)));
+      }
+    }
+  }
   for (int i = 0; i <= 10; ++i) {
     cs.push_back(mk(PARITY_DIRECTION_AROUND, vec4(glm::normalize(vec3(0.1f * i - 0.5f, 0.2f, -0.9f)), 0),
                     vec4(-1.0f + 0.2f * i, 0.6f * i, 0, 0)));
@@ -256,7 +284,10 @@ float floor_for(unsigned id, int component) {
     case PARITY_ENU_FRAME:
     case PARITY_DIRECTION_AROUND:
     case PARITY_ECEF_TO_SPHERE:
-    case PARITY_VOLUME_COORDS: return 1.0f;  // grid indices
+    case PARITY_VOLUME_COORDS:  // grid indices
+    case PARITY_NOISE_TILE_COORDS:  // tile coordinates in [0, 1)
+    case PARITY_NOISE_TEXEL_PAIR:  // interpolation weight
+    case PARITY_EROSION: return 1.0f;  // threshold and fraction kept, both in [0, 1]
     case PARITY_RAY_SPHERE_REL:
     case PARITY_RAY_SHELL_REL:
     case PARITY_RAY_SPHERE:
@@ -275,7 +306,7 @@ const char* name_of(unsigned id) {
                                 "segment_integral", "transmittance", "octaves_hg", "octaves_mie", "ray_sphere_rel",
                                 "ray_shell_rel", "ray_sphere", "sphere_to_ecef", "ecef_to_sphere", "enu_frame",
                                 "geopotential", "pcg_hash", "two_prod", "direction_around", "volume_coords", "step_jitter",
-                                "ray_altitude"};
+                                "ray_altitude", "noise_tile_coords", "noise_texel_pair", "erosion"};
   return id < PARITY_FUNCTION_COUNT ? names[id] : "?";
 }
 
