@@ -22,6 +22,7 @@
 #include "render/image_output.hpp"
 #include "render/raymarcher.hpp"
 #include "render/shader_loader.hpp"
+#include "viewer/viewer.hpp"
 
 namespace {
 
@@ -49,6 +50,9 @@ void print_usage() {
       "         [--pfm OUT.pfm]\n"
       "                           (the sun stands where it stood at the valid time unless --sun is given)\n"
       "                           render a NetCDF file or .cvvol volume headlessly (EGL) to a PNG\n"
+      "  view INPUT [--size WxH] [--time N] [--hide-ui] [--frames N --screenshot OUT.png]\n"
+      "                           the interactive viewer (GLFW window); with --frames it renders N frames,\n"
+      "                           saves the window to OUT.png and exits\n"
       "  --version                print the version\n");
 }
 
@@ -410,7 +414,8 @@ int main(int argc, char** argv) {
     if (cmd == "import") return cmd_import(args);
     if (cmd == "phase") return cmd_phase(args);
     if (cmd == "render") return cmd_render(args);
-    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase or render"};
+    if (cmd == "view") return cv::viewer::cmd_view(args);
+    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase, render or view"};
   } catch (const UsageError& e) {
     std::fprintf(stderr, "%s\n", e.message.c_str());
     return kExitBadInput;

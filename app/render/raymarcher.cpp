@@ -44,12 +44,7 @@ void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExt
   grid_ = grid;
 }
 
-std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s) {
-  // The read-back takes its byte count as a GLsizei.
-  if (static_cast<double>(cam.width) * cam.height * sizeof(glm::vec4) >= 2147483647.0) {
-    throw GlError("an image of " + std::to_string(cam.width) + " x " + std::to_string(cam.height) +
-                  " pixels is too large to read back at once (at most 134 million pixels)");
-  }
+void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s) {
   const GLuint p = program_.id();
   const core::CameraFrame c = core::camera_frame(cam);
   const double r0 = grid_.earth_radius_m;
@@ -77,15 +72,26 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   glProgramUniform1f(p, loc(p, "u_droplet_um"), static_cast<float>(s.droplet_diameter_um));
   glProgramUniform1f(p, loc(p, "u_ice_g"), static_cast<float>(s.ice_g));
   glProgramUniform1i(p, loc(p, "u_frame"), s.frame);
-  GLuint out = 0;
-  glCreateTextures(GL_TEXTURE_2D, 1, &out);
-  glTextureStorage2D(out, 1, GL_RGBA32F, cam.width, cam.height);
   glBindImageTexture(0, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glBindTextureUnit(1, textures_[0]);
   glBindTextureUnit(2, textures_[1]);
   glUseProgram(p);
   glDispatchCompute(static_cast<GLuint>((cam.width + 7) / 8), static_cast<GLuint>((cam.height + 7) / 8), 1);
-  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+  // Readers either fetch texels (the viewer's accumulation) or read the image back.
+  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  check_gl("running the raymarcher");
+}
+
+std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s) {
+  // The read-back takes its byte count as a GLsizei.
+  if (static_cast<double>(cam.width) * cam.height * sizeof(glm::vec4) >= 2147483647.0) {
+    throw GlError("an image of " + std::to_string(cam.width) + " x " + std::to_string(cam.height) +
+                  " pixels is too large to read back at once (at most 134 million pixels)");
+  }
+  GLuint out = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &out);
+  glTextureStorage2D(out, 1, GL_RGBA32F, cam.width, cam.height);
+  render_into(out, cam, sun, s);
   std::vector<glm::vec4> pixels(static_cast<std::size_t>(cam.width) * cam.height);
   glGetTextureImage(out, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(pixels.size() * sizeof(glm::vec4)), pixels.data());
   glDeleteTextures(1, &out);

@@ -26,6 +26,10 @@ class GpuRaymarcher {
   // Renders: rgb = radiance, a = view transmittance, rows top to bottom.
   std::vector<glm::vec4> render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings);
 
+  // Renders into `out`, an RGBA32F 2-D texture of at least cam.width x cam.height that stays on
+  // the GPU (the viewer draws and accumulates it there; nothing is read back).
+  void render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings);
+
  private:
   GlProgram program_;
   GLuint textures_[2] = {0, 0};
