@@ -82,11 +82,6 @@ void Presenter::resize(int width, int height) {
   glTextureStorage2D(frame_, 1, GL_RGBA32F, width, height);
   glCreateTextures(GL_TEXTURE_2D, 1, &mean_);
   glTextureStorage2D(mean_, 1, GL_RGBA32F, width, height);
-  // Upscaling a reduced march size: bilinear; the edge clamps instead of wrapping to the far side.
-  glTextureParameteri(mean_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(mean_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTextureParameteri(mean_, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(mean_, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   width_ = width;
   height_ = height;
   check_gl("allocating the viewer's march and accumulation textures");

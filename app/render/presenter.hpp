@@ -36,7 +36,7 @@ class Presenter {
   void accumulate(int count);
 
   // Draws the mean, tonemapped, over the currently bound framebuffer's viewport (x, y, w, h),
-  // scaling with bilinear filtering when the march size differs.
+  // scaling bilinearly (between tonemapped texels) when the march size differs.
   void draw(const ToneSettings& tone, int x, int y, int w, int h) const;
 
  private:
