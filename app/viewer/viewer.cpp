@@ -65,6 +65,17 @@ class PassTimer {
       used_[old] = false;
     }
   }
+  // Waits for every pass still in flight and keeps the newest time (for the screenshot's report).
+  void finish() {
+    for (int k = 0; k < kRing; ++k) {
+      const int q = (next_ + k) % kRing;  // oldest first
+      if (!used_[q]) continue;
+      GLuint64 ns = 0;
+      glGetQueryObjectui64v(ids_[q], GL_QUERY_RESULT, &ns);
+      ms_ = static_cast<double>(ns) * 1e-6;
+      used_[q] = false;
+    }
+  }
   double ms() const { return ms_; }
 
  private:
@@ -285,6 +296,8 @@ int run_viewer(const ViewerOptions& o) {
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     if (o.frames > 0 && frame == o.frames - 1 && !o.screenshot.empty()) {
       save_screenshot(o.screenshot, fbw, fbh);
+      march_timer.finish();
+      stats.march_ms = march_timer.ms();
       std::printf("wrote %s (%d x %d window, %d frame(s) accumulated in %.2f s wall, GPU march %.1f ms per frame on %s)\n",
                   o.screenshot.c_str(), fbw, fbh, accumulated, std::chrono::duration<double>(clock::now() - start).count(),
                   stats.march_ms, stats.renderer.c_str());

@@ -1,17 +1,20 @@
 // Checks a viewer screenshot is not blank: clouds present means a spread of pixel values and many
-// pixels away from the empty-sky colour. Usage: screenshot_check FILE.png [EXPOSURE]
+// pixels away from the empty-sky colour. Usage: screenshot_check FILE.png [--same-as OTHER.png]; with
+// --same-as it also requires every channel within one 8-bit step of OTHER (e.g. `render`'s image).
 #include <stb_image.h>
 
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "render/image_output.hpp"
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: screenshot_check FILE.png\n");
+  if (argc != 2 && !(argc == 4 && std::string(argv[2]) == "--same-as")) {
+    std::fprintf(stderr, "usage: screenshot_check FILE.png [--same-as OTHER.png]\n");
     return 2;
   }
   int w = 0, h = 0, n = 0;
@@ -35,6 +38,22 @@ int main(int argc, char** argv) {
     sum2 += y * y;
     levels.insert(static_cast<int>(y));
     away += std::abs(p[0] - sky[0]) + std::abs(p[1] - sky[1]) + std::abs(p[2] - sky[2]) > 24;
+  }
+  if (argc == 4) {
+    int w2 = 0, h2 = 0;
+    unsigned char* other = stbi_load(argv[3], &w2, &h2, &n, 3);
+    if (!other || w2 != w || h2 != h) {
+      std::fprintf(stderr, "%s: cannot read it, or it is not %d x %d\n", argv[3], w, h);
+      return 1;
+    }
+    int worst = 0;
+    for (long i = 0; i < count * 3; ++i) worst = std::max(worst, std::abs(int(px[i]) - int(other[i])));
+    stbi_image_free(other);
+    std::printf("largest channel difference from %s: %d\n", argv[3], worst);
+    if (worst > 1) {
+      std::fprintf(stderr, "%s differs from %s by up to %d steps (expected at most 1)\n", argv[1], argv[3], worst);
+      return 1;
+    }
   }
   stbi_image_free(px);
   const double mean = sum / count, sd = std::sqrt(std::max(0.0, sum2 / count - mean * mean));
