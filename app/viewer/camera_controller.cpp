@@ -64,22 +64,19 @@ void orbit(core::Camera& cam, double dx_px, double dy_px, double r0) {
   const double a = -dx_px * rad_per_px;
   eye = rotate(eye, pole, a);
   fwd = rotate(fwd, pole, a);
-  // Vertical drag: about the axis through the centre along the camera's horizontal right vector.
-  const glm::dvec3 right = glm::normalize(glm::cross(fwd, glm::normalize(eye)));
-  const double b = dy_px * rad_per_px;
-  if (std::isfinite(right.x)) {
-    eye = rotate(eye, right, b);
-    fwd = rotate(fwd, right, b);
-  }
+  // Vertical drag: about the axis through the centre along the camera's level right vector (defined
+  // at every pitch, also straight down); dragging up pushes the ground away, so the camera goes back.
+  const glm::dvec3 right = rotate(f.right, pole, a);
+  const double b = -dy_px * rad_per_px;
+  eye = rotate(eye, right, b);
+  fwd = rotate(fwd, right, b);
   place_camera(cam, eye, glm::normalize(fwd), r0);
 }
 
 void zoom(core::Camera& cam, double notches, double r0, double min_alt_m) {
   const glm::dvec3 fwd = core::camera_frame(cam).forward;
-  const double heading = cam.heading_deg;
   const double step = 0.15 * notches * std::max(cam.alt_m, min_alt_m);
   place_camera(cam, eye_of(cam, r0) + step * fwd, fwd, r0);
-  cam.heading_deg = std::abs(cam.pitch_deg) > 89.999 ? heading : cam.heading_deg;
   cam.alt_m = std::max(cam.alt_m, min_alt_m);
 }
 

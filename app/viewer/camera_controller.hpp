@@ -15,9 +15,10 @@ core::Camera frame_volume(const core::VolumeGrid& grid, int width, int height);
 // and view direction (metres, unit vector) on a sphere of radius r0_m.
 void place_camera(core::Camera& cam, const glm::dvec3& eye_ecef_m, const glm::dvec3& forward, double r0_m);
 
-// Orbit: drags the globe under the camera. dx, dy are the drag in pixels (right, down); the
-// globe turns about its centre so that a point on the ground under the image centre follows the
-// cursor roughly, the altitude and the view relative to the ground below stay the same.
+// Orbit: drags the globe under the camera. dx, dy are the drag in pixels (right, down); the globe
+// turns about its centre (horizontal drags about its axis, vertical ones about the camera's right
+// vector) by about the ground one pixel covers at nadir, so the ground follows the cursor roughly;
+// the altitude and the view relative to the ground below stay the same.
 void orbit(core::Camera& cam, double dx_px, double dy_px, double r0_m);
 
 // Zoom: moves along the view direction by `notches` x 15 % of the altitude (positive: closer),

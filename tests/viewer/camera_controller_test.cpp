@@ -43,9 +43,14 @@ TEST(CameraController, OrbitKeepsAltitudeAndTheViewRelativeToTheGround) {
   EXPECT_NEAR(c.lon_deg, 100.0 - expect_deg, 1e-9);
   EXPECT_NEAR(c.heading_deg, 0.0, 1e-9);
   EXPECT_NEAR(c.pitch_deg, -60.0, 1e-9);
-  viewer::orbit(c, 0.0, -50.0, kR);  // dragging up moves the camera north when looking north
-  EXPECT_GT(c.lat_deg, 20.0);
+  viewer::orbit(c, 0.0, -50.0, kR);  // dragging the ground up (away) moves the camera back, south
+  EXPECT_NEAR(c.lat_deg, 20.0 - expect_deg / 2.0, 1e-9);
   EXPECT_NEAR(c.alt_m, 500000.0, 1e-3);
+  EXPECT_NEAR(c.pitch_deg, -60.0, 1e-9);
+  core::Camera down = camera(0.0, 0.0, 1e6, 0.0, -90.0);  // straight down: the vertical drag still works
+  viewer::orbit(down, 0.0, 40.0, kR);
+  EXPECT_GT(down.lat_deg, 0.0);
+  EXPECT_NEAR(down.pitch_deg, -90.0, 1e-6);
 }
 
 TEST(CameraController, FlySpeedScalesWithAltitudeAndMovesAlongTheView) {
