@@ -50,7 +50,7 @@ void print_usage() {
       "         [--pfm OUT.pfm]\n"
       "                           (the sun stands where it stood at the valid time unless --sun is given)\n"
       "                           render a NetCDF file or .cvvol volume headlessly (EGL) to a PNG\n"
-      "  view INPUT [--size WxH] [--time N] [--hide-ui] [--frames N --screenshot OUT.png]\n"
+      "  view INPUT [--size WxH] [--time N] [--scale S] [--hide-ui] [--frames N --screenshot OUT.png]\n"
       "                           the interactive viewer (GLFW window); with --frames it renders N frames,\n"
       "                           saves the window to OUT.png and exits\n"
       "  --version                print the version\n");

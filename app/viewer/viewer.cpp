@@ -139,6 +139,18 @@ int cmd_view(const std::vector<std::string>& args) {
         o.time_step = parse_int("--time", next(), 0, 1000000);
       } else if (a == "--screenshot") {
         o.screenshot = next();
+      } else if (a == "--scale") {
+        const std::string v = next();
+        try {
+          std::size_t used = 0;
+          o.scale = std::stod(v, &used);
+          if (used != v.size()) o.scale = -1.0;
+        } catch (const std::exception&) {
+          o.scale = -1.0;
+        }
+        if (!(o.scale >= 0.1 && o.scale <= 1.0)) {
+          throw ViewerInputError("cloudviewer view: --scale: found '" + v + "', expected a resolution scale in 0.1..1");
+        }
       } else if (a == "--hide-ui") {
         o.hide_ui = true;
       } else if (!a.empty() && a[0] == '-') {
@@ -185,6 +197,7 @@ int run_viewer(const ViewerOptions& o) {
   s.scene.render.march.sun_steps = 16;
   s.scene.render.march.octaves = 4;
   s.scene.render.accumulate = o.frames > 0 ? o.frames : 64;
+  s.scene.render.resolution_scale = o.scale;
 
   auto win = render::make_window_context(o.width, o.height, "cloudviewer - " + o.input);
   glfwSwapInterval(o.frames > 0 ? 0 : 1);

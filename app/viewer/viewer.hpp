@@ -14,6 +14,7 @@ struct ViewerOptions {
   int frames = 0;           // 0: interactive until the window closes
   std::string screenshot;   // PNG of the window's framebuffer after the last frame
   bool hide_ui = false;     // start with the panels hidden (F1 toggles them)
+  double scale = 1.0;       // resolution scale: march at this fraction of the window size
 };
 
 // Parses the `view` arguments and runs; returns the exit code (2 with one line for bad arguments).

@@ -87,6 +87,48 @@ TEST_F(PresenterTest, TonemapShaderMatchesTheCpuTonemapWithinOneStep) {
   EXPECT_NE(cpu[0], cpu[3 * 100]);
 }
 
+TEST_F(PresenterTest, ReducedResolutionUpscalesWithoutSpreadingANonFiniteTexel) {
+  // A 12 x 7 march drawn over 48 x 27 pixels (resolution scale 1/4): a uniform image stays uniform,
+  // and a NaN texel in the top-left corner whitens only pixels within one texel of it.
+  const int w = 12, h = 7, W = 48, H = 27;
+  std::vector<glm::vec4> px(static_cast<std::size_t>(w) * h, glm::vec4(0.05f, 0.04f, 0.03f, 0.2f));
+  px[0] = glm::vec4(std::numeric_limits<float>::quiet_NaN());
+  Presenter p(loader_);
+  p.resize(w, h);
+  upload(p.frame_texture(), w, h, px);
+  p.accumulate(0);
+  GLuint fbo = 0, color = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &color);
+  glTextureStorage2D(color, 1, GL_RGBA8, W, H);
+  glCreateFramebuffers(1, &fbo);
+  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  ToneSettings tone;
+  p.draw(tone, 0, 0, W, H);
+  std::vector<unsigned char> out(static_cast<std::size_t>(W) * H * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(color, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(out.size()), out.data());
+  check_gl("reading the upscaled test image");
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteTextures(1, &color);
+  const std::vector<unsigned char> want = tonemap_srgb8({px[1]}, tone);
+  int far_off = 0, near_white = 0;
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      const unsigned char* o = &out[(static_cast<std::size_t>(H - 1 - y) * W + x) * 4];  // y from the top
+      const bool near_corner = x < 2 * W / w && y < 2 * H / h + 1;  // within about one texel of texel (0, 0)
+      if (near_corner) {
+        near_white += o[0] > want[0] + 8;
+      } else {
+        for (int c = 0; c < 3; ++c) far_off += std::abs(int(o[c]) - int(want[static_cast<std::size_t>(c)])) > 1;
+      }
+    }
+  }
+  EXPECT_EQ(far_off, 0);
+  EXPECT_GT(near_white, 0);  // the non-finite texel itself shows (white), as in image_output
+}
+
 TEST_F(PresenterTest, AccumulationIsTheRunningMeanOfTheFrames) {
   const int w = 19, h = 11, frames = 6;  // not multiples of the 8 x 8 work groups
   Presenter p(loader_);
