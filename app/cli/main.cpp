@@ -17,6 +17,7 @@
 #include "cli_common.hpp"
 #include "render_command.hpp"
 #include "scene/scene_json.hpp"
+#include "viewer/viewer.hpp"
 
 namespace {
 
@@ -38,6 +39,9 @@ void print_usage() {
       "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"
       "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"
       "%s"
+      "  view INPUT [--size WxH] [--time N] [--scale S] [--hide-ui] [--frames N --screenshot OUT.png]\n"
+      "                           the interactive viewer (GLFW window); with --frames it renders N frames,\n"
+      "                           saves the window to OUT.png and exits\n"
       "  --version                print the version\n",
       cv::cli::render_usage());
 }
@@ -214,7 +218,8 @@ int main(int argc, char** argv) {
     if (cmd == "import") return cmd_import(args);
     if (cmd == "phase") return cmd_phase(args);
     if (cmd == "render") return cv::cli::cmd_render(args);
-    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase or render"};
+    if (cmd == "view") return cv::viewer::cmd_view(args);
+    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase, render or view"};
   } catch (const UsageError& e) {
     std::fprintf(stderr, "%s\n", e.message.c_str());
     return kExitBadInput;

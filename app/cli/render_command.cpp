@@ -24,6 +24,7 @@
 #include "scene/framing.hpp"
 #include "scene/quality.hpp"
 #include "scene/scene_json.hpp"
+#include "viewer/scene_io.hpp"
 #include "volume/volume_io.hpp"
 
 namespace cv::cli {
@@ -172,27 +173,6 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
   return r;
 }
 
-// Reads the scene's data: a .cvvol as it is, NetCDF through the importer with the scene's subset,
-// so only that part of the file is read.
-core::CloudVolume load_volume(const core::Scene& scene) {
-  const core::DataSource& d = scene.data;
-  if (ends_with(d.path, ".cvvol")) {
-    if (d.region_deg || d.levels_hpa || d.horizontal_stride != 1 || d.dz_m != 0.0) {
-      throw UsageError{"cloudviewer render: " + d.path +
-                       ": found a region, levels, stride or dz for a .cvvol volume, expected them only for NetCDF input "
-                       "(a volume is subset when it is imported)"};
-    }
-    return core::read_cvvol(d.path, 1);
-  }
-  importers::ImportOptions o;
-  if (d.region_deg) o.region = importers::Region{(*d.region_deg)[0], (*d.region_deg)[1], (*d.region_deg)[2], (*d.region_deg)[3]};
-  if (d.levels_hpa) o.level_min_hpa = (*d.levels_hpa)[0], o.level_max_hpa = (*d.levels_hpa)[1];
-  o.horizontal_stride = d.horizontal_stride;
-  o.dz_m = d.dz_m;
-  o.cache_steps = 1;  // one time step is rendered
-  return importers::import_file(d.path, o);
-}
-
 // Bilinear resampling of linear pixels (radiance and transmittance) from a reduced march size to
 // the output size, pixel centres aligned.
 std::vector<glm::vec4> upscale(const std::vector<glm::vec4>& in, int iw, int ih, int ow, int oh) {
@@ -229,7 +209,7 @@ int cmd_render(const std::vector<std::string>& args) {
   core::Scene scene;
   const RenderArgs ra = parse_render_args(args, scene);
   auto t0 = clock::now();
-  core::CloudVolume vol = load_volume(scene);
+  core::CloudVolume vol = viewer::load_scene_volume(scene, 1);  // one time step is rendered
   if (static_cast<std::size_t>(scene.time_step) >= vol.times.size()) {
     throw UsageError{"cloudviewer render: --time (time_step): found " + std::to_string(scene.time_step) + ", the input has " +
                      std::to_string(vol.times.size()) + " time step(s)"};

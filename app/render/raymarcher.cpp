@@ -65,13 +65,8 @@ void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExt
   grid_ = grid;
 }
 
-std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
-                                             const DispatchOptions& dispatch) {
-  // The read-back takes its byte count as a GLsizei.
-  if (static_cast<double>(cam.width) * cam.height * sizeof(glm::vec4) >= 2147483647.0) {
-    throw GlError("an image of " + std::to_string(cam.width) + " x " + std::to_string(cam.height) +
-                  " pixels is too large to read back at once (at most 134 million pixels)");
-  }
+void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
+                                const DispatchOptions& dispatch) {
   const bool noise = s.noise_amount > 0.0;
   if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
   if (noise && !(s.noise_scale_m > 0.0)) throw GlError("noise_scale_m must be > 0");
@@ -111,9 +106,6 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
     glBindTextureUnit(3, noise_textures_[0]);
     glBindTextureUnit(4, noise_textures_[1]);
   }
-  GLuint out = 0;
-  glCreateTextures(GL_TEXTURE_2D, 1, &out);
-  glTextureStorage2D(out, 1, GL_RGBA32F, cam.width, cam.height);
   glBindImageTexture(0, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glBindTextureUnit(1, textures_[0]);
   glBindTextureUnit(2, textures_[1]);
@@ -138,7 +130,22 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
     }
   }
   if (query) glDeleteQueries(1, &query);
-  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+  // Readers either fetch texels (the viewer's accumulation) or read the image back.
+  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  check_gl("running the raymarcher");
+}
+
+std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
+                                             const DispatchOptions& dispatch) {
+  // The read-back takes its byte count as a GLsizei.
+  if (static_cast<double>(cam.width) * cam.height * sizeof(glm::vec4) >= 2147483647.0) {
+    throw GlError("an image of " + std::to_string(cam.width) + " x " + std::to_string(cam.height) +
+                  " pixels is too large to read back at once (at most 134 million pixels)");
+  }
+  GLuint out = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &out);
+  glTextureStorage2D(out, 1, GL_RGBA32F, cam.width, cam.height);
+  render_into(out, cam, sun, s, dispatch);
   std::vector<glm::vec4> pixels(static_cast<std::size_t>(cam.width) * cam.height);
   glGetTextureImage(out, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(pixels.size() * sizeof(glm::vec4)), pixels.data());
   glDeleteTextures(1, &out);

@@ -43,6 +43,11 @@ class GpuRaymarcher {
   std::vector<glm::vec4> render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings,
                                 const DispatchOptions& dispatch = {});
 
+  // Renders into `out`, an RGBA32F 2-D texture of at least cam.width x cam.height that stays on
+  // the GPU (the viewer draws and accumulates it there; nothing is read back).
+  void render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings,
+                   const DispatchOptions& dispatch = {});
+
  private:
   const ShaderLoader& loader_;
   GlProgram program_;

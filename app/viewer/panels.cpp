@@ -1,0 +1,186 @@
+// The viewer's ImGui panels. Every widget edits a field of the shared Scene directly, so the scene
+// file stores exactly what is on screen; the main loop resets the accumulation on any change.
+#include "viewer/panels.hpp"
+
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "viewer/camera_controller.hpp"
+#include "scene/quality.hpp"
+#include "viewer/scene_io.hpp"
+
+namespace cv::viewer {
+namespace {
+bool drag_double(const char* label, double* v, double speed, double lo, double hi, const char* fmt,
+                 ImGuiSliderFlags flags = 0) {
+  return ImGui::DragScalar(label, ImGuiDataType_Double, v, static_cast<float>(speed), &lo, &hi, fmt,
+                           flags | ImGuiSliderFlags_AlwaysClamp);
+}
+bool slider_double(const char* label, double* v, double lo, double hi, const char* fmt, ImGuiSliderFlags flags = 0) {
+  return ImGui::SliderScalar(label, ImGuiDataType_Double, v, &lo, &hi, fmt, flags | ImGuiSliderFlags_AlwaysClamp);
+}
+
+void data_panel(ViewerState& s) {
+  if (!ImGui::CollapsingHeader("Data", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  const auto& g = s.volume.grid;
+  ImGui::TextWrapped("file: %s", s.scene.data.path.c_str());
+  ImGui::Text("grid: %d x %d x %d", g.lon_deg.count, g.lat_deg.count, g.alt_m.count);
+  ImGui::Text("lon %.3f..%.3f, lat %.3f..%.3f deg", g.lon_deg.start, g.lon_deg.last(), g.lat_deg.start, g.lat_deg.last());
+  ImGui::Text("alt %.0f..%.0f m, step %.0f m", g.alt_m.start, g.alt_m.last(), g.alt_m.step);
+  std::string fields;
+  for (int i = 0; i < core::kFieldCount; ++i) {
+    if (s.volume.has_field[static_cast<std::size_t>(i)]) fields += std::string(fields.empty() ? "" : ", ") + core::field_name(static_cast<core::Field>(i));
+  }
+  ImGui::TextWrapped("fields: %s", fields.empty() ? "(none)" : fields.c_str());
+  const int n = static_cast<int>(s.volume.times.size());
+  if (n > 1) ImGui::SliderInt("time step", &s.scene.time_step, 0, n - 1, "%d", ImGuiSliderFlags_AlwaysClamp);
+  if (s.scene.time_step < n) ImGui::Text("valid time: %s", s.volume.times[static_cast<std::size_t>(s.scene.time_step)].iso_utc.c_str());
+  if (ImGui::TreeNode("import report")) {
+    ImGui::BeginChild("report", ImVec2(0, 160), true, ImGuiWindowFlags_HorizontalScrollbar);
+    ImGui::TextUnformatted(s.import_report.c_str());
+    ImGui::EndChild();
+    ImGui::TreePop();
+  }
+}
+
+void camera_panel(ViewerState& s, PanelContext& ctx) {
+  if (!ImGui::CollapsingHeader("Camera", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  core::Camera& c = *s.scene.camera;
+  int mode = s.fly_mode ? 1 : 0;
+  ImGui::RadioButton("orbit", &mode, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("fly", &mode, 1);
+  s.fly_mode = mode == 1;
+  ImGui::TextDisabled(s.fly_mode ? "drag: look; WASD move, QE down/up, shift x5 (%.0f m/s)"
+                                 : "left drag: orbit; right drag: look; wheel: zoom (%.0f m/s fly)",
+                      fly_speed_m_per_s(c.alt_m));
+  drag_double("lat (deg)", &c.lat_deg, 0.01, -90.0, 90.0, "%.4f");
+  drag_double("lon (deg)", &c.lon_deg, 0.01, -540.0, 540.0, "%.4f");
+  drag_double("alt (m)", &c.alt_m, std::max(1.0, 0.005 * c.alt_m), 0.0, 4e8, "%.0f");
+  drag_double("heading (deg)", &c.heading_deg, 0.2, -360.0, 360.0, "%.1f");
+  drag_double("pitch (deg)", &c.pitch_deg, 0.2, -90.0, 90.0, "%.1f");
+  slider_double("fov (deg)", &c.fov_deg, 5.0, 120.0, "%.0f");
+  ImGui::InputDouble("go-to lat", &ctx.goto_lat_deg, 0.0, 0.0, "%.4f");
+  ImGui::InputDouble("go-to lon", &ctx.goto_lon_deg, 0.0, 0.0, "%.4f");
+  ImGui::InputDouble("go-to alt (m)", &ctx.goto_alt_m, 0.0, 0.0, "%.0f");
+  if (ImGui::Button("go")) {
+    c.lat_deg = std::clamp(ctx.goto_lat_deg, -90.0, 90.0);
+    c.lon_deg = ctx.goto_lon_deg;
+    c.alt_m = std::clamp(ctx.goto_alt_m, 0.0, 4e8);
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("reset view")) {
+    c = ctx.home;
+    s.fly_mode = false;
+  }
+}
+
+void sun_panel(ViewerState& s, PanelContext& ctx) {
+  if (!ImGui::CollapsingHeader("Sun & date/time")) return;
+  int mode = static_cast<int>(s.scene.sun.mode);
+  ImGui::Combo("sun from", &mode, "valid time\0date/time (UTC)\0subsolar point\0");
+  s.scene.sun.mode = static_cast<core::SunMode>(mode);
+  if (s.scene.sun.mode == core::SunMode::DateTime) ImGui::InputText("UTC", &s.scene.sun.datetime_utc);
+  if (s.scene.sun.mode == core::SunMode::Manual) {
+    slider_double("subsolar lat", &s.scene.sun.subsolar_lat_deg, -23.44, 23.44, "%.2f");
+    slider_double("subsolar lon", &s.scene.sun.subsolar_lon_deg, -180.0, 180.0, "%.2f");
+  }
+  slider_double("irradiance", &s.scene.sun.irradiance, 0.0, 10.0, "%.2f");
+  ImGui::Text("sun overhead at %.2f, %.2f", ctx.sun.subsolar_lat_deg, ctx.sun.subsolar_lon_deg);
+  if (!ctx.sun_error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.4f, 1.0f), "%s", ctx.sun_error.c_str());
+}
+
+void lighting_panel(ViewerState& s) {
+  if (!ImGui::CollapsingHeader("Lighting")) return;
+  core::MarchSettings& m = s.scene.render.march;
+  slider_double("droplet diameter (um)", &m.droplet_diameter_um, 1.0, 50.0, "%.1f");
+  slider_double("ice g", &m.ice_g, 0.0, 0.99, "%.2f");
+  ImGui::SliderInt("octaves N", &m.octaves, 1, 16, "%d", ImGuiSliderFlags_AlwaysClamp);
+  slider_double("octave a (scattering)", &m.octave_a, 0.0, 1.0, "%.2f");
+  slider_double("octave b (extinction)", &m.octave_b, 0.0, 1.0, "%.2f");
+  slider_double("octave c (phase)", &m.octave_c, 0.0, 1.0, "%.2f");
+}
+
+void quality_panel(ViewerState& s) {
+  if (!ImGui::CollapsingHeader("Quality")) return;
+  {
+    core::RenderSettings& r = s.scene.render;
+    drag_double("view step (m)", &r.march.view_step_m, 5.0, 10.0, 10000.0, "%.0f", ImGuiSliderFlags_Logarithmic);
+    ImGui::SliderInt("sun steps", &r.march.sun_steps, 1, 256, "%d", ImGuiSliderFlags_AlwaysClamp);
+    slider_double("resolution scale", &r.resolution_scale, 0.1, 1.0, "%.2f");
+    ImGui::SliderInt("accumulate (frames)", &r.accumulate, 1, 1024, "%d", ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
+    slider_double("exposure", &r.exposure, 0.1, 64.0, "%.2f", ImGuiSliderFlags_Logarithmic);
+  }
+}
+
+void scene_panel(ViewerState& s, PanelContext& ctx) {
+  if (!ImGui::CollapsingHeader("Scene file")) return;
+  ImGui::InputText("path", &ctx.scene_path);
+  if (ImGui::Button("save")) {
+    try {
+      save_viewer_scene(s.scene, ctx.scene_path);
+      ctx.scene_message = "saved " + ctx.scene_path;
+    } catch (const std::exception& e) {
+      ctx.scene_message = e.what();
+    }
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("load")) {
+    // Camera, sun, time and settings come from the file; its data must be the data on screen
+    // (another file means another volume: start the viewer on that scene instead).
+    try {
+      core::Scene loaded = load_viewer_scene(ctx.scene_path);
+      if (loaded.data.path != s.scene.data.path) {
+        ctx.scene_message = ctx.scene_path + ": data.path is " + loaded.data.path + ", not the data on screen (" +
+                            s.scene.data.path + "): run cloudviewer view " + ctx.scene_path;
+      } else {
+        const int w = s.scene.width, h = s.scene.height;
+        s.scene = loaded;
+        s.scene.width = w, s.scene.height = h;  // the window keeps its size
+        if (s.scene.render.march.view_step_m <= 0.0) {
+          s.scene.render.march.view_step_m = core::resolve_view_step_m(s.scene.render, s.volume.grid);
+        }
+        ctx.scene_message = "loaded " + ctx.scene_path;
+      }
+    } catch (const std::exception& e) {
+      ctx.scene_message = e.what();
+    }
+  }
+  if (!ctx.scene_message.empty()) ImGui::TextWrapped("%s", ctx.scene_message.c_str());
+}
+}  // namespace
+
+void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats) {
+  ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(340, 520), ImGuiCond_FirstUseEver);
+  if (ImGui::Begin("cloudviewer")) {
+    data_panel(state);
+    camera_panel(state, ctx);
+    sun_panel(state, ctx);
+    lighting_panel(state);
+    quality_panel(state);
+    scene_panel(state, ctx);
+    ImGui::TextDisabled("F1 hides the panels; %s", stats.renderer.c_str());
+  }
+  ImGui::End();
+}
+
+void draw_stats_overlay(const FrameStats& s, int target) {
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(vp->WorkPos.x + vp->WorkSize.x - 8, vp->WorkPos.y + 8), ImGuiCond_Always, ImVec2(1, 0));
+  ImGui::SetNextWindowBgAlpha(0.5f);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
+                                 ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoMove;
+  if (ImGui::Begin("statistics", nullptr, flags)) {
+    ImGui::Text("march %.2f ms, accumulate + draw %.2f ms", s.march_ms, s.present_ms);
+    ImGui::Text("frames %d / %d at %d x %d", s.accumulated, target, s.march_w, s.march_h);
+    ImGui::Text("%.1f FPS", s.fps);
+  }
+  ImGui::End();
+}
+
+}  // namespace cv::viewer

@@ -1,0 +1,34 @@
+// The viewer's Dear ImGui panels: data, camera, sun and date/time, lighting, quality, scene file,
+// and the statistics overlay. They edit the ViewerState's Scene; the main loop sees what changed.
+#pragma once
+
+#include <string>
+
+#include "reference/raymarcher.hpp"
+#include "viewer/viewer_state.hpp"
+
+namespace cv::viewer {
+
+struct FrameStats {
+  double march_ms = 0.0;    // GPU time of the last raymarch dispatch (timer query)
+  double present_ms = 0.0;  // GPU time of accumulation + tonemap draw
+  double fps = 0.0;         // window frames per second, averaged over ~0.5 s
+  int accumulated = 0;      // frames in the current mean
+  int march_w = 0, march_h = 0;
+  std::string renderer;     // GL_RENDERER
+};
+
+// What the panels need besides the state, and what they ask of the main loop.
+struct PanelContext {
+  core::Camera home;            // the automatic framing, for "reset view"
+  core::Sun sun;                // as resolved this frame
+  std::string sun_error;        // why the typed date/time was not used, or empty
+  double goto_lat_deg = 0.0, goto_lon_deg = 0.0, goto_alt_m = 10000.0;
+  std::string scene_path = "scene.json";
+  std::string scene_message;    // result of the last load/save
+};
+
+void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats);
+void draw_stats_overlay(const FrameStats& stats, int target);
+
+}  // namespace cv::viewer

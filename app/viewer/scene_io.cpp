@@ -1,0 +1,34 @@
+// Scene files and the data they name (see scene_io.hpp).
+#include "viewer/scene_io.hpp"
+
+#include "importer.hpp"
+#include "scene/scene_json.hpp"
+#include "volume/volume_io.hpp"
+
+namespace cv::viewer {
+
+core::Scene load_viewer_scene(const std::string& path) { return core::load_scene(path); }
+
+void save_viewer_scene(const core::Scene& scene, const std::string& path) { core::save_scene(scene, path); }
+
+core::CloudVolume load_scene_volume(const core::Scene& scene, std::size_t cache_steps) {
+  const core::DataSource& d = scene.data;
+  const bool cvvol = d.path.size() >= 6 && d.path.compare(d.path.size() - 6, 6, ".cvvol") == 0;
+  if (cvvol) {
+    if (d.region_deg || d.levels_hpa || d.horizontal_stride != 1 || d.dz_m != 0.0) {
+      throw core::SceneError(d.path +
+                             ": found a region, levels, stride or dz for a .cvvol volume, expected them only for NetCDF input "
+                             "(a volume is subset when it is imported)");
+    }
+    return core::read_cvvol(d.path, cache_steps);
+  }
+  importers::ImportOptions o;
+  if (d.region_deg) o.region = importers::Region{(*d.region_deg)[0], (*d.region_deg)[1], (*d.region_deg)[2], (*d.region_deg)[3]};
+  if (d.levels_hpa) o.level_min_hpa = (*d.levels_hpa)[0], o.level_max_hpa = (*d.levels_hpa)[1];
+  o.horizontal_stride = d.horizontal_stride;
+  o.dz_m = d.dz_m;
+  o.cache_steps = cache_steps;
+  return importers::import_file(d.path, o);
+}
+
+}  // namespace cv::viewer

@@ -1,0 +1,346 @@
+// The viewer's main loop: loading the input, the window and ImGui, mouse and keyboard navigation,
+// the march -> accumulate -> tonemap path on the GPU with timer queries, and screenshots.
+#include "viewer/viewer.hpp"
+
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "importer.hpp"
+#include "render/context.hpp"
+#include "render/presenter.hpp"
+#include "render/raymarcher.hpp"
+#include "viewer/camera_controller.hpp"
+#include "viewer/panels.hpp"
+#include "viewer/scene_io.hpp"
+#include "scene/framing.hpp"
+#include "scene/quality.hpp"
+#include "scene/scene_json.hpp"
+#include "volume/volume_io.hpp"
+
+namespace cv::viewer {
+namespace {
+constexpr int kExitBadInput = 2;
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+int parse_int(const std::string& option, const std::string& text, int lo, int hi) {
+  try {
+    std::size_t used = 0;
+    const long v = std::stol(text, &used);
+    if (used == text.size() && v >= lo && v <= hi) return static_cast<int>(v);
+  } catch (const std::exception&) {
+  }
+  throw ViewerInputError("cloudviewer view: " + option + ": found '" + text + "', expected an integer in " +
+                         std::to_string(lo) + ".." + std::to_string(hi));
+}
+
+// GPU time of a pass, read a few frames later so the CPU never waits for the GPU.
+class PassTimer {
+ public:
+  PassTimer() { glCreateQueries(GL_TIME_ELAPSED, kRing, ids_); }
+  ~PassTimer() { glDeleteQueries(kRing, ids_); }
+  PassTimer(const PassTimer&) = delete;
+  PassTimer& operator=(const PassTimer&) = delete;
+  void begin() { glBeginQuery(GL_TIME_ELAPSED, ids_[next_]); }
+  void end() {
+    glEndQuery(GL_TIME_ELAPSED);
+    used_[next_] = true;
+    next_ = (next_ + 1) % kRing;
+    // The oldest query in the ring: read it if the GPU has finished it.
+    const int old = next_;
+    GLint ready = 0;
+    if (used_[old]) glGetQueryObjectiv(ids_[old], GL_QUERY_RESULT_AVAILABLE, &ready);
+    if (ready) {
+      GLuint64 ns = 0;
+      glGetQueryObjectui64v(ids_[old], GL_QUERY_RESULT, &ns);
+      ms_ = static_cast<double>(ns) * 1e-6;
+      used_[old] = false;
+    }
+  }
+  // Waits for every pass still in flight and keeps the newest time (for the screenshot's report).
+  void finish() {
+    for (int k = 0; k < kRing; ++k) {
+      const int q = (next_ + k) % kRing;  // oldest first
+      if (!used_[q]) continue;
+      GLuint64 ns = 0;
+      glGetQueryObjectui64v(ids_[q], GL_QUERY_RESULT, &ns);
+      ms_ = static_cast<double>(ns) * 1e-6;
+      used_[q] = false;
+    }
+  }
+  double ms() const { return ms_; }
+
+ private:
+  static constexpr int kRing = 4;
+  GLuint ids_[kRing] = {};
+  bool used_[kRing] = {};
+  int next_ = 0;
+  double ms_ = 0.0;
+};
+
+void save_screenshot(const std::string& path, int w, int h) {
+  std::vector<unsigned char> rgb(static_cast<std::size_t>(w) * h * 3), flipped(rgb.size());
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_BACK);
+  glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, rgb.data());
+  render::check_gl("reading the window's framebuffer for the screenshot");
+  const std::size_t row = static_cast<std::size_t>(w) * 3;
+  for (int y = 0; y < h; ++y) std::copy_n(rgb.data() + (h - 1 - y) * row, row, flipped.data() + y * row);  // GL rows are bottom up
+  render::write_png(path, w, h, flipped);
+}
+
+// Keyboard and mouse navigation, unless ImGui wants them.
+void navigate(GLFWwindow* win, ViewerState& s, double dt_s) {
+  const ImGuiIO& io = ImGui::GetIO();
+  core::Camera& cam = *s.scene.camera;
+  const double r0 = s.volume.grid.earth_radius_m;
+  if (!io.WantCaptureMouse) {
+    const double dx = io.MouseDelta.x, dy = io.MouseDelta.y;
+    const bool moved = dx != 0.0 || dy != 0.0;
+    if (moved && io.MouseDown[0] && !s.fly_mode) orbit(cam, dx, dy, r0);
+    else if (moved && (io.MouseDown[1] || (io.MouseDown[0] && s.fly_mode))) look(cam, dx, dy);
+    if (io.MouseWheel != 0.0f) zoom(cam, io.MouseWheel, r0);
+  }
+  if (!io.WantCaptureKeyboard && s.fly_mode) {
+    auto key = [&](int k) { return glfwGetKey(win, k) == GLFW_PRESS ? 1.0 : 0.0; };
+    const glm::dvec3 dir(key(GLFW_KEY_W) - key(GLFW_KEY_S), key(GLFW_KEY_D) - key(GLFW_KEY_A), key(GLFW_KEY_E) - key(GLFW_KEY_Q));
+    const double boost = key(GLFW_KEY_LEFT_SHIFT) > 0.0 ? 5.0 : 1.0;
+    if (dir != glm::dvec3(0.0)) fly(cam, dir * boost, dt_s, r0);
+  }
+}
+}  // namespace
+
+int cmd_view(const std::vector<std::string>& args) {
+  ViewerOptions o;
+  try {
+    for (std::size_t i = 0; i < args.size(); ++i) {
+      const std::string& a = args[i];
+      auto next = [&]() -> const std::string& {
+        if (i + 1 >= args.size()) throw ViewerInputError("cloudviewer view: " + a + ": expected a value after it");
+        return args[++i];
+      };
+      if (a == "--size") {
+        const std::string sz = next();
+        if (std::sscanf(sz.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 16 || o.height < 16 || o.width > 16384 ||
+            o.height > 16384) {
+          throw ViewerInputError("cloudviewer view: --size: found '" + sz + "', expected WxH with 16..16384 each");
+        }
+      } else if (a == "--frames") {
+        o.frames = parse_int("--frames", next(), 1, 100000);
+      } else if (a == "--time") {
+        o.time_step = parse_int("--time", next(), 0, 1000000);
+        o.time_given = true;
+      } else if (a == "--screenshot") {
+        o.screenshot = next();
+      } else if (a == "--scale") {
+        o.scale_given = true;
+        const std::string v = next();
+        try {
+          std::size_t used = 0;
+          o.scale = std::stod(v, &used);
+          if (used != v.size()) o.scale = -1.0;
+        } catch (const std::exception&) {
+          o.scale = -1.0;
+        }
+        if (!(o.scale >= 0.1 && o.scale <= 1.0)) {
+          throw ViewerInputError("cloudviewer view: --scale: found '" + v + "', expected a resolution scale in 0.1..1");
+        }
+      } else if (a == "--hide-ui") {
+        o.hide_ui = true;
+      } else if (!a.empty() && a[0] == '-') {
+        throw ViewerInputError("cloudviewer view: unknown option '" + a + "'");
+      } else if (o.input.empty()) {
+        o.input = a;
+      } else {
+        throw ViewerInputError("cloudviewer view: unexpected argument '" + a + "', expected one INPUT");
+      }
+    }
+    if (o.input.empty()) throw ViewerInputError("cloudviewer view: expected INPUT (.nc, .cvvol or a scene .json)");
+    if (!o.screenshot.empty() && o.frames == 0) {
+      throw ViewerInputError("cloudviewer view: --screenshot: expected --frames N as well (the frame to save is the Nth)");
+    }
+    if (ends_with(o.input, ".json")) o.scene = load_viewer_scene(o.input);
+  } catch (const std::runtime_error& e) {  // ViewerInputError and core::SceneError
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  }
+  return run_viewer(o);
+}
+
+int run_viewer(const ViewerOptions& o) {
+  ViewerState s;
+  if (o.scene) {
+    s.scene = *o.scene;
+  } else {
+    s.scene.data.path = o.input;
+  }
+  try {
+    s.volume = load_scene_volume(s.scene, 2);
+  } catch (const core::SceneError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  }
+  const auto& g = s.volume.grid;
+  if (g.lon_deg.count < 2 || g.lat_deg.count < 2 || g.alt_m.count < 2) {
+    std::fprintf(stderr, "cloudviewer view: %s: the volume is %d x %d x %d points; rendering needs at least 2 along each axis\n",
+                 o.input.c_str(), g.lon_deg.count, g.lat_deg.count, g.alt_m.count);
+    return kExitBadInput;
+  }
+  if (static_cast<std::size_t>(o.time_step) >= s.volume.times.size()) {
+    std::fprintf(stderr, "cloudviewer view: --time: found %d, %s has %zu time step(s)\n", o.time_step, o.input.c_str(),
+                 s.volume.times.size());
+    return kExitBadInput;
+  }
+  s.import_report = s.volume.report.to_text();
+  if (!o.scene || o.time_given) s.scene.time_step = o.time_step;
+  s.scene.width = o.width;
+  s.scene.height = o.height;
+  // As `render` does: the quality preset's settings, the view step from the grid's vertical spacing.
+  if (!o.scene) {
+    core::apply_quality("default", s.scene.render);
+    s.scene.render.accumulate = 64;
+  }
+  s.scene.render.march.view_step_m = core::resolve_view_step_m(s.scene.render, g);
+  if (o.frames > 0) s.scene.render.accumulate = o.frames;
+  if (!o.scene || o.scale_given) s.scene.render.resolution_scale = o.scale;
+
+  auto win = render::make_window_context(o.width, o.height, "cloudviewer - " + o.input);
+  glfwSwapInterval(o.frames > 0 ? 0 : 1);
+  const render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::GpuRaymarcher gpu(loader);
+  render::Presenter presenter(loader);
+
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini in whatever folder the viewer was started from
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(win->window(), true);
+  ImGui_ImplOpenGL3_Init("#version 450 core");
+  struct ImGuiGuard {  // shut ImGui down before the window goes, also when a frame throws
+    ~ImGuiGuard() {
+      ImGui_ImplOpenGL3_Shutdown();
+      ImGui_ImplGlfw_Shutdown();
+      ImGui::DestroyContext();
+    }
+  } imgui_guard;
+
+  PanelContext ctx;
+  FrameStats stats;
+  stats.renderer = win->info().renderer;
+  PassTimer march_timer, present_timer;
+  int uploaded_step = -1, accumulated = 0;
+  bool show_ui = !o.hide_ui, f1_was_down = false;
+  core::Scene previous;
+  using clock = std::chrono::steady_clock;
+  const auto start = clock::now();
+  auto last = start, fps_since = start;
+  int fps_frames = 0;
+  for (int frame = 0; o.frames == 0 ? !win->should_close() : frame < o.frames; ++frame) {
+    glfwPollEvents();
+    const auto now = clock::now();
+    const double dt = std::min(0.25, std::chrono::duration<double>(now - last).count());
+    last = now;
+    int fbw = 0, fbh = 0;
+    glfwGetFramebufferSize(win->window(), &fbw, &fbh);
+    if (fbw < 1 || fbh < 1) {  // minimised: nothing to draw into
+      glfwWaitEvents();
+      continue;
+    }
+    s.scene.width = fbw;
+    s.scene.height = fbh;
+    if (!s.scene.camera) {
+      s.scene.camera = core::auto_camera(g, fbw, fbh);
+      ctx.home = *s.scene.camera;
+      ctx.goto_lat_deg = ctx.home.lat_deg, ctx.goto_lon_deg = ctx.home.lon_deg, ctx.goto_alt_m = ctx.home.alt_m;
+    }
+
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    const bool f1 = glfwGetKey(win->window(), GLFW_KEY_F1) == GLFW_PRESS;
+    if (f1 && !f1_was_down) show_ui = !show_ui;
+    f1_was_down = f1;
+    navigate(win->window(), s, dt);
+    if (show_ui) draw_panels(s, ctx, stats);
+
+    // The march size follows the window and the resolution scale; the camera renders at it.
+    int mw = 0, mh = 0;
+    march_size(s.scene, fbw, fbh, mw, mh);
+    s.scene.camera->width = mw;
+    s.scene.camera->height = mh;
+    s.scene.time_step = std::clamp(s.scene.time_step, 0, static_cast<int>(s.volume.times.size()) - 1);
+    if (s.scene.time_step != uploaded_step) {
+      const core::TimeStepData& data = s.volume.step(static_cast<std::size_t>(s.scene.time_step));
+      gpu.upload(g, core::grid_mean_extinction(g, data));
+      uploaded_step = s.scene.time_step;
+    }
+    if (presenter.width() != mw || presenter.height() != mh) presenter.resize(mw, mh);
+    try {
+      ctx.sun = resolve_sun(s.scene, s.volume);
+      ctx.sun_error.clear();
+    } catch (const std::invalid_argument& e) {
+      ctx.sun_error = e.what();  // keep the last good sun while the date/time is being typed
+    }
+    if (frame == 0 || !same_march(s.scene, previous)) accumulated = 0;
+    previous = s.scene;
+
+    // One more jittered frame into the mean until the target; a target of 1 marches at step middles
+    // exactly as `render` does without --accumulate.
+    if (accumulated < s.scene.render.accumulate) {
+      core::MarchSettings m = s.scene.render.march;
+      m.frame = s.scene.render.accumulate == 1 ? -1 : accumulated;
+      march_timer.begin();
+      gpu.render_into(presenter.frame_texture(), *s.scene.camera, ctx.sun, m);
+      march_timer.end();
+      present_timer.begin();
+      presenter.accumulate(accumulated);
+      ++accumulated;
+    } else {
+      present_timer.begin();
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    render::ToneSettings tone;
+    tone.exposure = s.scene.render.exposure;
+    presenter.draw(tone, 0, 0, fbw, fbh);
+    present_timer.end();
+    stats.march_ms = march_timer.ms();
+    stats.present_ms = present_timer.ms();
+    stats.accumulated = accumulated;
+    stats.march_w = mw;
+    stats.march_h = mh;
+    if (show_ui) draw_stats_overlay(stats, s.scene.render.accumulate);  // built after the march: this frame's count
+
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    if (o.frames > 0 && frame == o.frames - 1 && !o.screenshot.empty()) {
+      save_screenshot(o.screenshot, fbw, fbh);
+      march_timer.finish();
+      stats.march_ms = march_timer.ms();
+      std::printf("wrote %s (%d x %d window, %d frame(s) accumulated in %.2f s wall, GPU march %.1f ms per frame on %s)\n",
+                  o.screenshot.c_str(), fbw, fbh, accumulated, std::chrono::duration<double>(clock::now() - start).count(),
+                  stats.march_ms, stats.renderer.c_str());
+    }
+    win->swap_buffers();
+    ++fps_frames;
+    const double since = std::chrono::duration<double>(clock::now() - fps_since).count();
+    if (since >= 0.5) {
+      stats.fps = fps_frames / since;
+      fps_frames = 0;
+      fps_since = clock::now();
+    }
+  }
+  return 0;
+}
+
+}  // namespace cv::viewer

@@ -1,0 +1,31 @@
+// The interactive viewer, `cloudviewer view INPUT`: a GLFW window with Dear ImGui panels over the
+// GPU raymarcher's accumulated image; with --frames N --screenshot PNG it runs N frames and exits.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scene/scene.hpp"
+
+namespace cv::viewer {
+
+struct ViewerOptions {
+  std::string input;        // NetCDF, .cvvol or a scene .json
+  std::optional<core::Scene> scene;  // the scene file's, when INPUT is one (options given override it)
+  bool time_given = false, scale_given = false;
+  int width = 1280, height = 720;  // window size, screen pixels
+  int time_step = 0;
+  int frames = 0;           // 0: interactive until the window closes
+  std::string screenshot;   // PNG of the window's framebuffer after the last frame
+  bool hide_ui = false;     // start with the panels hidden (F1 toggles them)
+  double scale = 1.0;       // resolution scale: march at this fraction of the window size
+};
+
+// Parses the `view` arguments and runs; returns the exit code (2 with one line for bad arguments).
+// Errors in the input file propagate as the importers' exceptions, as for `render`.
+int cmd_view(const std::vector<std::string>& args);
+
+int run_viewer(const ViewerOptions& options);
+
+}  // namespace cv::viewer

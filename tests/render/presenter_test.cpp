@@ -1,0 +1,181 @@
+// The viewer's GPU path (headless): the tonemap shader against image_output's CPU tonemap, the
+// running-mean accumulation against a CPU mean, and every vertex/fragment shader pair compiling.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "render/context.hpp"
+#include "render/image_output.hpp"
+#include "render/presenter.hpp"
+
+namespace {
+using namespace cv::render;
+namespace fs = std::filesystem;
+
+class PresenterTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { ctx_ = make_headless_context().release(); }
+  static void TearDownTestSuite() {
+    delete ctx_;
+    ctx_ = nullptr;
+  }
+  static GlContext* ctx_;
+  ShaderLoader loader_{{ShaderLoader::default_shader_dir()}};
+};
+GlContext* PresenterTest::ctx_ = nullptr;
+
+void upload(GLuint tex, int w, int h, const std::vector<glm::vec4>& px) {
+  glTextureSubImage2D(tex, 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, px.data());
+}
+
+TEST_F(PresenterTest, TonemapShaderMatchesTheCpuTonemapWithinOneStep) {
+  // Radiance over five decades, transmittance 0..1, and the non-finite cases.
+  const int w = 48, h = 27;
+  std::vector<glm::vec4> px(static_cast<std::size_t>(w) * h);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    const float r = std::pow(10.0f, -4.0f + 5.0f * u(rng));
+    px[i] = glm::vec4(r, r * u(rng), r * u(rng) * 0.5f, u(rng));
+  }
+  px[0] = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);  // clear sky: the background only
+  px[1] = glm::vec4(std::numeric_limits<float>::quiet_NaN(), 1.0f, std::numeric_limits<float>::infinity(), 0.0f);
+  Presenter p(loader_);
+  p.resize(w, h);
+  upload(p.frame_texture(), w, h, px);
+  p.accumulate(0);  // one frame: the mean is the frame
+  GLuint fbo = 0, color = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &color);
+  glTextureStorage2D(color, 1, GL_RGBA8, w, h);
+  glCreateFramebuffers(1, &fbo);
+  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
+  ASSERT_EQ(glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER), static_cast<GLenum>(GL_FRAMEBUFFER_COMPLETE));
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  ToneSettings tone;
+  tone.exposure = 4.0;
+  p.draw(tone, 0, 0, w, h);
+  std::vector<unsigned char> gpu(static_cast<std::size_t>(w) * h * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(color, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(gpu.size()), gpu.data());
+  check_gl("reading the tonemapped test image");
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteTextures(1, &color);
+  const std::vector<unsigned char> cpu = tonemap_srgb8(px, tone);
+  int worst = 0, differ = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      // The texture's row 0 is the image's top row; the draw puts it at the framebuffer's top (row h-1).
+      const std::size_t i = static_cast<std::size_t>(y) * w + x, j = static_cast<std::size_t>(h - 1 - y) * w + x;
+      for (int c = 0; c < 3; ++c) {
+        const int d = std::abs(int(gpu[j * 4 + c]) - int(cpu[i * 3 + c]));
+        worst = std::max(worst, d);
+        if (d > 1) ADD_FAILURE() << "pixel " << x << "," << y << " channel " << c << ": GPU " << int(gpu[j * 4 + c]) << ", CPU "
+                                 << int(cpu[i * 3 + c]) << " from " << px[i][c] << " (a " << px[i].w << ")";
+        differ += d > 0;
+      }
+    }
+  }
+  EXPECT_LE(worst, 1) << differ << " channel values differ";
+  // A sanity check on the comparison itself: the test image is not one colour.
+  EXPECT_NE(cpu[0], cpu[3 * 100]);
+}
+
+TEST_F(PresenterTest, ReducedResolutionUpscalesWithoutSpreadingANonFiniteTexel) {
+  // A 12 x 7 march drawn over 48 x 27 pixels (resolution scale 1/4): a uniform image stays uniform,
+  // and a NaN texel in the top-left corner whitens only pixels within one texel of it.
+  const int w = 12, h = 7, W = 48, H = 27;
+  std::vector<glm::vec4> px(static_cast<std::size_t>(w) * h, glm::vec4(0.05f, 0.04f, 0.03f, 0.2f));
+  px[0] = glm::vec4(std::numeric_limits<float>::quiet_NaN());
+  Presenter p(loader_);
+  p.resize(w, h);
+  upload(p.frame_texture(), w, h, px);
+  p.accumulate(0);
+  GLuint fbo = 0, color = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &color);
+  glTextureStorage2D(color, 1, GL_RGBA8, W, H);
+  glCreateFramebuffers(1, &fbo);
+  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  ToneSettings tone;
+  p.draw(tone, 0, 0, W, H);
+  std::vector<unsigned char> out(static_cast<std::size_t>(W) * H * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(color, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(out.size()), out.data());
+  check_gl("reading the upscaled test image");
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteTextures(1, &color);
+  const std::vector<unsigned char> want = tonemap_srgb8({px[1]}, tone);
+  int far_off = 0, near_white = 0;
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      const unsigned char* o = &out[(static_cast<std::size_t>(H - 1 - y) * W + x) * 4];  // y from the top
+      const bool near_corner = x < 2 * W / w && y < 2 * H / h + 1;  // within about one texel of texel (0, 0)
+      if (near_corner) {
+        near_white += o[0] > want[0] + 8;
+      } else {
+        for (int c = 0; c < 3; ++c) far_off += std::abs(int(o[c]) - int(want[static_cast<std::size_t>(c)])) > 1;
+      }
+    }
+  }
+  EXPECT_EQ(far_off, 0);
+  EXPECT_GT(near_white, 0);  // the non-finite texel itself shows (white), as in image_output
+}
+
+TEST_F(PresenterTest, AccumulationIsTheRunningMeanOfTheFrames) {
+  const int w = 19, h = 11, frames = 6;  // not multiples of the 8 x 8 work groups
+  Presenter p(loader_);
+  p.resize(w, h);
+  std::mt19937 rng(3);
+  std::normal_distribution<float> n(1.0f, 0.5f);
+  std::vector<glm::dvec4> mean(static_cast<std::size_t>(w) * h, glm::dvec4(0.0));
+  for (int f = 0; f < frames; ++f) {
+    std::vector<glm::vec4> px(mean.size());
+    for (auto& v : px) v = glm::vec4(n(rng), n(rng), n(rng), n(rng));
+    for (std::size_t i = 0; i < px.size(); ++i) mean[i] += glm::dvec4(px[i]) / double(frames);
+    upload(p.frame_texture(), w, h, px);
+    p.accumulate(f);
+  }
+  std::vector<glm::vec4> gpu(mean.size());
+  glGetTextureImage(p.mean_texture(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(gpu.size() * sizeof(glm::vec4)), gpu.data());
+  check_gl("reading the accumulated mean");
+  double worst = 0.0;
+  for (std::size_t i = 0; i < gpu.size(); ++i) {
+    for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(double(gpu[i][c]) - mean[i][c]));
+  }
+  EXPECT_LT(worst, 1e-5);  // float running mean of values ~1 over 6 frames
+  // Restarting (count 0) replaces the mean with the new frame.
+  std::vector<glm::vec4> one(mean.size(), glm::vec4(0.25f, 0.5f, 0.75f, 1.0f));
+  upload(p.frame_texture(), w, h, one);
+  p.accumulate(0);
+  glGetTextureImage(p.mean_texture(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(gpu.size() * sizeof(glm::vec4)), gpu.data());
+  EXPECT_EQ(gpu[5], one[5]);
+  EXPECT_EQ(gpu.back(), one.back());
+}
+
+TEST_F(PresenterTest, EveryVertexAndFragmentShaderPairCompilesAndLinks) {
+  // Graphics shaders come in pairs by name (x.vert + x.frag); the .comp files have their own test.
+  const fs::path dir = ShaderLoader::default_shader_dir();
+  int pairs = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    const fs::path& f = e.path();
+    if (f.extension() == ".frag") {
+      EXPECT_TRUE(fs::exists(fs::path(f).replace_extension(".vert"))) << f << " has no vertex shader";
+    }
+    if (f.extension() != ".vert") continue;
+    const fs::path frag = fs::path(f).replace_extension(".frag");
+    ASSERT_TRUE(fs::exists(frag)) << f << " has no fragment shader";
+    EXPECT_NO_THROW(load_graphics(loader_, f, frag)) << f;
+    ++pairs;
+  }
+  EXPECT_GE(pairs, 1);
+}
+
+}  // namespace
