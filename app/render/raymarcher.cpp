@@ -6,6 +6,7 @@
 #include <glm/glm.hpp>
 
 #include "geo/geodesy.hpp"
+#include "render/albedo_map.hpp"
 #include "volume/sampler.hpp"
 
 namespace cv::render {
@@ -21,6 +22,7 @@ GpuRaymarcher::GpuRaymarcher(const ShaderLoader& loader)
 
 GpuRaymarcher::~GpuRaymarcher() {
   if (textures_[0]) glDeleteTextures(2, textures_);
+  if (ground_) glDeleteTextures(1, &ground_);
 }
 
 void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExtinction& medium) {
@@ -77,12 +79,33 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   glProgramUniform1f(p, loc(p, "u_droplet_um"), static_cast<float>(s.droplet_diameter_um));
   glProgramUniform1f(p, loc(p, "u_ice_g"), static_cast<float>(s.ice_g));
   glProgramUniform1i(p, loc(p, "u_frame"), s.frame);
+  glProgramUniform1i(p, loc(p, "u_atmosphere"), s.atmosphere ? 1 : 0);
+  glProgramUniform1i(p, loc(p, "u_globe"), s.globe ? 1 : 0);
+  glProgramUniform1f(p, loc(p, "u_ambient"), static_cast<float>(s.ambient));
+  glProgramUniform1i(p, loc(p, "u_sky_steps"), s.sky_steps);
+  glProgramUniform1i(p, loc(p, "u_atmo_sun_steps"), s.atmo_sun_steps);
+  set3(p, "u_ground_albedo", s.ground_albedo);
+  const bool textured = s.globe && !s.ground_texture.empty();
+  if (textured && s.ground_texture != ground_path_) {
+    const core::AlbedoMap map = load_albedo_map(s.ground_texture);
+    if (ground_) glDeleteTextures(1, &ground_);
+    glCreateTextures(GL_TEXTURE_2D, 1, &ground_);
+    glTextureStorage2D(ground_, 1, GL_RGB32F, map.width, map.height);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTextureSubImage2D(ground_, 0, 0, 0, map.width, map.height, GL_RGB, GL_FLOAT, map.rgb.data());
+    check_gl("uploading the ground albedo texture");
+    ground_w_ = map.width;
+    ground_h_ = map.height;
+    ground_path_ = s.ground_texture;
+  }
+  glProgramUniform2i(p, loc(p, "u_ground_size"), textured ? ground_w_ : 0, textured ? ground_h_ : 0);
   GLuint out = 0;
   glCreateTextures(GL_TEXTURE_2D, 1, &out);
   glTextureStorage2D(out, 1, GL_RGBA32F, cam.width, cam.height);
   glBindImageTexture(0, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glBindTextureUnit(1, textures_[0]);
   glBindTextureUnit(2, textures_[1]);
+  glBindTextureUnit(3, ground_);
   glUseProgram(p);
   glDispatchCompute(static_cast<GLuint>((cam.width + 7) / 8), static_cast<GLuint>((cam.height + 7) / 8), 1);
   glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);

@@ -13,3 +13,5 @@
 #include "intersect.glsl"
 #include "geodesy.glsl"
 #include "volume_coords.glsl"
+#include "atmosphere.glsl"
+#include "ground.glsl"
