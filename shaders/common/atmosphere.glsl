@@ -44,19 +44,18 @@ CV_FN real alt_along_ray(real r0_m, real h_m, real mu, real t_m) {
   return h_m + t_m * (real(2) * r * mu + t_m) / (rt + r);
 }
 
-// The middle and length of step i of n over [a, b], the steps packed quadratically toward the end
-// where the ray is lowest (the air densest): toward a when toward_a, else toward b.
+// The middle and length of step i of n over [a, b], the steps packed toward the end where the ray
+// is lowest (the air densest): toward a when toward_a, else toward b. Cubic packing (t ~ u^3) puts
+// about five of 16 steps in the lowest 2 km of a vertical ray (the Mie layer) and still spans the
+// 1000 km of a horizontal one; quadratic packing left the Mie layer three.
 CV_FN void atmo_step(real a, real b, int i, int n, bool toward_a, CV_OUT(real) t, CV_OUT(real) dt) {
   real len = b - a;
-  if (toward_a) {
-    real u = (real(i) + real(0.5)) / real(n);
-    t = a + len * u * u;
-    dt = real(2) * len * u / real(n);
-  } else {
-    real v = (real(n - i) - real(0.5)) / real(n);
-    t = b - len * v * v;
-    dt = real(2) * len * v / real(n);
-  }
+  real u = toward_a ? (real(i) + real(0.5)) / real(n) : (real(n - i) - real(0.5)) / real(n);
+  real off = len * u * u * u;
+  t = toward_a ? a + off : b - off;
+  // The midpoint rule in u with the weight dt/du = 3 len u^2, scaled so the steps add up to the
+  // whole length (the plain weights fall short by 1 / (4 n^2): a quarter for a single step).
+  dt = real(3) * len * u * u / (real(n) - real(0.25) / real(n));
 }
 
 // Where a ray's altitude is lowest within [t0, t1]: r(t)^2 is least at t = -r mu.

@@ -3,6 +3,7 @@
 // zenith, sunset reddening, the sun below the horizon, and no NaN or Inf from 0 m to 4e8 m.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -45,17 +46,21 @@ TEST(Atmosphere, ConstantsAreThePublishedOnes) {
 }
 
 TEST(Atmosphere, VerticalOpticalDepthMatchesTheClosedForm) {
+  // Worst relative error over starting altitudes (0 to 33 km) and channels, per step count: the
+  // march converges toward the closed form (the ozone tent's kinks limit it to about second order).
+  double worst[4] = {0, 0, 0, 0};
+  const int steps[4] = {8, 16, 64, 256};
   for (double h0 : {0.0, 1000.0, 10000.0, 20000.0, 25000.0, 33000.0}) {
     const glm::dvec3 ref = vertical_depth(h0);
-    for (int steps : {8, 16, 64, 256}) {
-      const glm::dvec3 tau = f64::atmo_optical_depth(kR0, h0, 1.0, 0.0, kTop - h0, steps);
-      double err = 0.0;
-      for (int c = 0; c < 3; ++c) err = std::max(err, std::abs(tau[c] - ref[c]) / ref[c]);
-      if (h0 == 0.0) std::printf("vertical optical depth from 0 m, %3d steps: relative error %.2e\n", steps, err);
-      // The midpoint rule converges at second order; the tent's kinks cost a little at 8 steps.
-      EXPECT_LT(err, steps >= 64 ? 2e-4 : 3e-2) << "h0=" << h0 << " steps=" << steps;
+    for (int k = 0; k < 4; ++k) {
+      const glm::dvec3 tau = f64::atmo_optical_depth(kR0, h0, 1.0, 0.0, kTop - h0, steps[k]);
+      for (int c = 0; c < 3; ++c) worst[k] = std::max(worst[k], std::abs(tau[c] - ref[c]) / ref[c]);
     }
   }
+  for (int k = 0; k < 4; ++k) std::printf("vertical optical depth, %3d steps: worst relative error %.2e\n", steps[k], worst[k]);
+  EXPECT_LT(worst[1], 1e-2);  // 16 steps, the renderer's sky default: within 1 % (the ozone tent's kinks above 20 km)
+  EXPECT_LT(worst[3], 5e-5);
+  EXPECT_LT(worst[3], worst[1] / 10.0);
 }
 
 TEST(Atmosphere, OzoneColumnIsTheTentsArea) {
@@ -67,7 +72,7 @@ TEST(Atmosphere, OzoneColumnIsTheTentsArea) {
   const glm::dvec3 tau40 = f64::atmo_optical_depth(kR0, 40000.0, 1.0, 0.0, kTop - 40000.0, 256);
   const double rayleigh_mie_green = 13.558e-6 * 8000.0 * (1.0 - std::exp(-kTop / 8000.0)) + 4.40e-6 * 1200.0;
   EXPECT_NEAR(tau0.y - rayleigh_mie_green, 15000.0 * 1.881e-6, 2e-5);
-  EXPECT_NEAR(tau40.y, above.y, 1e-6 * above.y + 1e-9);
+  EXPECT_NEAR(tau40.y, above.y, 1e-5 * above.y);  // the march's own error at 256 steps
   EXPECT_LT(above.y, 0.01 * from_ground.y);
 }
 
@@ -94,9 +99,9 @@ TEST(Atmosphere, HorizonAgainstZenith) {
   const glm::dvec3 zen = f64::atmo_transmittance(kR0, 0.0, 1.0, 0.0, 16);
   const glm::dvec3 hor = f64::atmo_transmittance(kR0, 0.0, 0.0, 1.0, 16);
   const glm::dvec3 hor_ref = brute_force_depth(0.0, 0.0), zen_ref = vertical_depth(0.0);
+  double worst = 0.0;
   for (int c = 0; c < 3; ++c) {
-    EXPECT_NEAR(-std::log(zen[c]), zen_ref[c], 2e-3 * zen_ref[c]) << c;
-    EXPECT_NEAR(-std::log(hor[c]), hor_ref[c], 5e-3 * hor_ref[c]) << c;
+    worst = std::max({worst, std::abs(-std::log(zen[c]) - zen_ref[c]) / zen_ref[c], std::abs(-std::log(hor[c]) - hor_ref[c]) / hor_ref[c]});
   }
   const double ratio_blue = -std::log(hor.z) / -std::log(zen.z);
   std::printf("sea level, blue: zenith T %.4f, horizon T %.3g, optical depth ratio %.1f\n", zen.z, hor.z, ratio_blue);
@@ -106,8 +111,11 @@ TEST(Atmosphere, HorizonAgainstZenith) {
   for (double mu : {0.5, 0.1, 0.02, -0.005}) {
     const double nu = std::sqrt(1.0 - mu * mu);
     const glm::dvec3 t = f64::atmo_transmittance(kR0, 1000.0, mu, nu, 16), ref = brute_force_depth(1000.0, mu);
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(-std::log(t[c]), ref[c], 5e-3 * ref[c]) << "mu=" << mu << " c=" << c;
+    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(-std::log(t[c]) - ref[c]) / ref[c]);
   }
+  // A 16-step march keeps slanted optical depths within 1 % of brute force.
+  std::printf("16-step optical depths against brute force, zenith to below the horizon: worst relative %.2e\n", worst);
+  EXPECT_LT(worst, 1e-2);
 }
 
 TEST(Atmosphere, LowSunReddensAndTheSetSunDeliversNothing) {
