@@ -18,6 +18,7 @@
 #include "physics/physics.hpp"
 #include "volume/volume_io.hpp"
 #include "reference/raymarcher.hpp"
+#include "render/albedo_map.hpp"
 #include "render/context.hpp"
 #include "render/image_output.hpp"
 #include "render/raymarcher.hpp"
@@ -45,7 +46,7 @@ void print_usage() {
       "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"
       "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"
       "  render INPUT -o OUT.png [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov]\n"
-      "         [--sun LAT,LON] [--steps M] [--sun-steps N] [--octaves N] [--accumulate N] [--exposure E]\n"
+      "         [--sun LAT,LON] [--steps M] [--sun-steps N] [--octaves N] [--accumulate N] [--exposure E] [--no-sky]\n"
       "         [--pfm OUT.pfm]\n"
       "                           (the sun stands where it stood at the valid time unless --sun is given)\n"
       "                           render a NetCDF file or .cvvol volume headlessly (EGL) to a PNG\n"
@@ -245,6 +246,11 @@ int cmd_render(const std::vector<std::string>& args) {
   march.view_step_m = 0.0;  // from the grid unless set
   march.sun_steps = 16;
   march.octaves = 4;
+  // Sky, sun colour, ambient light and the globe (Natural Earth relief when installed); --no-sky
+  // gives the clouds alone on black, as before.
+  march.atmosphere = march.globe = true;
+  march.ambient = 1.0;
+  if (std::filesystem::exists(cv::render::kNaturalEarthRelief)) march.ground_texture = cv::render::kNaturalEarthRelief;
   cv::render::ToneSettings tone;
   tone.exposure = 4.0;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -279,6 +285,9 @@ int cmd_render(const std::vector<std::string>& args) {
     } else if (a == "--accumulate") {
       accumulate = static_cast<int>(parse_number("--accumulate", next()));
       if (accumulate < 1 || accumulate > 4096) throw UsageError{"cloudviewer render: --accumulate: expected 1..4096 frames"};
+    } else if (a == "--no-sky") {
+      march.atmosphere = march.globe = false;
+      march.ambient = 0.0;
     } else if (a == "--exposure") {
       tone.exposure = parse_number("--exposure", next());
       if (!(tone.exposure > 0)) throw UsageError{"cloudviewer render: --exposure: expected a number > 0"};

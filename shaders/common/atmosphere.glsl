@@ -108,43 +108,56 @@ CV_FN real3 atmo_transmittance(real r0_m, real h_m, real mu, real nu, int steps)
   return exp(-atmo_optical_depth(r0_m, h_m, mu, max(a0, real(0)), a1, steps));
 }
 
+// One step of the sky integral: in-scattered radiance added over [t - dt/2, t + dt/2] behind the
+// view optical depth tau (updated), per unit sun irradiance. See atmo_inscatter.
+CV_FN real3 atmo_inscatter_step(real r0_m, real h_m, real mu, real mu_s, real nu_vs, real t, real dt, real p_r, real p_m,
+                                int sun_steps, CV_INOUT(real3) tau) {
+  real alt = alt_along_ray(r0_m, h_m, mu, t);
+  real3 dens = atmo_density(alt);
+  real3 sigma_t = atmo_extinction_per_m(dens);
+  // The sun's cosine with the local up at the sample: (r up + t d) . to_sun / r(t).
+  real mu_st = clamp(((r0_m + h_m) * mu_s + t * nu_vs) / (r0_m + alt), real(-1), real(1));
+  real nu_st = sqrt(max(real(0), real(1) - mu_st * mu_st));
+  real3 t_sun = atmo_transmittance(r0_m, alt, mu_st, nu_st, sun_steps);
+  real3 s = t_sun * (rayleigh_scattering_per_m() * (dens.x * p_r) + real3(CV_MIE_SCATTERING_PER_M * dens.y * p_m));
+  real3 l = exp(-tau) * real3(segment_integral(s.x, sigma_t.x, dt), segment_integral(s.y, sigma_t.y, dt),
+                              segment_integral(s.z, sigma_t.z, dt));
+  tau += sigma_t * dt;
+  return l;
+}
+
 // Single-scattered sky radiance along the view ray from t0_m to t1_m (camera-relative: the ray
 // starts at altitude h_m, mu = cosine of the ray with the local up there, mu_s = cosine of the
 // sun's direction with that up, nu_vs = cosine between the ray and the sun's direction), per unit
 // sun irradiance. Each step adds (sigma_R P_R + sigma_M P_CS) T_sun over the step with the
 // energy-conserving segment integral per channel. Returns the in-scattered radiance; trans gets
-// the view transmittance over the segment.
+// the view transmittance over the segment. Two loops, one per side of the ray's lowest point (one
+// loop choosing the side per step miscompiled on Mesa llvmpipe 22.3 for 15 steps or more).
 CV_FN real3 atmo_inscatter(real r0_m, real h_m, real mu, real mu_s, real nu_vs, real t0_m, real t1_m, int steps,
                            int sun_steps, CV_OUT(real3) trans) {
   real3 radiance = real3(real(0));
   trans = real3(real(1));
   if (!(t1_m > t0_m)) return radiance;
-  real r = r0_m + h_m;
   // Sunlight propagates along -to_sun and leaves along -d: the scattering cosine is d . to_sun.
   real p_r = phase_rayleigh(nu_vs);
   real p_m = phase_cornette_shanks(nu_vs, CV_MIE_G);
   real tl = atmo_lowest_t(r0_m, h_m, mu, t0_m, t1_m);
   int n1 = atmo_first_steps(t0_m, tl, t1_m, steps);
-  for (int i = 0; i < steps; ++i) {
+  int n2 = steps - n1;
+  real3 tau = real3(real(0));
+  for (int i = 0; i < n1; ++i) {
     real t;
     real dt;
-    if (i < n1) {
-      atmo_step(t0_m, tl, i, n1, false, t, dt);
-    } else {
-      atmo_step(tl, t1_m, i - n1, steps - n1, true, t, dt);
-    }
-    real alt = alt_along_ray(r0_m, h_m, mu, t);
-    real3 dens = atmo_density(alt);
-    real3 sigma_t = atmo_extinction_per_m(dens);
-    // The sun's cosine with the local up at the sample: (r up + t d) . to_sun / r(t).
-    real mu_st = clamp((r * mu_s + t * nu_vs) / (r0_m + alt), real(-1), real(1));
-    real nu_st = sqrt(max(real(0), real(1) - mu_st * mu_st));
-    real3 t_sun = atmo_transmittance(r0_m, alt, mu_st, nu_st, sun_steps);
-    real3 s = t_sun * (rayleigh_scattering_per_m() * (dens.x * p_r) + real3(CV_MIE_SCATTERING_PER_M * dens.y * p_m));
-    radiance += trans * real3(segment_integral(s.x, sigma_t.x, dt), segment_integral(s.y, sigma_t.y, dt),
-                              segment_integral(s.z, sigma_t.z, dt));
-    trans *= exp(-sigma_t * dt);
+    atmo_step(t0_m, tl, i, n1, false, t, dt);
+    radiance += atmo_inscatter_step(r0_m, h_m, mu, mu_s, nu_vs, t, dt, p_r, p_m, sun_steps, tau);
   }
+  for (int i = 0; i < n2; ++i) {
+    real t;
+    real dt;
+    atmo_step(tl, t1_m, i, n2, true, t, dt);
+    radiance += atmo_inscatter_step(r0_m, h_m, mu, mu_s, nu_vs, t, dt, p_r, p_m, sun_steps, tau);
+  }
+  trans = exp(-tau);
   return radiance;
 }
 
