@@ -17,6 +17,7 @@
 #include "cli_common.hpp"
 #include "importer.hpp"
 #include "noise/noise.hpp"
+#include "render/albedo_map.hpp"
 #include "render/context.hpp"
 #include "render/image_output.hpp"
 #include "render/raymarcher.hpp"
@@ -60,12 +61,14 @@ int parse_int(const std::string& option, const std::string& text, int lo, int hi
 // The options, applied to `scene` in the order given (later ones win).
 RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& scene) {
   RenderArgs r;
-  // Every option takes a value; the one argument that is no option's value is the input. It is
+  // Every option but --no-sky takes a value; the one argument that is no option's value is the input. It is
   // read first so that a scene file's settings are the base the options override.
   std::vector<std::pair<std::string, std::string>> options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (!a.empty() && a[0] == '-') {
+    if (a == "--no-sky") {  // the one flag without a value
+      options.emplace_back(a, "");
+    } else if (!a.empty() && a[0] == '-') {
       if (i + 1 >= args.size()) throw UsageError{"cloudviewer render: " + a + ": expected a value after it"};
       options.emplace_back(a, args[++i]);
     } else if (r.input.empty()) {
@@ -147,6 +150,9 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
       if (!(m.noise_scale_m >= 10 && m.noise_scale_m <= 1e7)) {
         throw UsageError{"cloudviewer render: --noise-scale: found " + v + ", expected the noise tile's period in metres, 10..1e7"};
       }
+    } else if (a == "--no-sky") {
+      m.atmosphere = m.globe = false;
+      m.ambient = 0.0;
     } else if (a == "--exposure") {
       scene.render.exposure = parse_number(a, v);
       if (!(scene.render.exposure > 0)) throw UsageError{"cloudviewer render: --exposure: found '" + v + "', expected a number > 0"};
@@ -200,7 +206,7 @@ const char* render_usage() {
          "         [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov] [--sun LAT,LON | --sun-time ISO]\n"
          "         [--quality low|default|high|custom] [--steps M] [--sun-steps N] [--octaves N] [--accumulate N]\n"
          "         [--exposure E] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N] [--pfm OUT.pfm]\n"
-         "         [--noise AMOUNT] [--noise-scale METRES]\n"
+         "         [--noise AMOUNT] [--noise-scale METRES] [--no-sky]\n"
          "         [--save-scene OUT.json]  (the effective scene, camera and sun resolved, to reproduce the image)\n"
          "                           the sun stands where it stood at the valid time unless --sun or --sun-time\n";
 }
@@ -257,6 +263,7 @@ int cmd_render(const std::vector<std::string>& args) {
 
   const core::RenderSettings& rs = scene.render;
   core::MarchSettings march = rs.march;
+  march.ground_texture = render::resolve_ground_texture(march.ground_texture);
   const int mw = std::max(1, static_cast<int>(std::lround(cam.width * rs.resolution_scale)));
   const int mh = std::max(1, static_cast<int>(std::lround(cam.height * rs.resolution_scale)));
   core::Camera march_cam = cam;

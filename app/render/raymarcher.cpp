@@ -7,6 +7,7 @@
 #include <glm/glm.hpp>
 
 #include "geo/geodesy.hpp"
+#include "render/albedo_map.hpp"
 #include "volume/sampler.hpp"
 
 namespace cv::render {
@@ -22,6 +23,7 @@ GpuRaymarcher::GpuRaymarcher(const ShaderLoader& loader)
 
 GpuRaymarcher::~GpuRaymarcher() {
   if (textures_[0]) glDeleteTextures(2, textures_);
+  if (ground_) glDeleteTextures(1, &ground_);
   if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
 }
 
@@ -106,9 +108,30 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
     glBindTextureUnit(3, noise_textures_[0]);
     glBindTextureUnit(4, noise_textures_[1]);
   }
+  glProgramUniform1i(p, loc(p, "u_atmosphere"), s.atmosphere ? 1 : 0);
+  glProgramUniform1i(p, loc(p, "u_globe"), s.globe ? 1 : 0);
+  glProgramUniform1f(p, loc(p, "u_ambient"), static_cast<float>(s.ambient));
+  glProgramUniform1i(p, loc(p, "u_sky_steps"), s.sky_steps);
+  glProgramUniform1i(p, loc(p, "u_atmo_sun_steps"), s.atmo_sun_steps);
+  set3(p, "u_ground_albedo", s.ground_albedo);
+  const bool textured = s.globe && !s.ground_texture.empty();
+  if (textured && s.ground_texture != ground_path_) {
+    const core::AlbedoMap map = load_albedo_map(s.ground_texture);
+    if (ground_) glDeleteTextures(1, &ground_);
+    glCreateTextures(GL_TEXTURE_2D, 1, &ground_);
+    glTextureStorage2D(ground_, 1, GL_RGB32F, map.width, map.height);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTextureSubImage2D(ground_, 0, 0, 0, map.width, map.height, GL_RGB, GL_FLOAT, map.rgb.data());
+    check_gl("uploading the ground albedo texture");
+    ground_w_ = map.width;
+    ground_h_ = map.height;
+    ground_path_ = s.ground_texture;
+  }
+  glProgramUniform2i(p, loc(p, "u_ground_size"), textured ? ground_w_ : 0, textured ? ground_h_ : 0);
   glBindImageTexture(0, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glBindTextureUnit(1, textures_[0]);
   glBindTextureUnit(2, textures_[1]);
+  glBindTextureUnit(5, ground_);  // 3 and 4 are the noise textures
   glUseProgram(p);
   const int tile = dispatch.rows_per_tile > 0 ? (dispatch.rows_per_tile + 7) / 8 * 8 : cam.height;
   GLuint query = 0;

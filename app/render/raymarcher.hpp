@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -38,8 +39,10 @@ class GpuRaymarcher {
   // before a render with settings.noise_amount > 0, not done otherwise.
   void upload_noise(const core::ErosionNoise& noise);
 
-  // Renders: rgb = radiance, a = view transmittance, rows top to bottom. With noise_amount 0 the
-  // program without the noise code runs and the noise textures are not bound.
+  // Renders: rgb = radiance, a = view transmittance (0 where the globe shows), rows top to bottom.
+  // With noise_amount 0 the program without the noise code runs and the noise textures are not
+  // bound. With settings.globe and a ground_texture, the image is loaded (once per path) with
+  // load_albedo_map; a file that cannot be read throws std::runtime_error.
   std::vector<glm::vec4> render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings,
                                 const DispatchOptions& dispatch = {});
 
@@ -54,6 +57,9 @@ class GpuRaymarcher {
   GlProgram noise_program_;  // the NoiseDetail variant, compiled by upload_noise
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
+  GLuint ground_ = 0;               // linear albedo (RGB32F), loaded from ground_path_
+  int ground_w_ = 0, ground_h_ = 0;
+  std::string ground_path_;
   core::VolumeGrid grid_;
 };
 

@@ -15,6 +15,7 @@
 #include <cstdio>
 
 #include "importer.hpp"
+#include "render/albedo_map.hpp"
 #include "render/context.hpp"
 #include "render/presenter.hpp"
 #include "render/raymarcher.hpp"
@@ -299,6 +300,7 @@ int run_viewer(const ViewerOptions& o) {
     // exactly as `render` does without --accumulate.
     if (accumulated < s.scene.render.accumulate) {
       core::MarchSettings m = s.scene.render.march;
+      m.ground_texture = render::resolve_ground_texture(m.ground_texture);
       m.frame = s.scene.render.accumulate == 1 ? -1 : accumulated;
       march_timer.begin();
       gpu.render_into(presenter.frame_texture(), *s.scene.camera, ctx.sun, m);

@@ -43,8 +43,87 @@ struct Medium {
     sigma_ice = ice.sample(lat, lon, alt, 0.0);
     if (erosion.noise && sigma_liquid + sigma_ice > 0.0) erosion.apply(p, sigma_liquid, sigma_ice);
   }
+  // Optical depth of the clouds from p (altitude alt_p) toward the sun (cosine mu_sun, sine nu_sun
+  // with the local up at p): sun_steps per shell segment, as cloud_sun_depth in raymarch.comp.
+  double sun_depth(const glm::dvec3& p, double alt_p, double mu_sun, double nu_sun, const glm::dvec3& to_sun,
+                   int sun_steps) const {
+    glm::dvec4 sseg;
+    const int sn = p64::ray_shell_rel_nu(grid.earth_radius_m, alt_p, mu_sun, nu_sun, grid.alt_m.start, grid.alt_m.last(), sseg);
+    double tau = 0.0;
+    for (int q = 0; q < sn; ++q) {
+      const double ds = (sseg[2 * q + 1] - sseg[2 * q]) / sun_steps;
+      for (int j = 0; j < sun_steps; ++j) {
+        double a, b;
+        at(p + (sseg[2 * q] + (j + 0.5) * ds) * to_sun, a, b);
+        tau += (a + b) * ds;
+      }
+    }
+    return tau;
+  }
 };
+
+// The air and the ground around the clouds, as sky_and_ground in shaders/render/sky_ground.glsl:
+// sky in front + T (cloud + cloud_t (sky behind + T ground)); alpha 0 where the globe shows.
+glm::dvec4 sky_and_ground(const Medium& medium, const MarchSettings& s, const AlbedoMap* map, const glm::dvec3& cam_ecef,
+                          double cam_alt, const glm::dvec3& d, const glm::dvec3& to_sun, const glm::dvec3& irradiance,
+                          const glm::dvec3& cloud_l, double cloud_t, bool has_cloud, const glm::dvec3& p_cloud) {
+  const double r0 = medium.grid.earth_radius_m, top = p64::CV_ATMO_TOP_M;
+  glm::dvec3 o = cam_ecef, up = glm::normalize(cam_ecef);
+  double h = cam_alt, mu = glm::dot(d, up), nu = glm::length(glm::cross(d, up));
+  double a0, a1;
+  if (!p64::ray_sphere_rel_nu(r0, h, mu, nu, top, a0, a1) || a1 < 0.0) return glm::dvec4(cloud_l, cloud_t);
+  if (h > top && a0 > 0.0) {
+    o = glm::normalize(o + a0 * d) * (r0 + top);
+    h = top;
+    up = glm::normalize(o);
+    mu = glm::dot(d, up);
+    nu = glm::length(glm::cross(d, up));
+    p64::ray_sphere_rel_nu(r0, h, mu, nu, top, a0, a1);
+  }
+  double g0, g1;
+  const bool hits_ground = p64::ray_sphere_rel_nu(r0, h, mu, nu, 0.0, g0, g1) && g1 > 0.0;
+  const double t_end = hits_ground ? std::max(g0, 0.0) : a1;
+  const double t_cloud = has_cloud ? std::clamp(glm::dot(p_cloud - o, d), 0.0, t_end) : t_end;
+  glm::dvec3 sky_front(0.0), sky_back(0.0), tr_front(1.0), tr_back(1.0);
+  if (s.atmosphere) {
+    const double mu_s = glm::dot(to_sun, up), nu_vs = glm::dot(d, to_sun);
+    sky_front = irradiance * p64::atmo_inscatter(r0, h, mu, mu_s, nu_vs, 0.0, t_cloud, s.sky_steps, s.atmo_sun_steps, tr_front);
+    if (t_end > t_cloud) {
+      sky_back = irradiance * p64::atmo_inscatter(r0, h, mu, mu_s, nu_vs, t_cloud, t_end, s.sky_steps, s.atmo_sun_steps, tr_back);
+    }
+  }
+  glm::dvec3 ground(0.0);
+  const bool globe = hits_ground && s.globe;
+  if (globe) {
+    const glm::dvec3 pg = glm::normalize(o + t_end * d) * r0, n = glm::normalize(pg);
+    const double mu_sg = glm::dot(to_sun, n), nu_sg = glm::length(glm::cross(to_sun, n));
+    glm::dvec3 sun_air(mu_sg > 0.0 ? 1.0 : 0.0), e_sky(0.0);
+    if (s.atmosphere) {
+      sun_air = p64::atmo_transmittance(r0, 0.0, mu_sg, nu_sg, s.atmo_sun_steps);
+      e_sky = p64::sky_irradiance(sun_air, mu_sg);
+    }
+    // The clouds' shadow: the same sun march the cloud samples use.
+    const double shadow = mu_sg > 0.0 ? p64::transmittance(medium.sun_depth(pg, 0.0, mu_sg, nu_sg, to_sun, s.sun_steps)) : 0.0;
+    const glm::dvec3 ll = p64::ecef_to_sphere(pg, r0);
+    const glm::dvec3 albedo = map ? map->at(ll.x, ll.y) : s.ground_albedo;
+    ground = irradiance * p64::ground_radiance(albedo, mu_sg, sun_air * shadow, e_sky);
+  }
+  const glm::dvec3 l = sky_front + tr_front * (cloud_l + cloud_t * (sky_back + tr_back * ground));
+  return glm::dvec4(l, globe ? 0.0 : cloud_t * tr_front.y * tr_back.y);
+}
 }  // namespace
+
+glm::dvec3 AlbedoMap::at(double lat_rad, double lon_rad) const {
+  const glm::dvec4 c = p64::equirect_texel(lat_rad, lon_rad, width, height);
+  const int x0 = static_cast<int>(c.x), y0 = static_cast<int>(c.y);
+  const int x1 = (x0 + 1) % width, y1 = std::min(y0 + 1, height - 1);
+  auto texel = [&](int x, int y) {
+    const std::size_t i = (static_cast<std::size_t>(y) * width + x) * 3;
+    return glm::dvec3(rgb[i], rgb[i + 1], rgb[i + 2]);
+  };
+  const glm::dvec3 a = glm::mix(texel(x0, y0), texel(x1, y0), c.z), b = glm::mix(texel(x0, y1), texel(x1, y1), c.z);
+  return glm::mix(a, b, c.w);
+}
 
 GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepData& data) {
   GridMeanExtinction m;
@@ -90,7 +169,7 @@ glm::dvec3 grid_centre_ecef(const VolumeGrid& grid) {
 }
 
 ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction& ext, const Camera& cam, const Sun& sun,
-                                const MarchSettings& s, const ErosionNoise* noise) {
+                                const MarchSettings& s, const ErosionNoise* noise, const AlbedoMap* ground_map) {
   ReferenceImage img;
   img.width = cam.width;
   img.height = cam.height;
@@ -119,11 +198,11 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
       double h = cam.alt_m;
       glm::dvec3 up = up_cam;
       double mu_up = glm::dot(d, up), nu_up = glm::length(glm::cross(d, up));
-      bool skip = false;
+      bool in_shell = true;  // false: the ray misses the cloud shell (the sky may still show)
       if (h > ht) {
         double e0, e1;
         if (!p64::ray_sphere_rel_nu(r0, h, mu_up, nu_up, ht, e0, e1) || e1 < 0.0) {
-          skip = true;
+          in_shell = false;
         } else if (e0 > 0.0) {
           origin = glm::normalize(origin + e0 * d) * (r0 + ht);
           h = ht;
@@ -132,9 +211,8 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
           nu_up = glm::length(glm::cross(d, up));
         }
       }
-      if (skip) continue;
       glm::dvec4 seg;
-      const int n = p64::ray_shell_rel_nu(r0, h, mu_up, nu_up, hb, ht, seg);
+      const int n = in_shell ? p64::ray_shell_rel_nu(r0, h, mu_up, nu_up, hb, ht, seg) : 0;
       // The ground ends the ray.
       double tg0, tg1;
       const double t_ground = p64::ray_sphere_rel_nu(r0, h, mu_up, nu_up, 0.0, tg0, tg1) && tg1 > 0.0 ? std::max(tg0, 0.0) : 1e300;
@@ -143,6 +221,7 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
       const double mu = glm::dot(d, to_sun);
       glm::dvec3 radiance(0.0);
       double transmittance = 1.0;
+      double depth_w = 0.0, depth_t = 0.0;  // where the cloud is: the mean depth of the light it takes out
       for (int k = 0; k < n && transmittance > 1e-6; ++k) {
         const double t_start = seg[2 * k], t_end = std::min(seg[2 * k + 1], t_ground);
         if (!(t_end > t_start)) continue;
@@ -161,29 +240,34 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
           const glm::dvec3 up_p = glm::normalize(p);
           const double alt_p = glm::length(p) - r0;
           const double mu_sun = glm::dot(to_sun, up_p), nu_sun = glm::length(glm::cross(to_sun, up_p));
-          double e0, e1, tau_sun = 0.0;
-          bool lit = !(p64::ray_sphere_rel_nu(r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
-          if (lit) {
-            glm::dvec4 sseg;
-            const int sn = p64::ray_shell_rel_nu(r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
-            for (int q = 0; q < sn; ++q) {
-              const double ds = (sseg[2 * q + 1] - sseg[2 * q]) / s.sun_steps;
-              for (int j = 0; j < s.sun_steps; ++j) {
-                double a, b;
-                medium.at(p + (sseg[2 * q] + (j + 0.5) * ds) * to_sun, a, b);
-                tau_sun += (a + b) * ds;
-              }
-            }
-          }
+          double e0, e1;
+          const bool lit = !(p64::ray_sphere_rel_nu(r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
+          const double tau_sun = lit ? medium.sun_depth(p, alt_p, mu_sun, nu_sun, to_sun, s.sun_steps) : 0.0;
+          // Sunlight reaches the sample through the air (reddened when low), and the sky lights it
+          // too: isotropic irradiance E_sky scattered as sigma_s E_sky / (2 pi) (docs/physics.md).
+          const glm::dvec3 sun_air = s.atmosphere && lit ? p64::atmo_transmittance(r0, alt_p, mu_sun, nu_sun, s.atmo_sun_steps)
+                                                         : glm::dvec3(1.0);
+          const glm::dvec3 ambient = s.atmosphere ? s.ambient * p64::sky_irradiance(sun_air, mu_sun) * (sigma / p64::CV_TWO_PI)
+                                                  : glm::dvec3(0.0);
           // In-scattered radiance per metre: the octave sums of both phases (clouds do not absorb).
           const double scatter = lit ? p64::ms_octaves_mie(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c) +
                                            p64::ms_octaves_hg(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c)
                                      : 0.0;
-          radiance += transmittance * p64::segment_integral(sun.irradiance * scatter, sigma, dt);
-          transmittance *= p64::transmittance(sigma * dt);
+          radiance += transmittance * p64::segment_integral(sun.irradiance * (sun_air * scatter + ambient), sigma, dt);
+          const double t_next = transmittance * p64::transmittance(sigma * dt);
+          depth_w += transmittance - t_next;
+          depth_t += (transmittance - t_next) * (t_start + (i + offset) * dt);
+          transmittance = t_next;
         }
       }
       const std::size_t idx = static_cast<std::size_t>(py) * cam.width + px;
+      if (s.atmosphere || s.globe) {
+        const glm::dvec3 p_cloud = origin + (depth_w > 0.0 ? depth_t / depth_w : 0.0) * d;
+        const glm::dvec4 c = sky_and_ground(medium, s, ground_map, o, cam.alt_m, d, to_sun, sun.irradiance, radiance,
+                                            transmittance, depth_w > 1e-6, p_cloud);
+        radiance = glm::dvec3(c);
+        transmittance = c.w;
+      }
       img.radiance[idx] = radiance;
       img.transmittance[idx] = transmittance;
     }

@@ -1,9 +1,11 @@
 // The CPU reference raymarcher: double precision, through the same physics functions
 // (shaders/common) and the same sampling of the data (volume/sampler) as the GPU will use, so
 // tests can hold the GPU image against it. Single scattering toward the sun with the
-// multiple-scattering octaves; no sky, ground or ambient term yet (the renderer issue adds them).
+// multiple-scattering octaves, sunlight through the atmosphere, an ambient sky term, the sky's
+// in-scatter around the clouds and the globe with the clouds' shadows.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -42,12 +44,30 @@ struct MarchSettings {
   // data's field exactly, and no noise is generated, bound or sampled. Up to 1 = strongest.
   double noise_amount = 0.0;
   double noise_scale_m = 20000.0;  // period of the low-frequency noise tile, metres
+  // Air and ground (shaders/common/atmosphere.glsl, ground.glsl). Off by default: the clouds alone,
+  // lit by the sun as it arrives at the top of the atmosphere, on black.
+  bool atmosphere = false;  // sunlight reddened through the air, sky in-scatter, ambient sky light
+  bool globe = false;       // the ground where a view ray meets it (else the ray just ends there)
+  double ambient = 0.0;     // strength of the isotropic sky light on clouds (1 = the modelled sky)
+  int sky_steps = 16;       // steps of each sky in-scatter integral along a view ray
+  int atmo_sun_steps = 8;   // steps of each atmospheric transmittance toward the sun
+  glm::dvec3 ground_albedo{0.12, 0.12, 0.12};  // linear, where no ground texture is given
+  std::string ground_texture;  // equirectangular albedo image (PNG); empty: ground_albedo
+};
+
+// An equirectangular ground albedo image: linear rgb per texel, rows from latitude 90 down to -90,
+// columns from longitude -180 east to 180.
+struct AlbedoMap {
+  int width = 0, height = 0;
+  std::vector<float> rgb;
+  // Bilinear over texel centres (shaders/common/ground.glsl equirect_texel), as the GPU samples it.
+  glm::dvec3 at(double lat_rad, double lon_rad) const;
 };
 
 struct ReferenceImage {
   int width = 0, height = 0;
   std::vector<glm::dvec3> radiance;    // scattered toward the camera, per pixel
-  std::vector<double> transmittance;   // of the view ray through the clouds
+  std::vector<double> transmittance;   // of the view ray through the clouds (and air); 0 on the globe
 };
 
 // The renderer's medium: grid-box-mean extinction (cloud fraction x in-cloud extinction) of
@@ -74,12 +94,16 @@ glm::dvec3 camera_ray(const Camera& cam, int px, int py);
 glm::dvec3 grid_centre_ecef(const VolumeGrid& grid);
 
 // Renders one time step of a volume. `noise` is needed when settings.noise_amount > 0
-// (std::invalid_argument otherwise) and is not read when it is 0.
+// (std::invalid_argument otherwise) and is not read when it is 0. The globe takes its albedo from
+// `ground` when given (the caller loads settings.ground_texture: core reads no images), else from
+// settings.ground_albedo.
 ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction& medium, const Camera& cam, const Sun& sun,
-                                const MarchSettings& settings, const ErosionNoise* noise = nullptr);
+                                const MarchSettings& settings, const ErosionNoise* noise = nullptr,
+                                const AlbedoMap* ground = nullptr);
 inline ReferenceImage render_reference(const VolumeGrid& grid, const TimeStepData& data, const Camera& cam, const Sun& sun,
-                                       const MarchSettings& settings) {
-  return render_reference(grid, grid_mean_extinction(grid, data), cam, sun, settings);
+                                       const MarchSettings& settings, const ErosionNoise* noise = nullptr,
+                                       const AlbedoMap* ground = nullptr) {
+  return render_reference(grid, grid_mean_extinction(grid, data), cam, sun, settings, noise, ground);
 }
 
 }  // namespace cv::core

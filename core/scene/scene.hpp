@@ -31,9 +31,21 @@ struct SunSpec {
   double irradiance = 1.0;  // relative units at the top of the atmosphere
 };
 
+// A scene's march settings before any file or option changes them: the product's look, with the
+// air, the globe and ambient sky light on (MarchSettings alone defaults to clouds on black, which
+// tests of the cloud physics rely on). An empty ground_texture means the Natural Earth relief
+// where it is installed; "none" means the constant ground_albedo.
+inline MarchSettings scene_march_defaults() {
+  MarchSettings m;
+  m.atmosphere = true;
+  m.globe = true;
+  m.ambient = 1.0;
+  return m;
+}
+
 // Settings of the image as a whole (the march's own settings are in MarchSettings).
 struct RenderSettings {
-  MarchSettings march;
+  MarchSettings march = scene_march_defaults();
   std::string quality = "default";  // the preset the march settings came from, or "custom"
   int accumulate = 1;               // jittered frames averaged per image
   double resolution_scale = 1.0;    // march at this fraction of the output size

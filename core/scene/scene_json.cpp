@@ -74,6 +74,13 @@ class Reader {
     out = static_cast<int>(d);
   }
 
+  void boolean(const char* key, bool& out) const {
+    const json* v = find(key);
+    if (!v) return;
+    if (!v->is_boolean()) fail(key, shown(*v), "true or false");
+    out = v->get<bool>();
+  }
+
   void string(const char* key, std::string& out) const {
     const json* v = find(key);
     if (!v) return;
@@ -160,7 +167,8 @@ void read_sun(const Reader& r, SunSpec& s) {
 
 void read_march(const Reader& r, MarchSettings& m) {
   r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "droplet_diameter_um", "ice_g", "frame",
-          "noise_amount", "noise_scale_m"});
+          "noise_amount", "noise_scale_m", "atmosphere", "globe", "ambient", "sky_steps", "atmo_sun_steps",
+          "ground_albedo", "ground_texture"});
   r.number("view_step_m", m.view_step_m, 0.0, 1e7, "a view step in metres 0..1e7 (0: from the grid)");
   r.integer("sun_steps", m.sun_steps, 1, 1024);
   r.integer("octaves", m.octaves, 1, 16);
@@ -172,6 +180,22 @@ void read_march(const Reader& r, MarchSettings& m) {
   r.integer("frame", m.frame, -1, 1 << 30);
   r.number("noise_amount", m.noise_amount, 0.0, 1.0, "an erosion amount 0..1 (0: the data only)");
   r.number("noise_scale_m", m.noise_scale_m, 10.0, 1e7, "a noise tile period in metres 10..1e7");
+  r.boolean("atmosphere", m.atmosphere);
+  r.boolean("globe", m.globe);
+  r.number("ambient", m.ambient, 0.0, 10.0, "an ambient sky light strength 0..10 (1: the modelled sky)");
+  r.integer("sky_steps", m.sky_steps, 1, 1024);
+  r.integer("atmo_sun_steps", m.atmo_sun_steps, 1, 1024);
+  if (const auto a = r.numbers<3>("ground_albedo", "three linear albedos 0..1 [r, g, b]")) {
+    for (double v : *a) {
+      if (!(v >= 0.0 && v <= 1.0)) {
+        char found[64];
+        std::snprintf(found, sizeof found, "a value of %g", v);
+        r.fail("ground_albedo", found, "three linear albedos 0..1 [r, g, b]");
+      }
+    }
+    m.ground_albedo = glm::dvec3((*a)[0], (*a)[1], (*a)[2]);
+  }
+  r.string("ground_texture", m.ground_texture);
 }
 
 void read_render(const Reader& r, RenderSettings& s) {
@@ -277,7 +301,14 @@ std::string scene_to_json(const Scene& s) {
                       {"ice_g", m.ice_g},
                       {"frame", m.frame},
                       {"noise_amount", m.noise_amount},
-                      {"noise_scale_m", m.noise_scale_m}}}};
+                      {"noise_scale_m", m.noise_scale_m},
+                      {"atmosphere", m.atmosphere},
+                      {"globe", m.globe},
+                      {"ambient", m.ambient},
+                      {"sky_steps", m.sky_steps},
+                      {"atmo_sun_steps", m.atmo_sun_steps},
+                      {"ground_albedo", {m.ground_albedo.x, m.ground_albedo.y, m.ground_albedo.z}},
+                      {"ground_texture", m.ground_texture}}}};
   root["overlays"] = s.overlays;
   return root.dump(2) + "\n";
 }

@@ -14,3 +14,5 @@
 #include "geodesy.glsl"
 #include "volume_coords.glsl"
 #include "erosion.glsl"
+#include "atmosphere.glsl"
+#include "ground.glsl"

@@ -1,8 +1,9 @@
 // The volumetric raymarcher on the spherical shell, in the form of the CPU reference
 // (core/reference/raymarcher.cpp): shell intersection from the camera's altitude, the segment
 // integral per step, a secondary march toward the sun with the Earth's shadow, and the octave sum
-// with the approximate Mie phase for liquid and Henyey-Greenstein for ice. Output: rgb radiance,
-// a = view transmittance.
+// with the approximate Mie phase for liquid and Henyey-Greenstein for ice; the sun's light reaches
+// each sample through the atmosphere, with an ambient sky term. Sky and globe are composited around
+// the clouds in sky_ground.glsl. Output: rgb radiance, a = view transmittance (0 on the globe).
 #include "../common/physics.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -34,6 +35,14 @@ uniform vec3 u_octave_abc;
 uniform float u_droplet_um;
 uniform float u_ice_g;
 uniform int u_frame;  // -1: step middles; else the accumulation frame (step_jitter)
+uniform bool u_atmosphere;    // sun colour through air, sky in-scatter, ambient sky light
+uniform bool u_globe;         // shade the ground where a ray meets it
+uniform float u_ambient;      // strength of the isotropic sky light on clouds
+uniform int u_sky_steps;      // steps of a sky in-scatter integral
+uniform int u_atmo_sun_steps; // steps of an atmospheric transmittance toward the sun
+uniform vec3 u_ground_albedo; // when there is no ground texture
+uniform ivec2 u_ground_size;  // of the albedo texture; (0, 0): constant albedo
+layout(binding = 5) uniform sampler2D u_ground;  // linear albedo, equirectangular
 
 const float kDeg = 0.017453292519943295;
 
@@ -112,6 +121,31 @@ void medium_at(vec3 p, float alt_m, out float sl, out float si) {
 #endif
 }
 
+// Optical depth of the clouds from p (at altitude alt_p, m) toward the sun, whose cosine and sine
+// with the local up at p are mu_sun and nu_sun: a march of u_sun_steps per shell segment.
+float cloud_sun_depth(vec3 p, float alt_p, float mu_sun, float nu_sun) {
+  float hb = u_grid_start.z;
+  float ht = u_grid_start.z + u_grid_step.z * (u_grid_count.z - 1.0);
+  float tau_sun = 0.0;
+  vec4 sseg;
+  int sn = ray_shell_rel_nu(u_r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
+  for (int q = 0; q < sn; ++q) {
+    float s0 = q == 0 ? sseg.x : sseg.z;
+    float s1 = q == 0 ? sseg.y : sseg.w;
+    float ds = (s1 - s0) / float(u_sun_steps);
+    for (int j = 0; j < u_sun_steps; ++j) {
+      float s = s0 + (float(j) + 0.5) * ds;
+      float a;
+      float b;
+      medium_at(p + s * u_to_sun, ray_altitude(u_r0, alt_p, mu_sun, s), a, b);
+      tau_sun += (a + b) * ds;
+    }
+  }
+  return tau_sun;
+}
+
+#include "sky_ground.glsl"
+
 void main() {
   ivec2 px = ivec2(gl_GlobalInvocationID.xy) + ivec2(0, u_row_offset);
   if (px.x >= u_size.x || px.y >= u_size.y) return;
@@ -128,14 +162,13 @@ void main() {
   vec3 up = u_cam_up;
   float mu_up = dot(d, up);
   float nu_up = length(cross(d, up));
+  bool in_shell = true;  // false: the ray misses the cloud shell (the sky may still show)
   if (h > ht) {
     float e0;
     float e1;
     if (!ray_sphere_rel_nu(u_r0, h, mu_up, nu_up, ht, e0, e1) || e1 < 0.0) {
-      imageStore(u_out, px, vec4(0.0, 0.0, 0.0, 1.0));
-      return;
-    }
-    if (e0 > 0.0) {
+      in_shell = false;
+    } else if (e0 > 0.0) {
       origin = normalize(origin + e0 * d) * (u_r0 + ht);
       h = ht;
       up = normalize(origin);
@@ -144,7 +177,7 @@ void main() {
     }
   }
   vec4 seg;
-  int n = ray_shell_rel_nu(u_r0, h, mu_up, nu_up, hb, ht, seg);
+  int n = in_shell ? ray_shell_rel_nu(u_r0, h, mu_up, nu_up, hb, ht, seg) : 0;
   float tg0;
   float tg1;
   float t_ground = ray_sphere_rel_nu(u_r0, h, mu_up, nu_up, 0.0, tg0, tg1) && tg1 > 0.0 ? max(tg0, 0.0) : 3.0e38;
@@ -152,6 +185,8 @@ void main() {
   MieParams mie = mie_params(u_droplet_um);
   vec3 radiance = vec3(0.0);
   float t_view = 1.0;
+  float depth_w = 0.0;  // sum over steps of the light each takes out of the view: where the cloud is
+  float depth_t = 0.0;
   for (int k = 0; k < n && t_view > 1e-6; ++k) {
     float t_start = k == 0 ? seg.x : seg.z;
     float t_end = min(k == 0 ? seg.y : seg.w, t_ground);
@@ -174,29 +209,25 @@ void main() {
       float e0;
       float e1;
       bool lit = !(ray_sphere_rel_nu(u_r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
-      float tau_sun = 0.0;
-      if (lit) {
-        vec4 sseg;
-        int sn = ray_shell_rel_nu(u_r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
-        for (int q = 0; q < sn; ++q) {
-          float s0 = q == 0 ? sseg.x : sseg.z;
-          float s1 = q == 0 ? sseg.y : sseg.w;
-          float ds = (s1 - s0) / float(u_sun_steps);
-          for (int j = 0; j < u_sun_steps; ++j) {
-            float s = s0 + (float(j) + 0.5) * ds;
-            float a;
-            float b;
-            medium_at(p + s * u_to_sun, ray_altitude(u_r0, alt_p, mu_sun, s), a, b);
-            tau_sun += (a + b) * ds;
-          }
-        }
-      }
+      float tau_sun = lit ? cloud_sun_depth(p, alt_p, mu_sun, nu_sun) : 0.0;
+      // Sunlight reaches the sample through the air (reddened when low), and the sky lights it too.
+      vec3 sun_air = u_atmosphere && lit ? atmo_transmittance(u_r0, alt_p, mu_sun, nu_sun, u_atmo_sun_steps) : vec3(1.0);
+      vec3 ambient = u_atmosphere ? u_ambient * sky_irradiance(sun_air, mu_sun) * (sigma / CV_TWO_PI) : vec3(0.0);
       float scatter = lit ? ms_octaves_mie(sl, mu, mie, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z) +
                                 ms_octaves_hg(si, mu, u_ice_g, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
                           : 0.0;
-      radiance += t_view * segment_integral(u_irradiance * scatter, sigma, dt);
-      t_view *= transmittance(sigma * dt);
+      radiance += t_view * segment_integral(u_irradiance * (sun_air * scatter + ambient), sigma, dt);
+      float t_next = t_view * transmittance(sigma * dt);
+      depth_w += t_view - t_next;
+      depth_t += (t_view - t_next) * (t_start + (float(i) + offset) * dt);
+      t_view = t_next;
     }
   }
-  imageStore(u_out, px, vec4(radiance, t_view));
+  if (u_atmosphere || u_globe) {
+    // The cloud stands, for the air around it, at the mean depth of the light it takes out.
+    vec3 p_cloud = origin + (depth_w > 0.0 ? depth_t / depth_w : 0.0) * d;
+    imageStore(u_out, px, sky_and_ground(d, radiance, t_view, depth_w > 1e-6, p_cloud));
+  } else {
+    imageStore(u_out, px, vec4(radiance, t_view));
+  }
 }

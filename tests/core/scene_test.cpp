@@ -172,7 +172,8 @@ TEST(SceneJson, OutOfRangeValuesAreRefused) {
 TEST(SceneJson, UnknownKeysAreNamedSoTyposAreCaught) {
   EXPECT_EQ(error_of(R"({"version": 1, "render": {"march": {"sun_step": 8}}})"),
             "scene.json: render.march.sun_step: unknown key, expected one of view_step_m, sun_steps, octaves, octave_a, "
-            "octave_b, octave_c, droplet_diameter_um, ice_g, frame, noise_amount, noise_scale_m");
+            "octave_b, octave_c, droplet_diameter_um, ice_g, frame, noise_amount, noise_scale_m, atmosphere, globe, "
+            "ambient, sky_steps, atmo_sun_steps, ground_albedo, ground_texture");
   EXPECT_EQ(error_of(R"({"version": 1, "camra": {}})"),
             "scene.json: camra: unknown key, expected one of version, data, time_step, camera, width, height, sun, render, "
             "overlays");
