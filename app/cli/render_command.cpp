@@ -322,6 +322,7 @@ int cmd_render(const std::vector<std::string>& args) {
   for (const auto& p : pixels) bad += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w));
   render::ToneSettings tone;
   tone.exposure = rs.exposure;
+  if (march.atmosphere || march.globe) tone.background = glm::dvec3(0.0);  // the sky and space are in the image
   const std::vector<unsigned char> rgb8 = render::tonemap_srgb8(pixels, tone);
   const double t_tone = seconds_since(t0);
   t0 = clock::now();

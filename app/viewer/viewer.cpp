@@ -314,6 +314,7 @@ int run_viewer(const ViewerOptions& o) {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     render::ToneSettings tone;
     tone.exposure = s.scene.render.exposure;
+    if (s.scene.render.march.atmosphere || s.scene.render.march.globe) tone.background = glm::dvec3(0.0);
     presenter.draw(tone, 0, 0, fbw, fbh);
     present_timer.end();
     stats.march_ms = march_timer.ms();
