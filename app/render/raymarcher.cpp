@@ -21,6 +21,8 @@ GpuRaymarcher::GpuRaymarcher(const ShaderLoader& loader)
 
 GpuRaymarcher::~GpuRaymarcher() {
   if (textures_[0]) glDeleteTextures(2, textures_);
+  if (pyramid_buffer_) glDeleteBuffers(1, &pyramid_buffer_);
+  if (stats_buffer_) glDeleteBuffers(1, &stats_buffer_);
 }
 
 void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExtinction& medium) {
@@ -42,6 +44,15 @@ void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExt
   }
   check_gl("uploading the volume's extinction textures");
   grid_ = grid;
+  // The pyramid for empty-space skipping and adapted steps, all levels in one buffer.
+  pyramid_ = core::ExtinctionPyramid(grid, medium.liquid_per_m, medium.ice_per_m);
+  std::vector<glm::vec2> packed;
+  for (const auto& l : pyramid_.levels()) packed.insert(packed.end(), l.min_max.begin(), l.min_max.end());
+  if (packed.empty()) packed.emplace_back(0.0f, 1.0f);  // a buffer must not be empty; u_levels = 0 ignores it
+  if (pyramid_buffer_) glDeleteBuffers(1, &pyramid_buffer_);
+  glCreateBuffers(1, &pyramid_buffer_);
+  glNamedBufferStorage(pyramid_buffer_, static_cast<GLsizeiptr>(packed.size() * sizeof(glm::vec2)), packed.data(), 0);
+  check_gl("uploading the extinction pyramid");
 }
 
 std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s) {
@@ -77,6 +88,32 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   glProgramUniform1f(p, loc(p, "u_droplet_um"), static_cast<float>(s.droplet_diameter_um));
   glProgramUniform1f(p, loc(p, "u_ice_g"), static_cast<float>(s.ice_g));
   glProgramUniform1i(p, loc(p, "u_frame"), s.frame);
+  glProgramUniform1i(p, loc(p, "u_skip_empty"), s.skip_empty ? 1 : 0);
+  glProgramUniform1i(p, loc(p, "u_adaptive"), s.adaptive_steps ? 1 : 0);
+  glProgramUniform1f(p, loc(p, "u_max_step_tau"), static_cast<float>(s.max_step_optical_depth));
+  glProgramUniform1f(p, loc(p, "u_min_t"), static_cast<float>(s.min_transmittance));
+  const auto& levels = pyramid_.levels();
+  GLint bricks[3 * core::ExtinctionPyramid::kMaxLevels] = {}, nodes[core::ExtinctionPyramid::kMaxLevels] = {},
+        offsets[core::ExtinctionPyramid::kMaxLevels] = {};
+  GLint offset = 0;
+  for (std::size_t l = 0; l < levels.size(); ++l) {
+    bricks[3 * l] = levels[l].nx, bricks[3 * l + 1] = levels[l].ny, bricks[3 * l + 2] = levels[l].nz;
+    nodes[l] = levels[l].nodes;
+    offsets[l] = offset;
+    offset += static_cast<GLint>(levels[l].min_max.size());
+  }
+  glProgramUniform1i(p, loc(p, "u_levels"), static_cast<GLint>(levels.size()));
+  glProgramUniform3iv(p, loc(p, "u_bricks"), core::ExtinctionPyramid::kMaxLevels, bricks);
+  glProgramUniform1iv(p, loc(p, "u_level_nodes"), core::ExtinctionPyramid::kMaxLevels, nodes);
+  glProgramUniform1iv(p, loc(p, "u_level_offset"), core::ExtinctionPyramid::kMaxLevels, offsets);
+  if (!stats_buffer_) {
+    glCreateBuffers(1, &stats_buffer_);
+    glNamedBufferStorage(stats_buffer_, 12 * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  }
+  const GLuint zeros[12] = {};
+  glNamedBufferSubData(stats_buffer_, 0, sizeof(zeros), zeros);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, pyramid_buffer_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, stats_buffer_);
   GLuint out = 0;
   glCreateTextures(GL_TEXTURE_2D, 1, &out);
   glTextureStorage2D(out, 1, GL_RGBA32F, cam.width, cam.height);
@@ -85,10 +122,14 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   glBindTextureUnit(2, textures_[1]);
   glUseProgram(p);
   glDispatchCompute(static_cast<GLuint>((cam.width + 7) / 8), static_cast<GLuint>((cam.height + 7) / 8), 1);
-  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   std::vector<glm::vec4> pixels(static_cast<std::size_t>(cam.width) * cam.height);
   glGetTextureImage(out, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(pixels.size() * sizeof(glm::vec4)), pixels.data());
   glDeleteTextures(1, &out);
+  GLuint counts[12] = {};
+  glGetNamedBufferSubData(stats_buffer_, 0, sizeof(counts), counts);
+  auto count = [&](int k) { return (std::uint64_t(counts[2 * k + 1]) << 32) | counts[2 * k]; };
+  stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5)};
   check_gl("running the raymarcher");
   return pixels;
 }

@@ -8,6 +8,7 @@
 #include <glm/vec4.hpp>
 
 #include "reference/raymarcher.hpp"
+#include "volume/extinction_pyramid.hpp"
 #include "render/shader_loader.hpp"
 
 namespace cv::render {
@@ -26,10 +27,16 @@ class GpuRaymarcher {
   // Renders: rgb = radiance, a = view transmittance, rows top to bottom.
   std::vector<glm::vec4> render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings);
 
+  // The counts of the last render (samples taken and skipped, rays that missed the shell).
+  const core::MarchStats& last_stats() const { return stats_; }
+
  private:
   GlProgram program_;
   GLuint textures_[2] = {0, 0};
+  GLuint pyramid_buffer_ = 0, stats_buffer_ = 0;
+  core::ExtinctionPyramid pyramid_;
   core::VolumeGrid grid_;
+  core::MarchStats stats_;
 };
 
 }  // namespace cv::render

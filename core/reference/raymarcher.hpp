@@ -4,6 +4,7 @@
 // multiple-scattering octaves; no sky, ground or ambient term yet (the renderer issue adds them).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -37,12 +38,32 @@ struct MarchSettings {
   // -1: sample each step at its middle; otherwise the accumulation frame whose jittered offsets
   // (shaders/common/rng.glsl step_jitter) place the samples, so banding averages away over frames.
   int frame = -1;
+  // Acceleration (shaders/common/march_control.glsl). Skipping jumps over bricks of the extinction
+  // pyramid that hold no cloud and resumes on the same sample grid: the image does not change.
+  bool skip_empty = true;
+  // Splits a view step into substeps where the brick's largest extinction would give a step an
+  // optical depth above max_step_optical_depth (thick cores are then not under-sampled).
+  bool adaptive_steps = false;
+  double max_step_optical_depth = 1.0;
+  // View rays stop below this transmittance, sun marches once every octave's attenuation is below it.
+  double min_transmittance = 1e-6;
+};
+
+// What a frame's march did, summed over its pixels (the GPU counts with atomics).
+struct MarchStats {
+  std::uint64_t view_samples = 0;   // medium lookups along view rays (substeps included)
+  std::uint64_t view_skipped = 0;   // view step positions jumped over in empty bricks
+  std::uint64_t bricks_jumped = 0;  // jumps over empty bricks, view and sun rays
+  std::uint64_t sun_samples = 0;    // medium lookups along sun rays
+  std::uint64_t sun_skipped = 0;    // sun step positions jumped over or cut off by sun_march_done
+  std::uint64_t rays_missed = 0;    // pixels whose ray never crossed the cloud shell
 };
 
 struct ReferenceImage {
   int width = 0, height = 0;
   std::vector<glm::dvec3> radiance;    // scattered toward the camera, per pixel
   std::vector<double> transmittance;   // of the view ray through the clouds
+  MarchStats stats;
 };
 
 // The renderer's medium: grid-box-mean extinction (cloud fraction x in-cloud extinction) of

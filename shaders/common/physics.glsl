@@ -13,3 +13,4 @@
 #include "intersect.glsl"
 #include "geodesy.glsl"
 #include "volume_coords.glsl"
+#include "march_control.glsl"

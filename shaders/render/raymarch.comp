@@ -33,6 +33,27 @@ uniform vec3 u_octave_abc;
 uniform float u_droplet_um;
 uniform float u_ice_g;
 uniform int u_frame;  // -1: step middles; else the accumulation frame (step_jitter)
+uniform bool u_skip_empty;
+uniform bool u_adaptive;
+uniform float u_max_step_tau;     // optical depth a view substep may hold (adaptive steps)
+uniform float u_min_t;            // view rays stop below this transmittance; sun marches see sun_march_done
+uniform int u_levels;             // pyramid levels, 0: no pyramid
+uniform ivec3 u_bricks[4];        // bricks per axis, finest level first
+uniform int u_level_nodes[4];     // grid nodes per brick side
+uniform int u_level_offset[4];    // first brick of each level in u_min_max
+
+// The extinction pyramid (core/volume/extinction_pyramid): (min, max) per brick, levels one after
+// the other, x fastest.
+layout(std430, binding = 3) readonly buffer Pyramid { vec2 u_min_max[]; };
+// Per-frame counters (core::MarchStats), each as (low, high) 32-bit words.
+layout(std430, binding = 4) buffer Stats { uint u_stats[]; };
+const int kStatViewSamples = 0;
+const int kStatViewSkipped = 1;
+const int kStatBricksJumped = 2;
+const int kStatSunSamples = 3;
+const int kStatSunSkipped = 4;
+const int kStatRaysMissed = 5;
+uint g_stats[6] = uint[6](0u, 0u, 0u, 0u, 0u, 0u);
 
 const float kDeg = 0.017453292519943295;
 
@@ -55,6 +76,27 @@ float fetch(sampler3D tex, vec3 f) {
   return mix(mix(c00, c10, wy), mix(c01, c11, wy), wz);
 }
 
+float node_sum(ivec3 q) { return texelFetch(u_liquid, q, 0).r + texelFetch(u_ice, q, 0).r; }
+
+// The largest extinction (1/m, liquid + ice) that trilinear sampling can return in the grid cell
+// around p: the largest of its 8 nodes, as fetch reads them; 0 outside the grid.
+float cell_max(vec3 p) {
+  vec3 g = ecef_to_sphere(p, u_r0);
+  vec3 f;
+  if (!volume_coords(g.x / kDeg, g.y / kDeg, g.z, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return 0.0;
+  ivec3 n = ivec3(u_grid_count);
+  int x0 = min(int(floor(f.x)), n.x - 1);
+  int y0 = min(int(floor(f.y)), max(0, n.y - 2));
+  int z0 = min(int(floor(f.z)), max(0, n.z - 2));
+  int x1 = u_wraps ? (x0 + 1) % n.x : min(x0 + 1, n.x - 1);
+  int y1 = min(y0 + 1, n.y - 1);
+  int z1 = min(z0 + 1, n.z - 1);
+  // Written out, not looped: see space_at on llvmpipe's loop budget.
+  float m = max(max(node_sum(ivec3(x0, y0, z0)), node_sum(ivec3(x1, y0, z0))), max(node_sum(ivec3(x0, y1, z0)), node_sum(ivec3(x1, y1, z0))));
+  m = max(m, max(max(node_sum(ivec3(x0, y0, z1)), node_sum(ivec3(x1, y0, z1))), max(node_sum(ivec3(x0, y1, z1)), node_sum(ivec3(x1, y1, z1)))));
+  return m;
+}
+
 void medium_at(vec3 p, out float sl, out float si) {
   sl = 0.0;
   si = 0.0;
@@ -63,6 +105,118 @@ void medium_at(vec3 p, out float sl, out float si) {
   if (!volume_coords(g.x / kDeg, g.y / kDeg, g.z, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
   sl = fetch(u_liquid, f);
   si = fetch(u_ice, f);
+}
+
+// One level of the pyramid at grid index g (see space_at): true when its brick there is empty, with
+// the distance the ray may jump; else the brick's largest extinction, and the distance it holds.
+bool level_empty(int l, vec3 g, float lat, float r, float mu_up, out float extent_m, out float brick_max) {
+  vec3 nb = vec3(u_bricks[l]);
+  float nodes = float(u_level_nodes[l]);
+  vec3 b = march_brick(g, nodes);
+  extent_m = march_brick_exit_m(lat, r, mu_up, g, b, nodes, nb, u_grid_start, u_grid_step, u_global_lat, u_r0);
+  brick_max = 0.0;
+  if (march_brick_inside(b, nb)) {
+    ivec3 bi = ivec3(b);
+    brick_max = u_min_max[u_level_offset[l] + (bi.z * u_bricks[l].y + bi.y) * u_bricks[l].x + bi.x].y;
+  }
+  return !(brick_max > 0.0);
+}
+
+// What a ray along dir learns about the space around p (core::ExtinctionPyramid::at): true when
+// empty, with the distance (m) it may jump; else the finest brick's largest extinction (1/m) and
+// the distance over which that holds. The levels are visited without a loop: llvmpipe ends the
+// loops of an invocation after 65535 iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS, shared by
+// every loop), and this runs inside both marches.
+bool space_at(vec3 p, vec3 dir, out float extent_m, out float sigma_max) {
+  extent_m = 0.0;
+  sigma_max = 0.0;
+  if (u_levels <= 0) return false;
+  vec3 g3 = ecef_to_sphere(p, u_r0);
+  float lat = g3.x / kDeg;
+  float r = length(p);
+  float mu_up = dot(dir, p) / r;
+  vec3 g = march_grid_index(lat, g3.y / kDeg, g3.z, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat);
+  float unused;
+  if (u_levels > 3 && level_empty(3, g, lat, r, mu_up, extent_m, unused)) return true;
+  if (u_levels > 2 && level_empty(2, g, lat, r, mu_up, extent_m, unused)) return true;
+  if (u_levels > 1 && level_empty(1, g, lat, r, mu_up, extent_m, unused)) return true;
+  return level_empty(0, g, lat, r, mu_up, extent_m, sigma_max);
+}
+
+// Optical depth from p toward the sun through the shell; false when the Earth is in the way. The
+// shell's (at most two) segments and their steps run as one loop (see space_at on loop counts).
+bool sun_optical_depth(vec3 p, float hb, float ht, out float tau_sun) {
+  tau_sun = 0.0;
+  vec3 up_p = normalize(p);
+  float alt_p = length(p) - u_r0;
+  float mu_sun = dot(u_to_sun, up_p);
+  float nu_sun = length(cross(u_to_sun, up_p));
+  float e0;
+  float e1;
+  if (ray_sphere_rel_nu(u_r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0) return false;
+  vec4 sseg;
+  int sn = ray_shell_rel_nu(u_r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
+  int total = sn * u_sun_steps;
+  float known_end = -1.0;  // what the pyramid said holds below this distance into the segment
+  for (int k = 0; k < total;) {
+    int q = k / u_sun_steps;
+    int j = k - q * u_sun_steps;
+    if (j == 0) known_end = -1.0;
+    float s0 = q == 0 ? sseg.x : sseg.z;
+    float s1 = q == 0 ? sseg.y : sseg.w;
+    float ds = (s1 - s0) / float(u_sun_steps);
+    float t_rel = (float(j) + 0.5) * ds;
+    vec3 ps = p + (s0 + t_rel) * u_to_sun;
+    if (u_skip_empty && !(t_rel < known_end)) {
+      float extent;
+      float smax;
+      if (space_at(ps, u_to_sun, extent, smax)) {
+        int next = min(march_resume_index(j, extent, ds), u_sun_steps);
+        g_stats[kStatSunSkipped] += uint(next - j);
+        g_stats[kStatBricksJumped] += next - j > 1 ? 1u : 0u;
+        k += next - j;
+        continue;
+      }
+      known_end = t_rel + extent;
+    }
+    float a;
+    float b;
+    medium_at(ps, a, b);
+    tau_sun += (a + b) * ds;
+    g_stats[kStatSunSamples] += 1u;
+    ++k;
+    if (sun_march_done(tau_sun, u_octaves, u_octave_abc.x, u_min_t)) {
+      g_stats[kStatSunSkipped] += uint(total - k);
+      break;
+    }
+  }
+  return true;
+}
+
+// One view sample at p standing for a step of ds: in-scattered light and attenuation.
+void march_sample(vec3 p, float ds, float mu, MieParams mie, float hb, float ht, inout vec3 radiance, inout float t_view) {
+  float sl;
+  float si;
+  medium_at(p, sl, si);
+  g_stats[kStatViewSamples] += 1u;
+  float sigma = sl + si;
+  if (sigma <= 0.0) return;
+  float tau_sun;
+  bool lit = sun_optical_depth(p, hb, ht, tau_sun);
+  float scatter = lit ? ms_octaves_mie(sl, mu, mie, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z) +
+                            ms_octaves_hg(si, mu, u_ice_g, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
+                      : 0.0;
+  radiance += t_view * segment_integral(u_irradiance * scatter, sigma, ds);
+  t_view *= transmittance(sigma * ds);
+}
+
+// Adds this invocation's counts to the frame's, carrying into the high words.
+void flush_stats() {
+  for (int k = 0; k < 6; ++k) {
+    if (g_stats[k] == 0u) continue;
+    uint old = atomicAdd(u_stats[2 * k], g_stats[k]);
+    if (old > 0xFFFFFFFFu - g_stats[k]) atomicAdd(u_stats[2 * k + 1], 1u);
+  }
 }
 
 void main() {
@@ -86,6 +240,8 @@ void main() {
     float e1;
     if (!ray_sphere_rel_nu(u_r0, h, mu_up, nu_up, ht, e0, e1) || e1 < 0.0) {
       imageStore(u_out, px, vec4(0.0, 0.0, 0.0, 1.0));
+      g_stats[kStatRaysMissed] += 1u;
+      flush_stats();
       return;
     }
     if (e0 > 0.0) {
@@ -105,49 +261,56 @@ void main() {
   MieParams mie = mie_params(u_droplet_um);
   vec3 radiance = vec3(0.0);
   float t_view = 1.0;
-  for (int k = 0; k < n && t_view > 1e-6; ++k) {
+  bool crossed = false;
+  for (int k = 0; k < n && t_view > u_min_t; ++k) {
     float t_start = k == 0 ? seg.x : seg.z;
     float t_end = min(k == 0 ? seg.y : seg.w, t_ground);
     if (!(t_end > t_start)) continue;
+    crossed = true;
     int steps = max(1, int(ceil((t_end - t_start) / u_view_step)));
     float dt = (t_end - t_start) / float(steps);
     float offset = u_frame < 0 ? 0.5 : step_jitter(uint(px.x), uint(px.y), uint(u_frame));
-    for (int i = 0; i < steps && t_view > 1e-6; ++i) {
-      vec3 p = origin + (t_start + (float(i) + offset) * dt) * d;
-      float sl;
-      float si;
-      medium_at(p, sl, si);
-      float sigma = sl + si;
-      if (sigma <= 0.0) continue;
-      vec3 up_p = normalize(p);
-      float alt_p = length(p) - u_r0;
-      float mu_sun = dot(u_to_sun, up_p);
-      float nu_sun = length(cross(u_to_sun, up_p));
-      float e0;
-      float e1;
-      bool lit = !(ray_sphere_rel_nu(u_r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
-      float tau_sun = 0.0;
-      if (lit) {
-        vec4 sseg;
-        int sn = ray_shell_rel_nu(u_r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
-        for (int q = 0; q < sn; ++q) {
-          float s0 = q == 0 ? sseg.x : sseg.z;
-          float s1 = q == 0 ? sseg.y : sseg.w;
-          float ds = (s1 - s0) / float(u_sun_steps);
-          for (int j = 0; j < u_sun_steps; ++j) {
-            float a;
-            float b;
-            medium_at(p + (s0 + (float(j) + 0.5) * ds) * u_to_sun, a, b);
-            tau_sun += (a + b) * ds;
+    // What the pyramid said about the brick ahead: valid for sample distances below known_end.
+    float known_end = -1.0;
+    float sigma_max = 0.0;
+    // One loop iteration per sample, substeps included (see space_at on loop counts): sample j of
+    // the substeps of step i.
+    int i = 0;
+    int j = 0;
+    int substeps = 1;
+    while (i < steps && t_view > u_min_t) {
+      if (j == 0) {
+        float t_rel = (float(i) + offset) * dt;
+        if ((u_skip_empty || u_adaptive) && !(t_rel < known_end)) {
+          float extent;
+          bool empty = space_at(origin + (t_start + t_rel) * d, d, extent, sigma_max);
+          if (empty && u_skip_empty) {
+            int next = march_resume_index(i, extent, dt);
+            g_stats[kStatViewSkipped] += uint(min(next, steps) - i);
+            g_stats[kStatBricksJumped] += next - i > 1 ? 1u : 0u;
+            i = next;
+            continue;
           }
+          known_end = t_rel + extent;
+        }
+        substeps = 1;
+        if (u_adaptive && march_substeps(sigma_max, dt, u_max_step_tau) > 1) {
+          // The brick's bound is loose (a brick spans 4 cells and more): bound the step by the
+          // cells at its two ends instead, so only steps near thick cloud are divided.
+          float bound = max(cell_max(origin + (t_start + float(i) * dt) * d), cell_max(origin + (t_start + float(i + 1) * dt) * d));
+          substeps = march_substeps(bound, dt, u_max_step_tau);
         }
       }
-      float scatter = lit ? ms_octaves_mie(sl, mu, mie, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z) +
-                                ms_octaves_hg(si, mu, u_ice_g, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
-                          : 0.0;
-      radiance += t_view * segment_integral(u_irradiance * scatter, sigma, dt);
-      t_view *= transmittance(sigma * dt);
+      float ds = dt / float(substeps);
+      vec3 p = origin + (t_start + (float(i) + (float(j) + offset) / float(substeps)) * dt) * d;
+      march_sample(p, ds, mu, mie, hb, ht, radiance, t_view);
+      if (++j == substeps) {
+        j = 0;
+        ++i;
+      }
     }
   }
+  g_stats[kStatRaysMissed] += crossed ? 0u : 1u;
+  flush_stats();
   imageStore(u_out, px, vec4(radiance, t_view));
 }
