@@ -46,8 +46,10 @@ void print_usage() {
       "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"
       "  render INPUT -o OUT.png [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov]\n"
       "         [--sun LAT,LON] [--steps M] [--sun-steps N] [--octaves N] [--accumulate N] [--exposure E]\n"
-      "         [--pfm OUT.pfm]\n"
-      "                           (the sun stands where it stood at the valid time unless --sun is given)\n"
+      "         [--pfm OUT.pfm] [--no-skip] [--adaptive TAU]\n"
+      "                           (the sun stands where it stood at the valid time unless --sun is given;\n"
+      "                           --no-skip marches empty bricks too, --adaptive divides view steps to\n"
+      "                           at most TAU optical depth each)\n"
       "                           render a NetCDF file or .cvvol volume headlessly (EGL) to a PNG\n"
       "  --version                print the version\n");
 }
@@ -282,6 +284,14 @@ int cmd_render(const std::vector<std::string>& args) {
     } else if (a == "--exposure") {
       tone.exposure = parse_number("--exposure", next());
       if (!(tone.exposure > 0)) throw UsageError{"cloudviewer render: --exposure: expected a number > 0"};
+    } else if (a == "--no-skip") {
+      march.skip_empty = false;
+    } else if (a == "--adaptive") {
+      march.adaptive_steps = true;
+      march.max_step_optical_depth = parse_number("--adaptive", next());
+      if (!(march.max_step_optical_depth > 0)) {
+        throw UsageError{"cloudviewer render: --adaptive: expected the optical depth per substep, a number > 0"};
+      }
     } else if (!a.empty() && a[0] == '-') {
       throw UsageError{"cloudviewer render: unknown option '" + a + "'"};
     } else if (input.empty()) {
@@ -385,6 +395,13 @@ int cmd_render(const std::vector<std::string>& args) {
   const double t_write = seconds(t0);
   std::printf("timings: load %.2f s, upload %.3f s, march %.2f s, tonemap and write %.3f s (%s)\n", t_load, t_upload,
               t_march, t_write, ctx->info().renderer.c_str());
+  const cv::core::MarchStats& ms = gpu.last_stats();
+  std::printf("march%s: %llu view samples, %llu skipped in %llu empty-brick jumps (view and sun), %llu sun samples, "
+              "%llu skipped or cut off, %llu of %d rays missed the cloud shell%s\n",
+              accumulate > 1 ? " (last frame)" : "", static_cast<unsigned long long>(ms.view_samples),
+              static_cast<unsigned long long>(ms.view_skipped), static_cast<unsigned long long>(ms.bricks_jumped),
+              static_cast<unsigned long long>(ms.sun_samples), static_cast<unsigned long long>(ms.sun_skipped),
+              static_cast<unsigned long long>(ms.rays_missed), w * h, march.skip_empty ? "" : " (skipping off)");
   if (bad) std::fprintf(stderr, "cloudviewer render: %zu pixels were not finite (drawn white)\n", bad);
   std::printf("wrote %s%s\n", out.c_str(), pfm.empty() ? "" : (" and " + pfm).c_str());
   return bad ? 1 : 0;
