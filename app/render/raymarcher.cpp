@@ -1,11 +1,13 @@
 // The GPU raymarcher: texture upload, uniforms, dispatch, read-back.
 #include "render/raymarcher.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/glm.hpp>
 
 #include "geo/geodesy.hpp"
+#include "physics/physics.hpp"
 #include "volume/sampler.hpp"
 
 namespace cv::render {
@@ -16,8 +18,19 @@ void set3(GLuint p, const char* n, const glm::dvec3& v) {
 }
 }  // namespace
 
-GpuRaymarcher::GpuRaymarcher(const ShaderLoader& loader)
-    : program_(load_compute(loader, ShaderLoader::default_shader_dir() / "render" / "raymarch.comp")) {}
+GpuRaymarcher::GpuRaymarcher(const ShaderLoader& loader) : loader_(loader) {
+  program_for(core::MarchSettings{});  // the default program now: shader errors show at construction
+}
+
+const GlProgram& GpuRaymarcher::program_for(const core::MarchSettings& s) {
+  std::unique_ptr<GlProgram>& p = programs_[s.skip_empty ? 1 : 0][s.adaptive_steps ? 1 : 0];
+  if (!p) {
+    p = std::make_unique<GlProgram>(load_compute(loader_, ShaderLoader::default_shader_dir() / "render" / "raymarch.comp", {},
+                                                 {{"CV_SKIP_EMPTY", s.skip_empty ? "1" : "0"},
+                                                  {"CV_ADAPTIVE", s.adaptive_steps ? "1" : "0"}}));
+  }
+  return *p;
+}
 
 GpuRaymarcher::~GpuRaymarcher() {
   if (textures_[0]) glDeleteTextures(2, textures_);
@@ -61,7 +74,7 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
     throw GlError("an image of " + std::to_string(cam.width) + " x " + std::to_string(cam.height) +
                   " pixels is too large to read back at once (at most 134 million pixels)");
   }
-  const GLuint p = program_.id();
+  const GLuint p = program_for(s).id();
   const core::CameraFrame c = core::camera_frame(cam);
   const double r0 = grid_.earth_radius_m;
   glProgramUniform2i(p, loc(p, "u_size"), cam.width, cam.height);
@@ -88,10 +101,10 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   glProgramUniform1f(p, loc(p, "u_droplet_um"), static_cast<float>(s.droplet_diameter_um));
   glProgramUniform1f(p, loc(p, "u_ice_g"), static_cast<float>(s.ice_g));
   glProgramUniform1i(p, loc(p, "u_frame"), s.frame);
-  glProgramUniform1i(p, loc(p, "u_skip_empty"), s.skip_empty ? 1 : 0);
-  glProgramUniform1i(p, loc(p, "u_adaptive"), s.adaptive_steps ? 1 : 0);
   glProgramUniform1f(p, loc(p, "u_max_step_tau"), static_cast<float>(s.max_step_optical_depth));
   glProgramUniform1f(p, loc(p, "u_min_t"), static_cast<float>(s.min_transmittance));
+  glProgramUniform1f(p, loc(p, "u_sun_tau_limit"),
+                     static_cast<float>(std::min(3.0e38, physics::f64::sun_march_tau_limit(s.octaves, s.octave_a, s.min_transmittance))));
   const auto& levels = pyramid_.levels();
   GLint bricks[3 * core::ExtinctionPyramid::kMaxLevels] = {}, nodes[core::ExtinctionPyramid::kMaxLevels] = {},
         offsets[core::ExtinctionPyramid::kMaxLevels] = {};

@@ -3,6 +3,7 @@
 // as the CPU reference (core/reference/raymarcher).
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -31,7 +32,10 @@ class GpuRaymarcher {
   const core::MarchStats& last_stats() const { return stats_; }
 
  private:
-  GlProgram program_;
+  // The program for a march's switches (skip_empty, adaptive_steps), compiled on first use.
+  const GlProgram& program_for(const core::MarchSettings& s);
+  ShaderLoader loader_;
+  std::unique_ptr<GlProgram> programs_[2][2];
   GLuint textures_[2] = {0, 0};
   GLuint pyramid_buffer_ = 0, stats_buffer_ = 0;
   core::ExtinctionPyramid pyramid_;

@@ -108,6 +108,7 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
   const glm::dvec3 to_sun = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0));
   const p64::MieParams mie = p64::mie_params(s.droplet_diameter_um);
   const glm::dvec3 up_cam = glm::normalize(o);
+  const double sun_tau_limit = p64::sun_march_tau_limit(s.octaves, s.octave_a, s.min_transmittance);
   const bool use_pyramid = s.skip_empty || s.adaptive_steps;
   const ExtinctionPyramid pyramid =
       use_pyramid ? ExtinctionPyramid(grid, ext.liquid_per_m, ext.ice_per_m) : ExtinctionPyramid();
@@ -143,7 +144,7 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
         tau_sun += (a + b) * ds;
         ++img.stats.sun_samples;
         ++j;
-        if (p64::sun_march_done(tau_sun, s.octaves, s.octave_a, s.min_transmittance)) {
+        if (tau_sun > sun_tau_limit) {
           img.stats.sun_skipped += static_cast<std::uint64_t>((sn - q - 1) * s.sun_steps + s.sun_steps - j);
           return true;
         }

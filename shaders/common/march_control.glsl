@@ -86,11 +86,12 @@ CV_FN int march_substeps(real sigma_max_per_m, real dt_m, real max_tau) {
   return int(clamp(n, real(1), real(64)));
 }
 
-// Whether the sun march may stop at optical depth tau_sun: every octave's exp(-a^i tau_sun) is then
+// The optical depth at which a sun march may stop: beyond it every octave's exp(-a^i tau_sun) is
 // below min_transmittance (the weakest attenuation is the last octave's, a^(n-1) for a < 1), so the
-// rest of the path changes the light by less than that fraction. min_transmittance <= 0: never.
-CV_FN bool sun_march_done(real tau_sun, int octaves, real a, real min_transmittance) {
-  if (!(min_transmittance > real(0))) return false;
+// rest of the path changes the light by less than that fraction. min_transmittance <= 0: never
+// (a huge limit). Computed once per frame: pow and log per sun step cost llvmpipe dearly.
+CV_FN real sun_march_tau_limit(int octaves, real a, real min_transmittance) {
+  if (!(min_transmittance > real(0))) return real(3.0e38);
   real scale = a < real(1) ? pow(a, real(max(octaves - 1, 0))) : real(1);
-  return scale * tau_sun > -log(min_transmittance);
+  return -log(min_transmittance) / max(scale, real(1e-30));
 }

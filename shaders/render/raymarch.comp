@@ -33,10 +33,19 @@ uniform vec3 u_octave_abc;
 uniform float u_droplet_um;
 uniform float u_ice_g;
 uniform int u_frame;  // -1: step middles; else the accumulation frame (step_jitter)
-uniform bool u_skip_empty;
-uniform bool u_adaptive;
+// Compile-time switches (GpuRaymarcher builds a program per combination): llvmpipe runs both sides
+// of a branch under masks, so code switched off by a uniform would still cost every iteration.
+#ifndef CV_SKIP_EMPTY
+#define CV_SKIP_EMPTY 1
+#endif
+#ifndef CV_ADAPTIVE
+#define CV_ADAPTIVE 0
+#endif
+const bool kSkipEmpty = CV_SKIP_EMPTY != 0;
+const bool kAdaptive = CV_ADAPTIVE != 0;
 uniform float u_max_step_tau;     // optical depth a view substep may hold (adaptive steps)
-uniform float u_min_t;            // view rays stop below this transmittance; sun marches see sun_march_done
+uniform float u_min_t;            // view rays stop below this transmittance
+uniform float u_sun_tau_limit;    // sun marches stop past this optical depth (sun_march_tau_limit)
 uniform int u_levels;             // pyramid levels, 0: no pyramid
 uniform ivec3 u_bricks[4];        // bricks per axis, finest level first
 uniform int u_level_nodes[4];     // grid nodes per brick side
@@ -167,7 +176,7 @@ bool sun_optical_depth(vec3 p, float hb, float ht, out float tau_sun) {
     float ds = (s1 - s0) / float(u_sun_steps);
     float t_rel = (float(j) + 0.5) * ds;
     vec3 ps = p + (s0 + t_rel) * u_to_sun;
-    if (u_skip_empty && !(t_rel < known_end)) {
+    if (kSkipEmpty && !(t_rel < known_end)) {
       float extent;
       float smax;
       if (space_at(ps, u_to_sun, extent, smax)) {
@@ -185,7 +194,7 @@ bool sun_optical_depth(vec3 p, float hb, float ht, out float tau_sun) {
     tau_sun += (a + b) * ds;
     g_stats[kStatSunSamples] += 1u;
     ++k;
-    if (sun_march_done(tau_sun, u_octaves, u_octave_abc.x, u_min_t)) {
+    if (tau_sun > u_sun_tau_limit) {
       g_stats[kStatSunSkipped] += uint(total - k);
       break;
     }
@@ -281,10 +290,10 @@ void main() {
     while (i < steps && t_view > u_min_t) {
       if (j == 0) {
         float t_rel = (float(i) + offset) * dt;
-        if ((u_skip_empty || u_adaptive) && !(t_rel < known_end)) {
+        if ((kSkipEmpty || kAdaptive) && !(t_rel < known_end)) {
           float extent;
           bool empty = space_at(origin + (t_start + t_rel) * d, d, extent, sigma_max);
-          if (empty && u_skip_empty) {
+          if (empty && kSkipEmpty) {
             int next = march_resume_index(i, extent, dt);
             g_stats[kStatViewSkipped] += uint(min(next, steps) - i);
             g_stats[kStatBricksJumped] += next - i > 1 ? 1u : 0u;
@@ -294,7 +303,7 @@ void main() {
           known_end = t_rel + extent;
         }
         substeps = 1;
-        if (u_adaptive && march_substeps(sigma_max, dt, u_max_step_tau) > 1) {
+        if (kAdaptive && march_substeps(sigma_max, dt, u_max_step_tau) > 1) {
           // The brick's bound is loose (a brick spans 4 cells and more): bound the step by the
           // cells at its two ends instead, so only steps near thick cloud are divided.
           float bound = max(cell_max(origin + (t_start + float(i) * dt) * d), cell_max(origin + (t_start + float(i + 1) * dt) * d));
