@@ -1,8 +1,10 @@
 // The volumetric raymarcher on the spherical shell, in the form of the CPU reference
 // (core/reference/raymarcher.cpp): shell intersection from the camera's altitude, the segment
 // integral per step, a secondary march toward the sun with the Earth's shadow, and the octave sum
-// with the approximate Mie phase for liquid and Henyey-Greenstein for ice. Output: rgb radiance,
-// a = view transmittance.
+// with the approximate Mie phase for liquid and Henyey-Greenstein for ice. Both marches jump over
+// empty bricks of the extinction pyramid and view steps through thick cloud are divided
+// (shaders/common/march_control.glsl), as in the reference. Output: rgb radiance, a = view
+// transmittance; per-frame counters in the Stats buffer.
 #include "../common/physics.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
