@@ -55,7 +55,7 @@ struct MarchStats {
   std::uint64_t view_skipped = 0;   // view step positions jumped over in empty bricks
   std::uint64_t bricks_jumped = 0;  // jumps over empty bricks, view and sun rays
   std::uint64_t sun_samples = 0;    // medium lookups along sun rays
-  std::uint64_t sun_skipped = 0;    // sun step positions jumped over or cut off by sun_march_done
+  std::uint64_t sun_skipped = 0;    // sun step positions jumped over or cut off by sun_march_tau_limit
   std::uint64_t rays_missed = 0;    // pixels whose ray never crossed the cloud shell
 };
 
