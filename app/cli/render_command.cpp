@@ -61,12 +61,12 @@ int parse_int(const std::string& option, const std::string& text, int lo, int hi
 // The options, applied to `scene` in the order given (later ones win).
 RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& scene) {
   RenderArgs r;
-  // Every option but --no-sky takes a value; the one argument that is no option's value is the input. It is
+  // Every option but --no-sky and --no-skip takes a value; the one argument that is no option's value is the input. It is
   // read first so that a scene file's settings are the base the options override.
   std::vector<std::pair<std::string, std::string>> options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "--no-sky") {  // the one flag without a value
+    if (a == "--no-sky" || a == "--no-skip") {  // the flags without a value
       options.emplace_back(a, "");
     } else if (!a.empty() && a[0] == '-') {
       if (i + 1 >= args.size()) throw UsageError{"cloudviewer render: " + a + ": expected a value after it"};
@@ -150,6 +150,14 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
       if (!(m.noise_scale_m >= 10 && m.noise_scale_m <= 1e7)) {
         throw UsageError{"cloudviewer render: --noise-scale: found " + v + ", expected the noise tile's period in metres, 10..1e7"};
       }
+    } else if (a == "--no-skip") {
+      m.skip_empty = false;
+    } else if (a == "--adaptive") {
+      m.adaptive_steps = true;
+      m.max_step_optical_depth = parse_number(a, v);
+      if (!(m.max_step_optical_depth > 0)) {
+        throw UsageError{"cloudviewer render: --adaptive: found '" + v + "', expected the optical depth per substep, a number > 0"};
+      }
     } else if (a == "--no-sky") {
       m.atmosphere = m.globe = false;
       m.ambient = 0.0;
@@ -206,7 +214,7 @@ const char* render_usage() {
          "         [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov] [--sun LAT,LON | --sun-time ISO]\n"
          "         [--quality low|default|high|custom] [--steps M] [--sun-steps N] [--octaves N] [--accumulate N]\n"
          "         [--exposure E] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N] [--pfm OUT.pfm]\n"
-         "         [--noise AMOUNT] [--noise-scale METRES] [--no-sky]\n"
+         "         [--noise AMOUNT] [--noise-scale METRES] [--no-sky] [--no-skip] [--adaptive TAU]\n"
          "         [--save-scene OUT.json]  (the effective scene, camera and sun resolved, to reproduce the image)\n"
          "                           the sun stands where it stood at the valid time unless --sun or --sun-time\n";
 }
@@ -315,6 +323,13 @@ int cmd_render(const std::vector<std::string>& args) {
     std::printf("\n");
   }
   const double t_march = seconds_since(t0);
+  const core::MarchStats& ms = gpu.last_stats();
+  std::printf("march%s: %llu view samples, %llu skipped in %llu empty-brick jumps (view and sun), %llu sun samples, "
+              "%llu skipped or cut off, %llu of %d rays missed the cloud shell%s\n",
+              rs.accumulate > 1 ? " (last frame)" : "", static_cast<unsigned long long>(ms.view_samples),
+              static_cast<unsigned long long>(ms.view_skipped), static_cast<unsigned long long>(ms.bricks_jumped),
+              static_cast<unsigned long long>(ms.sun_samples), static_cast<unsigned long long>(ms.sun_skipped),
+              static_cast<unsigned long long>(ms.rays_missed), mw * mh, march.skip_empty ? "" : " (skipping off)");
 
   t0 = clock::now();
   if (mw != cam.width || mh != cam.height) pixels = upscale(pixels, mw, mh, cam.width, cam.height);

@@ -8,6 +8,7 @@
 
 #include "geo/geodesy.hpp"
 #include "render/albedo_map.hpp"
+#include "physics/physics.hpp"
 #include "volume/sampler.hpp"
 
 namespace cv::render {
@@ -18,21 +19,36 @@ void set3(GLuint p, const char* n, const glm::dvec3& v) {
 }
 }  // namespace
 
-GpuRaymarcher::GpuRaymarcher(const ShaderLoader& loader)
-    : loader_(loader), program_(load_compute(loader, ShaderLoader::default_shader_dir() / "render" / "raymarch.comp")) {}
+GpuRaymarcher::GpuRaymarcher(const ShaderLoader& loader) : loader_(loader) {
+  program_for(core::MarchSettings{});  // the default program now: shader errors show at construction
+}
+
+const GlProgram& GpuRaymarcher::program_for(const core::MarchSettings& s) {
+  const bool noise = s.noise_amount > 0.0;
+  std::unique_ptr<GlProgram>& p = programs_[noise ? 1 : 0][s.skip_empty ? 1 : 0][s.adaptive_steps ? 1 : 0];
+  if (!p) {
+    p = std::make_unique<GlProgram>(load_compute(loader_, ShaderLoader::default_shader_dir() / "render" / "raymarch.comp",
+                                                 noise ? ShaderFeatures{ShaderFeature::NoiseDetail} : ShaderFeatures{},
+                                                 {{"CV_SKIP_EMPTY", s.skip_empty ? "1" : "0"},
+                                                  {"CV_ADAPTIVE", s.adaptive_steps ? "1" : "0"}}));
+  }
+  return *p;
+}
 
 GpuRaymarcher::~GpuRaymarcher() {
   if (textures_[0]) glDeleteTextures(2, textures_);
   if (ground_) glDeleteTextures(1, &ground_);
   if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
+  if (pyramid_buffer_) glDeleteBuffers(1, &pyramid_buffer_);
+  if (stats_buffer_) glDeleteBuffers(1, &stats_buffer_);
 }
 
 void GpuRaymarcher::upload_noise(const core::ErosionNoise& noise) {
-  // The noise variant is compiled here, not in the first render, so render timings are the march's.
-  if (!noise_program_.id()) {
-    noise_program_ = load_compute(loader_, ShaderLoader::default_shader_dir() / "render" / "raymarch.comp",
-                                  ShaderFeatures{ShaderFeature::NoiseDetail});
-  }
+  // The noise variant (with the default march switches) is compiled here, not in the first
+  // render, so render timings are the march's.
+  core::MarchSettings with_noise;
+  with_noise.noise_amount = 1.0;
+  program_for(with_noise);
   if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
   glCreateTextures(GL_TEXTURE_3D, 2, noise_textures_);
   const core::NoiseTexture* tex[2] = {&noise.low, &noise.high};
@@ -65,6 +81,15 @@ void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExt
   }
   check_gl("uploading the volume's extinction textures");
   grid_ = grid;
+  // The pyramid for empty-space skipping and adapted steps, all levels in one buffer.
+  pyramid_ = core::ExtinctionPyramid(grid, medium.liquid_per_m, medium.ice_per_m);
+  std::vector<glm::vec2> packed;
+  for (const auto& l : pyramid_.levels()) packed.insert(packed.end(), l.min_max.begin(), l.min_max.end());
+  if (packed.empty()) packed.emplace_back(0.0f, 1.0f);  // a buffer must not be empty; u_levels = 0 ignores it
+  if (pyramid_buffer_) glDeleteBuffers(1, &pyramid_buffer_);
+  glCreateBuffers(1, &pyramid_buffer_);
+  glNamedBufferStorage(pyramid_buffer_, static_cast<GLsizeiptr>(packed.size() * sizeof(glm::vec2)), packed.data(), 0);
+  check_gl("uploading the extinction pyramid");
 }
 
 void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
@@ -72,7 +97,7 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   const bool noise = s.noise_amount > 0.0;
   if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
   if (noise && !(s.noise_scale_m > 0.0)) throw GlError("noise_scale_m must be > 0");
-  const GLuint p = noise ? noise_program_.id() : program_.id();
+  const GLuint p = program_for(s).id();
   const core::CameraFrame c = core::camera_frame(cam);
   const double r0 = grid_.earth_radius_m;
   glProgramUniform2i(p, loc(p, "u_size"), cam.width, cam.height);
@@ -128,6 +153,32 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
     ground_path_ = s.ground_texture;
   }
   glProgramUniform2i(p, loc(p, "u_ground_size"), textured ? ground_w_ : 0, textured ? ground_h_ : 0);
+  glProgramUniform1f(p, loc(p, "u_max_step_tau"), static_cast<float>(s.max_step_optical_depth));
+  glProgramUniform1f(p, loc(p, "u_min_t"), static_cast<float>(s.min_transmittance));
+  glProgramUniform1f(p, loc(p, "u_sun_tau_limit"),
+                     static_cast<float>(std::min(3.0e38, physics::f64::sun_march_tau_limit(s.octaves, s.octave_a, s.min_transmittance))));
+  const auto& levels = pyramid_.levels();
+  GLint bricks[3 * core::ExtinctionPyramid::kMaxLevels] = {}, nodes[core::ExtinctionPyramid::kMaxLevels] = {},
+        offsets[core::ExtinctionPyramid::kMaxLevels] = {};
+  GLint offset = 0;
+  for (std::size_t l = 0; l < levels.size(); ++l) {
+    bricks[3 * l] = levels[l].nx, bricks[3 * l + 1] = levels[l].ny, bricks[3 * l + 2] = levels[l].nz;
+    nodes[l] = levels[l].nodes;
+    offsets[l] = offset;
+    offset += static_cast<GLint>(levels[l].min_max.size());
+  }
+  glProgramUniform1i(p, loc(p, "u_levels"), static_cast<GLint>(levels.size()));
+  glProgramUniform3iv(p, loc(p, "u_bricks"), core::ExtinctionPyramid::kMaxLevels, bricks);
+  glProgramUniform1iv(p, loc(p, "u_level_nodes"), core::ExtinctionPyramid::kMaxLevels, nodes);
+  glProgramUniform1iv(p, loc(p, "u_level_offset"), core::ExtinctionPyramid::kMaxLevels, offsets);
+  if (!stats_buffer_) {
+    glCreateBuffers(1, &stats_buffer_);
+    glNamedBufferStorage(stats_buffer_, 12 * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  }
+  const GLuint zeros[12] = {};
+  glNamedBufferSubData(stats_buffer_, 0, sizeof(zeros), zeros);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, pyramid_buffer_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, stats_buffer_);
   glBindImageTexture(0, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glBindTextureUnit(1, textures_[0]);
   glBindTextureUnit(2, textures_[1]);
@@ -154,8 +205,22 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   }
   if (query) glDeleteQueries(1, &query);
   // Readers either fetch texels (the viewer's accumulation) or read the image back.
-  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                  GL_BUFFER_UPDATE_BARRIER_BIT);
+  stats_read_ = false;
   check_gl("running the raymarcher");
+}
+
+const core::MarchStats& GpuRaymarcher::last_stats() {
+  // Read on demand: reading waits for the march, which the viewer should not do every frame.
+  if (!stats_read_ && stats_buffer_) {
+    GLuint counts[12] = {};
+    glGetNamedBufferSubData(stats_buffer_, 0, sizeof(counts), counts);
+    auto count = [&](int k) { return (std::uint64_t(counts[2 * k + 1]) << 32) | counts[2 * k]; };
+    stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5)};
+    stats_read_ = true;
+  }
+  return stats_;
 }
 
 std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
@@ -172,6 +237,10 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   std::vector<glm::vec4> pixels(static_cast<std::size_t>(cam.width) * cam.height);
   glGetTextureImage(out, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(pixels.size() * sizeof(glm::vec4)), pixels.data());
   glDeleteTextures(1, &out);
+  GLuint counts[12] = {};
+  glGetNamedBufferSubData(stats_buffer_, 0, sizeof(counts), counts);
+  auto count = [&](int k) { return (std::uint64_t(counts[2 * k + 1]) << 32) | counts[2 * k]; };
+  stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5)};
   check_gl("running the raymarcher");
   return pixels;
 }

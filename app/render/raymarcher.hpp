@@ -5,11 +5,13 @@
 
 #include <functional>
 #include <string>
+#include <memory>
 #include <vector>
 
 #include <glm/vec4.hpp>
 
 #include "reference/raymarcher.hpp"
+#include "volume/extinction_pyramid.hpp"
 #include "render/shader_loader.hpp"
 
 namespace cv::render {
@@ -51,16 +53,26 @@ class GpuRaymarcher {
   void render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings,
                    const DispatchOptions& dispatch = {});
 
+  // The counts of the last render (samples taken and skipped, rays that missed the shell).
+  // What the last march did (view and sun samples, what was skipped); waits for it to finish.
+  const core::MarchStats& last_stats();
+
  private:
+  // The program for a march's switches (noise detail, skip_empty, adaptive_steps), compiled on
+  // first use (the noise variants need upload_noise first).
+  const GlProgram& program_for(const core::MarchSettings& s);
   const ShaderLoader& loader_;
-  GlProgram program_;
-  GlProgram noise_program_;  // the NoiseDetail variant, compiled by upload_noise
+  std::unique_ptr<GlProgram> programs_[2][2][2];  // [noise][skip][adaptive]
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
   GLuint ground_ = 0;               // linear albedo (RGB32F), loaded from ground_path_
   int ground_w_ = 0, ground_h_ = 0;
   std::string ground_path_;
+  GLuint pyramid_buffer_ = 0, stats_buffer_ = 0;
+  core::ExtinctionPyramid pyramid_;
+  bool stats_read_ = true;
   core::VolumeGrid grid_;
+  core::MarchStats stats_;
 };
 
 }  // namespace cv::render

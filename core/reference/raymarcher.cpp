@@ -9,6 +9,7 @@
 
 #include "geo/geodesy.hpp"
 #include "physics/physics.hpp"
+#include "volume/extinction_pyramid.hpp"
 #include "volume/sampler.hpp"
 
 namespace cv::core {
@@ -43,8 +44,33 @@ struct Medium {
     sigma_ice = ice.sample(lat, lon, alt, 0.0);
     if (erosion.noise && sigma_liquid + sigma_ice > 0.0) erosion.apply(p, sigma_liquid, sigma_ice);
   }
+  // The largest extinction (liquid + ice) trilinear sampling can return in the grid cell around p:
+  // the largest of the 8 nodes the sampler reads there, border nodes as 0 (as cell_max in
+  // raymarch.comp); 0 outside.
+  double cell_max(const glm::dvec3& p) const {
+    const glm::dvec3 g = p64::ecef_to_sphere(p, grid.earth_radius_m);
+    const glm::dvec3 start(grid.lon_deg.start, grid.lat_deg.start, grid.alt_m.start);
+    const glm::dvec3 step(grid.lon_deg.step, grid.lat_deg.step, grid.alt_m.step);
+    const glm::dvec3 count(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
+    glm::dvec3 f;
+    if (!p64::volume_coords(g.x / kDeg, g.y / kDeg, g.z, start, step, count, wraps, global_lat, f)) return 0.0;
+    const int nx = grid.lon_deg.count, ny = grid.lat_deg.count, nz = grid.alt_m.count;
+    double w;
+    const int x0 = p64::volume_fetch_index(f.x, nx, w), y0 = p64::volume_fetch_index(f.y, ny, w);
+    const int z0 = p64::volume_fetch_index(f.z, nz, w);
+    const int x1 = wraps ? (x0 + 1) % nx : x0 + 1, y1 = y0 + 1, z1 = std::min(z0 + 1, nz - 1);
+    double m = 0.0;
+    for (int c = 0; c < 8; ++c) {
+      const int x = c & 1 ? x1 : x0, y = c & 2 ? y1 : y0, z = c & 4 ? z1 : z0;
+      if (x < 0 || x >= nx || y < 0 || y >= ny) continue;  // the border: no cloud
+      const std::size_t idx = grid.index(x, y, z);
+      m = std::max(m, (liquid_per_m.empty() ? 0.0 : liquid_per_m[idx]) + (ice_per_m.empty() ? 0.0 : ice_per_m[idx]));
+    }
+    return m;
+  }
   // Optical depth of the clouds from p (altitude alt_p) toward the sun (cosine mu_sun, sine nu_sun
-  // with the local up at p): sun_steps per shell segment, as cloud_sun_depth in raymarch.comp.
+  // with the local up at p): sun_steps per shell segment, empty bricks jumped, stopped past
+  // sun_tau_limit, as cloud_sun_depth in raymarch.comp. Counts into *stats.
   double sun_depth(const glm::dvec3& p, double alt_p, double mu_sun, double nu_sun, const glm::dvec3& to_sun,
                    int sun_steps) const {
     glm::dvec4 sseg;
@@ -52,14 +78,41 @@ struct Medium {
     double tau = 0.0;
     for (int q = 0; q < sn; ++q) {
       const double ds = (sseg[2 * q + 1] - sseg[2 * q]) / sun_steps;
-      for (int j = 0; j < sun_steps; ++j) {
+      double known_end = -1.0;
+      for (int j = 0; j < sun_steps;) {
+        const double t_rel = (j + 0.5) * ds;
+        const glm::dvec3 ps = p + (sseg[2 * q] + t_rel) * to_sun;
+        if (skip_empty && !(t_rel < known_end)) {
+          const ExtinctionPyramid::Space sp = pyramid->at(ps, to_sun);
+          if (sp.empty) {
+            const int next = p64::march_resume_index(j, sp.extent_m, ds);
+            stats->sun_skipped += static_cast<std::uint64_t>(std::min(next, sun_steps) - j);
+            stats->bricks_jumped += next - j > 1;
+            j = next;
+            continue;
+          }
+          known_end = t_rel + sp.extent_m;
+        }
         double a, b;
-        at(p + (sseg[2 * q] + (j + 0.5) * ds) * to_sun, a, b);
+        at(ps, a, b);
         tau += (a + b) * ds;
+        ++stats->sun_samples;
+        ++j;
+        if (tau > sun_tau_limit) {
+          stats->sun_skipped += static_cast<std::uint64_t>((sn - q - 1) * sun_steps + sun_steps - j);
+          return tau;
+        }
       }
     }
     return tau;
   }
+  const std::vector<float>& liquid_per_m;
+  const std::vector<float>& ice_per_m;
+  bool wraps = false, global_lat = false;
+  const ExtinctionPyramid* pyramid = nullptr;
+  bool skip_empty = false;
+  double sun_tau_limit = 3.0e38;
+  MarchStats* stats = nullptr;
 };
 
 // The air and the ground around the clouds, as sky_and_ground in shaders/render/sky_ground.glsl:
@@ -181,7 +234,22 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
     if (!(s.noise_scale_m > 0.0)) throw std::invalid_argument("render_reference: noise_scale_m must be > 0");
     erosion = {noise, noise_anchor(grid_centre_ecef(grid), s.noise_scale_m), s.noise_scale_m, s.noise_amount};
   }
-  const Medium medium{grid, VolumeSampler(grid, ext.liquid_per_m), VolumeSampler(grid, ext.ice_per_m), erosion};
+  const bool use_pyramid = s.skip_empty || s.adaptive_steps;
+  const ExtinctionPyramid pyramid =
+      use_pyramid ? ExtinctionPyramid(grid, ext.liquid_per_m, ext.ice_per_m) : ExtinctionPyramid();
+  const VolumeSampler liquid_sampler(grid, ext.liquid_per_m);
+  const Medium medium{grid,
+                      liquid_sampler,
+                      VolumeSampler(grid, ext.ice_per_m),
+                      erosion,
+                      ext.liquid_per_m,
+                      ext.ice_per_m,
+                      grid.wraps_lon(),
+                      liquid_sampler.global_lat(),
+                      &pyramid,
+                      s.skip_empty,
+                      p64::sun_march_tau_limit(s.octaves, s.octave_a, s.min_transmittance),
+                      &img.stats};
   const double r0 = grid.earth_radius_m;
   const double hb = grid.alt_m.start, ht = grid.alt_m.last();
   const glm::dvec3 o = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);
@@ -222,44 +290,78 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
       glm::dvec3 radiance(0.0);
       double transmittance = 1.0;
       double depth_w = 0.0, depth_t = 0.0;  // where the cloud is: the mean depth of the light it takes out
-      for (int k = 0; k < n && transmittance > 1e-6; ++k) {
+      // One view sample at distance t standing for a step of ds: in-scattered light and attenuation.
+      auto march_sample = [&](double t, double ds) {
+        const glm::dvec3 p = origin + t * d;
+        double sl, si;
+        medium.at(p, sl, si);
+        ++img.stats.view_samples;
+        const double sigma = sl + si;
+        if (sigma <= 0.0) return;
+        // Optical depth toward the sun, unless the Earth is in the way.
+        const glm::dvec3 up_p = glm::normalize(p);
+        const double alt_p = glm::length(p) - r0;
+        const double mu_sun = glm::dot(to_sun, up_p), nu_sun = glm::length(glm::cross(to_sun, up_p));
+        double e0, e1;
+        const bool lit = !(p64::ray_sphere_rel_nu(r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
+        const double tau_sun = lit ? medium.sun_depth(p, alt_p, mu_sun, nu_sun, to_sun, s.sun_steps) : 0.0;
+        // Sunlight reaches the sample through the air (reddened when low), and the sky lights it
+        // too: isotropic irradiance E_sky scattered as sigma_s E_sky / (2 pi) (docs/physics.md).
+        const glm::dvec3 sun_air = s.atmosphere && lit ? p64::atmo_transmittance(r0, alt_p, mu_sun, nu_sun, s.atmo_sun_steps)
+                                                       : glm::dvec3(1.0);
+        const glm::dvec3 ambient = s.atmosphere ? s.ambient * p64::sky_irradiance(sun_air, mu_sun) * (sigma / p64::CV_TWO_PI)
+                                                : glm::dvec3(0.0);
+        // In-scattered radiance per metre: the octave sums of both phases (clouds do not absorb).
+        const double scatter = lit ? p64::ms_octaves_mie(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c) +
+                                         p64::ms_octaves_hg(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c)
+                                   : 0.0;
+        radiance += transmittance * p64::segment_integral(sun.irradiance * (sun_air * scatter + ambient), sigma, ds);
+        const double t_next = transmittance * p64::transmittance(sigma * ds);
+        depth_w += transmittance - t_next;
+        depth_t += (transmittance - t_next) * t;
+        transmittance = t_next;
+      };
+      bool crossed = false;
+      for (int k = 0; k < n && transmittance > s.min_transmittance; ++k) {
         const double t_start = seg[2 * k], t_end = std::min(seg[2 * k + 1], t_ground);
         if (!(t_end > t_start)) continue;
+        crossed = true;
         const int steps = std::max(1, static_cast<int>(std::ceil((t_end - t_start) / s.view_step_m)));
         const double dt = (t_end - t_start) / steps;
         const double offset = s.frame < 0 ? 0.5
                                           : p64::step_jitter(static_cast<p64::uint>(px), static_cast<p64::uint>(py),
                                                              static_cast<p64::uint>(s.frame));
-        for (int i = 0; i < steps && transmittance > 1e-6; ++i) {
-          const glm::dvec3 p = origin + (t_start + (i + offset) * dt) * d;
-          double sl, si;
-          medium.at(p, sl, si);
-          const double sigma = sl + si;
-          if (sigma <= 0.0) continue;
-          // Optical depth toward the sun, unless the Earth is in the way.
-          const glm::dvec3 up_p = glm::normalize(p);
-          const double alt_p = glm::length(p) - r0;
-          const double mu_sun = glm::dot(to_sun, up_p), nu_sun = glm::length(glm::cross(to_sun, up_p));
-          double e0, e1;
-          const bool lit = !(p64::ray_sphere_rel_nu(r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
-          const double tau_sun = lit ? medium.sun_depth(p, alt_p, mu_sun, nu_sun, to_sun, s.sun_steps) : 0.0;
-          // Sunlight reaches the sample through the air (reddened when low), and the sky lights it
-          // too: isotropic irradiance E_sky scattered as sigma_s E_sky / (2 pi) (docs/physics.md).
-          const glm::dvec3 sun_air = s.atmosphere && lit ? p64::atmo_transmittance(r0, alt_p, mu_sun, nu_sun, s.atmo_sun_steps)
-                                                         : glm::dvec3(1.0);
-          const glm::dvec3 ambient = s.atmosphere ? s.ambient * p64::sky_irradiance(sun_air, mu_sun) * (sigma / p64::CV_TWO_PI)
-                                                  : glm::dvec3(0.0);
-          // In-scattered radiance per metre: the octave sums of both phases (clouds do not absorb).
-          const double scatter = lit ? p64::ms_octaves_mie(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c) +
-                                           p64::ms_octaves_hg(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c)
-                                     : 0.0;
-          radiance += transmittance * p64::segment_integral(sun.irradiance * (sun_air * scatter + ambient), sigma, dt);
-          const double t_next = transmittance * p64::transmittance(sigma * dt);
-          depth_w += transmittance - t_next;
-          depth_t += (transmittance - t_next) * (t_start + (i + offset) * dt);
-          transmittance = t_next;
+        // What the pyramid said about the brick ahead: valid for sample distances below known_end.
+        double known_end = -1.0, sigma_max = 0.0;
+        for (int i = 0; i < steps && transmittance > s.min_transmittance;) {
+          const double t_rel = (i + offset) * dt;
+          int substeps = 1;
+          if (use_pyramid && !(t_rel < known_end)) {
+            const ExtinctionPyramid::Space sp = pyramid.at(origin + (t_start + t_rel) * d, d);
+            if (sp.empty && s.skip_empty) {
+              const int next = p64::march_resume_index(i, sp.extent_m, dt);
+              img.stats.view_skipped += static_cast<std::uint64_t>(std::min(next, steps) - i);
+              img.stats.bricks_jumped += next - i > 1;
+              i = next;
+              continue;
+            }
+            sigma_max = sp.empty ? 0.0 : sp.sigma_max_per_m;
+            known_end = t_rel + sp.extent_m;
+          }
+          if (s.adaptive_steps && p64::march_substeps(sigma_max, dt, s.max_step_optical_depth) > 1) {
+            // The brick's bound is loose (a brick spans 4 cells and more): bound the step by the
+            // cells at its two ends instead, so only steps near thick cloud are divided.
+            const double bound = std::max(medium.cell_max(origin + (t_start + i * dt) * d),
+                                          medium.cell_max(origin + (t_start + (i + 1) * dt) * d));
+            substeps = p64::march_substeps(bound, dt, s.max_step_optical_depth);
+          }
+          for (int j = 0; j < substeps && transmittance > s.min_transmittance; ++j) {
+            march_sample(t_start + (i + (j + offset) / substeps) * dt, dt / substeps);
+          }
+          ++i;
         }
       }
+      img.stats.rays_missed += !crossed;
       const std::size_t idx = static_cast<std::size_t>(py) * cam.width + px;
       if (s.atmosphere || s.globe) {
         const glm::dvec3 p_cloud = origin + (depth_w > 0.0 ? depth_t / depth_w : 0.0) * d;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <cstdint>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -53,6 +54,15 @@ struct MarchSettings {
   int atmo_sun_steps = 8;   // steps of each atmospheric transmittance toward the sun
   glm::dvec3 ground_albedo{0.12, 0.12, 0.12};  // linear, where no ground texture is given
   std::string ground_texture;  // equirectangular albedo image (PNG); empty: ground_albedo
+  // Acceleration (shaders/common/march_control.glsl). Skipping jumps over bricks of the extinction
+  // pyramid that hold no cloud and resumes on the same sample grid: the image does not change.
+  bool skip_empty = true;
+  // Splits a view step into substeps where the brick's largest extinction would give a step an
+  // optical depth above max_step_optical_depth (thick cores are then not under-sampled).
+  bool adaptive_steps = false;
+  double max_step_optical_depth = 1.0;
+  // View rays stop below this transmittance, sun marches once every octave's attenuation is below it.
+  double min_transmittance = 1e-6;
 };
 
 // An equirectangular ground albedo image: linear rgb per texel, rows from latitude 90 down to -90,
@@ -64,10 +74,21 @@ struct AlbedoMap {
   glm::dvec3 at(double lat_rad, double lon_rad) const;
 };
 
+// What a frame's march did, summed over its pixels (the GPU counts with atomics).
+struct MarchStats {
+  std::uint64_t view_samples = 0;   // medium lookups along view rays (substeps included)
+  std::uint64_t view_skipped = 0;   // view step positions jumped over in empty bricks
+  std::uint64_t bricks_jumped = 0;  // jumps over empty bricks, view and sun rays
+  std::uint64_t sun_samples = 0;    // medium lookups along sun rays
+  std::uint64_t sun_skipped = 0;    // sun step positions jumped over or cut off by sun_march_tau_limit
+  std::uint64_t rays_missed = 0;    // pixels whose ray never crossed the cloud shell
+};
+
 struct ReferenceImage {
   int width = 0, height = 0;
   std::vector<glm::dvec3> radiance;    // scattered toward the camera, per pixel
   std::vector<double> transmittance;   // of the view ray through the clouds (and air); 0 on the globe
+  MarchStats stats;
 };
 
 // The renderer's medium: grid-box-mean extinction (cloud fraction x in-cloud extinction) of

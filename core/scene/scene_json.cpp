@@ -168,7 +168,8 @@ void read_sun(const Reader& r, SunSpec& s) {
 void read_march(const Reader& r, MarchSettings& m) {
   r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "droplet_diameter_um", "ice_g", "frame",
           "noise_amount", "noise_scale_m", "atmosphere", "globe", "ambient", "sky_steps", "atmo_sun_steps",
-          "ground_albedo", "ground_texture"});
+          "ground_albedo", "ground_texture", "skip_empty", "adaptive_steps", "max_step_optical_depth",
+          "min_transmittance"});
   r.number("view_step_m", m.view_step_m, 0.0, 1e7, "a view step in metres 0..1e7 (0: from the grid)");
   r.integer("sun_steps", m.sun_steps, 1, 1024);
   r.integer("octaves", m.octaves, 1, 16);
@@ -196,6 +197,10 @@ void read_march(const Reader& r, MarchSettings& m) {
     m.ground_albedo = glm::dvec3((*a)[0], (*a)[1], (*a)[2]);
   }
   r.string("ground_texture", m.ground_texture);
+  r.boolean("skip_empty", m.skip_empty);
+  r.boolean("adaptive_steps", m.adaptive_steps);
+  r.number("max_step_optical_depth", m.max_step_optical_depth, 1e-3, 1e3, "an optical depth per substep 0.001..1000");
+  r.number("min_transmittance", m.min_transmittance, 0.0, 0.1, "a transmittance 0..0.1 below which a view ray stops");
 }
 
 void read_render(const Reader& r, RenderSettings& s) {
@@ -308,7 +313,11 @@ std::string scene_to_json(const Scene& s) {
                       {"sky_steps", m.sky_steps},
                       {"atmo_sun_steps", m.atmo_sun_steps},
                       {"ground_albedo", {m.ground_albedo.x, m.ground_albedo.y, m.ground_albedo.z}},
-                      {"ground_texture", m.ground_texture}}}};
+                      {"ground_texture", m.ground_texture},
+                      {"skip_empty", m.skip_empty},
+                      {"adaptive_steps", m.adaptive_steps},
+                      {"max_step_optical_depth", m.max_step_optical_depth},
+                      {"min_transmittance", m.min_transmittance}}}};
   root["overlays"] = s.overlays;
   return root.dump(2) + "\n";
 }

@@ -16,3 +16,4 @@
 #include "erosion.glsl"
 #include "atmosphere.glsl"
 #include "ground.glsl"
+#include "march_control.glsl"

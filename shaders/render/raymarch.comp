@@ -2,8 +2,11 @@
 // (core/reference/raymarcher.cpp): shell intersection from the camera's altitude, the segment
 // integral per step, a secondary march toward the sun with the Earth's shadow, and the octave sum
 // with the approximate Mie phase for liquid and Henyey-Greenstein for ice; the sun's light reaches
-// each sample through the atmosphere, with an ambient sky term. Sky and globe are composited around
-// the clouds in sky_ground.glsl. Output: rgb radiance, a = view transmittance (0 on the globe).
+// each sample through the atmosphere, with an ambient sky term. Both marches jump over empty bricks
+// of the extinction pyramid and view steps through thick cloud are divided
+// (shaders/common/march_control.glsl), as in the reference. Sky and globe are composited around the
+// clouds in sky_ground.glsl. Output: rgb radiance, a = view transmittance (0 on the globe);
+// per-frame counters in the Stats buffer.
 #include "../common/physics.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -43,6 +46,37 @@ uniform int u_atmo_sun_steps; // steps of an atmospheric transmittance toward th
 uniform vec3 u_ground_albedo; // when there is no ground texture
 uniform ivec2 u_ground_size;  // of the albedo texture; (0, 0): constant albedo
 layout(binding = 5) uniform sampler2D u_ground;  // linear albedo, equirectangular
+
+// Compile-time switches (GpuRaymarcher builds a program per combination): llvmpipe runs both sides
+// of a branch under masks, so code switched off by a uniform would still cost every iteration.
+#ifndef CV_SKIP_EMPTY
+#define CV_SKIP_EMPTY 1
+#endif
+#ifndef CV_ADAPTIVE
+#define CV_ADAPTIVE 0
+#endif
+const bool kSkipEmpty = CV_SKIP_EMPTY != 0;
+const bool kAdaptive = CV_ADAPTIVE != 0;
+uniform float u_max_step_tau;     // optical depth a view substep may hold (adaptive steps)
+uniform float u_min_t;            // view rays stop below this transmittance
+uniform float u_sun_tau_limit;    // sun marches stop past this optical depth (sun_march_tau_limit)
+uniform int u_levels;             // pyramid levels, 0: no pyramid
+uniform ivec3 u_bricks[4];        // bricks per axis, finest level first
+uniform int u_level_nodes[4];     // grid nodes per brick side
+uniform int u_level_offset[4];    // first brick of each level in u_min_max
+
+// The extinction pyramid (core/volume/extinction_pyramid): (min, max) per brick, levels one after
+// the other, x fastest.
+layout(std430, binding = 3) readonly buffer Pyramid { vec2 u_min_max[]; };
+// Per-frame counters (core::MarchStats), each as (low, high) 32-bit words.
+layout(std430, binding = 4) buffer Stats { uint u_stats[]; };
+const int kStatViewSamples = 0;
+const int kStatViewSkipped = 1;
+const int kStatBricksJumped = 2;
+const int kStatSunSamples = 3;
+const int kStatSunSkipped = 4;
+const int kStatRaysMissed = 5;
+uint g_stats[6] = uint[6](0u, 0u, 0u, 0u, 0u, 0u);
 
 const float kDeg = 0.017453292519943295;
 
@@ -106,6 +140,28 @@ void erode_at(vec3 p, inout float sl, inout float si) {
 }
 #endif
 
+float node_sum(int x, int y, int z) { return node(u_liquid, x, y, z) + node(u_ice, x, y, z); }
+
+// The largest extinction (1/m, liquid + ice) that trilinear sampling can return in the grid cell
+// around p (altitude alt_m): the largest of the 8 nodes fetch reads there; 0 outside the grid.
+float cell_max(vec3 p, float alt_m) {
+  vec3 g = ecef_to_sphere(p, u_r0);
+  vec3 f;
+  if (!volume_coords(g.x / kDeg, g.y / kDeg, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return 0.0;
+  ivec3 n = ivec3(u_grid_count);
+  float w;
+  int x0 = volume_fetch_index(f.x, n.x, w);
+  int y0 = volume_fetch_index(f.y, n.y, w);
+  int z0 = volume_fetch_index(f.z, n.z, w);
+  int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
+  int y1 = y0 + 1;
+  int z1 = min(z0 + 1, n.z - 1);
+  // Written out, not looped: see space_at on llvmpipe's loop budget.
+  float m = max(max(node_sum(x0, y0, z0), node_sum(x1, y0, z0)), max(node_sum(x0, y1, z0), node_sum(x1, y1, z0)));
+  m = max(m, max(max(node_sum(x0, y0, z1), node_sum(x1, y0, z1)), max(node_sum(x0, y1, z1), node_sum(x1, y1, z1))));
+  return m;
+}
+
 // The medium at Earth-centred point p whose altitude alt_m the caller knows better than |p| - r0
 // (ray_altitude): latitude and longitude come from p.
 void medium_at(vec3 p, float alt_m, out float sl, out float si) {
@@ -121,27 +177,129 @@ void medium_at(vec3 p, float alt_m, out float sl, out float si) {
 #endif
 }
 
+// One level of the pyramid at grid index g (see space_at): true when its brick there is empty, with
+// the distance the ray may jump; else the brick's largest extinction, and the distance it holds.
+bool level_empty(int l, vec3 g, float lat, float r, float mu_up, out float extent_m, out float brick_max) {
+  vec3 nb = vec3(u_bricks[l]);
+  float nodes = float(u_level_nodes[l]);
+  vec3 b = march_brick(g, nodes);
+  extent_m = march_brick_exit_m(lat, r, mu_up, g, b, nodes, nb, u_grid_start, u_grid_step, u_global_lat, u_r0);
+  brick_max = 0.0;
+  if (march_brick_inside(b, nb)) {
+    ivec3 bi = ivec3(b);
+    brick_max = u_min_max[u_level_offset[l] + (bi.z * u_bricks[l].y + bi.y) * u_bricks[l].x + bi.x].y;
+  }
+  return !(brick_max > 0.0);
+}
+
+// What a ray along dir learns about the space around p, at altitude alt_m
+// (core::ExtinctionPyramid::at): true when
+// empty, with the distance (m) it may jump; else the finest brick's largest extinction (1/m) and
+// the distance over which that holds. The levels are visited without a loop: llvmpipe ends the
+// loops of an invocation after 65535 iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS, shared by
+// every loop), and this runs inside both marches.
+bool space_at(vec3 p, float alt_m, vec3 dir, out float extent_m, out float sigma_max) {
+  extent_m = 0.0;
+  sigma_max = 0.0;
+  if (u_levels <= 0) return false;
+  vec3 g3 = ecef_to_sphere(p, u_r0);
+  float lat = g3.x / kDeg;
+  float r = u_r0 + alt_m;
+  float mu_up = dot(dir, p) / length(p);
+  vec3 g = march_grid_index(lat, g3.y / kDeg, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat);
+  float unused;
+  if (u_levels > 3 && level_empty(3, g, lat, r, mu_up, extent_m, unused)) return true;
+  if (u_levels > 2 && level_empty(2, g, lat, r, mu_up, extent_m, unused)) return true;
+  if (u_levels > 1 && level_empty(1, g, lat, r, mu_up, extent_m, unused)) return true;
+  return level_empty(0, g, lat, r, mu_up, extent_m, sigma_max);
+}
+
 // Optical depth of the clouds from p (at altitude alt_p, m) toward the sun, whose cosine and sine
-// with the local up at p are mu_sun and nu_sun: a march of u_sun_steps per shell segment.
+// with the local up at p are mu_sun and nu_sun: sun_steps per shell segment, empty bricks jumped,
+// stopped past u_sun_tau_limit. The shell's (at most two) segments and their steps run as one loop
+// (see space_at on loop counts). The cloud samples and the ground's shadow both use it.
 float cloud_sun_depth(vec3 p, float alt_p, float mu_sun, float nu_sun) {
   float hb = u_grid_start.z;
   float ht = u_grid_start.z + u_grid_step.z * (u_grid_count.z - 1.0);
   float tau_sun = 0.0;
   vec4 sseg;
   int sn = ray_shell_rel_nu(u_r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
-  for (int q = 0; q < sn; ++q) {
+  int total = sn * u_sun_steps;
+  float known_end = -1.0;  // what the pyramid said holds below this distance into the segment
+  for (int k = 0; k < total;) {
+    int q = k / u_sun_steps;
+    int j = k - q * u_sun_steps;
+    if (j == 0) known_end = -1.0;
     float s0 = q == 0 ? sseg.x : sseg.z;
     float s1 = q == 0 ? sseg.y : sseg.w;
     float ds = (s1 - s0) / float(u_sun_steps);
-    for (int j = 0; j < u_sun_steps; ++j) {
-      float s = s0 + (float(j) + 0.5) * ds;
-      float a;
-      float b;
-      medium_at(p + s * u_to_sun, ray_altitude(u_r0, alt_p, mu_sun, s), a, b);
-      tau_sun += (a + b) * ds;
+    float t_rel = (float(j) + 0.5) * ds;
+    vec3 ps = p + (s0 + t_rel) * u_to_sun;
+    float alt_s = ray_altitude(u_r0, alt_p, mu_sun, s0 + t_rel);
+    if (kSkipEmpty && !(t_rel < known_end)) {
+      float extent;
+      float smax;
+      if (space_at(ps, alt_s, u_to_sun, extent, smax)) {
+        int next = min(march_resume_index(j, extent, ds), u_sun_steps);
+        g_stats[kStatSunSkipped] += uint(next - j);
+        g_stats[kStatBricksJumped] += next - j > 1 ? 1u : 0u;
+        k += next - j;
+        continue;
+      }
+      known_end = t_rel + extent;
+    }
+    float a;
+    float b;
+    medium_at(ps, alt_s, a, b);
+    tau_sun += (a + b) * ds;
+    g_stats[kStatSunSamples] += 1u;
+    ++k;
+    if (tau_sun > u_sun_tau_limit) {
+      g_stats[kStatSunSkipped] += uint(total - k);
+      break;
     }
   }
   return tau_sun;
+}
+
+// One view sample at p (altitude alt_p, distance t along the ray) standing for a step of ds:
+// in-scattered light (sun through the air, ambient sky light), attenuation, and where the light
+// was taken out of the view (depth_w, depth_t: the cloud's mean depth for the sky around it).
+void march_sample(vec3 p, float alt_p, float t, float ds, float mu, MieParams mie, inout vec3 radiance, inout float t_view,
+                  inout float depth_w, inout float depth_t) {
+  float sl;
+  float si;
+  medium_at(p, alt_p, sl, si);
+  g_stats[kStatViewSamples] += 1u;
+  float sigma = sl + si;
+  if (sigma <= 0.0) return;
+  vec3 up_p = normalize(p);
+  float mu_sun = dot(u_to_sun, up_p);
+  float nu_sun = length(cross(u_to_sun, up_p));
+  float e0;
+  float e1;
+  bool lit = !(ray_sphere_rel_nu(u_r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
+  float tau_sun = lit ? cloud_sun_depth(p, alt_p, mu_sun, nu_sun) : 0.0;
+  // Sunlight reaches the sample through the air (reddened when low), and the sky lights it too.
+  vec3 sun_air = u_atmosphere && lit ? atmo_transmittance(u_r0, alt_p, mu_sun, nu_sun, u_atmo_sun_steps) : vec3(1.0);
+  vec3 ambient = u_atmosphere ? u_ambient * sky_irradiance(sun_air, mu_sun) * (sigma / CV_TWO_PI) : vec3(0.0);
+  float scatter = lit ? ms_octaves_mie(sl, mu, mie, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z) +
+                            ms_octaves_hg(si, mu, u_ice_g, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
+                      : 0.0;
+  radiance += t_view * segment_integral(u_irradiance * (sun_air * scatter + ambient), sigma, ds);
+  float t_next = t_view * transmittance(sigma * ds);
+  depth_w += t_view - t_next;
+  depth_t += (t_view - t_next) * t;
+  t_view = t_next;
+}
+
+// Adds this invocation's counts to the frame's, carrying into the high words.
+void flush_stats() {
+  for (int k = 0; k < 6; ++k) {
+    if (g_stats[k] == 0u) continue;
+    uint old = atomicAdd(u_stats[2 * k], g_stats[k]);
+    if (old > 0xFFFFFFFFu - g_stats[k]) atomicAdd(u_stats[2 * k + 1], 1u);
+  }
 }
 
 #include "sky_ground.glsl"
@@ -187,42 +345,61 @@ void main() {
   float t_view = 1.0;
   float depth_w = 0.0;  // sum over steps of the light each takes out of the view: where the cloud is
   float depth_t = 0.0;
-  for (int k = 0; k < n && t_view > 1e-6; ++k) {
+  bool crossed = false;
+  for (int k = 0; k < n && t_view > u_min_t; ++k) {
     float t_start = k == 0 ? seg.x : seg.z;
     float t_end = min(k == 0 ? seg.y : seg.w, t_ground);
     if (!(t_end > t_start)) continue;
+    crossed = true;
     int steps = max(1, int(ceil((t_end - t_start) / u_view_step)));
     float dt = (t_end - t_start) / float(steps);
     float offset = u_frame < 0 ? 0.5 : step_jitter(uint(px.x), uint(px.y), uint(u_frame));
-    for (int i = 0; i < steps && t_view > 1e-6; ++i) {
-      float t = t_start + (float(i) + offset) * dt;
-      vec3 p = origin + t * d;
-      float alt_p = ray_altitude(u_r0, h, mu_up, t);
-      float sl;
-      float si;
-      medium_at(p, alt_p, sl, si);
-      float sigma = sl + si;
-      if (sigma <= 0.0) continue;
-      vec3 up_p = normalize(p);
-      float mu_sun = dot(u_to_sun, up_p);
-      float nu_sun = length(cross(u_to_sun, up_p));
-      float e0;
-      float e1;
-      bool lit = !(ray_sphere_rel_nu(u_r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
-      float tau_sun = lit ? cloud_sun_depth(p, alt_p, mu_sun, nu_sun) : 0.0;
-      // Sunlight reaches the sample through the air (reddened when low), and the sky lights it too.
-      vec3 sun_air = u_atmosphere && lit ? atmo_transmittance(u_r0, alt_p, mu_sun, nu_sun, u_atmo_sun_steps) : vec3(1.0);
-      vec3 ambient = u_atmosphere ? u_ambient * sky_irradiance(sun_air, mu_sun) * (sigma / CV_TWO_PI) : vec3(0.0);
-      float scatter = lit ? ms_octaves_mie(sl, mu, mie, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z) +
-                                ms_octaves_hg(si, mu, u_ice_g, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
-                          : 0.0;
-      radiance += t_view * segment_integral(u_irradiance * (sun_air * scatter + ambient), sigma, dt);
-      float t_next = t_view * transmittance(sigma * dt);
-      depth_w += t_view - t_next;
-      depth_t += (t_view - t_next) * (t_start + (float(i) + offset) * dt);
-      t_view = t_next;
+    // What the pyramid said about the brick ahead: valid for sample distances below known_end.
+    float known_end = -1.0;
+    float sigma_max = 0.0;
+    // One loop iteration per sample, substeps included (see space_at on loop counts): sample j of
+    // the substeps of step i.
+    int i = 0;
+    int j = 0;
+    int substeps = 1;
+    while (i < steps && t_view > u_min_t) {
+      if (j == 0) {
+        float t_rel = (float(i) + offset) * dt;
+        if ((kSkipEmpty || kAdaptive) && !(t_rel < known_end)) {
+          float extent;
+          float t_q = t_start + t_rel;
+          bool empty = space_at(origin + t_q * d, ray_altitude(u_r0, h, mu_up, t_q), d, extent, sigma_max);
+          if (empty && kSkipEmpty) {
+            int next = march_resume_index(i, extent, dt);
+            g_stats[kStatViewSkipped] += uint(min(next, steps) - i);
+            g_stats[kStatBricksJumped] += next - i > 1 ? 1u : 0u;
+            i = next;
+            continue;
+          }
+          known_end = t_rel + extent;
+        }
+        substeps = 1;
+        if (kAdaptive && march_substeps(sigma_max, dt, u_max_step_tau) > 1) {
+          // The brick's bound is loose (a brick spans 4 cells and more): bound the step by the
+          // cells at its two ends instead, so only steps near thick cloud are divided.
+          float ta = t_start + float(i) * dt;
+          float tb = t_start + float(i + 1) * dt;
+          float bound = max(cell_max(origin + ta * d, ray_altitude(u_r0, h, mu_up, ta)),
+                            cell_max(origin + tb * d, ray_altitude(u_r0, h, mu_up, tb)));
+          substeps = march_substeps(bound, dt, u_max_step_tau);
+        }
+      }
+      float ds = dt / float(substeps);
+      float t = t_start + (float(i) + (float(j) + offset) / float(substeps)) * dt;
+      march_sample(origin + t * d, ray_altitude(u_r0, h, mu_up, t), t, ds, mu, mie, radiance, t_view, depth_w, depth_t);
+      if (++j == substeps) {
+        j = 0;
+        ++i;
+      }
     }
   }
+  g_stats[kStatRaysMissed] += crossed ? 0u : 1u;
+  flush_stats();
   if (u_atmosphere || u_globe) {
     // The cloud stands, for the air around it, at the mean depth of the light it takes out.
     vec3 p_cloud = origin + (depth_w > 0.0 ? depth_t / depth_w : 0.0) * d;

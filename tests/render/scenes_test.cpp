@@ -56,6 +56,28 @@ TEST_P(StandardScenes, GpuMatchesTheCpuReferenceWithEveryPixelFinite) {
   EXPECT_LT(worst_t, 1e-3);
 }
 
+// Skipping empty bricks must not change the image: every skipped sample would have read exactly
+// 0, including beside a regional grid's edge, where the data fades out over a border cell.
+TEST_P(StandardScenes, SkippingEmptySpaceLeavesTheImageExactlyAsItWas) {
+  core::StandardScene sc = core::standard_scene(GetParam(), 32, 18);
+  const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
+  sc.march.skip_empty = false;
+  const auto plain = core::render_reference(sc.grid, medium, sc.camera, sc.sun, sc.march);
+  sc.march.skip_empty = true;
+  const auto skipped = core::render_reference(sc.grid, medium, sc.camera, sc.sun, sc.march);
+  for (std::size_t i = 0; i < plain.radiance.size(); ++i) {
+    ASSERT_EQ(plain.radiance[i], skipped.radiance[i]) << sc.name << " pixel " << i;
+    ASSERT_EQ(plain.transmittance[i], skipped.transmittance[i]) << sc.name << " pixel " << i;
+  }
+  std::printf("%-14s skipping: %llu of %llu view positions and %llu sun positions left out, same image\n", sc.name.c_str(),
+              static_cast<unsigned long long>(skipped.stats.view_skipped),
+              static_cast<unsigned long long>(plain.stats.view_samples),
+              static_cast<unsigned long long>(skipped.stats.sun_skipped));
+  if (sc.name != "clear_sky" && sc.name != "inside_cloud") {
+    EXPECT_GT(skipped.stats.view_skipped, 0u) << sc.name;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(All, StandardScenes, ::testing::ValuesIn(core::standard_scene_names()),
                          [](const auto& info) { return info.param; });
 
