@@ -81,6 +81,7 @@ void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExt
   }
   check_gl("uploading the volume's extinction textures");
   grid_ = grid;
+  layer_ = core::cloud_layer(grid, medium);
   // The pyramid for empty-space skipping and adapted steps, all levels in one buffer.
   pyramid_ = core::ExtinctionPyramid(grid, medium.liquid_per_m, medium.ice_per_m);
   std::vector<glm::vec2> packed;
@@ -118,6 +119,8 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glProgramUniform1i(p, loc(p, "u_wraps"), grid_.wraps_lon() ? 1 : 0);
   glProgramUniform1i(p, loc(p, "u_global_lat"), core::VolumeSampler(grid_, unused).global_lat() ? 1 : 0);
   glProgramUniform1f(p, loc(p, "u_view_step"), static_cast<float>(s.view_step_m));
+  glProgramUniform2f(p, loc(p, "u_layer"), static_cast<float>(layer_.bottom_m), static_cast<float>(layer_.top_m));
+  glProgramUniform1i(p, loc(p, "u_cloudless"), layer_.empty ? 1 : 0);
   glProgramUniform1i(p, loc(p, "u_sun_steps"), s.sun_steps);
   glProgramUniform1i(p, loc(p, "u_octaves"), s.octaves);
   set3(p, "u_octave_abc", {s.octave_a, s.octave_b, s.octave_c});

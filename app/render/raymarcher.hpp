@@ -70,6 +70,7 @@ class GpuRaymarcher {
   std::string ground_path_;
   GLuint pyramid_buffer_ = 0, stats_buffer_ = 0;
   core::ExtinctionPyramid pyramid_;
+  core::CloudLayer layer_;  // the altitudes that hold cloud: the shell the march intersects
   bool stats_read_ = true;
   core::VolumeGrid grid_;
   core::MarchStats stats_;

@@ -74,7 +74,7 @@ struct Medium {
   double sun_depth(const glm::dvec3& p, double alt_p, double mu_sun, double nu_sun, const glm::dvec3& to_sun,
                    int sun_steps) const {
     glm::dvec4 sseg;
-    const int sn = p64::ray_shell_rel_nu(grid.earth_radius_m, alt_p, mu_sun, nu_sun, grid.alt_m.start, grid.alt_m.last(), sseg);
+    const int sn = layer.empty ? 0 : p64::ray_shell_rel_nu(grid.earth_radius_m, alt_p, mu_sun, nu_sun, layer.bottom_m, layer.top_m, sseg);
     double tau = 0.0;
     for (int q = 0; q < sn; ++q) {
       const double ds = (sseg[2 * q + 1] - sseg[2 * q]) / sun_steps;
@@ -108,6 +108,7 @@ struct Medium {
   }
   const std::vector<float>& liquid_per_m;
   const std::vector<float>& ice_per_m;
+  CloudLayer layer;
   bool wraps = false, global_lat = false;
   const ExtinctionPyramid* pyramid = nullptr;
   bool skip_empty = false;
@@ -195,6 +196,29 @@ GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepDa
   return m;
 }
 
+CloudLayer cloud_layer(const VolumeGrid& grid, const GridMeanExtinction& medium) {
+  const std::size_t per_level = grid.columns();
+  int lo = -1, hi = -1;
+  for (int k = 0; k < grid.alt_m.count; ++k) {
+    bool any = false;
+    for (const std::vector<float>* f : {&medium.liquid_per_m, &medium.ice_per_m}) {
+      if (f->empty()) continue;
+      const auto first = f->begin() + static_cast<std::ptrdiff_t>(per_level * k);
+      any = any || std::any_of(first, first + static_cast<std::ptrdiff_t>(per_level), [](float v) { return v > 0.0f; });
+    }
+    if (any) {
+      if (lo < 0) lo = k;
+      hi = k;
+    }
+  }
+  CloudLayer l;
+  if (lo < 0) return l;
+  l.empty = false;
+  l.bottom_m = grid.alt_m.at(std::max(lo - 1, 0));
+  l.top_m = grid.alt_m.at(std::min(hi + 1, grid.alt_m.count - 1));
+  return l;
+}
+
 CameraFrame camera_frame(const Camera& cam) {
   const geo::EnuFrame f = geo::sphere_enu(cam.lat_deg, cam.lon_deg);
   const double h = cam.heading_deg * kDeg, pitch = cam.pitch_deg * kDeg;
@@ -234,6 +258,8 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
     if (!(s.noise_scale_m > 0.0)) throw std::invalid_argument("render_reference: noise_scale_m must be > 0");
     erosion = {noise, noise_anchor(grid_centre_ecef(grid), s.noise_scale_m), s.noise_scale_m, s.noise_amount};
   }
+  // Only the layer that holds cloud is marched (and nothing when none does).
+  const CloudLayer layer = cloud_layer(grid, ext);
   const bool use_pyramid = s.skip_empty || s.adaptive_steps;
   const ExtinctionPyramid pyramid =
       use_pyramid ? ExtinctionPyramid(grid, ext.liquid_per_m, ext.ice_per_m) : ExtinctionPyramid();
@@ -244,6 +270,7 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
                       erosion,
                       ext.liquid_per_m,
                       ext.ice_per_m,
+                      layer,
                       grid.wraps_lon(),
                       liquid_sampler.global_lat(),
                       &pyramid,
@@ -251,7 +278,7 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
                       p64::sun_march_tau_limit(s.octaves, s.octave_a, s.min_transmittance),
                       &img.stats};
   const double r0 = grid.earth_radius_m;
-  const double hb = grid.alt_m.start, ht = grid.alt_m.last();
+  const double hb = layer.bottom_m, ht = layer.top_m;
   const glm::dvec3 o = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);
   const glm::dvec3 to_sun = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0));
   const p64::MieParams mie = p64::mie_params(s.droplet_diameter_um);
@@ -280,7 +307,7 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
         }
       }
       glm::dvec4 seg;
-      const int n = in_shell ? p64::ray_shell_rel_nu(r0, h, mu_up, nu_up, hb, ht, seg) : 0;
+      const int n = in_shell && !layer.empty ? p64::ray_shell_rel_nu(r0, h, mu_up, nu_up, hb, ht, seg) : 0;
       // The ground ends the ray.
       double tg0, tg1;
       const double t_ground = p64::ray_sphere_rel_nu(r0, h, mu_up, nu_up, 0.0, tg0, tg1) && tg1 > 0.0 ? std::max(tg0, 0.0) : 1e300;

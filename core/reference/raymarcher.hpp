@@ -99,6 +99,16 @@ struct GridMeanExtinction {
 };
 GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepData& data);
 
+// The altitudes between which a volume holds cloud: from the level below its lowest level with any
+// extinction to the level above its highest (trilinear sampling reads cloud between those), so the
+// marchers intersect this thinner shell and never step through layers that hold nothing. `empty`
+// when no node holds cloud: then nothing is marched at all.
+struct CloudLayer {
+  double bottom_m = 0.0, top_m = 0.0;
+  bool empty = true;
+};
+CloudLayer cloud_layer(const VolumeGrid& grid, const GridMeanExtinction& medium);
+
 // A camera's orientation in Earth-centred coordinates, and its half-width: pixel (px, py) looks
 // along forward + x right + y up with x, y in [-tan_half, tan_half] (y scaled by the aspect).
 struct CameraFrame {

@@ -32,6 +32,8 @@ uniform vec3 u_grid_count;
 uniform bool u_wraps;
 uniform bool u_global_lat;
 uniform float u_view_step;
+uniform vec2 u_layer;         // altitudes (m) between which the data holds cloud (core::cloud_layer)
+uniform bool u_cloudless;     // no cloud anywhere: nothing to march
 uniform int u_sun_steps;
 uniform int u_octaves;
 uniform vec3 u_octave_abc;
@@ -219,11 +221,11 @@ bool space_at(vec3 p, float alt_m, vec3 dir, out float extent_m, out float sigma
 // stopped past u_sun_tau_limit. The shell's (at most two) segments and their steps run as one loop
 // (see space_at on loop counts). The cloud samples and the ground's shadow both use it.
 float cloud_sun_depth(vec3 p, float alt_p, float mu_sun, float nu_sun) {
-  float hb = u_grid_start.z;
-  float ht = u_grid_start.z + u_grid_step.z * (u_grid_count.z - 1.0);
+  float hb = u_layer.x;
+  float ht = u_layer.y;
   float tau_sun = 0.0;
   vec4 sseg;
-  int sn = ray_shell_rel_nu(u_r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
+  int sn = u_cloudless ? 0 : ray_shell_rel_nu(u_r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
   int total = sn * u_sun_steps;
   float known_end = -1.0;  // what the pyramid said holds below this distance into the segment
   for (int k = 0; k < total;) {
@@ -310,8 +312,8 @@ void main() {
   float x = (2.0 * (float(px.x) + 0.5) / float(u_size.x) - 1.0) * u_tan_half;
   float y = (1.0 - 2.0 * (float(px.y) + 0.5) / float(u_size.y)) * u_tan_half * float(u_size.y) / float(u_size.x);
   vec3 d = normalize(u_forward + x * u_right + y * u_upv);
-  float hb = u_grid_start.z;
-  float ht = u_grid_start.z + u_grid_step.z * (u_grid_count.z - 1.0);
+  float hb = u_layer.x;
+  float ht = u_layer.y;
   // A camera above the shell marches from where its ray enters the shell, placed on the exact
   // sphere: positions near the Earth keep their digits (at 4e8 m a float position is +-32 m), and
   // nu = |d x up| keeps near-nadir and near-tangent rays right where mu rounds to +-1.
@@ -335,7 +337,7 @@ void main() {
     }
   }
   vec4 seg;
-  int n = in_shell ? ray_shell_rel_nu(u_r0, h, mu_up, nu_up, hb, ht, seg) : 0;
+  int n = in_shell && !u_cloudless ? ray_shell_rel_nu(u_r0, h, mu_up, nu_up, hb, ht, seg) : 0;
   float tg0;
   float tg1;
   float t_ground = ray_sphere_rel_nu(u_r0, h, mu_up, nu_up, 0.0, tg0, tg1) && tg1 > 0.0 ? max(tg0, 0.0) : 3.0e38;

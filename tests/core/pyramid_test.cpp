@@ -163,7 +163,9 @@ TEST(Pyramid, SkippingEmptySpaceLeavesTheImageUnchanged) {
     EXPECT_EQ(plain.stats.view_samples, skip.stats.view_samples + skip.stats.view_skipped);
     // The box is mostly empty; what stays is the tower itself (measured: 198 134 -> 55 208).
     EXPECT_LT(skip.stats.view_samples * 3, plain.stats.view_samples);
-    EXPECT_LT(skip.stats.sun_samples, plain.stats.sun_samples);
+    // The sun march runs only through the layer that holds cloud (cloud_layer), which already leaves
+    // out the empty air above the tower: skipping may find nothing more there.
+    EXPECT_LE(skip.stats.sun_samples, plain.stats.sun_samples);
   }
 }
 

@@ -127,7 +127,7 @@ TEST(Accel, SkippingEmptyBricksLeavesTheGpuImageUnchanged) {
     // Every step position was sampled or skipped, and skipping saved most of them.
     EXPECT_EQ(plain_stats.view_samples, skip_stats.view_samples + skip_stats.view_skipped);
     EXPECT_LT(skip_stats.view_samples * 2, plain_stats.view_samples);
-    EXPECT_LT(skip_stats.sun_samples, plain_stats.sun_samples);
+    EXPECT_LE(skip_stats.sun_samples, plain_stats.sun_samples);  // the cloud layer may leave nothing to skip
     EXPECT_GT(skip_stats.bricks_jumped, 0u);
     // The GPU marches the reference's samples: its counts agree within the few decisions that
     // float rounding tips the other way.

@@ -73,7 +73,8 @@ TEST_P(StandardScenes, SkippingEmptySpaceLeavesTheImageExactlyAsItWas) {
               static_cast<unsigned long long>(skipped.stats.view_skipped),
               static_cast<unsigned long long>(plain.stats.view_samples),
               static_cast<unsigned long long>(skipped.stats.sun_skipped));
-  if (sc.name != "clear_sky" && sc.name != "inside_cloud") {
+  // Broken cloud leaves empty bricks inside the cloud layer (the decks and bands fill theirs).
+  if (sc.name == "cumulus_field" || sc.name == "towering_cell" || sc.name == "sunset" || sc.name == "pole") {
     EXPECT_GT(skipped.stats.view_skipped, 0u) << sc.name;
   }
 }
