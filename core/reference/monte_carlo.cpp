@@ -47,7 +47,9 @@ void MonteCarloStats::add(const MonteCarloStats& o) {
 
 // ---- accumulator ----
 
-glm::dvec3 MonteCarloImage::mean(std::size_t i) const { return spp ? sum[i] / static_cast<double>(spp) : glm::dvec3(0.0); }
+glm::dvec3 MonteCarloImage::mean(std::size_t i) const {
+  return spp ? sum[i] / static_cast<double>(spp) : glm::dvec3(0.0);
+}
 
 glm::dvec3 MonteCarloImage::standard_error(std::size_t i) const {
   if (spp < 2) return glm::dvec3(kInf);
@@ -58,7 +60,9 @@ glm::dvec3 MonteCarloImage::standard_error(std::size_t i) const {
   return glm::sqrt(var / n);
 }
 
-double MonteCarloImage::luminance(std::size_t i) const { return spp ? lum_sum[i] / static_cast<double>(spp) : 0.0; }
+double MonteCarloImage::luminance(std::size_t i) const {
+  return spp ? lum_sum[i] / static_cast<double>(spp) : 0.0;
+}
 
 double MonteCarloImage::luminance_standard_error(std::size_t i) const {
   if (spp < 2) return kInf;
@@ -90,17 +94,22 @@ std::vector<glm::dvec3> MonteCarloImage::radiance() const {
 // ---- random numbers ----
 
 PathRng::PathRng(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample)
-    : key_(mix64(mix64(seed + kGolden) ^ mix64(pixel * 0xD1B54A32D192ED03ull + 1) ^ mix64(sample * kGolden + 7))) {}
+    : key_(mix64(mix64(seed + kGolden) ^ mix64(pixel * 0xD1B54A32D192ED03ull + 1) ^
+                 mix64(sample * kGolden + 7))) {}
 
-double PathRng::uniform() { return static_cast<double>(mix64(key_ + (++counter_) * kGolden) >> 11) * 0x1.0p-53; }
+double PathRng::uniform() {
+  return static_cast<double>(mix64(key_ + (++counter_) * kGolden) >> 11) * 0x1.0p-53;
+}
 
-std::uint32_t PathRng::bits32() { return static_cast<std::uint32_t>(mix64(key_ + (++counter_) * kGolden) >> 32); }
+std::uint32_t PathRng::bits32() {
+  return static_cast<std::uint32_t>(mix64(key_ + (++counter_) * kGolden) >> 32);
+}
 
 // ---- the tracer ----
 
-MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExtinction& ext, const Camera& cam,
-                                       const Sun& sun, const MarchSettings& march, const MonteCarloSettings& mc,
-                                       const ErosionNoise* noise)
+MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExtinction& ext,
+                                       const Camera& cam, const Sun& sun, const MarchSettings& march,
+                                       const MonteCarloSettings& mc, const ErosionNoise* noise)
     : grid_(grid),
       ext_(ext),
       cam_(cam),
@@ -111,7 +120,8 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
       liquid_(grid, ext.liquid_per_m),
       ice_(grid, ext.ice_per_m) {
   if (march.atmosphere) {
-    throw std::invalid_argument("monte carlo: atmosphere on is not modelled (clouds only, optionally the globe)");
+    throw std::invalid_argument(
+        "monte carlo: atmosphere on is not modelled (clouds only, optionally the globe)");
   }
   if (mc.max_bounces < 1) throw std::invalid_argument("monte carlo: max_bounces must be >= 1");
   if (march.noise_amount > 0.0) {
@@ -128,7 +138,8 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
     majorant_ = std::max(majorant_, l + c);
   }
   if (mc.brick_majorants) pyramid_ = ExtinctionPyramid(grid, ext.liquid_per_m, ext.ice_per_m);
-  to_sun_ = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, grid.earth_radius_m));
+  to_sun_ = glm::normalize(
+      geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, grid.earth_radius_m));
 }
 
 void MonteCarloRenderer::extinction(const glm::dvec3& p, double& sl, double& si) const {
@@ -139,15 +150,16 @@ void MonteCarloRenderer::extinction(const glm::dvec3& p, double& sl, double& si)
   if (noise_ && march_.noise_amount > 0.0 && sl + si > 0.0) {
     // The same erosion as the raymarcher's (shaders/common/erosion.glsl), anchored at the grid centre.
     const glm::dvec3 t = p64::noise_tile_coords(p - anchor_.ecef_m, anchor_.frac, march_.noise_scale_m);
-    const double e = p64::erosion_threshold(noise_->low.sample(t), noise_->high.sample(p64::noise_high_coords(t)),
-                                            march_.noise_amount);
+    const double e = p64::erosion_threshold(
+        noise_->low.sample(t), noise_->high.sample(p64::noise_high_coords(t)), march_.noise_amount);
     const double feature_m = p64::noise_feature_m(march_.noise_scale_m);
     sl = p64::erode_extinction(sl, e, feature_m);
     si = p64::erode_extinction(si, e, feature_m);
   }
 }
 
-int MonteCarloRenderer::shell_parts(const glm::dvec3& p, const glm::dvec3& d, double seg[4], double& t_ground) const {
+int MonteCarloRenderer::shell_parts(const glm::dvec3& p, const glm::dvec3& d, double seg[4],
+                                    double& t_ground) const {
   const double r0 = grid_.earth_radius_m;
   const double r = glm::length(p), alt = r - r0;
   const glm::dvec3 up = p / r;
@@ -174,8 +186,8 @@ int MonteCarloRenderer::shell_parts(const glm::dvec3& p, const glm::dvec3& d, do
   return kept;
 }
 
-void MonteCarloRenderer::majorant_at(const glm::dvec3& p, const glm::dvec3& d, double t, double t_end, double& sigma_max,
-                                     double& t_valid) const {
+void MonteCarloRenderer::majorant_at(const glm::dvec3& p, const glm::dvec3& d, double t, double t_end,
+                                     double& sigma_max, double& t_valid) const {
   sigma_max = majorant_;
   t_valid = t_end;
   if (!mc_.brick_majorants) return;
@@ -188,8 +200,8 @@ void MonteCarloRenderer::majorant_at(const glm::dvec3& p, const glm::dvec3& d, d
   t_valid = std::min(t + sp.extent_m, t_end);
 }
 
-double MonteCarloRenderer::free_path(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng, MonteCarloStats& st,
-                                     double* ground_m) const {
+double MonteCarloRenderer::free_path(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng,
+                                     MonteCarloStats& st, double* ground_m) const {
   double seg[4], t_ground;
   const int n = shell_parts(p, d, seg, t_ground);
   if (ground_m) *ground_m = t_ground;
@@ -279,8 +291,9 @@ MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec
       // Next-event estimation: the sun is a delta light, reachable only this way. The scattering
       // cosine is between the sunlight's propagation (-to_sun) and the light's toward the camera (-d).
       const double mu = glm::dot(d, to_sun_);
-      const double phase = sigma > 0.0 ? (sl * p64::phase_mie(mu, mie) + si * p64::phase_hg(mu, march_.ice_g)) / sigma
-                                       : p64::phase_isotropic();
+      const double phase = sigma > 0.0
+                               ? (sl * p64::phase_mie(mu, mie) + si * p64::phase_hg(mu, march_.ice_g)) / sigma
+                               : p64::phase_isotropic();
       r.radiance += beta * sun_.irradiance * (phase * transmittance(p, to_sun_, rng, st));
       if (r.scatterings >= mc_.max_bounces) {
         r.end = End::Truncated;
@@ -306,7 +319,8 @@ MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec
       const double mu_s = glm::dot(n, to_sun_);
       if (mu_s > 0.0) {
         const double tr = transmittance(p, to_sun_, rng, st);
-        r.radiance += beta * sun_.irradiance * p64::ground_radiance(march_.ground_albedo, mu_s, glm::dvec3(tr), glm::dvec3(0.0));
+        r.radiance += beta * sun_.irradiance *
+                      p64::ground_radiance(march_.ground_albedo, mu_s, glm::dvec3(tr), glm::dvec3(0.0));
       }
       r.absorbed += beta * (glm::dvec3(1.0) - march_.ground_albedo);
       beta *= march_.ground_albedo;
@@ -349,7 +363,8 @@ MonteCarloImage MonteCarloRenderer::start() const {
 }
 
 void MonteCarloRenderer::add_samples(MonteCarloImage& img, int spp) const {
-  if (img.width != cam_.width || img.height != cam_.height || img.sum.size() != static_cast<std::size_t>(cam_.width) * cam_.height) {
+  if (img.width != cam_.width || img.height != cam_.height ||
+      img.sum.size() != static_cast<std::size_t>(cam_.width) * cam_.height) {
     throw std::invalid_argument("monte carlo: the accumulator was not made for this camera");
   }
   if (spp <= 0) return;
@@ -371,7 +386,8 @@ void MonteCarloRenderer::add_samples(MonteCarloImage& img, int spp) const {
         if (cam_.alt_m > ht) {
           const glm::dvec3 up = glm::normalize(cam_ecef);
           double e0, e1;
-          if (!p64::ray_sphere_rel_nu(r0, cam_.alt_m, glm::dot(d, up), glm::length(glm::cross(d, up)), ht, e0, e1) ||
+          if (!p64::ray_sphere_rel_nu(r0, cam_.alt_m, glm::dot(d, up), glm::length(glm::cross(d, up)), ht, e0,
+                                      e1) ||
               e1 < 0.0) {
             misses = true;
           } else if (e0 > 0.0) {
@@ -403,9 +419,9 @@ void MonteCarloRenderer::add_samples(MonteCarloImage& img, int spp) const {
   img.spp += static_cast<std::uint64_t>(spp);
 }
 
-MonteCarloImage render_monte_carlo(const VolumeGrid& grid, const GridMeanExtinction& medium, const Camera& cam,
-                                   const Sun& sun, const MarchSettings& march, const MonteCarloSettings& mc, int spp,
-                                   const ErosionNoise* noise) {
+MonteCarloImage render_monte_carlo(const VolumeGrid& grid, const GridMeanExtinction& medium,
+                                   const Camera& cam, const Sun& sun, const MarchSettings& march,
+                                   const MonteCarloSettings& mc, int spp, const ErosionNoise* noise) {
   const MonteCarloRenderer r(grid, medium, cam, sun, march, mc, noise);
   MonteCarloImage img = r.start();
   r.add_samples(img, spp);

@@ -38,21 +38,21 @@ struct MonteCarloSettings {
 // What the tracer did, summed over all samples (integers: the same for any thread count).
 struct MonteCarloStats {
   std::uint64_t paths = 0;
-  std::uint64_t scatterings = 0;       // real collisions in cloud, plus ground bounces
-  std::uint64_t null_collisions = 0;   // tentative collisions rejected by delta tracking
-  std::uint64_t shadow_lookups = 0;    // medium lookups of ratio tracking toward the sun
-  std::uint64_t truncated = 0;         // paths stopped at max_bounces while still in flight
-  std::uint64_t roulette_killed = 0;   // paths ended by Russian roulette
-  std::uint64_t majorant_exceeded = 0; // lookups above their majorant (a bug if ever non-zero)
+  std::uint64_t scatterings = 0;        // real collisions in cloud, plus ground bounces
+  std::uint64_t null_collisions = 0;    // tentative collisions rejected by delta tracking
+  std::uint64_t shadow_lookups = 0;     // medium lookups of ratio tracking toward the sun
+  std::uint64_t truncated = 0;          // paths stopped at max_bounces while still in flight
+  std::uint64_t roulette_killed = 0;    // paths ended by Russian roulette
+  std::uint64_t majorant_exceeded = 0;  // lookups above their majorant (a bug if ever non-zero)
   void add(const MonteCarloStats& o);
 };
 
 // A progressive estimate: running sums per pixel, from which the mean and its standard error follow.
 struct MonteCarloImage {
   int width = 0, height = 0;
-  std::uint64_t spp = 0;                 // samples per pixel so far
-  std::vector<glm::dvec3> sum, sum_sq;   // of per-sample radiance (per unit sun irradiance times it)
-  std::vector<double> lum_sum, lum_sq;   // of per-sample luminance (Rec. 709 weights)
+  std::uint64_t spp = 0;                // samples per pixel so far
+  std::vector<glm::dvec3> sum, sum_sq;  // of per-sample radiance (per unit sun irradiance times it)
+  std::vector<double> lum_sum, lum_sq;  // of per-sample luminance (Rec. 709 weights)
   MonteCarloStats stats;
 
   glm::dvec3 mean(std::size_t i) const;
@@ -80,8 +80,9 @@ class MonteCarloRenderer {
  public:
   // `noise` is needed when march.noise_amount > 0. Throws std::invalid_argument for settings the
   // tracer does not model (march.atmosphere: the air's scattering and the sky light).
-  MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExtinction& medium, const Camera& cam, const Sun& sun,
-                     const MarchSettings& march, const MonteCarloSettings& mc, const ErosionNoise* noise = nullptr);
+  MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExtinction& medium, const Camera& cam,
+                     const Sun& sun, const MarchSettings& march, const MonteCarloSettings& mc,
+                     const ErosionNoise* noise = nullptr);
 
   // An empty accumulator for this camera.
   MonteCarloImage start() const;
@@ -138,8 +139,9 @@ class MonteCarloRenderer {
 };
 
 // One call: a fresh accumulator with `spp` samples per pixel.
-MonteCarloImage render_monte_carlo(const VolumeGrid& grid, const GridMeanExtinction& medium, const Camera& cam,
-                                   const Sun& sun, const MarchSettings& march, const MonteCarloSettings& mc, int spp,
+MonteCarloImage render_monte_carlo(const VolumeGrid& grid, const GridMeanExtinction& medium,
+                                   const Camera& cam, const Sun& sun, const MarchSettings& march,
+                                   const MonteCarloSettings& mc, int spp,
                                    const ErosionNoise* noise = nullptr);
 
 }  // namespace cv::core

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include <glm/glm.hpp>
 
@@ -32,7 +33,9 @@ struct Slab {
     ext.liquid_per_m.assign(grid.points(), static_cast<float>(sigma_per_m));
     ext.ice_per_m.assign(grid.points(), 0.0f);
   }
-  double stored_sigma() const { return static_cast<double>(ext.liquid_per_m[0]); }  // the float the grid holds
+  double stored_sigma() const {
+    return static_cast<double>(ext.liquid_per_m[0]);
+  }  // the float the grid holds
 };
 
 Camera nadir_pixel() {
@@ -44,7 +47,9 @@ Camera nadir_pixel() {
   return c;
 }
 
-glm::dvec3 ecef(double lat, double lon, double alt) { return cv::geo::sphere_to_ecef({lat, lon, alt}, 6371000.0); }
+glm::dvec3 ecef(double lat, double lon, double alt) {
+  return cv::geo::sphere_to_ecef({lat, lon, alt}, 6371000.0);
+}
 
 TEST(MonteCarlo, UnscatteredTransmissionThroughASlabIsExpMinusTau) {
   // From below the slab straight up (a ray down would end on the Earth, which casts shadow).
@@ -71,9 +76,12 @@ TEST(MonteCarlo, UnscatteredTransmissionThroughASlabIsExpMinusTau) {
       const double frac = static_cast<double>(crossed) / n;
       const double se_binomial = std::sqrt(expected * (1.0 - expected) / n);
       // Ratio tracking: the sample mean with its own standard error.
-      const double mean = ratio_sum / n, se_ratio = std::sqrt(std::max(ratio_sq / n - mean * mean, 0.0) / (n - 1));
-      std::printf("tau %.1f bricks %d: exp(-tau) %.5f  delta tracking %.5f (%.2f se)  ratio tracking %.5f (%.2f se)\n",
-                  tau, bricks, expected, frac, (frac - expected) / se_binomial, mean, (mean - expected) / se_ratio);
+      const double mean = ratio_sum / n,
+                   se_ratio = std::sqrt(std::max(ratio_sq / n - mean * mean, 0.0) / (n - 1));
+      std::printf(
+          "tau %.1f bricks %d: exp(-tau) %.5f  delta tracking %.5f (%.2f se)  ratio tracking %.5f (%.2f "
+          "se)\n",
+          tau, bricks, expected, frac, (frac - expected) / se_binomial, mean, (mean - expected) / se_ratio);
       EXPECT_LT(std::abs(frac - expected), kSigmas * se_binomial) << tau;
       EXPECT_LT(std::abs(mean - expected), kSigmas * se_ratio) << tau;
       EXPECT_EQ(st.majorant_exceeded, 0u);
@@ -88,7 +96,8 @@ TEST(MonteCarlo, ANonAbsorbingSlabConservesEnergy) {
   const Slab slab(4e-3, 5.0);
   const glm::dvec3 p = ecef(0.0, 0.0, 3000.0), down = -glm::normalize(p);
   {
-    const MonteCarloRenderer r(slab.grid, slab.ext, nadir_pixel(), Sun{}, MarchSettings{}, MonteCarloSettings{});
+    const MonteCarloRenderer r(slab.grid, slab.ext, nadir_pixel(), Sun{}, MarchSettings{},
+                               MonteCarloSettings{});
     const int n = 20000;
     MonteCarloStats st;
     int up = 0, ground = 0, lost = 0;
@@ -100,8 +109,8 @@ TEST(MonteCarlo, ANonAbsorbingSlabConservesEnergy) {
       lost += res.end == MonteCarloRenderer::End::Truncated || res.end == MonteCarloRenderer::End::Roulette;
     }
     const double rr = static_cast<double>(up) / n, tt = static_cast<double>(ground) / n;
-    std::printf("conservative slab tau 4: R %.4f  T %.4f  R + T %.4f  lost %d  mean scatterings %.1f\n", rr, tt, rr + tt,
-                lost, static_cast<double>(st.scatterings) / n);
+    std::printf("conservative slab tau 4: R %.4f  T %.4f  R + T %.4f  lost %d  mean scatterings %.1f\n", rr,
+                tt, rr + tt, lost, static_cast<double>(st.scatterings) / n);
     EXPECT_EQ(lost, 0);
     EXPECT_EQ(up + ground, n);
     // The transmitted share includes the unscattered exp(-4) = 1.8 %; forward-peaked scattering
@@ -129,8 +138,9 @@ TEST(MonteCarlo, ANonAbsorbingSlabConservesEnergy) {
       sq += e * e;
     }
     const double mean = sum / n, se = std::sqrt(std::max(sq / n - mean * mean, 0.0) / (n - 1));
-    std::printf("slab over albedo 0.5 ground: escaped + absorbed %.4f +- %.4f, %llu paths ended by roulette\n", mean, se,
-                static_cast<unsigned long long>(st.roulette_killed));
+    std::printf(
+        "slab over albedo 0.5 ground: escaped + absorbed %.4f +- %.4f, %llu paths ended by roulette\n", mean,
+        se, static_cast<unsigned long long>(st.roulette_killed));
     EXPECT_GT(st.roulette_killed, 0u);
     EXPECT_EQ(st.truncated, 0u);
     EXPECT_LT(std::abs(mean - 1.0), kSigmas * se);
@@ -164,7 +174,8 @@ TEST(MonteCarlo, SingleScatteringAgreesWithTheRaymarcher) {
   mc.max_bounces = 1;
   mc.seed = 3;
   t0 = std::chrono::steady_clock::now();
-  const MonteCarloImage img = render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m, mc, 512);
+  const MonteCarloImage img =
+      render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m, mc, 512);
   const double t_mc = seconds_since(t0);
   double z2 = 0.0, z_max = 0.0, diff_sum = 0.0, var_sum = 0.0, ref_sum = 0.0;
   int lit = 0;
@@ -184,10 +195,11 @@ TEST(MonteCarlo, SingleScatteringAgreesWithTheRaymarcher) {
   }
   const double npx = static_cast<double>(ref.radiance.size());
   const double bias = diff_sum / npx, bias_se = std::sqrt(var_sum) / npx;
-  std::printf("single scattering, stratocumulus 24x14: reference %.2f s, MC 512 spp %.2f s (mean rel. s.e. %.4f); "
-              "%d cloudy pixels, mean z^2 %.3f, max |z| %.2f, mean bias %.3g +- %.3g (%.3g of the mean radiance)\n",
-              t_ref, t_mc, img.mean_relative_standard_error(), lit, z2 / std::max(lit, 1), z_max, bias, bias_se,
-              bias / (ref_sum / npx));
+  std::printf(
+      "single scattering, stratocumulus 24x14: reference %.2f s, MC 512 spp %.2f s (mean rel. s.e. %.4f); "
+      "%d cloudy pixels, mean z^2 %.3f, max |z| %.2f, mean bias %.3g +- %.3g (%.3g of the mean radiance)\n",
+      t_ref, t_mc, img.mean_relative_standard_error(), lit, z2 / std::max(lit, 1), z_max, bias, bias_se,
+      bias / (ref_sum / npx));
   ASSERT_GT(lit, 50);
   // Each pixel within the noise; the z^2 average near 1 says the standard error is itself right
   // (for `lit` independent pixels its spread is sqrt(2 / lit) ~ 0.1).
@@ -202,8 +214,10 @@ TEST(MonteCarlo, TheSameSeedGivesTheSameImageOnAnyThreadCountAndInSteps) {
   MonteCarloSettings one, two;
   one.threads = 1;
   two.threads = 2;
-  const MonteCarloImage a = render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, MarchSettings{}, one, 8);
-  const MonteCarloImage b = render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, MarchSettings{}, two, 8);
+  const MonteCarloImage a =
+      render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, MarchSettings{}, one, 8);
+  const MonteCarloImage b =
+      render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, MarchSettings{}, two, 8);
   // Progressive: 4 samples and 4 more are the same 8 samples.
   const MonteCarloRenderer r(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, MarchSettings{}, two);
   MonteCarloImage steps = r.start();
@@ -222,7 +236,8 @@ TEST(MonteCarlo, TheSameSeedGivesTheSameImageOnAnyThreadCountAndInSteps) {
   // A different seed gives a different image.
   MonteCarloSettings other = two;
   other.seed = 2;
-  const MonteCarloImage d = render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, MarchSettings{}, other, 8);
+  const MonteCarloImage d =
+      render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, MarchSettings{}, other, 8);
   int differ = 0;
   for (std::size_t i = 0; i < a.sum.size(); ++i) differ += a.sum[i] != d.sum[i];
   EXPECT_GT(differ, 0);
@@ -230,34 +245,50 @@ TEST(MonteCarlo, TheSameSeedGivesTheSameImageOnAnyThreadCountAndInSteps) {
 
 TEST(MonteCarlo, MeasuresTheOctaveApproximation) {
   // Issue 5's figure: full multiple scattering against the raymarcher's octaves, clouds only.
-  // Printed, not asserted: it is a property of the approximation, not a check of either code.
-  const SceneCase c("stratocumulus", 16, 9);
-  MarchSettings m = c.scene.march;
-  MonteCarloSettings mc;
-  mc.seed = 5;
-  auto t0 = std::chrono::steady_clock::now();
-  const MonteCarloImage img = render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m, mc, 64);
-  const double t_mc = seconds_since(t0);
-  double mc_lum = 0.0;
-  for (std::size_t i = 0; i < img.sum.size(); ++i) mc_lum += img.luminance(i);
-  std::printf("stratocumulus 16x9, full multiple scattering, 64 spp: %.2f s, mean rel. s.e. %.4f, "
-              "%.1f scatterings per path, %llu of %llu paths cut at %d bounces\n",
-              t_mc, img.mean_relative_standard_error(), static_cast<double>(img.stats.scatterings) / img.stats.paths,
-              static_cast<unsigned long long>(img.stats.truncated), static_cast<unsigned long long>(img.stats.paths),
-              mc.max_bounces);
-  ASSERT_GT(mc_lum, 0.0);
-  for (int octaves : {1, 4, 8}) {
-    m.octaves = octaves;
-    const ReferenceImage ref = render_reference(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m);
-    double ref_lum = 0.0, sq = 0.0;
-    for (std::size_t i = 0; i < ref.radiance.size(); ++i) {
-      const double l = glm::dot(ref.radiance[i], glm::dvec3(0.2126, 0.7152, 0.0722));
-      ref_lum += l;
-      sq += (l - img.luminance(i)) * (l - img.luminance(i));
+  // Printed, not asserted: it is a property of the approximation, not a check of either code. The
+  // thin cirrus converges fast; the stratocumulus's droplet forward peak (g_HG ~ 0.995) makes
+  // next-event estimation heavy-tailed, and its figure carries the standard error printed with it.
+  for (const auto& [name, spp] : {std::pair<const char*, int>{"thin_cirrus", 4096}, {"stratocumulus", 256}}) {
+    const SceneCase c(name, 16, 9);
+    MarchSettings m = c.scene.march;
+    MonteCarloSettings mc;
+    mc.seed = 5;
+    auto t0 = std::chrono::steady_clock::now();
+    const MonteCarloImage img =
+        render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m, mc, spp);
+    const double t_mc = seconds_since(t0);
+    double mc_lum = 0.0, noise_var = 0.0;
+    for (std::size_t i = 0; i < img.sum.size(); ++i) {
+      mc_lum += img.luminance(i);
+      noise_var += img.luminance_standard_error(i) * img.luminance_standard_error(i);
     }
-    const double npx = static_cast<double>(ref.radiance.size());
-    std::printf("  octaves %d: mean luminance %.4g vs Monte Carlo %.4g (bias %+.1f %%), relative RMSE %.1f %%\n", octaves,
-                ref_lum / npx, mc_lum / npx, 100.0 * (ref_lum - mc_lum) / mc_lum, 100.0 * std::sqrt(sq / npx) / (mc_lum / npx));
+    const double npx = static_cast<double>(img.sum.size());
+    std::printf(
+        "%s 16x9, full multiple scattering, %d spp: %.2f s, mean rel. s.e. %.4f, mean luminance %.4g "
+        "+- %.2g, %.1f scatterings per path, %llu of %llu paths cut at %d bounces\n",
+        name, spp, t_mc, img.mean_relative_standard_error(), mc_lum / npx, std::sqrt(noise_var) / npx,
+        static_cast<double>(img.stats.scatterings) / static_cast<double>(img.stats.paths),
+        static_cast<unsigned long long>(img.stats.truncated),
+        static_cast<unsigned long long>(img.stats.paths), mc.max_bounces);
+    ASSERT_GT(mc_lum, 0.0);
+    for (int octaves : {1, 4, 8}) {
+      m.octaves = octaves;
+      const ReferenceImage ref = render_reference(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m);
+      double ref_lum = 0.0, sq = 0.0;
+      for (std::size_t i = 0; i < ref.radiance.size(); ++i) {
+        const double l = glm::dot(ref.radiance[i], glm::dvec3(0.2126, 0.7152, 0.0722));
+        ref_lum += l;
+        sq += (l - img.luminance(i)) * (l - img.luminance(i));
+      }
+      // The Monte Carlo image's own noise adds its variance to the squared differences: take it out,
+      // so what remains is the octaves' error.
+      const double rmse = std::sqrt(std::max(sq - noise_var, 0.0) / npx) / (mc_lum / npx);
+      std::printf(
+          "  octaves %d: mean luminance %.4g (bias %+.1f %% of the Monte Carlo mean), relative RMSE %.1f %% "
+          "(noise removed; raw %.1f %%)\n",
+          octaves, ref_lum / npx, 100.0 * (ref_lum - mc_lum) / mc_lum, 100.0 * rmse,
+          100.0 * std::sqrt(sq / npx) / (mc_lum / npx));
+    }
   }
 }
 
