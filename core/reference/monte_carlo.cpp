@@ -1,0 +1,431 @@
+// The Monte Carlo reference: delta tracking, ratio-tracked sun rays, phase sampling, roulette.
+#include "reference/monte_carlo.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+
+#include <glm/glm.hpp>
+
+#include "geo/geodesy.hpp"
+#include "physics/physics.hpp"
+
+namespace cv::core {
+namespace {
+namespace p64 = cv::physics::f64;
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+const glm::dvec3 kLumWeights(0.2126, 0.7152, 0.0722);
+
+// splitmix64's finaliser: a bijective 64-bit mix with full avalanche.
+std::uint64_t mix64(std::uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+constexpr std::uint64_t kGolden = 0x9E3779B97F4A7C15ull;
+
+// Below this many metres the pyramid's extent is not trusted to make progress (a query on a brick
+// face); the grid-wide majorant covers that metre instead, which keeps the estimate unbiased.
+constexpr double kMinBrickExtentM = 1.0;
+// Ratio tracking plays roulette below this transmittance: deep in thick cloud a sun ray would
+// otherwise look up the medium for hundreds of optical depths to multiply tiny factors.
+constexpr double kShadowRouletteBelow = 1e-2;
+}  // namespace
+
+void MonteCarloStats::add(const MonteCarloStats& o) {
+  paths += o.paths;
+  scatterings += o.scatterings;
+  null_collisions += o.null_collisions;
+  shadow_lookups += o.shadow_lookups;
+  truncated += o.truncated;
+  roulette_killed += o.roulette_killed;
+  majorant_exceeded += o.majorant_exceeded;
+}
+
+// ---- accumulator ----
+
+glm::dvec3 MonteCarloImage::mean(std::size_t i) const {
+  return spp ? sum[i] / static_cast<double>(spp) : glm::dvec3(0.0);
+}
+
+glm::dvec3 MonteCarloImage::standard_error(std::size_t i) const {
+  if (spp < 2) return glm::dvec3(kInf);
+  const double n = static_cast<double>(spp);
+  const glm::dvec3 m = sum[i] / n;
+  // Sample variance (n - 1 in the denominator), then the variance of the mean.
+  const glm::dvec3 var = glm::max(sum_sq[i] - n * m * m, glm::dvec3(0.0)) / (n - 1.0);
+  return glm::sqrt(var / n);
+}
+
+double MonteCarloImage::luminance(std::size_t i) const {
+  return spp ? lum_sum[i] / static_cast<double>(spp) : 0.0;
+}
+
+double MonteCarloImage::luminance_standard_error(std::size_t i) const {
+  if (spp < 2) return kInf;
+  const double n = static_cast<double>(spp), m = lum_sum[i] / n;
+  return std::sqrt(std::max(lum_sq[i] - n * m * m, 0.0) / (n - 1.0) / n);
+}
+
+double MonteCarloImage::mean_relative_standard_error(double floor_fraction) const {
+  double top = 0.0;
+  for (std::size_t i = 0; i < lum_sum.size(); ++i) top = std::max(top, luminance(i));
+  double total = 0.0;
+  int count = 0;
+  for (std::size_t i = 0; i < lum_sum.size(); ++i) {
+    const double l = luminance(i);
+    if (l > 0.0 && l >= floor_fraction * top) {
+      total += luminance_standard_error(i) / l;
+      ++count;
+    }
+  }
+  return count ? total / count : 0.0;
+}
+
+std::vector<glm::dvec3> MonteCarloImage::radiance() const {
+  std::vector<glm::dvec3> out(sum.size());
+  for (std::size_t i = 0; i < sum.size(); ++i) out[i] = mean(i);
+  return out;
+}
+
+// ---- random numbers ----
+
+PathRng::PathRng(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample)
+    : key_(mix64(mix64(seed + kGolden) ^ mix64(pixel * 0xD1B54A32D192ED03ull + 1) ^
+                 mix64(sample * kGolden + 7))) {}
+
+double PathRng::uniform() {
+  return static_cast<double>(mix64(key_ + (++counter_) * kGolden) >> 11) * 0x1.0p-53;
+}
+
+std::uint32_t PathRng::bits32() {
+  return static_cast<std::uint32_t>(mix64(key_ + (++counter_) * kGolden) >> 32);
+}
+
+// ---- the tracer ----
+
+MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExtinction& ext,
+                                       const Camera& cam, const Sun& sun, const MarchSettings& march,
+                                       const MonteCarloSettings& mc, const ErosionNoise* noise)
+    : grid_(grid),
+      ext_(ext),
+      cam_(cam),
+      sun_(sun),
+      march_(march),
+      mc_(mc),
+      noise_(noise),
+      liquid_(grid, ext.liquid_per_m),
+      ice_(grid, ext.ice_per_m) {
+  if (march.atmosphere) {
+    throw std::invalid_argument(
+        "monte carlo: atmosphere on is not modelled (clouds only, optionally the globe)");
+  }
+  if (mc.max_bounces < 1) throw std::invalid_argument("monte carlo: max_bounces must be >= 1");
+  if (march.noise_amount > 0.0) {
+    if (!noise) throw std::invalid_argument("monte carlo: noise_amount > 0 needs the erosion noise textures");
+    anchor_ = noise_anchor(grid_centre_ecef(grid), march.noise_scale_m);
+  }
+  wraps_ = grid.wraps_lon();
+  global_lat_ = liquid_.global_lat();
+  // Trilinear weights are convex, so liquid + ice anywhere is at most the largest node sum; erosion
+  // only lowers extinction (erode_extinction keeps at most the data's value).
+  for (std::size_t i = 0; i < grid.points(); ++i) {
+    const double l = ext.liquid_per_m.empty() ? 0.0 : ext.liquid_per_m[i];
+    const double c = ext.ice_per_m.empty() ? 0.0 : ext.ice_per_m[i];
+    majorant_ = std::max(majorant_, l + c);
+  }
+  if (mc.brick_majorants) pyramid_ = ExtinctionPyramid(grid, ext.liquid_per_m, ext.ice_per_m);
+  to_sun_ = glm::normalize(
+      geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, grid.earth_radius_m));
+}
+
+void MonteCarloRenderer::extinction(const glm::dvec3& p, double& sl, double& si) const {
+  const glm::dvec3 g = p64::ecef_to_sphere(p, grid_.earth_radius_m);
+  const double lat = g.x / kDeg, lon = g.y / kDeg, alt = g.z;
+  sl = liquid_.sample(lat, lon, alt, 0.0);
+  si = ice_.sample(lat, lon, alt, 0.0);
+  if (noise_ && march_.noise_amount > 0.0 && sl + si > 0.0) {
+    // The same erosion as the raymarcher's (shaders/common/erosion.glsl), anchored at the grid centre.
+    const glm::dvec3 t = p64::noise_tile_coords(p - anchor_.ecef_m, anchor_.frac, march_.noise_scale_m);
+    const double e = p64::erosion_threshold(
+        noise_->low.sample(t), noise_->high.sample(p64::noise_high_coords(t)), march_.noise_amount);
+    const double feature_m = p64::noise_feature_m(march_.noise_scale_m);
+    sl = p64::erode_extinction(sl, e, feature_m);
+    si = p64::erode_extinction(si, e, feature_m);
+  }
+}
+
+int MonteCarloRenderer::shell_parts(const glm::dvec3& p, const glm::dvec3& d, double seg[4],
+                                    double& t_ground) const {
+  const double r0 = grid_.earth_radius_m;
+  const double r = glm::length(p), alt = r - r0;
+  const glm::dvec3 up = p / r;
+  const double mu = glm::dot(d, up), nu = glm::length(glm::cross(d, up));
+  t_ground = kInf;
+  double g0, g1;
+  // A rising ray from the ground or above never meets it: a point placed on the ground may round to
+  // a nanometre below it, and must not then find the ground at t = 0.
+  const bool rising = mu >= 0.0 && alt > -1.0;
+  if (!rising && p64::ray_sphere_rel_nu(r0, alt, mu, nu, 0.0, g0, g1) && g1 > 0.0) {
+    t_ground = std::max(g0, 0.0);
+  }
+  glm::dvec4 s;
+  const int n = p64::ray_shell_rel_nu(r0, alt, mu, nu, grid_.alt_m.start, grid_.alt_m.last(), s);
+  int kept = 0;
+  for (int k = 0; k < n; ++k) {
+    const double a = s[2 * k], b = std::min(s[2 * k + 1], t_ground);
+    if (b > a) {
+      seg[2 * kept] = a;
+      seg[2 * kept + 1] = b;
+      ++kept;
+    }
+  }
+  return kept;
+}
+
+void MonteCarloRenderer::majorant_at(const glm::dvec3& p, const glm::dvec3& d, double t, double t_end,
+                                     double& sigma_max, double& t_valid) const {
+  sigma_max = majorant_;
+  t_valid = t_end;
+  if (!mc_.brick_majorants) return;
+  const ExtinctionPyramid::Space sp = pyramid_.at(p + t * d, d);
+  if (!(sp.extent_m >= kMinBrickExtentM) || !std::isfinite(sp.extent_m)) {
+    t_valid = std::min(t + kMinBrickExtentM, t_end);
+    return;
+  }
+  sigma_max = sp.empty ? 0.0 : sp.sigma_max_per_m;
+  t_valid = std::min(t + sp.extent_m, t_end);
+}
+
+double MonteCarloRenderer::free_path(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng,
+                                     MonteCarloStats& st, double* ground_m) const {
+  double seg[4], t_ground;
+  const int n = shell_parts(p, d, seg, t_ground);
+  if (ground_m) *ground_m = t_ground;
+  for (int k = 0; k < n; ++k) {
+    double t = seg[2 * k];
+    const double b = seg[2 * k + 1];
+    while (t < b) {
+      double maj, lim;
+      majorant_at(p, d, t, b, maj, lim);
+      if (!(maj > 0.0)) {
+        t = lim;
+        continue;
+      }
+      // The exponential distribution is memoryless: a draw past the majorant's range restarts there.
+      const double s = -std::log1p(-rng.uniform()) / maj;
+      if (t + s >= lim) {
+        t = lim;
+        continue;
+      }
+      t += s;
+      double sl, si;
+      extinction(p + t * d, sl, si);
+      const double sigma = sl + si;
+      st.majorant_exceeded += sigma > maj * (1.0 + 1e-9);
+      if (rng.uniform() * maj < sigma) return t;
+      ++st.null_collisions;
+    }
+  }
+  return kInf;
+}
+
+double MonteCarloRenderer::transmittance(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng,
+                                         MonteCarloStats& st) const {
+  double seg[4], t_ground;
+  const int n = shell_parts(p, d, seg, t_ground);
+  if (std::isfinite(t_ground)) return 0.0;  // the Earth's shadow
+  double tr = 1.0;
+  for (int k = 0; k < n; ++k) {
+    double t = seg[2 * k];
+    const double b = seg[2 * k + 1];
+    while (t < b) {
+      double maj, lim;
+      majorant_at(p, d, t, b, maj, lim);
+      if (!(maj > 0.0)) {
+        t = lim;
+        continue;
+      }
+      const double s = -std::log1p(-rng.uniform()) / maj;
+      if (t + s >= lim) {
+        t = lim;
+        continue;
+      }
+      t += s;
+      double sl, si;
+      extinction(p + t * d, sl, si);
+      ++st.shadow_lookups;
+      const double sigma = sl + si;
+      st.majorant_exceeded += sigma > maj * (1.0 + 1e-9);
+      tr *= std::max(0.0, 1.0 - sigma / maj);
+      if (tr < kShadowRouletteBelow) {
+        // Survive with probability tr / threshold carrying the threshold: expectation unchanged.
+        if (rng.uniform() * kShadowRouletteBelow >= tr) return 0.0;
+        tr = kShadowRouletteBelow;
+      }
+    }
+  }
+  return tr;
+}
+
+MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec3 d, PathRng& rng,
+                                                         MonteCarloStats& st) const {
+  const double r0 = grid_.earth_radius_m;
+  const p64::MieParams mie = p64::mie_params(march_.droplet_diameter_um);
+  PathResult r;
+  glm::dvec3 beta(1.0);
+  ++st.paths;
+  for (;;) {
+    double t_ground;
+    const double t = free_path(p, d, rng, st, &t_ground);
+    if (std::isfinite(t)) {
+      p += t * d;
+      double sl, si;
+      extinction(p, sl, si);
+      const double sigma = sl + si;
+      ++r.scatterings;
+      ++st.scatterings;
+      // Next-event estimation: the sun is a delta light, reachable only this way. The scattering
+      // cosine is between the sunlight's propagation (-to_sun) and the light's toward the camera (-d).
+      const double mu = glm::dot(d, to_sun_);
+      const double phase = sigma > 0.0
+                               ? (sl * p64::phase_mie(mu, mie) + si * p64::phase_hg(mu, march_.ice_g)) / sigma
+                               : p64::phase_isotropic();
+      r.radiance += beta * sun_.irradiance * (phase * transmittance(p, to_sun_, rng, st));
+      if (r.scatterings >= mc_.max_bounces) {
+        r.end = End::Truncated;
+        ++st.truncated;
+        break;
+      }
+      // Clouds do not absorb (albedo 1): the new direction is drawn from the phase function of the
+      // component that scattered, chosen by its share of the extinction, and beta is unchanged.
+      double pdf;
+      if (rng.uniform() * sigma < sl || !(sigma > 0.0)) {
+        std::uint32_t state = rng.bits32();
+        d = p64::sample_mie(d, mie, state, pdf);
+      } else {
+        d = p64::sample_hg(d, march_.ice_g, glm::dvec2(rng.uniform(), rng.uniform()), pdf);
+      }
+    } else if (march_.globe && std::isfinite(t_ground)) {
+      // A Lambertian ground of constant albedo: lit by the sun through the clouds, and reflecting
+      // a cosine-distributed new direction with throughput times albedo.
+      p = glm::normalize(p + t_ground * d) * r0;
+      const glm::dvec3 n = p / r0;
+      ++r.scatterings;
+      ++st.scatterings;
+      const double mu_s = glm::dot(n, to_sun_);
+      if (mu_s > 0.0) {
+        const double tr = transmittance(p, to_sun_, rng, st);
+        r.radiance += beta * sun_.irradiance *
+                      p64::ground_radiance(march_.ground_albedo, mu_s, glm::dvec3(tr), glm::dvec3(0.0));
+      }
+      r.absorbed += beta * (glm::dvec3(1.0) - march_.ground_albedo);
+      beta *= march_.ground_albedo;
+      if (r.scatterings >= mc_.max_bounces) {
+        r.end = End::Truncated;
+        ++st.truncated;
+        break;
+      }
+      d = p64::direction_around(n, std::sqrt(rng.uniform()), p64::CV_TWO_PI * rng.uniform());
+    } else {
+      r.end = std::isfinite(t_ground) ? End::Ground : End::Space;
+      break;
+    }
+    if (r.scatterings >= mc_.roulette_after) {
+      const double q = std::min(1.0, std::max({beta.x, beta.y, beta.z}));
+      if (q < 1.0) {
+        if (rng.uniform() >= q) {
+          r.end = End::Roulette;
+          ++st.roulette_killed;
+          break;
+        }
+        beta /= q;
+      }
+    }
+  }
+  r.weight = beta;
+  return r;
+}
+
+MonteCarloImage MonteCarloRenderer::start() const {
+  MonteCarloImage img;
+  img.width = cam_.width;
+  img.height = cam_.height;
+  const std::size_t n = static_cast<std::size_t>(cam_.width) * static_cast<std::size_t>(cam_.height);
+  img.sum.assign(n, glm::dvec3(0.0));
+  img.sum_sq.assign(n, glm::dvec3(0.0));
+  img.lum_sum.assign(n, 0.0);
+  img.lum_sq.assign(n, 0.0);
+  return img;
+}
+
+void MonteCarloRenderer::add_samples(MonteCarloImage& img, int spp) const {
+  if (img.width != cam_.width || img.height != cam_.height ||
+      img.sum.size() != static_cast<std::size_t>(cam_.width) * cam_.height) {
+    throw std::invalid_argument("monte carlo: the accumulator was not made for this camera");
+  }
+  if (spp <= 0) return;
+  const double r0 = grid_.earth_radius_m, ht = grid_.alt_m.last();
+  const glm::dvec3 cam_ecef = geo::sphere_to_ecef({cam_.lat_deg, cam_.lon_deg, cam_.alt_m}, r0);
+  const std::uint64_t first = img.spp;
+  unsigned threads = mc_.threads ? mc_.threads : std::max(1u, std::thread::hardware_concurrency());
+  threads = std::min<unsigned>(threads, static_cast<unsigned>(cam_.height));
+  std::vector<MonteCarloStats> stats(threads);
+  std::atomic<int> next_row{0};
+  auto work = [&](unsigned w) {
+    for (int py = next_row++; py < cam_.height; py = next_row++) {
+      for (int px = 0; px < cam_.width; ++px) {
+        const glm::dvec3 d = camera_ray(cam_, px, py);
+        // A camera above the shell starts its rays where they enter it, on the exact sphere, as
+        // render_reference does: distant cameras then keep the digits of the positions they sample.
+        glm::dvec3 o = cam_ecef;
+        bool misses = false;
+        if (cam_.alt_m > ht) {
+          const glm::dvec3 up = glm::normalize(cam_ecef);
+          double e0, e1;
+          if (!p64::ray_sphere_rel_nu(r0, cam_.alt_m, glm::dot(d, up), glm::length(glm::cross(d, up)), ht, e0,
+                                      e1) ||
+              e1 < 0.0) {
+            misses = true;
+          } else if (e0 > 0.0) {
+            o = glm::normalize(o + e0 * d) * (r0 + ht);
+          }
+        }
+        const std::size_t idx = static_cast<std::size_t>(py) * cam_.width + px;
+        // Samples in index order into this pixel's sums: the same sums whichever thread does it.
+        for (std::uint64_t s = first; s < first + static_cast<std::uint64_t>(spp); ++s) {
+          glm::dvec3 v(0.0);
+          if (!misses) {
+            PathRng rng(mc_.seed, idx, s);
+            v = trace(o, d, rng, stats[w]).radiance;
+          }
+          const double l = glm::dot(v, kLumWeights);
+          img.sum[idx] += v;
+          img.sum_sq[idx] += v * v;
+          img.lum_sum[idx] += l;
+          img.lum_sq[idx] += l * l;
+        }
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned w = 1; w < threads; ++w) pool.emplace_back(work, w);
+  work(0);
+  for (auto& th : pool) th.join();
+  for (const auto& s : stats) img.stats.add(s);
+  img.spp += static_cast<std::uint64_t>(spp);
+}
+
+MonteCarloImage render_monte_carlo(const VolumeGrid& grid, const GridMeanExtinction& medium,
+                                   const Camera& cam, const Sun& sun, const MarchSettings& march,
+                                   const MonteCarloSettings& mc, int spp, const ErosionNoise* noise) {
+  const MonteCarloRenderer r(grid, medium, cam, sun, march, mc, noise);
+  MonteCarloImage img = r.start();
+  r.add_samples(img, spp);
+  return img;
+}
+
+}  // namespace cv::core

@@ -1,0 +1,147 @@
+// The Monte Carlo reference: volumetric path tracing of the scene render_reference draws (same
+// medium lookup, phase functions, camera and sun), with full multiple scattering, so the
+// raymarcher's approximations (octaves, steps) can be measured against the transport solution.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "noise/noise.hpp"
+#include "reference/raymarcher.hpp"
+#include "volume/cloud_volume.hpp"
+#include "volume/extinction_pyramid.hpp"
+#include "volume/sampler.hpp"
+
+namespace cv::core {
+
+struct MonteCarloSettings {
+  // Scattering events per path (cloud and ground together). 1 = single scattering, the quantity
+  // render_reference computes with octaves = 1. Paths cut at this depth are counted in
+  // MonteCarloStats::truncated so an image states whether the cut matters.
+  int max_bounces = 1000;
+  // Russian roulette on the path throughput from this depth on. Clouds do not absorb, so in the
+  // clouds-only configuration it never fires; it ends paths whose throughput the ground has reduced.
+  int roulette_after = 4;
+  // Per-brick majorants from the extinction pyramid; false: the grid's largest extinction
+  // everywhere. Either gives the same expectation. Off by default: a pyramid query costs several
+  // medium lookups and its brick-exit distances are conservative (short near brick faces), so on
+  // the standard scenes it was 2-5x slower than null collisions against the global majorant
+  // (docs/physics.md, "Monte Carlo reference").
+  bool brick_majorants = false;
+  unsigned threads = 0;  // 0: std::thread::hardware_concurrency()
+  std::uint64_t seed = 1;
+};
+
+// What the tracer did, summed over all samples (integers: the same for any thread count).
+struct MonteCarloStats {
+  std::uint64_t paths = 0;
+  std::uint64_t scatterings = 0;        // real collisions in cloud, plus ground bounces
+  std::uint64_t null_collisions = 0;    // tentative collisions rejected by delta tracking
+  std::uint64_t shadow_lookups = 0;     // medium lookups of ratio tracking toward the sun
+  std::uint64_t truncated = 0;          // paths stopped at max_bounces while still in flight
+  std::uint64_t roulette_killed = 0;    // paths ended by Russian roulette
+  std::uint64_t majorant_exceeded = 0;  // lookups above their majorant (a bug if ever non-zero)
+  void add(const MonteCarloStats& o);
+};
+
+// A progressive estimate: running sums per pixel, from which the mean and its standard error follow.
+struct MonteCarloImage {
+  int width = 0, height = 0;
+  std::uint64_t spp = 0;                // samples per pixel so far
+  std::vector<glm::dvec3> sum, sum_sq;  // of per-sample radiance (per unit sun irradiance times it)
+  std::vector<double> lum_sum, lum_sq;  // of per-sample luminance (Rec. 709 weights)
+  MonteCarloStats stats;
+
+  glm::dvec3 mean(std::size_t i) const;
+  glm::dvec3 standard_error(std::size_t i) const;  // of the mean, per channel
+  double luminance(std::size_t i) const;
+  double luminance_standard_error(std::size_t i) const;
+  // Mean over pixels of standard error / mean luminance, over pixels whose mean luminance is at
+  // least `floor_fraction` of the image's largest (dark pixels have no meaningful relative error).
+  double mean_relative_standard_error(double floor_fraction = 0.05) const;
+  std::vector<glm::dvec3> radiance() const;  // the means
+};
+
+// A random stream per (seed, pixel, sample): counter-based, so any thread computes any sample.
+class PathRng {
+ public:
+  PathRng(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample);
+  double uniform();  // [0, 1)
+  std::uint32_t bits32();
+
+ private:
+  std::uint64_t key_, counter_ = 0;
+};
+
+class MonteCarloRenderer {
+ public:
+  // `noise` is needed when march.noise_amount > 0. Throws std::invalid_argument for settings the
+  // tracer does not model (march.atmosphere: the air's scattering and the sky light).
+  MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExtinction& medium, const Camera& cam,
+                     const Sun& sun, const MarchSettings& march, const MonteCarloSettings& mc,
+                     const ErosionNoise* noise = nullptr);
+
+  // An empty accumulator for this camera.
+  MonteCarloImage start() const;
+  // Adds `spp` samples to every pixel, continuing the sample indices already in `img`: two calls
+  // of n give bit for bit the image of one call of 2n, on any number of threads.
+  void add_samples(MonteCarloImage& img, int spp) const;
+
+  // The pieces, public for the validation tests. Rays start at Earth-centred p (m), unit d.
+  // Distance to the first real collision by delta tracking, or +inf when the ray leaves the clouds
+  // (through the top, or down to the ground: *ground_m then holds the distance to it, else +inf).
+  double free_path(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng, MonteCarloStats& st,
+                   double* ground_m = nullptr) const;
+  // Transmittance of the clouds from p along d by ratio tracking (unbiased, noisy); 0 if the ray
+  // meets the Earth.
+  double transmittance(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng, MonteCarloStats& st) const;
+  // How a path ended, for energy bookkeeping.
+  enum class End { Space, Ground, Truncated, Roulette };
+  struct PathResult {
+    glm::dvec3 radiance{0.0};  // per unit sun irradiance
+    glm::dvec3 weight{1.0};    // the throughput the path carried when it ended
+    glm::dvec3 absorbed{0.0};  // throughput the ground took out (1 - albedo of what reached it)
+    End end = End::Space;
+    int scatterings = 0;
+  };
+  // One path from p along d (the first segment is the view ray): next-event estimation toward the sun
+  // at every vertex, new directions by the phase functions, roulette, until it ends.
+  PathResult trace(glm::dvec3 p, glm::dvec3 d, PathRng& rng, MonteCarloStats& st) const;
+
+  double majorant_per_m() const { return majorant_; }
+
+ private:
+  void extinction(const glm::dvec3& p, double& sigma_liquid, double& sigma_ice) const;
+  // The ray's parts inside the cloud shell, cut at the ground; returns their count (<= 2).
+  int shell_parts(const glm::dvec3& p, const glm::dvec3& d, double seg[4], double& t_ground) const;
+  // Majorant valid from t on along the ray and the distance up to which it holds.
+  void majorant_at(const glm::dvec3& p, const glm::dvec3& d, double t, double t_end, double& sigma_max,
+                   double& t_valid) const;
+  glm::dvec3 sun_light(const glm::dvec3& x, PathRng& rng, MonteCarloStats& st, double& mu_sun_local) const;
+  glm::dvec3 pixel_sample(int px, int py, std::uint64_t sample, MonteCarloStats& st) const;
+
+  const VolumeGrid& grid_;
+  const GridMeanExtinction& ext_;
+  Camera cam_;
+  Sun sun_;
+  MarchSettings march_;
+  MonteCarloSettings mc_;
+  const ErosionNoise* noise_ = nullptr;
+  NoiseAnchor anchor_;
+  VolumeSampler liquid_, ice_;
+  ExtinctionPyramid pyramid_;
+  bool wraps_ = false, global_lat_ = false;
+  double majorant_ = 0.0;  // largest liquid + ice extinction of any node, 1/m
+  glm::dvec3 to_sun_{0.0};
+};
+
+// One call: a fresh accumulator with `spp` samples per pixel.
+MonteCarloImage render_monte_carlo(const VolumeGrid& grid, const GridMeanExtinction& medium,
+                                   const Camera& cam, const Sun& sun, const MarchSettings& march,
+                                   const MonteCarloSettings& mc, int spp,
+                                   const ErosionNoise* noise = nullptr);
+
+}  // namespace cv::core

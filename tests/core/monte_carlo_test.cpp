@@ -1,0 +1,295 @@
+// The Monte Carlo reference against closed forms, conservation of energy, the raymarcher's single
+// scattering, and itself (determinism); and the octave approximation measured against it.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
+#include <glm/glm.hpp>
+
+#include "geo/geodesy.hpp"
+#include "reference/monte_carlo.hpp"
+#include "reference/raymarcher.hpp"
+#include "scene/standard_scenes.hpp"
+
+namespace {
+using namespace cv::core;
+
+// Bounds below are stated in standard errors; at 4.5 sigma a correct estimator fails one check in
+// about 150 000, and the seeds are fixed, so a pass is reproducible.
+constexpr double kSigmas = 4.5;
+
+// A homogeneous liquid layer 1-2 km up over a box of +-half_deg degrees around (0, 0): with 5
+// degrees (550 km) against 1 km of depth it is a plane-parallel slab for a beam at its centre.
+struct Slab {
+  VolumeGrid grid;
+  GridMeanExtinction ext;
+  Slab(double sigma_per_m, double half_deg) {
+    grid.lon_deg = {-half_deg, half_deg / 10.0, 21};
+    grid.lat_deg = {-half_deg, half_deg / 10.0, 21};
+    grid.alt_m = {1000.0, 100.0, 11};
+    ext.liquid_per_m.assign(grid.points(), static_cast<float>(sigma_per_m));
+    ext.ice_per_m.assign(grid.points(), 0.0f);
+  }
+  double stored_sigma() const {
+    return static_cast<double>(ext.liquid_per_m[0]);
+  }  // the float the grid holds
+};
+
+Camera nadir_pixel() {
+  Camera c;
+  c.alt_m = 10000.0;
+  c.pitch_deg = -90.0;
+  c.fov_deg = 1e-3;
+  c.width = c.height = 1;
+  return c;
+}
+
+glm::dvec3 ecef(double lat, double lon, double alt) {
+  return cv::geo::sphere_to_ecef({lat, lon, alt}, 6371000.0);
+}
+
+TEST(MonteCarlo, UnscatteredTransmissionThroughASlabIsExpMinusTau) {
+  // From below the slab straight up (a ray down would end on the Earth, which casts shadow).
+  const glm::dvec3 p = ecef(0.0, 0.0, 500.0), up = glm::normalize(p);
+  for (double tau : {0.5, 2.0, 5.0}) {
+    for (bool bricks : {true, false}) {
+      const Slab slab(tau / 1000.0, 5.0);
+      MonteCarloSettings mc;
+      mc.brick_majorants = bricks;
+      const MonteCarloRenderer r(slab.grid, slab.ext, nadir_pixel(), Sun{}, MarchSettings{}, mc);
+      const double expected = std::exp(-slab.stored_sigma() * 1000.0);
+      const int n = 100000;
+      MonteCarloStats st;
+      int crossed = 0;
+      double ratio_sum = 0.0, ratio_sq = 0.0;
+      for (int i = 0; i < n; ++i) {
+        PathRng rng(7, 0, static_cast<std::uint64_t>(i));
+        crossed += std::isinf(r.free_path(p, up, rng, st));
+        const double t = r.transmittance(p, up, rng, st);
+        ratio_sum += t;
+        ratio_sq += t * t;
+      }
+      // Delta tracking: a binomial count with standard error sqrt(p (1 - p) / n).
+      const double frac = static_cast<double>(crossed) / n;
+      const double se_binomial = std::sqrt(expected * (1.0 - expected) / n);
+      // Ratio tracking: the sample mean with its own standard error.
+      const double mean = ratio_sum / n,
+                   se_ratio = std::sqrt(std::max(ratio_sq / n - mean * mean, 0.0) / (n - 1));
+      std::printf(
+          "tau %.1f bricks %d: exp(-tau) %.5f  delta tracking %.5f (%.2f se)  ratio tracking %.5f (%.2f "
+          "se)\n",
+          tau, bricks, expected, frac, (frac - expected) / se_binomial, mean, (mean - expected) / se_ratio);
+      EXPECT_LT(std::abs(frac - expected), kSigmas * se_binomial) << tau;
+      EXPECT_LT(std::abs(mean - expected), kSigmas * se_ratio) << tau;
+      EXPECT_EQ(st.majorant_exceeded, 0u);
+    }
+  }
+}
+
+TEST(MonteCarlo, ANonAbsorbingSlabConservesEnergy) {
+  // A broad beam falls straight down on a conservative slab of optical depth 4 (droplet Mie phase,
+  // g ~ 0.88): every path must end either back in space (reflected) or on the black ground below
+  // (transmitted), none cut short.
+  const Slab slab(4e-3, 5.0);
+  const glm::dvec3 p = ecef(0.0, 0.0, 3000.0), down = -glm::normalize(p);
+  {
+    const MonteCarloRenderer r(slab.grid, slab.ext, nadir_pixel(), Sun{}, MarchSettings{},
+                               MonteCarloSettings{});
+    const int n = 20000;
+    MonteCarloStats st;
+    int up = 0, ground = 0, lost = 0;
+    for (int i = 0; i < n; ++i) {
+      PathRng rng(11, 0, static_cast<std::uint64_t>(i));
+      const auto res = r.trace(p, down, rng, st);
+      up += res.end == MonteCarloRenderer::End::Space;
+      ground += res.end == MonteCarloRenderer::End::Ground;
+      lost += res.end == MonteCarloRenderer::End::Truncated || res.end == MonteCarloRenderer::End::Roulette;
+    }
+    const double rr = static_cast<double>(up) / n, tt = static_cast<double>(ground) / n;
+    std::printf("conservative slab tau 4: R %.4f  T %.4f  R + T %.4f  lost %d  mean scatterings %.1f\n", rr,
+                tt, rr + tt, lost, static_cast<double>(st.scatterings) / n);
+    EXPECT_EQ(lost, 0);
+    EXPECT_EQ(up + ground, n);
+    // The transmitted share includes the unscattered exp(-4) = 1.8 %; forward-peaked scattering
+    // lets most of the rest through too: similarity theory (tau (1 - g) ~ 0.5) puts R near 0.2.
+    EXPECT_GT(tt, 0.6);
+    EXPECT_GT(rr, 0.05);
+  }
+  {
+    // The same slab over a Lambertian ground of albedo 0.5: paths bounce between the two and Russian
+    // roulette ends them. Energy out to space plus energy the ground absorbed must be the beam's.
+    MarchSettings m;
+    m.globe = true;
+    m.ground_albedo = glm::dvec3(0.5);
+    MonteCarloSettings mc;
+    mc.roulette_after = 1;
+    const MonteCarloRenderer r(slab.grid, slab.ext, nadir_pixel(), Sun{}, m, mc);
+    const int n = 20000;
+    MonteCarloStats st;
+    double sum = 0.0, sq = 0.0;
+    for (int i = 0; i < n; ++i) {
+      PathRng rng(13, 0, static_cast<std::uint64_t>(i));
+      const auto res = r.trace(p, down, rng, st);
+      const double e = (res.end == MonteCarloRenderer::End::Space ? res.weight.x : 0.0) + res.absorbed.x;
+      sum += e;
+      sq += e * e;
+    }
+    const double mean = sum / n, se = std::sqrt(std::max(sq / n - mean * mean, 0.0) / (n - 1));
+    std::printf(
+        "slab over albedo 0.5 ground: escaped + absorbed %.4f +- %.4f, %llu paths ended by roulette\n", mean,
+        se, static_cast<unsigned long long>(st.roulette_killed));
+    EXPECT_GT(st.roulette_killed, 0u);
+    EXPECT_EQ(st.truncated, 0u);
+    EXPECT_LT(std::abs(mean - 1.0), kSigmas * se);
+  }
+}
+
+// The image both references draw of a standard scene, clouds only.
+struct SceneCase {
+  StandardScene scene;
+  GridMeanExtinction ext;
+  explicit SceneCase(const std::string& name, int w, int h) : scene(standard_scene(name, w, h)) {
+    ext = grid_mean_extinction(scene.grid, scene.data);
+  }
+};
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+TEST(MonteCarlo, SingleScatteringAgreesWithTheRaymarcher) {
+  // The deck seen from above: every pixel looks at cloud of optical depth up to 6.
+  const SceneCase c("stratocumulus", 24, 14);
+  MarchSettings m = c.scene.march;
+  m.octaves = 1;
+  m.view_step_m = 10.0;
+  m.sun_steps = 128;
+  auto t0 = std::chrono::steady_clock::now();
+  const ReferenceImage ref = render_reference(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m);
+  const double t_ref = seconds_since(t0);
+  MonteCarloSettings mc;
+  mc.max_bounces = 1;
+  mc.seed = 3;
+  t0 = std::chrono::steady_clock::now();
+  const MonteCarloImage img =
+      render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m, mc, 512);
+  const double t_mc = seconds_since(t0);
+  double z2 = 0.0, z_max = 0.0, diff_sum = 0.0, var_sum = 0.0, ref_sum = 0.0;
+  int lit = 0;
+  for (std::size_t i = 0; i < ref.radiance.size(); ++i) {
+    const double mean = img.mean(i).y, se = img.standard_error(i).y, expect = ref.radiance[i].y;
+    diff_sum += mean - expect;
+    var_sum += se * se;
+    ref_sum += expect;
+    if (!(se > 0.0)) {
+      EXPECT_NEAR(mean, expect, 1e-9 * (1.0 + expect)) << i;  // no cloud on this ray: both exactly dark
+      continue;
+    }
+    const double z = (mean - expect) / se;
+    z2 += z * z;
+    z_max = std::max(z_max, std::abs(z));
+    ++lit;
+  }
+  const double npx = static_cast<double>(ref.radiance.size());
+  const double bias = diff_sum / npx, bias_se = std::sqrt(var_sum) / npx;
+  std::printf(
+      "single scattering, stratocumulus 24x14: reference %.2f s, MC 512 spp %.2f s (mean rel. s.e. %.4f); "
+      "%d cloudy pixels, mean z^2 %.3f, max |z| %.2f, mean bias %.3g +- %.3g (%.3g of the mean radiance)\n",
+      t_ref, t_mc, img.mean_relative_standard_error(), lit, z2 / std::max(lit, 1), z_max, bias, bias_se,
+      bias / (ref_sum / npx));
+  ASSERT_GT(lit, 50);
+  // Each pixel within the noise; the z^2 average near 1 says the standard error is itself right
+  // (for `lit` independent pixels its spread is sqrt(2 / lit) ~ 0.1).
+  EXPECT_LT(z_max, kSigmas + 0.5);  // the largest of ~300 |z| values
+  EXPECT_NEAR(z2 / lit, 1.0, 0.4);
+  EXPECT_LT(std::abs(bias), kSigmas * bias_se);
+  EXPECT_EQ(img.stats.majorant_exceeded, 0u);
+}
+
+TEST(MonteCarlo, TheSameSeedGivesTheSameImageOnAnyThreadCountAndInSteps) {
+  const SceneCase c("stratocumulus", 12, 7);
+  MonteCarloSettings one, two;
+  one.threads = 1;
+  two.threads = 2;
+  const MonteCarloImage a =
+      render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, MarchSettings{}, one, 8);
+  const MonteCarloImage b =
+      render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, MarchSettings{}, two, 8);
+  // Progressive: 4 samples and 4 more are the same 8 samples.
+  const MonteCarloRenderer r(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, MarchSettings{}, two);
+  MonteCarloImage steps = r.start();
+  r.add_samples(steps, 4);
+  r.add_samples(steps, 4);
+  ASSERT_EQ(steps.spp, 8u);
+  double total = 0.0;
+  for (std::size_t i = 0; i < a.sum.size(); ++i) {
+    ASSERT_EQ(a.sum[i], b.sum[i]) << i;
+    ASSERT_EQ(a.sum_sq[i], b.sum_sq[i]) << i;
+    ASSERT_EQ(a.sum[i], steps.sum[i]) << i;
+    total += a.sum[i].y;
+  }
+  EXPECT_GT(total, 0.0);  // the scene is lit: identical zeros would prove nothing
+  EXPECT_EQ(a.stats.scatterings, b.stats.scatterings);
+  // A different seed gives a different image.
+  MonteCarloSettings other = two;
+  other.seed = 2;
+  const MonteCarloImage d =
+      render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, MarchSettings{}, other, 8);
+  int differ = 0;
+  for (std::size_t i = 0; i < a.sum.size(); ++i) differ += a.sum[i] != d.sum[i];
+  EXPECT_GT(differ, 0);
+}
+
+TEST(MonteCarlo, MeasuresTheOctaveApproximation) {
+  // Issue 5's figure: full multiple scattering against the raymarcher's octaves, clouds only.
+  // Printed, not asserted: it is a property of the approximation, not a check of either code. The
+  // thin cirrus converges fast; the stratocumulus's droplet forward peak (g_HG ~ 0.995) makes
+  // next-event estimation heavy-tailed, and its figure carries the standard error printed with it.
+  for (const auto& [name, spp] : {std::pair<const char*, int>{"thin_cirrus", 4096}, {"stratocumulus", 256}}) {
+    const SceneCase c(name, 16, 9);
+    MarchSettings m = c.scene.march;
+    MonteCarloSettings mc;
+    mc.seed = 5;
+    auto t0 = std::chrono::steady_clock::now();
+    const MonteCarloImage img =
+        render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m, mc, spp);
+    const double t_mc = seconds_since(t0);
+    double mc_lum = 0.0, noise_var = 0.0;
+    for (std::size_t i = 0; i < img.sum.size(); ++i) {
+      mc_lum += img.luminance(i);
+      noise_var += img.luminance_standard_error(i) * img.luminance_standard_error(i);
+    }
+    const double npx = static_cast<double>(img.sum.size());
+    std::printf(
+        "%s 16x9, full multiple scattering, %d spp: %.2f s, mean rel. s.e. %.4f, mean luminance %.4g "
+        "+- %.2g, %.1f scatterings per path, %llu of %llu paths cut at %d bounces\n",
+        name, spp, t_mc, img.mean_relative_standard_error(), mc_lum / npx, std::sqrt(noise_var) / npx,
+        static_cast<double>(img.stats.scatterings) / static_cast<double>(img.stats.paths),
+        static_cast<unsigned long long>(img.stats.truncated),
+        static_cast<unsigned long long>(img.stats.paths), mc.max_bounces);
+    ASSERT_GT(mc_lum, 0.0);
+    for (int octaves : {1, 4, 8}) {
+      m.octaves = octaves;
+      const ReferenceImage ref = render_reference(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m);
+      double ref_lum = 0.0, sq = 0.0;
+      for (std::size_t i = 0; i < ref.radiance.size(); ++i) {
+        const double l = glm::dot(ref.radiance[i], glm::dvec3(0.2126, 0.7152, 0.0722));
+        ref_lum += l;
+        sq += (l - img.luminance(i)) * (l - img.luminance(i));
+      }
+      // The Monte Carlo image's own noise adds its variance to the squared differences: take it out,
+      // so what remains is the octaves' error.
+      const double rmse = std::sqrt(std::max(sq - noise_var, 0.0) / npx) / (mc_lum / npx);
+      std::printf(
+          "  octaves %d: mean luminance %.4g (bias %+.1f %% of the Monte Carlo mean), relative RMSE %.1f %% "
+          "(noise removed; raw %.1f %%)\n",
+          octaves, ref_lum / npx, 100.0 * (ref_lum - mc_lum) / mc_lum, 100.0 * rmse,
+          100.0 * std::sqrt(sq / npx) / (mc_lum / npx));
+    }
+  }
+}
+
+}  // namespace
