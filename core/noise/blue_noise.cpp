@@ -15,12 +15,14 @@ namespace {
 // Adding or removing a point updates every pixel (O(n^2)); the kernel is tabulated once.
 class Energy {
  public:
-  Energy(int n, double sigma_px) : n_(n), kernel_(static_cast<std::size_t>(n) * n), energy_(kernel_.size(), 0.0) {
+  Energy(int n, double sigma_px)
+      : n_(n), kernel_(static_cast<std::size_t>(n) * n), energy_(kernel_.size(), 0.0) {
     for (int dy = 0; dy < n; ++dy)
       for (int dx = 0; dx < n; ++dx) {
         // Toroidal distance: the mask must tile, so the pattern repels across its edges too.
         const double wx = std::min(dx, n - dx), wy = std::min(dy, n - dy);
-        kernel_[static_cast<std::size_t>(dy) * n + dx] = std::exp(-(wx * wx + wy * wy) / (2.0 * sigma_px * sigma_px));
+        kernel_[static_cast<std::size_t>(dy) * n + dx] =
+            std::exp(-(wx * wx + wy * wy) / (2.0 * sigma_px * sigma_px));
       }
   }
   void add(int p, double sign) {
@@ -54,7 +56,8 @@ class Energy {
 }  // namespace
 
 BlueNoiseMask make_blue_noise(int n, std::uint32_t seed, double sigma_px) {
-  if (n < 4 || n > 4096) throw std::invalid_argument("blue-noise mask size " + std::to_string(n) + ": expected 4 .. 4096");
+  if (n < 4 || n > 4096)
+    throw std::invalid_argument("blue-noise mask size " + std::to_string(n) + ": expected 4 .. 4096");
   if (!(sigma_px > 0.0)) throw std::invalid_argument("blue-noise filter width must be > 0 pixels");
   const int total = n * n;
   std::vector<char> pattern(static_cast<std::size_t>(total), 0);

@@ -33,13 +33,15 @@ std::vector<double> radial_spectrum(const std::vector<float>& v, int n) {
   for (int y = 0; y < n; ++y)
     for (int k = 0; k < n; ++k) {
       std::complex<double> s = 0.0;
-      for (int x = 0; x < n; ++x) s += (v[static_cast<std::size_t>(y * n + x)] - mean) * std::polar(1.0, -two_pi * k * x / n);
+      for (int x = 0; x < n; ++x)
+        s += (v[static_cast<std::size_t>(y * n + x)] - mean) * std::polar(1.0, -two_pi * k * x / n);
       rows[static_cast<std::size_t>(y * n + k)] = s;
     }
   for (int kx = 0; kx < n; ++kx)
     for (int ky = 0; ky < n; ++ky) {
       std::complex<double> s = 0.0;
-      for (int y = 0; y < n; ++y) s += rows[static_cast<std::size_t>(y * n + kx)] * std::polar(1.0, -two_pi * ky * y / n);
+      for (int y = 0; y < n; ++y)
+        s += rows[static_cast<std::size_t>(y * n + kx)] * std::polar(1.0, -two_pi * ky * y / n);
       full[static_cast<std::size_t>(ky * n + kx)] = s;
     }
   const int bands = 8;
@@ -54,7 +56,8 @@ std::vector<double> radial_spectrum(const std::vector<float>& v, int n) {
       sum[static_cast<std::size_t>(b)] += std::norm(full[static_cast<std::size_t>(ky * n + kx)]) / (n * n);
       count[static_cast<std::size_t>(b)] += 1.0;
     }
-  for (int b = 0; b < bands; ++b) sum[static_cast<std::size_t>(b)] /= count[static_cast<std::size_t>(b)] * var;
+  for (int b = 0; b < bands; ++b)
+    sum[static_cast<std::size_t>(b)] /= count[static_cast<std::size_t>(b)] * var;
   return sum;
 }
 
@@ -67,7 +70,8 @@ TEST(BlueNoise, MaskIsAPermutationOfRanksAndDeterministic) {
   ASSERT_EQ(m.values.size(), 4096u);
   std::vector<float> sorted = m.values;
   std::sort(sorted.begin(), sorted.end());
-  for (int r = 0; r < 4096; ++r) ASSERT_EQ(sorted[static_cast<std::size_t>(r)], static_cast<float>(r) / 4096.0f) << r;
+  for (int r = 0; r < 4096; ++r)
+    ASSERT_EQ(sorted[static_cast<std::size_t>(r)], static_cast<float>(r) / 4096.0f) << r;
   EXPECT_EQ(core::make_blue_noise(64, 1).values, m.values);
   EXPECT_NE(core::make_blue_noise(64, 2).values, m.values);
   // The renderer's mask is this one, made once.
@@ -126,8 +130,9 @@ TEST(BlueNoise, LowRanksAreEvenlySpreadAcrossTheSeams) {
   std::shuffle(all.begin(), all.end(), std::mt19937(11));
   random.assign(all.begin(), all.begin() + count);
   const double blue_d = closest_pair(low), white_d = closest_pair(random);
-  std::printf("closest pair among the %d lowest ranks: %.2f px (random points: %.2f px; mean spacing %.1f px)\n", count,
-              blue_d, white_d, std::sqrt(double(n * n) / count));
+  std::printf(
+      "closest pair among the %d lowest ranks: %.2f px (random points: %.2f px; mean spacing %.1f px)\n",
+      count, blue_d, white_d, std::sqrt(double(n * n) / count));
   EXPECT_GE(blue_d, 2.0);
   EXPECT_LT(white_d, blue_d);
 }

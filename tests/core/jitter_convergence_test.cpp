@@ -14,8 +14,8 @@
 namespace {
 using namespace cv;
 
-std::vector<double> mean_of_frames(const core::StandardScene& sc, const core::GridMeanExtinction& medium, bool blue,
-                                   int first, int count) {
+std::vector<double> mean_of_frames(const core::StandardScene& sc, const core::GridMeanExtinction& medium,
+                                   bool blue, int first, int count) {
   core::MarchSettings s = sc.march;
   s.blue_noise = blue;
   std::vector<double> sum;
@@ -48,7 +48,8 @@ TEST(JitterConvergence, BlueNoiseAccumulatesFasterThanTheHash) {
   mean_radiance /= static_cast<double>(ref.size());
   ASSERT_GT(mean_radiance, 0.0);
   const double hash_64 = rms(mean_of_frames(sc, medium, false, 1000, 64), ref) / mean_radiance;
-  std::printf("stratocumulus 48x27, RMS error of the N-frame mean / mean radiance, against 256 blue-noise frames:\n");
+  std::printf(
+      "stratocumulus 48x27, RMS error of the N-frame mean / mean radiance, against 256 blue-noise frames:\n");
   std::printf("  hash, 64 frames (1000..1063): %.3g\n", hash_64);
   double blue_at[3] = {}, hash_at[3] = {};
   const int ns[3] = {4, 8, 16};
