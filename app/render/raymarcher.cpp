@@ -7,6 +7,7 @@
 #include <glm/glm.hpp>
 
 #include "geo/geodesy.hpp"
+#include "noise/blue_noise.hpp"
 #include "render/albedo_map.hpp"
 #include "physics/physics.hpp"
 #include "volume/sampler.hpp"
@@ -21,6 +22,13 @@ void set3(GLuint p, const char* n, const glm::dvec3& v) {
 
 GpuRaymarcher::GpuRaymarcher(const ShaderLoader& loader) : loader_(loader) {
   program_for(core::MarchSettings{});  // the default program now: shader errors show at construction
+  // The jitter's blue-noise mask, the very array the CPU reference reads (made once per process),
+  // fetched texel by texel: a sampler's filtering would blend ranks.
+  const core::BlueNoiseMask& mask = core::step_jitter_mask();
+  glCreateTextures(GL_TEXTURE_2D, 1, &jitter_mask_);
+  glTextureStorage2D(jitter_mask_, 1, GL_R32F, mask.n, mask.n);
+  glTextureSubImage2D(jitter_mask_, 0, 0, 0, mask.n, mask.n, GL_RED, GL_FLOAT, mask.values.data());
+  check_gl("uploading the blue-noise jitter mask");
 }
 
 const GlProgram& GpuRaymarcher::program_for(const core::MarchSettings& s) {
@@ -38,6 +46,7 @@ const GlProgram& GpuRaymarcher::program_for(const core::MarchSettings& s) {
 GpuRaymarcher::~GpuRaymarcher() {
   if (textures_[0]) glDeleteTextures(2, textures_);
   if (ground_) glDeleteTextures(1, &ground_);
+  if (jitter_mask_) glDeleteTextures(1, &jitter_mask_);
   if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
   if (pyramid_buffer_) glDeleteBuffers(1, &pyramid_buffer_);
   if (stats_buffer_) glDeleteBuffers(1, &stats_buffer_);
@@ -127,6 +136,7 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glProgramUniform1f(p, loc(p, "u_droplet_um"), static_cast<float>(s.droplet_diameter_um));
   glProgramUniform1f(p, loc(p, "u_ice_g"), static_cast<float>(s.ice_g));
   glProgramUniform1i(p, loc(p, "u_frame"), s.frame);
+  glProgramUniform1i(p, loc(p, "u_blue_noise"), s.blue_noise ? 1 : 0);
   if (noise) {
     const core::NoiseAnchor a = core::noise_anchor(core::grid_centre_ecef(grid_), s.noise_scale_m);
     set3(p, "u_noise_anchor", a.ecef_m);  // float-exact by construction
@@ -186,6 +196,7 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glBindTextureUnit(1, textures_[0]);
   glBindTextureUnit(2, textures_[1]);
   glBindTextureUnit(5, ground_);  // 3 and 4 are the noise textures
+  glBindTextureUnit(6, jitter_mask_);
   glUseProgram(p);
   const int tile = dispatch.rows_per_tile > 0 ? (dispatch.rows_per_tile + 7) / 8 * 8 : cam.height;
   GLuint query = 0;

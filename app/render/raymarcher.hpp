@@ -65,6 +65,7 @@ class GpuRaymarcher {
   std::unique_ptr<GlProgram> programs_[2][2][2];  // [noise][skip][adaptive]
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
+  GLuint jitter_mask_ = 0;          // the blue-noise mask (R32F), uploaded at construction
   GLuint ground_ = 0;               // linear albedo (RGB32F), loaded from ground_path_
   int ground_w_ = 0, ground_h_ = 0;
   std::string ground_path_;

@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include "geo/geodesy.hpp"
+#include "noise/blue_noise.hpp"
 #include "physics/physics.hpp"
 #include "volume/extinction_pyramid.hpp"
 #include "volume/sampler.hpp"
@@ -165,6 +166,14 @@ glm::dvec4 sky_and_ground(const Medium& medium, const MarchSettings& s, const Al
   const glm::dvec3 l = sky_front + tr_front * (cloud_l + cloud_t * (sky_back + tr_back * ground));
   return glm::dvec4(l, globe ? 0.0 : cloud_t * tr_front.y * tr_back.y);
 }
+// Where in its step a pixel's view samples lie (0..1): step middles without a frame, else the
+// frame's jitter, computed as the GPU computes it (shaders/render/raymarch.comp).
+double step_offset(const MarchSettings& s, int px, int py) {
+  if (s.frame < 0) return 0.5;
+  const auto x = static_cast<p64::uint>(px), y = static_cast<p64::uint>(py), f = static_cast<p64::uint>(s.frame);
+  return s.blue_noise ? p64::blue_noise_jitter(step_jitter_mask().at(x, y), f) : p64::step_jitter(x, y, f);
+}
+
 }  // namespace
 
 glm::dvec3 AlbedoMap::at(double lat_rad, double lon_rad) const {
@@ -355,9 +364,7 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
         crossed = true;
         const int steps = std::max(1, static_cast<int>(std::ceil((t_end - t_start) / s.view_step_m)));
         const double dt = (t_end - t_start) / steps;
-        const double offset = s.frame < 0 ? 0.5
-                                          : p64::step_jitter(static_cast<p64::uint>(px), static_cast<p64::uint>(py),
-                                                             static_cast<p64::uint>(s.frame));
+        const double offset = step_offset(s, px, py);
         // What the pyramid said about the brick ahead: valid for sample distances below known_end.
         double known_end = -1.0, sigma_max = 0.0;
         for (int i = 0; i < steps && transmittance > s.min_transmittance;) {

@@ -39,8 +39,12 @@ struct MarchSettings {
   double droplet_diameter_um = 20.0;  // approximate Mie phase for liquid
   double ice_g = 0.75;                // Henyey-Greenstein for ice
   // -1: sample each step at its middle; otherwise the accumulation frame whose jittered offsets
-  // (shaders/common/rng.glsl step_jitter) place the samples, so banding averages away over frames.
+  // place the samples, so banding averages away over frames.
   int frame = -1;
+  // The offsets: true, the blue-noise mask rotated by the golden ratio per frame (rng.glsl
+  // blue_noise_jitter, core/noise/blue_noise): low-discrepancy per pixel, so a mean over frames
+  // converges faster; false, the white-noise hash step_jitter (kept for comparison).
+  bool blue_noise = true;
   // Sub-grid erosion noise (core/noise, shaders/common/erosion.glsl). 0 = off: the image is the
   // data's field exactly, and no noise is generated, bound or sampled. Up to 1 = strongest.
   double noise_amount = 0.0;

@@ -167,7 +167,7 @@ void read_sun(const Reader& r, SunSpec& s) {
 
 void read_march(const Reader& r, MarchSettings& m) {
   r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "droplet_diameter_um", "ice_g", "frame",
-          "noise_amount", "noise_scale_m", "atmosphere", "globe", "ambient", "sky_steps", "atmo_sun_steps",
+          "blue_noise", "noise_amount", "noise_scale_m", "atmosphere", "globe", "ambient", "sky_steps", "atmo_sun_steps",
           "ground_albedo", "ground_texture", "skip_empty", "adaptive_steps", "max_step_optical_depth",
           "min_transmittance"});
   r.number("view_step_m", m.view_step_m, 0.0, 1e7, "a view step in metres 0..1e7 (0: from the grid)");
@@ -179,6 +179,7 @@ void read_march(const Reader& r, MarchSettings& m) {
   r.number("droplet_diameter_um", m.droplet_diameter_um, 0.01, 50.0, "a droplet diameter in um 0.01..50");
   r.number("ice_g", m.ice_g, -0.999, 0.999, "an asymmetry parameter -0.999..0.999");
   r.integer("frame", m.frame, -1, 1 << 30);
+  r.boolean("blue_noise", m.blue_noise);
   r.number("noise_amount", m.noise_amount, 0.0, 1.0, "an erosion amount 0..1 (0: the data only)");
   r.number("noise_scale_m", m.noise_scale_m, 10.0, 1e7, "a noise tile period in metres 10..1e7");
   r.boolean("atmosphere", m.atmosphere);
@@ -305,6 +306,7 @@ std::string scene_to_json(const Scene& s) {
                       {"droplet_diameter_um", m.droplet_diameter_um},
                       {"ice_g", m.ice_g},
                       {"frame", m.frame},
+                      {"blue_noise", m.blue_noise},
                       {"noise_amount", m.noise_amount},
                       {"noise_scale_m", m.noise_scale_m},
                       {"atmosphere", m.atmosphere},

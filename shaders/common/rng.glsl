@@ -18,3 +18,15 @@ CV_FN real step_jitter(uint px, uint py, uint frame) {
   uint seed = pcg_hash(px * 1973u + py * 9277u + frame * 26699u + 1u);
   return real(seed >> 8u) * real(5.9604644775390625e-8);
 }
+
+// The offset within a march step from the blue-noise mask (core/noise/blue_noise): the pixel's
+// mask value rotated by the golden ratio each frame, fract(mask + frame * 0.6180339887), so one
+// pixel's offsets over frames form a low-discrepancy (R1) sequence while neighbouring pixels keep
+// their blue-noise differences. The sum is taken in 24-bit fixed point (0.618034 * 2^24 rounded)
+// with integer wrap-around: the GPU's float and the reference's double then give the same offset
+// bit for bit at any frame, where a float sum frame * 0.618 would lose digits as frames grow.
+// mask_value is rank / n^2 with n^2 <= 2^24, so mask_value * 2^24 is an exact integer.
+CV_FN real blue_noise_jitter(real mask_value, uint frame) {
+  uint fixed24 = uint(mask_value * real(16777216.0)) + frame * 10368890u;
+  return real(fixed24 & 16777215u) * real(5.9604644775390625e-8);
+}

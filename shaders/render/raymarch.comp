@@ -39,7 +39,10 @@ uniform int u_octaves;
 uniform vec3 u_octave_abc;
 uniform float u_droplet_um;
 uniform float u_ice_g;
-uniform int u_frame;  // -1: step middles; else the accumulation frame (step_jitter)
+uniform int u_frame;  // -1: step middles; else the accumulation frame whose jitter places the samples
+uniform bool u_blue_noise;  // the jitter from the blue-noise mask (blue_noise_jitter), else the hash
+// The blue-noise mask (core/noise/blue_noise), rank / n^2 per texel, tiled over the image.
+layout(binding = 6) uniform sampler2D u_jitter_mask;
 uniform bool u_atmosphere;    // sun colour through air, sky in-scatter, ambient sky light
 uniform bool u_globe;         // shade the ground where a ray meets it
 uniform float u_ambient;      // strength of the isotropic sky light on clouds
@@ -296,6 +299,14 @@ void march_sample(vec3 p, float alt_p, float t, float ds, float mu, MieParams mi
 }
 
 // Adds this invocation's counts to the frame's, carrying into the high words.
+// Where in its step a pixel's view samples lie (0..1), as core/reference/raymarcher.cpp step_offset.
+float step_offset(ivec2 px) {
+  if (u_frame < 0) return 0.5;
+  if (!u_blue_noise) return step_jitter(uint(px.x), uint(px.y), uint(u_frame));
+  ivec2 n = textureSize(u_jitter_mask, 0);
+  return blue_noise_jitter(texelFetch(u_jitter_mask, px % n, 0).r, uint(u_frame));
+}
+
 void flush_stats() {
   for (int k = 0; k < 6; ++k) {
     if (g_stats[k] == 0u) continue;
@@ -355,7 +366,7 @@ void main() {
     crossed = true;
     int steps = max(1, int(ceil((t_end - t_start) / u_view_step)));
     float dt = (t_end - t_start) / float(steps);
-    float offset = u_frame < 0 ? 0.5 : step_jitter(uint(px.x), uint(px.y), uint(u_frame));
+    float offset = step_offset(px);
     // What the pyramid said about the brick ahead: valid for sample distances below known_end.
     float known_end = -1.0;
     float sigma_max = 0.0;

@@ -115,6 +115,7 @@ void main() {
       break;
     }
     case PARITY_STEP_JITTER: r.a.x = step_jitter(uint(c.in0.x), uint(c.in0.y), c.meta.y); break;
+    case PARITY_BLUE_NOISE_JITTER: r.a.x = blue_noise_jitter(c.in0.x, c.meta.y); break;
     case PARITY_RAY_ALTITUDE: r.a.x = ray_altitude(c.in0.x, c.in0.y, c.in0.z, c.in0.w); break;
     case PARITY_NOISE_TILE_COORDS: r.a.xyz = noise_tile_coords(c.in0.xyz, c.in1.xyz, c.in0.w); break;
     case PARITY_NOISE_TEXEL_PAIR: {

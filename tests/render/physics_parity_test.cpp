@@ -129,6 +129,7 @@ Result eval(const Case& c) {
       break;
     }
     case PARITY_STEP_JITTER: r.a.x = f32::step_jitter(static_cast<f32::uint>(c.in0.x), static_cast<f32::uint>(c.in0.y), c.meta.y); break;
+    case PARITY_BLUE_NOISE_JITTER: r.a.x = f32::blue_noise_jitter(c.in0.x, c.meta.y); break;
     case PARITY_RAY_ALTITUDE: r.a.x = f32::ray_altitude(c.in0.x, c.in0.y, c.in0.z, c.in0.w); break;
     case PARITY_NOISE_TILE_COORDS: r.a = vec4(f32::noise_tile_coords(vec3(c.in0), vec3(c.in1), c.in0.w), 0); break;
     case PARITY_NOISE_TEXEL_PAIR: {
@@ -244,6 +245,10 @@ std::vector<Case> build_cases() {
   for (unsigned f = 0; f < 4; ++f) {
     for (float px : {0.0f, 17.0f, 1919.0f}) cs.push_back(mk(PARITY_STEP_JITTER, vec4(px, 3.0f * px + 1.0f, 0, 0), vec4(0.0f), f));
   }
+  // Mask values (rank / 4096) from the ends and the middle, at frames up to the 32-bit wrap.
+  for (unsigned f : {0u, 1u, 7u, 1000u, 4000000000u})
+    for (float v : {0.0f, 1.0f / 4096.0f, 0.2998046875f, 0.5f, 4095.0f / 4096.0f})
+      cs.push_back(mk(PARITY_BLUE_NOISE_JITTER, vec4(v, 0, 0, 0), vec4(0.0f), f));
   for (float h : {0.0f, 2500.0f, 4e8f})
     for (float mu : {-0.9f, -0.004f, 0.0f, 0.3f, 1.0f})
       for (float t : {0.0f, 150.0f, 4.0e5f}) cs.push_back(mk(PARITY_RAY_ALTITUDE, vec4(6371000.0f, h, mu, t)));
@@ -306,7 +311,8 @@ const char* name_of(unsigned id) {
                                 "segment_integral", "transmittance", "octaves_hg", "octaves_mie", "ray_sphere_rel",
                                 "ray_shell_rel", "ray_sphere", "sphere_to_ecef", "ecef_to_sphere", "enu_frame",
                                 "geopotential", "pcg_hash", "two_prod", "direction_around", "volume_coords", "step_jitter",
-                                "ray_altitude", "noise_tile_coords", "noise_texel_pair", "erosion"};
+                                "ray_altitude", "noise_tile_coords", "noise_texel_pair", "erosion",
+                                "blue_noise_jitter"};
   return id < PARITY_FUNCTION_COUNT ? names[id] : "?";
 }
 

@@ -95,6 +95,55 @@ TEST(Raymarch, GpuMatchesTheCpuReference) {
   std::printf("with jitter (frame 7): worst %.3g; jitter moved pixels by up to %.3g\n", worst_j, changed);
   EXPECT_LT(worst_j, 1e-3);
   EXPECT_GT(changed, 1e-4);  // the jitter does move the samples
+  // The white-noise hash the blue noise replaced (march.blue_noise = false) is still the same on both.
+  s.blue_noise = false;
+  const auto cpu_h = core::render_reference(sc.grid, medium, cam, sun, s);
+  const auto gpu_h = gpu.render(cam, sun, s);
+  double worst_h = 0.0, differs = 0.0;
+  for (std::size_t i = 0; i < gpu_h.size(); ++i) {
+    worst_h = std::max(worst_h, std::abs(gpu_h[i].x - cpu_h.radiance[i].x) / max_l);
+    differs = std::max(differs, std::abs(cpu_h.radiance[i].x - cpu_j.radiance[i].x) / max_l);
+  }
+  std::printf("with the hash jitter (frame 7): worst %.3g; differs from blue noise by up to %.3g\n", worst_h, differs);
+  EXPECT_LT(worst_h, 1e-3);
+  EXPECT_GT(differs, 1e-4);
+}
+
+// An image wider and taller than the 64 x 64 blue-noise mask: pixels past it take the mask again
+// (texelFetch at px mod 64 on the GPU, BlueNoiseMask::at on the CPU), the same on both.
+TEST(Raymarch, BlueNoiseJitterTilesPastTheMaskOnGpuAsOnCpu) {
+  BubbleOnGpu g;
+  auto& [ctx, loader, gpu, sc, medium] = g;
+  core::Camera cam;
+  cam.lat_deg = -1.5;
+  cam.alt_m = 2000.0;
+  cam.pitch_deg = 5.0;
+  cam.fov_deg = 60.0;
+  cam.width = 80;
+  cam.height = 70;
+  core::Sun sun;
+  sun.subsolar_lat_deg = 10.0;
+  sun.subsolar_lon_deg = 60.0;
+  core::MarchSettings s;
+  s.view_step_m = 400.0;  // coarse: the offsets matter, and llvmpipe stays quick on 5600 pixels
+  s.sun_steps = 8;
+  s.frame = 3;
+  const auto cpu = core::render_reference(sc.grid, medium, cam, sun, s);
+  const auto img = gpu.render(cam, sun, s);
+  double max_l = 0.0;
+  for (const auto& l : cpu.radiance) max_l = std::max(max_l, l.x);
+  ASSERT_GT(max_l, 0.0);
+  double worst_inside = 0.0, worst_past = 0.0;
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * cam.width + x;
+      const double e = std::abs(img[i].x - cpu.radiance[i].x) / max_l;
+      double& worst = x < 64 && y < 64 ? worst_inside : worst_past;
+      worst = std::max(worst, e);
+    }
+  std::printf("blue-noise jitter, 80x70: worst inside the first tile %.3g, past it %.3g\n", worst_inside, worst_past);
+  EXPECT_LT(worst_inside, 1e-3);
+  EXPECT_LT(worst_past, 1e-3);
 }
 
 TEST(Raymarch, FarCamerasMatchTheCpuReference) {
