@@ -352,10 +352,11 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
                                          p64::ms_octaves_hg(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c)
                                    : 0.0;
         radiance += transmittance * p64::segment_integral(sun.irradiance * (sun_air * scatter + ambient), sigma, ds);
-        const double t_next = transmittance * p64::transmittance(sigma * ds);
-        depth_w += transmittance - t_next;
-        depth_t += (transmittance - t_next) * t;
-        transmittance = t_next;
+        // The light the step takes out of the view, T (1 - exp(-sigma ds)), formed as the GPU forms it.
+        const double taken = transmittance * p64::segment_integral(sigma, sigma, ds);
+        depth_w += taken;
+        depth_t += taken * t;
+        transmittance *= p64::transmittance(sigma * ds);
       };
       bool crossed = false;
       for (int k = 0; k < n && transmittance > s.min_transmittance; ++k) {

@@ -7,10 +7,24 @@
 // (shaders/common/march_control.glsl), as in the reference. Sky and globe are composited around the
 // clouds in sky_ground.glsl. Output: rgb radiance, a = view transmittance (0 on the globe);
 // per-frame counters in the Stats buffer.
+//
+// A frame takes several dispatches: pass 0 marches the view steps [u_step_begin, u_step_begin +
+// u_step_count) of every ray (counted over both shell segments) and keeps the march's state in
+// u_state_l and u_state_depth; pass 1 adds the air and the ground and writes u_out. The reason is
+// Mesa's llvmpipe: all loops of one invocation share a budget of 65 535 iterations
+// (LP_MAX_TGSI_LOOP_ITERATIONS in gallivm), after which every loop, the march's own included, runs
+// its body once and stops, silently. A ray along the horizon spent it all in one dispatch
+// (docs/physics.md, "GPU parity"); the host (app/render/raymarcher.cpp) sizes u_step_count so that
+// one dispatch stays inside it.
 #include "../common/physics.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(rgba32f, binding = 0) writeonly uniform image2D u_out;
+layout(rgba32f, binding = 6) uniform image2D u_state_l;      // radiance so far, view transmittance
+layout(rgba32f, binding = 7) uniform image2D u_state_depth;  // depth_w, depth_t, 1 once ended, next step
+uniform int u_pass;        // 0: march a range of steps; 1: air and ground, then u_out
+uniform int u_step_begin;  // pass 0: the first view step (counted over both shell segments)
+uniform int u_step_count;  // pass 0: how many
 layout(binding = 1) uniform sampler3D u_liquid;  // grid-mean extinction, 1/m (cf x in-cloud)
 layout(binding = 2) uniform sampler3D u_ice;
 
@@ -292,10 +306,13 @@ void march_sample(vec3 p, float alt_p, float t, float ds, float mu, MieParams mi
                             ms_octaves_hg(si, mu, u_ice_g, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
                       : 0.0;
   radiance += t_view * segment_integral(u_irradiance * (sun_air * scatter + ambient), sigma, ds);
-  float t_next = t_view * transmittance(sigma * ds);
-  depth_w += t_view - t_next;
-  depth_t += (t_view - t_next) * t;
-  t_view = t_next;
+  // The light the step takes out of the view, t_view (1 - exp(-sigma ds)), without the
+  // cancellation of t_view - t_next: in float that is a multiple of 6e-8, which left faint cloud
+  // with a mean depth tens of kilometres off the CPU's (as in the reference raymarcher).
+  float taken = t_view * segment_integral(sigma, sigma, ds);
+  depth_w += taken;
+  depth_t += taken * t;
+  t_view *= transmittance(sigma * ds);
 }
 
 // Adds this invocation's counts to the frame's, carrying into the high words.
@@ -354,12 +371,20 @@ void main() {
   float t_ground = ray_sphere_rel_nu(u_r0, h, mu_up, nu_up, 0.0, tg0, tg1) && tg1 > 0.0 ? max(tg0, 0.0) : 3.0e38;
   float mu = dot(d, u_to_sun);
   MieParams mie = mie_params(u_droplet_um);
-  vec3 radiance = vec3(0.0);
-  float t_view = 1.0;
-  float depth_w = 0.0;  // sum over steps of the light each takes out of the view: where the cloud is
-  float depth_t = 0.0;
+  bool first = u_pass == 0 && u_step_begin == 0;
+  vec4 state_l = first ? vec4(0.0, 0.0, 0.0, 1.0) : imageLoad(u_state_l, px);
+  vec4 state_depth = first ? vec4(0.0) : imageLoad(u_state_depth, px);
+  vec3 radiance = state_l.rgb;
+  float t_view = state_l.a;
+  float depth_w = state_depth.x;  // sum over steps of the light each takes out of the view: where the cloud is
+  float depth_t = state_depth.y;
+  // The first step this dispatch takes (counted over both segments): a jump of the previous
+  // dispatch may have carried past the start of this one's range.
+  int next_step = max(u_step_begin, int(state_depth.w));
+  int range_end = u_step_begin + u_step_count;
+  int base = 0;  // steps of the segments before segment k
   bool crossed = false;
-  for (int k = 0; k < n && t_view > u_min_t; ++k) {
+  for (int k = 0; k < (u_pass == 0 && state_depth.z == 0.0 ? n : 0) && t_view > u_min_t; ++k) {
     float t_start = k == 0 ? seg.x : seg.z;
     float t_end = min(k == 0 ? seg.y : seg.w, t_ground);
     if (!(t_end > t_start)) continue;
@@ -367,15 +392,18 @@ void main() {
     int steps = max(1, int(ceil((t_end - t_start) / u_view_step)));
     float dt = (t_end - t_start) / float(steps);
     float offset = step_offset(px);
+    int i_end = min(range_end - base, steps);
+    int i = max(next_step - base, 0);
+    base += steps;
+    if (i >= i_end) continue;
     // What the pyramid said about the brick ahead: valid for sample distances below known_end.
     float known_end = -1.0;
     float sigma_max = 0.0;
     // One loop iteration per sample, substeps included (see space_at on loop counts): sample j of
     // the substeps of step i.
-    int i = 0;
     int j = 0;
     int substeps = 1;
-    while (i < steps && t_view > u_min_t) {
+    while (i < i_end && t_view > u_min_t) {
       if (j == 0) {
         float t_rel = (float(i) + offset) * dt;
         if ((kSkipEmpty || kAdaptive) && !(t_rel < known_end)) {
@@ -387,6 +415,7 @@ void main() {
             g_stats[kStatViewSkipped] += uint(min(next, steps) - i);
             g_stats[kStatBricksJumped] += next - i > 1 ? 1u : 0u;
             i = next;
+            next_step = base - steps + min(next, steps);  // where the march goes on, maybe in a later dispatch
             continue;
           }
           known_end = t_rel + extent;
@@ -408,11 +437,18 @@ void main() {
       if (++j == substeps) {
         j = 0;
         ++i;
+        next_step = base - steps + i;
       }
     }
   }
-  g_stats[kStatRaysMissed] += crossed ? 0u : 1u;
-  flush_stats();
+  if (u_pass == 0) {
+    if (first) g_stats[kStatRaysMissed] += crossed ? 0u : 1u;
+    flush_stats();
+    bool ended = !(t_view > u_min_t) || state_depth.z > 0.0 || range_end >= base;
+    imageStore(u_state_l, px, vec4(radiance, t_view));
+    imageStore(u_state_depth, px, vec4(depth_w, depth_t, ended ? 1.0 : 0.0, float(next_step)));
+    return;
+  }
   if (u_atmosphere || u_globe) {
     // The cloud stands, for the air around it, at the mean depth of the light it takes out.
     vec3 p_cloud = origin + (depth_w > 0.0 ? depth_t / depth_w : 0.0) * d;
