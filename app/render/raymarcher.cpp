@@ -18,6 +18,23 @@ void set3(GLuint p, const char* n, const glm::dvec3& v) {
 }
 }  // namespace
 
+int loop_iterations_per_view_step(const core::MarchSettings& s) {
+  const int sun = 3 + 2 * (std::max(s.sun_steps, 0) + 1);
+  const int air = std::max(s.atmo_sun_steps, 0) + 2;
+  const int octaves = 2 * (std::max(s.octaves, 0) + 1);
+  return 1 + sun + air + octaves;
+}
+
+int view_steps_per_dispatch(const core::MarchSettings& s) {
+  return std::max(1, (kLlvmpipeLoopBudget - kLoopReserve) / loop_iterations_per_view_step(s));
+}
+
+int max_view_steps(double r0_m, double top_m, double view_step_m) {
+  const double top = std::max(top_m, 0.0);
+  const double chord = 2.0 * std::sqrt((r0_m + top) * (r0_m + top) - r0_m * r0_m);
+  return static_cast<int>(std::min(std::ceil(chord / view_step_m) + 4.0, 2e9));
+}
+
 GpuRaymarcher::GpuRaymarcher(const ShaderLoader& loader)
     : loader_(loader), program_(load_compute(loader, ShaderLoader::default_shader_dir() / "render" / "raymarch.comp")) {}
 
@@ -25,6 +42,7 @@ GpuRaymarcher::~GpuRaymarcher() {
   if (textures_[0]) glDeleteTextures(2, textures_);
   if (ground_) glDeleteTextures(1, &ground_);
   if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
+  if (state_[0]) glDeleteTextures(2, state_);
 }
 
 void GpuRaymarcher::upload_noise(const core::ErosionNoise& noise) {
@@ -72,6 +90,7 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   const bool noise = s.noise_amount > 0.0;
   if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
   if (noise && !(s.noise_scale_m > 0.0)) throw GlError("noise_scale_m must be > 0");
+  if (!(s.view_step_m > 0.0)) throw GlError("view_step_m must be > 0");
   const GLuint p = noise ? noise_program_.id() : program_.id();
   const core::CameraFrame c = core::camera_frame(cam);
   const double r0 = grid_.earth_radius_m;
@@ -128,7 +147,16 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
     ground_path_ = s.ground_texture;
   }
   glProgramUniform2i(p, loc(p, "u_ground_size"), textured ? ground_w_ : 0, textured ? ground_h_ : 0);
+  if (!state_[0] || state_w_ != cam.width || state_h_ != cam.height) {
+    if (state_[0]) glDeleteTextures(2, state_);
+    glCreateTextures(GL_TEXTURE_2D, 2, state_);
+    for (GLuint t : state_) glTextureStorage2D(t, 1, GL_RGBA32F, cam.width, cam.height);
+    state_w_ = cam.width;
+    state_h_ = cam.height;
+  }
   glBindImageTexture(0, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(6, state_[0], 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  glBindImageTexture(7, state_[1], 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindTextureUnit(1, textures_[0]);
   glBindTextureUnit(2, textures_[1]);
   glBindTextureUnit(5, ground_);  // 3 and 4 are the noise textures
@@ -136,11 +164,25 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   const int tile = dispatch.rows_per_tile > 0 ? (dispatch.rows_per_tile + 7) / 8 * 8 : cam.height;
   GLuint query = 0;
   if (dispatch.gpu_seconds) glCreateQueries(GL_TIME_ELAPSED, 1, &query);
+  // The march goes in ranges of view steps, one dispatch each, then the air and the ground: no
+  // dispatch exceeds llvmpipe's loop budget (see loop_iterations_per_view_step).
+  const double top_m = grid_.alt_m.start + grid_.alt_m.step * (grid_.alt_m.count - 1);
+  const int total_steps = max_view_steps(r0, top_m, s.view_step_m);
+  const int chunk = view_steps_per_dispatch(s);
+  glProgramUniform1i(p, loc(p, "u_step_count"), chunk);
   for (int row = 0; row < cam.height; row += tile) {
     const int rows = std::min(tile, cam.height - row);
     glProgramUniform1i(p, loc(p, "u_row_offset"), row);
     if (query) glBeginQuery(GL_TIME_ELAPSED, query);
-    glDispatchCompute(static_cast<GLuint>((cam.width + 7) / 8), static_cast<GLuint>((rows + 7) / 8), 1);
+    const auto groups_x = static_cast<GLuint>((cam.width + 7) / 8), groups_y = static_cast<GLuint>((rows + 7) / 8);
+    glProgramUniform1i(p, loc(p, "u_pass"), 0);
+    for (int begin = 0; begin < total_steps; begin += chunk) {
+      glProgramUniform1i(p, loc(p, "u_step_begin"), begin);
+      glDispatchCompute(groups_x, groups_y, 1);
+      glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    }
+    glProgramUniform1i(p, loc(p, "u_pass"), 1);
+    glDispatchCompute(groups_x, groups_y, 1);
     if (query) {
       glEndQuery(GL_TIME_ELAPSED);
       GLuint64 ns = 0;

@@ -23,6 +23,29 @@ struct DispatchOptions {
   double* gpu_seconds = nullptr;  // if set, the dispatches' GPU time (GL_TIME_ELAPSED queries) is added
 };
 
+// Mesa's llvmpipe lets the loops of one shader invocation run 65 535 iterations in all
+// (LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop and never reset); past it, each loop runs its
+// body once and stops, without an error. Other drivers have no such limit.
+inline constexpr int kLlvmpipeLoopBudget = 65535;
+
+// An upper bound on the loop iterations one view step of raymarch.comp costs on llvmpipe: the step
+// itself, the sun march (up to two shell segments of sun_steps), the atmosphere's transmittance
+// toward the sun (two loops, atmo_sun_steps in all) and the two octave sums. Every loop counts one
+// iteration more than its trip count (the test that ends it), and a loop that no lane needs still
+// runs once (llvmpipe executes masked code).
+int loop_iterations_per_view_step(const core::MarchSettings& settings);
+
+// How many view steps one dispatch of the march takes: the budget, less kLoopReserve for the loops
+// outside the steps (the two shell segments), over the bound above.
+inline constexpr int kLoopReserve = 1024;
+int view_steps_per_dispatch(const core::MarchSettings& settings);
+
+// At most how many view steps any ray takes through a cloud shell whose top is top_m above the
+// sphere of radius r0_m: a ray that stays above the ground spends at most the chord of the top
+// sphere tangent to the ground inside it, one that meets the ground less; two per segment for
+// rounding up.
+int max_view_steps(double r0_m, double top_m, double view_step_m);
+
 class GpuRaymarcher {
  public:
   // Needs a current OpenGL 4.5 context; compiles the raymarcher. Keeps a reference to the loader
@@ -58,6 +81,8 @@ class GpuRaymarcher {
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
   GLuint ground_ = 0;               // linear albedo (RGB32F), loaded from ground_path_
+  GLuint state_[2] = {0, 0};        // the march's state between dispatches (RGBA32F, image-sized)
+  int state_w_ = 0, state_h_ = 0;
   int ground_w_ = 0, ground_h_ = 0;
   std::string ground_path_;
   core::VolumeGrid grid_;

@@ -4,10 +4,23 @@
 // with the approximate Mie phase for liquid and Henyey-Greenstein for ice; the sun's light reaches
 // each sample through the atmosphere, with an ambient sky term. Sky and globe are composited around
 // the clouds in sky_ground.glsl. Output: rgb radiance, a = view transmittance (0 on the globe).
+//
+// A frame takes several dispatches: pass 0 marches the view steps [u_step_begin, u_step_begin +
+// u_step_count) of every ray and keeps the march's state in u_state_l and u_state_depth; pass 1
+// adds the air and the ground and writes u_out. The reason is Mesa's llvmpipe: all loops of one
+// invocation share a budget of 65 535 iterations (LP_MAX_TGSI_LOOP_ITERATIONS in gallivm), after
+// which every loop, the march's own included, runs its body once and stops, silently. A ray along
+// the horizon spent it all in one dispatch (docs/physics.md, "GPU parity"); the host
+// (app/render/raymarcher.cpp) sizes u_step_count so that one dispatch stays inside it.
 #include "../common/physics.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(rgba32f, binding = 0) writeonly uniform image2D u_out;
+layout(rgba32f, binding = 6) uniform image2D u_state_l;      // radiance so far, view transmittance
+layout(rgba32f, binding = 7) uniform image2D u_state_depth;  // depth_w, depth_t (see main), 1 once ended
+uniform int u_pass;        // 0: march a range of steps; 1: air and ground, then u_out
+uniform int u_step_begin;  // pass 0: the first view step (counted over both shell segments)
+uniform int u_step_count;  // pass 0: how many
 layout(binding = 1) uniform sampler3D u_liquid;  // grid-mean extinction, 1/m (cf x in-cloud)
 layout(binding = 2) uniform sampler3D u_ice;
 
@@ -149,6 +162,9 @@ float cloud_sun_depth(vec3 p, float alt_p, float mu_sun, float nu_sun) {
 void main() {
   ivec2 px = ivec2(gl_GlobalInvocationID.xy) + ivec2(0, u_row_offset);
   if (px.x >= u_size.x || px.y >= u_size.y) return;
+  bool first = u_pass == 0 && u_step_begin == 0;
+  vec4 state_depth = first ? vec4(0.0) : imageLoad(u_state_depth, px);
+  if (u_pass == 0 && state_depth.z > 0.0) return;  // this ray's march has ended
   float x = (2.0 * (float(px.x) + 0.5) / float(u_size.x) - 1.0) * u_tan_half;
   float y = (1.0 - 2.0 * (float(px.y) + 0.5) / float(u_size.y)) * u_tan_half * float(u_size.y) / float(u_size.x);
   vec3 d = normalize(u_forward + x * u_right + y * u_upv);
@@ -183,18 +199,23 @@ void main() {
   float t_ground = ray_sphere_rel_nu(u_r0, h, mu_up, nu_up, 0.0, tg0, tg1) && tg1 > 0.0 ? max(tg0, 0.0) : 3.0e38;
   float mu = dot(d, u_to_sun);
   MieParams mie = mie_params(u_droplet_um);
-  vec3 radiance = vec3(0.0);
-  float t_view = 1.0;
-  float depth_w = 0.0;  // sum over steps of the light each takes out of the view: where the cloud is
-  float depth_t = 0.0;
-  for (int k = 0; k < n && t_view > 1e-6; ++k) {
+  vec4 state_l = first ? vec4(0.0, 0.0, 0.0, 1.0) : imageLoad(u_state_l, px);
+  vec3 radiance = state_l.rgb;
+  float t_view = state_l.a;
+  float depth_w = state_depth.x;  // sum over steps of the light each takes out of the view: where the cloud is
+  float depth_t = state_depth.y;
+  int base = 0;  // steps of the segments before segment k
+  for (int k = 0; k < (u_pass == 0 ? n : 0) && t_view > 1e-6; ++k) {
     float t_start = k == 0 ? seg.x : seg.z;
     float t_end = min(k == 0 ? seg.y : seg.w, t_ground);
     if (!(t_end > t_start)) continue;
     int steps = max(1, int(ceil((t_end - t_start) / u_view_step)));
     float dt = (t_end - t_start) / float(steps);
     float offset = u_frame < 0 ? 0.5 : step_jitter(uint(px.x), uint(px.y), uint(u_frame));
-    for (int i = 0; i < steps && t_view > 1e-6; ++i) {
+    int i_begin = max(u_step_begin - base, 0);
+    int i_end = min(u_step_begin + u_step_count - base, steps);
+    base += steps;
+    for (int i = i_begin; i < i_end && t_view > 1e-6; ++i) {
       float t = t_start + (float(i) + offset) * dt;
       vec3 p = origin + t * d;
       float alt_p = ray_altitude(u_r0, h, mu_up, t);
@@ -223,7 +244,11 @@ void main() {
       t_view = t_next;
     }
   }
-  if (u_atmosphere || u_globe) {
+  if (u_pass == 0) {
+    imageStore(u_state_l, px, vec4(radiance, t_view));
+    bool ended = !(t_view > 1e-6) || u_step_begin + u_step_count >= base;
+    imageStore(u_state_depth, px, vec4(depth_w, depth_t, ended ? 1.0 : 0.0, 0.0));
+  } else if (u_atmosphere || u_globe) {
     // The cloud stands, for the air around it, at the mean depth of the light it takes out.
     vec3 p_cloud = origin + (depth_w > 0.0 ? depth_t / depth_w : 0.0) * d;
     imageStore(u_out, px, sky_and_ground(d, radiance, t_view, depth_w > 1e-6, p_cloud));
