@@ -254,10 +254,12 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
                                            p64::ms_octaves_hg(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c)
                                      : 0.0;
           radiance += transmittance * p64::segment_integral(sun.irradiance * (sun_air * scatter + ambient), sigma, dt);
-          const double t_next = transmittance * p64::transmittance(sigma * dt);
-          depth_w += transmittance - t_next;
-          depth_t += (transmittance - t_next) * (t_start + (i + offset) * dt);
-          transmittance = t_next;
+          // The light the step takes out of the view, T (1 - exp(-sigma dt)), as raymarch.comp
+          // forms it (there, T - T_next would cancel in float).
+          const double taken = transmittance * p64::segment_integral(sigma, sigma, dt);
+          depth_w += taken;
+          depth_t += taken * (t_start + (i + offset) * dt);
+          transmittance *= p64::transmittance(sigma * dt);
         }
       }
       const std::size_t idx = static_cast<std::size_t>(py) * cam.width + px;
