@@ -56,6 +56,40 @@ TEST_P(StandardScenes, GpuMatchesTheCpuReferenceWithEveryPixelFinite) {
   EXPECT_LT(worst_t, 1e-3);
 }
 
+// The same scenes as the product shows them: sunlight through the air, the sky, ambient light and
+// the globe (constant albedo) with the clouds' shadows, GPU against CPU within the sky tests' bounds.
+TEST_P(StandardScenes, WithSkyAndGlobeTheGpuMatchesTheCpuReference) {
+  core::StandardScene sc = core::standard_scene(GetParam(), 32, 18);
+  sc.march.atmosphere = sc.march.globe = true;
+  sc.march.ambient = 1.0;
+  auto ctx = render::make_headless_context();
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::GpuRaymarcher gpu(loader);
+  const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
+  gpu.upload(sc.grid, medium);
+  const auto cpu = core::render_reference(sc.grid, medium, sc.camera, sc.sun, sc.march);
+  const auto img = gpu.render(sc.camera, sc.sun, sc.march);
+  double max_l = 0.0, worst = 0.0, sum = 0.0, worst_t = 0.0;
+  for (const auto& l : cpu.radiance) max_l = std::max({max_l, l.x, l.y, l.z});
+  ASSERT_GT(max_l, 0.0) << "the sky or the ground should be lit";
+  for (std::size_t i = 0; i < img.size(); ++i) {
+    const glm::vec4& p = img[i];
+    ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w)) << "pixel " << i;
+    ASSERT_TRUE(p.x >= 0.0f && p.y >= 0.0f && p.z >= 0.0f && p.w >= 0.0f && p.w <= 1.0f) << "pixel " << i;
+    for (int k = 0; k < 3; ++k) {
+      const double e = std::abs(p[k] - cpu.radiance[i][k]) / max_l;
+      worst = std::max(worst, e);
+      sum += e;
+    }
+    worst_t = std::max(worst_t, std::abs(double(p.w) - cpu.transmittance[i]));
+  }
+  std::printf("%-14s with sky and globe: radiance error (of the brightest pixel) mean %.3g, worst %.3g; alpha worst %.3g\n",
+              sc.name.c_str(), sum / (3.0 * img.size()), worst, worst_t);
+  EXPECT_LT(worst, 2e-3);
+  EXPECT_LT(sum / (3.0 * img.size()), 2e-4);
+  EXPECT_LT(worst_t, 1e-3);
+}
+
 // Skipping empty bricks must not change the image: every skipped sample would have read exactly
 // 0, including beside a regional grid's edge, where the data fades out over a border cell.
 TEST_P(StandardScenes, SkippingEmptySpaceLeavesTheImageExactlyAsItWas) {
