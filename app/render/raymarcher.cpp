@@ -153,6 +153,7 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glProgramUniform1i(p, loc(p, "u_octaves"), s.octaves);
   set3(p, "u_octave_abc", {s.octave_a, s.octave_b, s.octave_c});
   glProgramUniform1f(p, loc(p, "u_droplet_um"), static_cast<float>(s.droplet_diameter_um));
+  glProgramUniform1i(p, loc(p, "u_liquid_phase_hg"), s.liquid_phase_hg ? 1 : 0);
   glProgramUniform1f(p, loc(p, "u_ice_g"), static_cast<float>(s.ice_g));
   glProgramUniform1i(p, loc(p, "u_frame"), s.frame);
   glProgramUniform1i(p, loc(p, "u_blue_noise"), s.blue_noise ? 1 : 0);

@@ -275,6 +275,7 @@ MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec
                                                          MonteCarloStats& st) const {
   const double r0 = grid_.earth_radius_m;
   const p64::MieParams mie = p64::mie_params(march_.droplet_diameter_um);
+  const double liquid_g = p64::mie_mean_cosine(mie);  // for liquid_phase_hg
   PathResult r;
   glm::dvec3 beta(1.0);
   ++st.paths;
@@ -292,7 +293,8 @@ MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec
       // cosine is between the sunlight's propagation (-to_sun) and the light's toward the camera (-d).
       const double mu = glm::dot(d, to_sun_);
       const double phase = sigma > 0.0
-                               ? (sl * p64::phase_mie(mu, mie) + si * p64::phase_hg(mu, march_.ice_g)) / sigma
+                               ? (sl * (march_.liquid_phase_hg ? p64::phase_hg(mu, liquid_g) : p64::phase_mie(mu, mie)) +
+                                  si * p64::phase_hg(mu, march_.ice_g)) / sigma
                                : p64::phase_isotropic();
       r.radiance += beta * sun_.irradiance * (phase * transmittance(p, to_sun_, rng, st));
       if (r.scatterings >= mc_.max_bounces) {
@@ -304,8 +306,12 @@ MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec
       // component that scattered, chosen by its share of the extinction, and beta is unchanged.
       double pdf;
       if (rng.uniform() * sigma < sl || !(sigma > 0.0)) {
-        std::uint32_t state = rng.bits32();
-        d = p64::sample_mie(d, mie, state, pdf);
+        if (march_.liquid_phase_hg) {
+          d = p64::sample_hg(d, liquid_g, glm::dvec2(rng.uniform(), rng.uniform()), pdf);
+        } else {
+          std::uint32_t state = rng.bits32();
+          d = p64::sample_mie(d, mie, state, pdf);
+        }
       } else {
         d = p64::sample_hg(d, march_.ice_g, glm::dvec2(rng.uniform(), rng.uniform()), pdf);
       }

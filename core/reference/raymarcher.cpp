@@ -291,6 +291,7 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
   const glm::dvec3 o = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);
   const glm::dvec3 to_sun = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0));
   const p64::MieParams mie = p64::mie_params(s.droplet_diameter_um);
+  const double liquid_g = p64::mie_mean_cosine(mie);  // for liquid_phase_hg
   const glm::dvec3 up_cam = glm::normalize(o);
   for (int py = 0; py < cam.height; ++py) {
     for (int px = 0; px < cam.width; ++px) {
@@ -348,7 +349,10 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
         const glm::dvec3 ambient = s.atmosphere ? s.ambient * p64::sky_irradiance(sun_air, mu_sun) * (sigma / p64::CV_TWO_PI)
                                                 : glm::dvec3(0.0);
         // In-scattered radiance per metre: the octave sums of both phases (clouds do not absorb).
-        const double scatter = lit ? p64::ms_octaves_mie(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c) +
+        const double liquid = s.liquid_phase_hg
+                                  ? p64::ms_octaves_hg(sl, mu, liquid_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c)
+                                  : p64::ms_octaves_mie(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c);
+        const double scatter = lit ? liquid +
                                          p64::ms_octaves_hg(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c)
                                    : 0.0;
         radiance += transmittance * p64::segment_integral(sun.irradiance * (sun_air * scatter + ambient), sigma, ds);

@@ -37,6 +37,9 @@ struct MarchSettings {
   int octaves = 1;             // 1 = single scattering
   double octave_a = 0.5, octave_b = 0.5, octave_c = 0.5;
   double droplet_diameter_um = 20.0;  // approximate Mie phase for liquid
+  // The liquid phase function: the approximate Mie fit (Jendersie & d'Eon 2023), or Henyey-Greenstein
+  // with the same mean cosine (the choice of the documents this product grew from, for comparison).
+  bool liquid_phase_hg = false;
   double ice_g = 0.75;                // Henyey-Greenstein for ice
   // -1: sample each step at its middle; otherwise the accumulation frame whose jittered offsets
   // place the samples, so banding averages away over frames.

@@ -166,7 +166,7 @@ void read_sun(const Reader& r, SunSpec& s) {
 }
 
 void read_march(const Reader& r, MarchSettings& m) {
-  r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "droplet_diameter_um", "ice_g", "frame",
+  r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "droplet_diameter_um", "liquid_phase", "ice_g", "frame",
           "blue_noise", "noise_amount", "noise_scale_m", "atmosphere", "globe", "ambient", "sky_steps", "atmo_sun_steps",
           "ground_albedo", "ground_texture", "skip_empty", "adaptive_steps", "max_step_optical_depth",
           "min_transmittance"});
@@ -177,6 +177,12 @@ void read_march(const Reader& r, MarchSettings& m) {
   r.number("octave_b", m.octave_b, 0.0, 1.0, "a number 0..1");
   r.number("octave_c", m.octave_c, 0.0, 1.0, "a number 0..1");
   r.number("droplet_diameter_um", m.droplet_diameter_um, 0.01, 50.0, "a droplet diameter in um 0.01..50");
+  {
+    std::string phase = m.liquid_phase_hg ? "hg" : "mie";
+    r.string("liquid_phase", phase);
+    if (phase != "mie" && phase != "hg") r.fail("liquid_phase", "\"" + phase + "\"", "\"mie\" or \"hg\"");
+    m.liquid_phase_hg = phase == "hg";
+  }
   r.number("ice_g", m.ice_g, -0.999, 0.999, "an asymmetry parameter -0.999..0.999");
   r.integer("frame", m.frame, -1, 1 << 30);
   r.boolean("blue_noise", m.blue_noise);
@@ -304,6 +310,7 @@ std::string scene_to_json(const Scene& s) {
                       {"octave_b", m.octave_b},
                       {"octave_c", m.octave_c},
                       {"droplet_diameter_um", m.droplet_diameter_um},
+                      {"liquid_phase", m.liquid_phase_hg ? "hg" : "mie"},
                       {"ice_g", m.ice_g},
                       {"frame", m.frame},
                       {"blue_noise", m.blue_noise},

@@ -52,6 +52,7 @@ uniform int u_sun_steps;
 uniform int u_octaves;
 uniform vec3 u_octave_abc;
 uniform float u_droplet_um;
+uniform bool u_liquid_phase_hg;  // Henyey-Greenstein with the Mie fit's mean cosine instead of the fit
 uniform float u_ice_g;
 uniform int u_frame;  // -1: step middles; else the accumulation frame whose jitter places the samples
 uniform bool u_blue_noise;  // the jitter from the blue-noise mask (blue_noise_jitter), else the hash
@@ -302,7 +303,9 @@ void march_sample(vec3 p, float alt_p, float t, float ds, float mu, MieParams mi
   // Sunlight reaches the sample through the air (reddened when low), and the sky lights it too.
   vec3 sun_air = u_atmosphere && lit ? atmo_transmittance(u_r0, alt_p, mu_sun, nu_sun, u_atmo_sun_steps) : vec3(1.0);
   vec3 ambient = u_atmosphere ? u_ambient * sky_irradiance(sun_air, mu_sun) * (sigma / CV_TWO_PI) : vec3(0.0);
-  float scatter = lit ? ms_octaves_mie(sl, mu, mie, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z) +
+  float liquid = u_liquid_phase_hg ? ms_octaves_hg(sl, mu, mie_mean_cosine(mie), tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
+                                   : ms_octaves_mie(sl, mu, mie, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z);
+  float scatter = lit ? liquid +
                             ms_octaves_hg(si, mu, u_ice_g, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
                       : 0.0;
   radiance += t_view * segment_integral(u_irradiance * (sun_air * scatter + ambient), sigma, ds);

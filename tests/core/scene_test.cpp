@@ -46,6 +46,7 @@ Scene full_scene() {
   s.render.march.droplet_diameter_um = 12.5, s.render.march.ice_g = 0.8, s.render.march.frame = 9;
   s.render.march.blue_noise = false;  // not the default, so the round trip shows it is stored
   s.render.march.noise_amount = 0.35, s.render.march.noise_scale_m = 12345.0;
+  s.render.march.liquid_phase_hg = true;
   s.render.accumulate = 8, s.render.resolution_scale = 0.5, s.render.exposure = 6.25;
   s.overlays = {"coastlines"};
   return s;
@@ -89,6 +90,7 @@ void expect_equal(const Scene& a, const Scene& b) {
   EXPECT_EQ(m.frame, n.frame);
   EXPECT_EQ(m.blue_noise, n.blue_noise);
   EXPECT_EQ(m.noise_amount, n.noise_amount);
+  EXPECT_EQ(m.liquid_phase_hg, n.liquid_phase_hg);
   EXPECT_EQ(m.noise_scale_m, n.noise_scale_m);
   EXPECT_EQ(a.render.accumulate, b.render.accumulate);
   EXPECT_EQ(a.render.resolution_scale, b.render.resolution_scale);
@@ -174,7 +176,7 @@ TEST(SceneJson, OutOfRangeValuesAreRefused) {
 TEST(SceneJson, UnknownKeysAreNamedSoTyposAreCaught) {
   EXPECT_EQ(error_of(R"({"version": 1, "render": {"march": {"sun_step": 8}}})"),
             "scene.json: render.march.sun_step: unknown key, expected one of view_step_m, sun_steps, octaves, octave_a, "
-            "octave_b, octave_c, droplet_diameter_um, ice_g, frame, blue_noise, noise_amount, noise_scale_m, atmosphere, "
+            "octave_b, octave_c, droplet_diameter_um, liquid_phase, ice_g, frame, blue_noise, noise_amount, noise_scale_m, atmosphere, "
             "globe, ambient, sky_steps, atmo_sun_steps, ground_albedo, ground_texture, skip_empty, adaptive_steps, "
             "max_step_optical_depth, min_transmittance");
   EXPECT_EQ(error_of(R"({"version": 1, "camra": {}})"),
