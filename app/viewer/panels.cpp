@@ -103,6 +103,15 @@ void lighting_panel(ViewerState& s) {
   slider_double("octave a (scattering)", &m.octave_a, 0.0, 1.0, "%.2f");
   slider_double("octave b (extinction)", &m.octave_b, 0.0, 1.0, "%.2f");
   slider_double("octave c (phase)", &m.octave_c, 0.0, 1.0, "%.2f");
+  int phase = m.liquid_phase_hg ? 1 : 0;
+  if (ImGui::Combo("liquid phase", &phase, "approximate Mie\0Henyey-Greenstein (same mean cosine)\0")) m.liquid_phase_hg = phase == 1;
+  ImGui::Checkbox("air (sun colour, sky, ambient)", &m.atmosphere);
+  ImGui::Checkbox("globe and cloud shadows", &m.globe);
+  slider_double("ambient sky light", &m.ambient, 0.0, 4.0, "%.2f");
+  slider_double("erosion noise (0: data only)", &m.noise_amount, 0.0, 1.0, "%.2f");
+  if (m.noise_amount > 0.0) {
+    drag_double("noise tile (m)", &m.noise_scale_m, 100.0, 100.0, 1e6, "%.0f", ImGuiSliderFlags_Logarithmic);
+  }
 }
 
 void quality_panel(ViewerState& s) {
@@ -111,6 +120,12 @@ void quality_panel(ViewerState& s) {
     core::RenderSettings& r = s.scene.render;
     drag_double("view step (m)", &r.march.view_step_m, 5.0, 10.0, 10000.0, "%.0f", ImGuiSliderFlags_Logarithmic);
     ImGui::SliderInt("sun steps", &r.march.sun_steps, 1, 256, "%d", ImGuiSliderFlags_AlwaysClamp);
+    ImGui::Checkbox("skip empty space", &r.march.skip_empty);
+    ImGui::Checkbox("adaptive steps", &r.march.adaptive_steps);
+    if (r.march.adaptive_steps) {
+      slider_double("optical depth per substep", &r.march.max_step_optical_depth, 0.05, 10.0, "%.2f", ImGuiSliderFlags_Logarithmic);
+    }
+    ImGui::Checkbox("blue-noise jitter", &r.march.blue_noise);
     slider_double("resolution scale", &r.resolution_scale, 0.1, 1.0, "%.2f");
     ImGui::SliderInt("accumulate (frames)", &r.accumulate, 1, 1024, "%d", ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
     slider_double("exposure", &r.exposure, 0.1, 64.0, "%.2f", ImGuiSliderFlags_Logarithmic);
@@ -179,6 +194,12 @@ void draw_stats_overlay(const FrameStats& s, int target) {
     ImGui::Text("march %.2f ms, accumulate + draw %.2f ms", s.march_ms, s.present_ms);
     ImGui::Text("frames %d / %d at %d x %d", s.accumulated, target, s.march_w, s.march_h);
     ImGui::Text("%.1f FPS", s.fps);
+    const core::MarchStats& m = s.march;
+    ImGui::Text("view samples %llu, skipped %llu (%llu jumps)", static_cast<unsigned long long>(m.view_samples),
+                static_cast<unsigned long long>(m.view_skipped), static_cast<unsigned long long>(m.bricks_jumped));
+    ImGui::Text("sun samples %llu, skipped or cut off %llu", static_cast<unsigned long long>(m.sun_samples),
+                static_cast<unsigned long long>(m.sun_skipped));
+    ImGui::Text("rays missing the cloud layer %llu", static_cast<unsigned long long>(m.rays_missed));
   }
   ImGui::End();
 }

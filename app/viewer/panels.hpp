@@ -15,6 +15,7 @@ struct FrameStats {
   double fps = 0.0;         // window frames per second, averaged over ~0.5 s
   int accumulated = 0;      // frames in the current mean
   int march_w = 0, march_h = 0;
+  core::MarchStats march;   // what the last marched frame sampled and left out
   std::string renderer;     // GL_RENDERER
 };
 

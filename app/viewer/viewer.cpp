@@ -15,6 +15,7 @@
 #include <cstdio>
 
 #include "importer.hpp"
+#include "noise/noise.hpp"
 #include "render/albedo_map.hpp"
 #include "render/context.hpp"
 #include "render/presenter.hpp"
@@ -241,6 +242,7 @@ int run_viewer(const ViewerOptions& o) {
   stats.renderer = win->info().renderer;
   PassTimer march_timer, present_timer;
   int uploaded_step = -1, accumulated = 0;
+  bool noise_uploaded = false;
   bool show_ui = !o.hide_ui, f1_was_down = false;
   core::Scene previous;
   using clock = std::chrono::steady_clock;
@@ -303,6 +305,10 @@ int run_viewer(const ViewerOptions& o) {
       m.ground_texture = render::resolve_ground_texture(m.ground_texture);
       m.frame = s.scene.render.accumulate == 1 ? -1 : accumulated;
       march_timer.begin();
+      if (m.noise_amount > 0.0 && !noise_uploaded) {  // generated and compiled the first time it is asked for
+        gpu.upload_noise(core::make_erosion_noise());
+        noise_uploaded = true;
+      }
       gpu.render_into(presenter.frame_texture(), *s.scene.camera, ctx.sun, m);
       march_timer.end();
       present_timer.begin();
@@ -319,6 +325,7 @@ int run_viewer(const ViewerOptions& o) {
     present_timer.end();
     stats.march_ms = march_timer.ms();
     stats.present_ms = present_timer.ms();
+    if (show_ui) stats.march = gpu.last_stats();  // read back only when shown (it waits for the march)
     stats.accumulated = accumulated;
     stats.march_w = mw;
     stats.march_h = mh;

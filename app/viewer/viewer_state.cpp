@@ -32,10 +32,15 @@ bool same_camera(const std::optional<core::Camera>& a, const std::optional<core:
          a->pitch_deg == b->pitch_deg && a->fov_deg == b->fov_deg && a->width == b->width && a->height == b->height;
 }
 bool same_settings(const core::MarchSettings& a, const core::MarchSettings& b) {
-  // `frame` is the accumulation's own counter, not a setting.
+  // Every setting that changes the marched image; `frame` is the accumulation's own counter.
   return a.view_step_m == b.view_step_m && a.sun_steps == b.sun_steps && a.octaves == b.octaves && a.octave_a == b.octave_a &&
          a.octave_b == b.octave_b && a.octave_c == b.octave_c && a.droplet_diameter_um == b.droplet_diameter_um &&
-         a.ice_g == b.ice_g;
+         a.liquid_phase_hg == b.liquid_phase_hg && a.ice_g == b.ice_g && a.blue_noise == b.blue_noise &&
+         a.noise_amount == b.noise_amount && a.noise_scale_m == b.noise_scale_m && a.atmosphere == b.atmosphere &&
+         a.globe == b.globe && a.ambient == b.ambient && a.sky_steps == b.sky_steps && a.atmo_sun_steps == b.atmo_sun_steps &&
+         a.ground_albedo == b.ground_albedo && a.ground_texture == b.ground_texture && a.skip_empty == b.skip_empty &&
+         a.adaptive_steps == b.adaptive_steps && a.max_step_optical_depth == b.max_step_optical_depth &&
+         a.min_transmittance == b.min_transmittance;
 }
 }  // namespace
 
