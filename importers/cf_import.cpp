@@ -529,6 +529,7 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
   S->layout = detect_cf_layout(f);
   CfLayout& L = S->layout;
   core::CloudVolume vol;
+  vol.liquid_r_eff_um = options.r_eff_liquid_um;
   vol.report.file = path;
   vol.report.format = "CF pressure levels";
   for (const auto& n : L.notes) vol.report.notes.push_back(n);

@@ -303,6 +303,7 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
   const std::string& path = f.path();
   const WrfProjection proj(f);
   core::CloudVolume vol;
+  vol.liquid_r_eff_um = options.r_eff_liquid_um;
   vol.report.file = path;
   vol.report.format = "WRF, " + proj.name();
   // Grid size from the dimensions: the global attributes may describe the uncropped domain.

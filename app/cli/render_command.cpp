@@ -271,6 +271,7 @@ int cmd_render(const std::vector<std::string>& args) {
 
   const core::RenderSettings& rs = scene.render;
   core::MarchSettings march = rs.march;
+  if (!(march.droplet_diameter_um > 0.0)) march.droplet_diameter_um = 2.0 * vol.liquid_r_eff_um;  // from the data
   march.ground_texture = render::resolve_ground_texture(march.ground_texture);
   const int mw = std::max(1, static_cast<int>(std::lround(cam.width * rs.resolution_scale)));
   const int mh = std::max(1, static_cast<int>(std::lround(cam.height * rs.resolution_scale)));

@@ -214,6 +214,7 @@ int run_viewer(const ViewerOptions& o) {
     s.scene.render.accumulate = 64;
   }
   s.scene.render.march.view_step_m = core::resolve_view_step_m(s.scene.render, g);
+  if (!(s.scene.render.march.droplet_diameter_um > 0.0)) s.scene.render.march.droplet_diameter_um = 2.0 * s.volume.liquid_r_eff_um;
   if (o.frames > 0) s.scene.render.accumulate = o.frames;
   if (!o.scene || o.scale_given) s.scene.render.resolution_scale = o.scale;
 

@@ -34,12 +34,14 @@ struct SunSpec {
 // A scene's march settings before any file or option changes them: the product's look, with the
 // air, the globe and ambient sky light on (MarchSettings alone defaults to clouds on black, which
 // tests of the cloud physics rely on). An empty ground_texture means the Natural Earth relief
-// where it is installed; "none" means the constant ground_albedo.
+// where it is installed; "none" means the constant ground_albedo. A droplet diameter of 0 is taken
+// from the data (CloudVolume::liquid_r_eff_um) when the scene is rendered.
 inline MarchSettings scene_march_defaults() {
   MarchSettings m;
   m.atmosphere = true;
   m.globe = true;
   m.ambient = 1.0;
+  m.droplet_diameter_um = 0.0;  // from the data: twice the effective radius its extinction assumed
   return m;
 }
 

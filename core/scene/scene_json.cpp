@@ -176,7 +176,10 @@ void read_march(const Reader& r, MarchSettings& m) {
   r.number("octave_a", m.octave_a, 0.0, 1.0, "a number 0..1");
   r.number("octave_b", m.octave_b, 0.0, 1.0, "a number 0..1");
   r.number("octave_c", m.octave_c, 0.0, 1.0, "a number 0..1");
-  r.number("droplet_diameter_um", m.droplet_diameter_um, 0.01, 50.0, "a droplet diameter in um 0.01..50");
+  r.number("droplet_diameter_um", m.droplet_diameter_um, 0.0, 50.0, "a droplet diameter in um 0.01..50, or 0: from the data");
+  if (m.droplet_diameter_um > 0.0 && m.droplet_diameter_um < 0.01) {
+    r.fail("droplet_diameter_um", std::to_string(m.droplet_diameter_um), "a droplet diameter in um 0.01..50, or 0: from the data");
+  }
   {
     std::string phase = m.liquid_phase_hg ? "hg" : "mie";
     r.string("liquid_phase", phase);

@@ -107,6 +107,9 @@ class CloudVolume {
 
   VolumeGrid grid;
   std::vector<ValidTime> times;
+  // The cloud droplets' effective radius the liquid extinction was computed with (micrometres):
+  // the renderer's approximate Mie phase takes its droplet diameter, 2 r_eff, from here.
+  double liquid_r_eff_um = 10.0;
   std::array<bool, kFieldCount> has_field{};
   ImportReport report;
 

@@ -76,7 +76,8 @@ void write_cvvol(const std::string& path, CloudVolume& v, const std::function<vo
   }
   const std::string header = "{\"format\": \"cvvol\", \"version\": 1,\n \"grid\": {\"lon_deg\": " + axis_json(v.grid.lon_deg) +
                              ", \"lat_deg\": " + axis_json(v.grid.lat_deg) + ", \"alt_m\": " + axis_json(v.grid.alt_m) +
-                             ", \"earth_radius_m\": " + std::to_string(v.grid.earth_radius_m) + "},\n \"times\": " + times +
+                             ", \"earth_radius_m\": " + std::to_string(v.grid.earth_radius_m) + "},\n \"liquid_r_eff_um\": " +
+                             std::to_string(v.liquid_r_eff_um) + ",\n \"times\": " + times +
                              "],\n \"fields\": " + fields + "],\n \"maps\": " + maps +
                              "],\n \"layout\": \"float32 little-endian; per time step, each field (lon fastest, then lat, "
                              "then alt) then each map (lon fastest, then lat); NaN = no data\"}\n";
@@ -147,6 +148,11 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   v.grid.lat_deg = json_axis(header, "lat_deg", path);
   v.grid.alt_m = json_axis(header, "alt_m", path);
   v.grid.earth_radius_m = json_number(header, "earth_radius_m", 0, path);
+  // Volumes written before the effective radius was recorded were all made with 10 um.
+  if (header.find("\"liquid_r_eff_um\":") != std::string::npos) v.liquid_r_eff_um = json_number(header, "liquid_r_eff_um", 0, path);
+  if (!(v.liquid_r_eff_um > 0.0 && v.liquid_r_eff_um < 1000.0)) {
+    throw VolumeFileError(path + ": liquid_r_eff_um is " + std::to_string(v.liquid_r_eff_um) + ", expected 0..1000 um");
+  }
   const std::vector<std::string> fields = json_strings(header, "fields", path);
   std::vector<int> order;
   for (const auto& name : fields) {

@@ -82,6 +82,7 @@ TEST_F(CfImport, AnalyticValuesUnpackedAndPacked) {
   SynthOptions o;
   o.packed = false;
   auto v = import(write(o));
+  EXPECT_EQ(v.liquid_r_eff_um, 10.0);  // the default the extinction was computed with
   EXPECT_EQ(v.grid.lon_deg.count, 6);
   EXPECT_DOUBLE_EQ(v.grid.lon_deg.start, 170.0);
   expect_synthetic_values(v, 1e-6);

@@ -128,6 +128,7 @@ TEST(VolumeIo, CvvolRoundTrip) {
   v.grid.lat_deg = {40.0, 5.0, 2};
   v.grid.alt_m = {100.0, 500.0, 4};
   v.times = {{1705276800, "2024-01-15T00:00:00Z"}, {1705287600, "2024-01-15T03:00:00Z"}};
+  v.liquid_r_eff_um = 7.5;  // the renderer's droplet diameter comes from it
   for (Field f : {Field::CloudFraction, Field::ExtinctionLiquid, Field::Temperature}) v.has_field[static_cast<int>(f)] = true;
   v.set_loader([&](std::size_t t, ImportReport&, TimeStepData& d) {
     for (Field f : {Field::CloudFraction, Field::ExtinctionLiquid, Field::Temperature}) {
@@ -139,6 +140,7 @@ TEST(VolumeIo, CvvolRoundTrip) {
   const std::string path = (dir / "rt.cvvol").string();
   write_cvvol(path, v);
   CloudVolume r = read_cvvol(path);
+  EXPECT_EQ(r.liquid_r_eff_um, 7.5);
   EXPECT_EQ(r.grid.lon_deg.start, 170.0);
   EXPECT_EQ(r.grid.alt_m.count, 4);
   ASSERT_EQ(r.times.size(), 2u);
