@@ -11,6 +11,7 @@
 #include "render/albedo_map.hpp"
 #include "render/context.hpp"
 #include "render/raymarcher.hpp"
+#include "support/bubble_scene.hpp"
 
 namespace {
 using namespace cv;
@@ -92,24 +93,6 @@ TEST(SkyGlobe, ACloudShadowsTheGroundBesideIt) {
   }
 }
 
-// The bubble of raymarch_test.cpp, smaller: a cumulus (optical depth ~20) at 3 km on (0, 0).
-struct Bubble {
-  core::VolumeGrid grid;
-  core::TimeStepData data;
-  Bubble() {
-    grid.lon_deg = {-2.0, 0.1, 41};
-    grid.lat_deg = {-2.0, 0.1, 41};
-    grid.alt_m = {500.0, 250.0, 41};
-    data[core::Field::ExtinctionLiquid].assign(grid.points(), 0.0f);
-    for (int k = 0; k < grid.alt_m.count; ++k)
-      for (int j = 0; j < grid.lat_deg.count; ++j)
-        for (int i = 0; i < grid.lon_deg.count; ++i) {
-          const double x = grid.lon_deg.at(i), y = grid.lat_deg.at(j), z = grid.alt_m.at(k);
-          const double r2 = (x * x + y * y) / 0.25 + (z - 3000.0) * (z - 3000.0) / (1500.0 * 1500.0);
-          data[core::Field::ExtinctionLiquid][grid.index(i, j, k)] = static_cast<float>(0.02 * std::exp(-2.0 * r2));
-        }
-  }
-};
 
 struct Case {
   const char* name;
@@ -128,7 +111,7 @@ void expect_gpu_matches_cpu_with_sky(std::initializer_list<Case> cases) {
   auto ctx = render::make_headless_context();
   render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
   render::GpuRaymarcher gpu(loader);
-  Bubble sc;
+  const test::BubbleScene sc(false);  // the bubble without its ice layer
   const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
   gpu.upload(sc.grid, medium);
   core::MarchSettings s;
