@@ -16,6 +16,7 @@
 #include "render/shader_loader.hpp"
 #include "cli_common.hpp"
 #include "render_command.hpp"
+#include "bench_command.hpp"
 #include "scene/scene_json.hpp"
 #include "viewer/viewer.hpp"
 
@@ -39,11 +40,12 @@ void print_usage() {
       "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"
       "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"
       "%s"
+      "%s"
       "  view INPUT [--size WxH] [--time N] [--scale S] [--hide-ui] [--frames N --screenshot OUT.png]\n"
       "                           the interactive viewer (GLFW window); with --frames it renders N frames,\n"
       "                           saves the window to OUT.png and exits\n"
       "  --version                print the version\n",
-      cv::cli::render_usage());
+      cv::cli::render_usage(), cv::cli::bench_usage());
 }
 
 std::vector<fs::path> all_shaders(const fs::path& dir) {
@@ -218,8 +220,9 @@ int main(int argc, char** argv) {
     if (cmd == "import") return cmd_import(args);
     if (cmd == "phase") return cmd_phase(args);
     if (cmd == "render") return cv::cli::cmd_render(args);
+    if (cmd == "bench") return cv::cli::cmd_bench(args);
     if (cmd == "view") return cv::viewer::cmd_view(args);
-    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase, render or view"};
+    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase, render, bench or view"};
   } catch (const UsageError& e) {
     std::fprintf(stderr, "%s\n", e.message.c_str());
     return kExitBadInput;

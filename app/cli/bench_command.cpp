@@ -1,0 +1,369 @@
+// `cloudviewer bench`: for each standard scene a cached Monte Carlo reference, then a sweep of quality
+// settings and the seed documents' presets on the GPU, timed and held against the reference.
+#include "bench_command.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <stdexcept>
+
+#include "bench/metrics.hpp"
+#include "bench_report.hpp"
+#include "cli_common.hpp"
+#include "geo/geodesy.hpp"
+#include "reference/monte_carlo.hpp"
+#include "render/context.hpp"
+#include "render/image_output.hpp"
+#include "render/raymarcher.hpp"
+#include "scene/quality.hpp"
+#include "scene/standard_scenes.hpp"
+#include "volume/volume_io.hpp"
+
+#include <glm/geometric.hpp>
+
+namespace cv::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using clock = std::chrono::steady_clock;
+
+double seconds_since(clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); }
+
+struct BenchArgs {
+  std::vector<std::string> scenes;
+  int spp = 64, width = 96, height = 54, repeats = 3;
+  std::string out = "bench_out";
+};
+
+int parse_int(const std::string& opt, const std::string& text, int lo, int hi, const char* expected) {
+  const double v = parse_number(opt, text);
+  if (v != std::floor(v) || v < lo || v > hi) {
+    throw UsageError{"cloudviewer bench: " + opt + ": found '" + text + "', expected " + expected};
+  }
+  return static_cast<int>(v);
+}
+
+BenchArgs parse_args(const std::vector<std::string>& args) {
+  BenchArgs a;
+  const auto known = core::standard_scene_names();
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& s = args[i];
+    auto next = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw UsageError{"cloudviewer bench: " + s + ": expected a value after it"};
+      return args[++i];
+    };
+    if (s == "--reference-spp") a.spp = parse_int(s, next(), 1, 1 << 20, "an integer in 1..1048576 samples per pixel");
+    else if (s == "--repeats") a.repeats = parse_int(s, next(), 1, 100, "an integer in 1..100");
+    else if (s == "--out") a.out = next();
+    else if (s == "--size") {
+      const std::string v = next();
+      const auto x = v.find('x');
+      if (x == std::string::npos) throw UsageError{"cloudviewer bench: --size: found '" + v + "', expected WxH such as 96x54"};
+      a.width = parse_int("--size", v.substr(0, x), 8, 4096, "WxH with each in 8..4096");
+      a.height = parse_int("--size", v.substr(x + 1), 8, 4096, "WxH with each in 8..4096");
+    } else if (!s.empty() && s[0] == '-') {
+      throw UsageError{"cloudviewer bench: unknown option '" + s + "', expected --reference-spp, --size, --repeats or --out"};
+    } else if (std::find(known.begin(), known.end(), s) == known.end()) {
+      std::string names;
+      for (const auto& n : known) names += (names.empty() ? "" : ", ") + n;
+      throw UsageError{"cloudviewer bench: unknown scene '" + s + "', expected one of " + names};
+    } else {
+      a.scenes.push_back(s);
+    }
+  }
+  if (a.scenes.empty()) a.scenes = known;
+  return a;
+}
+
+// FNV-1a, 64 bit: the cache key of a reference's settings.
+std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ull) {
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+// Everything that decides the reference image, as text (the data enter through a checksum).
+std::string reference_key(const core::StandardScene& sc, const core::GridMeanExtinction& medium,
+                          const core::MarchSettings& m, const core::MonteCarloSettings& mc) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < medium.liquid_per_m.size(); ++i) sum += medium.liquid_per_m[i] * (1.0 + 1e-3 * static_cast<double>(i % 977));
+  for (std::size_t i = 0; i < medium.ice_per_m.size(); ++i) sum += medium.ice_per_m[i] * (2.0 + 1e-3 * static_cast<double>(i % 983));
+  const auto& g = sc.grid;
+  const auto& c = sc.camera;
+  char b[1024];
+  std::snprintf(b, sizeof b,
+                "v1 grid %d %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g data %.17g cam %.17g %.17g %.17g %.17g %.17g "
+                "%.17g %d %d sun %.17g %.17g %.17g %.17g %.17g march d%.17g hg%d ice%.17g noise%.17g mc %d %d %llu",
+                g.lon_deg.count, g.lat_deg.count, g.alt_m.count, g.lon_deg.start, g.lon_deg.step, g.lat_deg.start,
+                g.lat_deg.step, g.alt_m.start, g.alt_m.step, g.earth_radius_m, sum, c.lat_deg, c.lon_deg, c.alt_m,
+                c.heading_deg, c.pitch_deg, c.fov_deg, c.width, c.height, sc.sun.subsolar_lat_deg, sc.sun.subsolar_lon_deg,
+                sc.sun.irradiance.x, sc.sun.irradiance.y, sc.sun.irradiance.z, m.droplet_diameter_um,
+                m.liquid_phase_hg ? 1 : 0, m.ice_g, m.noise_amount, mc.max_bounces, mc.roulette_after,
+                static_cast<unsigned long long>(mc.seed));
+  return b;
+}
+
+// The cache file: "CVREF1\n", int32 width, height, spp, double mean relative standard error, then
+// width*height rgb doubles.
+bool read_reference(const fs::path& p, int w, int h, int spp, std::vector<glm::dvec3>& rgb, double& mrse) {
+  std::ifstream f(p, std::ios::binary);
+  if (!f) return false;
+  char magic[7] = {};
+  std::int32_t dims[3] = {};
+  f.read(magic, 7);
+  f.read(reinterpret_cast<char*>(dims), sizeof dims);
+  f.read(reinterpret_cast<char*>(&mrse), sizeof mrse);
+  if (!f || std::string(magic, 7) != "CVREF1\n" || dims[0] != w || dims[1] != h || dims[2] != spp) return false;
+  rgb.resize(static_cast<std::size_t>(w) * h);
+  f.read(reinterpret_cast<char*>(rgb.data()), static_cast<std::streamsize>(rgb.size() * sizeof(glm::dvec3)));
+  return static_cast<bool>(f);
+}
+
+void write_reference(const fs::path& p, int w, int h, int spp, const std::vector<glm::dvec3>& rgb, double mrse) {
+  core::write_file_atomically(p.string(), [&](std::FILE* f) {
+    const std::int32_t dims[3] = {w, h, spp};
+    std::fwrite("CVREF1\n", 1, 7, f);
+    std::fwrite(dims, sizeof dims, 1, f);
+    std::fwrite(&mrse, sizeof mrse, 1, f);
+    std::fwrite(rgb.data(), sizeof(glm::dvec3), rgb.size(), f);
+  });
+}
+
+struct Config {
+  std::string name, description;
+  ConfigKind kind = ConfigKind::Sweep;
+  core::MarchSettings march;
+  int accumulate = 1;
+  double scale = 1.0;
+};
+
+// The length of the camera's central ray inside the cloud layer's shell (m), for Costa's fixed
+// count of steps per ray: our march takes one step length for the whole image, so the central
+// ray's chord stands for all. 0 when the central ray misses the shell.
+double central_chord_m(const core::StandardScene& sc, const core::CloudLayer& layer) {
+  const double r0 = sc.grid.earth_radius_m;
+  const glm::dvec3 o = geo::sphere_to_ecef({sc.camera.lat_deg, sc.camera.lon_deg, sc.camera.alt_m}, r0);
+  const glm::dvec3 d = core::camera_ray(sc.camera, sc.camera.width / 2, sc.camera.height / 2);
+  auto hits = [&](double r, double& t0, double& t1) {  // |o + t d| = r
+    const double b = glm::dot(o, d), c = glm::dot(o, o) - r * r, disc = b * b - c;
+    if (disc < 0) return false;
+    t0 = -b - std::sqrt(disc), t1 = -b + std::sqrt(disc);
+    return t1 > 0;
+  };
+  double a0, a1, b0, b1;
+  if (!hits(r0 + layer.top_m, a0, a1)) return 0.0;
+  a0 = std::max(a0, 0.0);
+  double len = a1 - a0;
+  if (hits(r0 + std::max(layer.bottom_m, 0.0), b0, b1)) {  // minus the part below the shell's bottom
+    len -= std::max(0.0, std::min(b1, a1) - std::max(b0, a0));
+    if (hits(r0, b0, b1) && b0 > a0) len = std::min(len, b0 - a0);  // a ray that meets the ground stops there
+  }
+  return std::max(len, 0.0);
+}
+
+std::vector<Config> make_configs(const core::StandardScene& sc, const core::MarchSettings& base, const core::CloudLayer& layer) {
+  std::vector<Config> out;
+  auto from_preset = [&](const std::string& preset) {
+    core::RenderSettings rs;
+    rs.march = base;
+    core::apply_quality(preset, rs);
+    rs.march.view_step_m = core::resolve_view_step_m(rs, sc.grid);
+    Config c{preset, "", ConfigKind::Preset, rs.march, rs.accumulate, 1.0};
+    return c;
+  };
+  for (const char* p : {"low", "default", "high"}) out.push_back(from_preset(p));
+  const Config def = from_preset("default");
+  const double dz = std::abs(sc.grid.alt_m.step);
+  auto add = [&](const std::string& name, auto change) {
+    Config c = def;
+    c.name = name, c.kind = ConfigKind::Sweep;
+    change(c);
+    out.push_back(c);
+  };
+  for (double f : {4.0, 2.0, 0.5, 0.25}) {
+    char n[32];
+    std::snprintf(n, sizeof n, "step_%gdz", f);
+    add(n, [&](Config& c) { c.march.view_step_m = std::max(25.0, f * dz); });
+  }
+  for (int s : {4, 8, 32}) add("sun_" + std::to_string(s), [&](Config& c) { c.march.sun_steps = s; });
+  for (int o : {1, 8}) add("octaves_" + std::to_string(o), [&](Config& c) { c.march.octaves = o; });
+  add("accumulate_4", [](Config& c) { c.accumulate = 4; });
+  add("scale_0.5", [](Config& c) { c.scale = 0.5; });
+  add("adaptive", [](Config& c) { c.march.adaptive_steps = true; });
+  add("fast_2dz_sun8_scale0.5", [&](Config& c) {
+    c.march.view_step_m = std::max(25.0, 2.0 * dz), c.march.sun_steps = 8, c.scale = 0.5;
+  });
+  // The seed documents' methods (../shared/seeds), as near as our march's settings come.
+  const double chord = central_chord_m(sc, layer);
+  add("costa2023", [&](Config& c) {
+    c.kind = ConfigKind::Seed;
+    c.description = "64 view steps over the central ray's chord of the cloud shell, 32 light steps, HG, single scattering";
+    c.march.view_step_m = chord > 0.0 ? chord / 64.0 : std::max(25.0, (layer.top_m - layer.bottom_m) / 64.0);
+    c.march.sun_steps = 32, c.march.octaves = 1, c.march.liquid_phase_hg = true;
+  });
+  add("haggstrom2018", [&](Config& c) {
+    c.kind = ConfigKind::Seed;
+    c.description = "long steps of 2 dz split into short ones in dense cloud (adaptive), 4 sun steps, HG";
+    c.march.view_step_m = std::max(50.0, 2.0 * dz), c.march.adaptive_steps = true;
+    c.march.sun_steps = 4, c.march.octaves = 1, c.march.liquid_phase_hg = true;
+  });
+  add("fordsung2024", [&](Config& c) {
+    c.kind = ConfigKind::Seed;
+    c.description = "100 m steps, 8 octaves, approximate Mie at 20 um, 8 accumulated frames";
+    c.march.view_step_m = 100.0, c.march.octaves = 8, c.march.droplet_diameter_um = 20.0, c.accumulate = 8;
+  });
+  return out;
+}
+
+// Error image: |L - L_ref| / max L_ref on a black-red-yellow-white ramp, full scale at 10 %.
+std::vector<unsigned char> error_png(const std::vector<double>& e) {
+  std::vector<unsigned char> out(e.size() * 3);
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    const double v = std::clamp(e[i] / 0.1, 0.0, 1.0) * 3.0;
+    out[i * 3 + 0] = static_cast<unsigned char>(255 * std::clamp(v, 0.0, 1.0));
+    out[i * 3 + 1] = static_cast<unsigned char>(255 * std::clamp(v - 1.0, 0.0, 1.0));
+    out[i * 3 + 2] = static_cast<unsigned char>(255 * std::clamp(v - 2.0, 0.0, 1.0));
+  }
+  return out;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+const char* bench_usage() {
+  return "  bench [SCENE...] [--reference-spp N] [--size WxH] [--repeats R] [--out DIR]\n"
+         "                           error against run time on the standard scenes (default all, 96x54, 64 spp,\n"
+         "                           3 repeats, into bench_out): results.csv, summary.md, plots and error images\n";
+}
+
+int cmd_bench(const std::vector<std::string>& args) {
+  const BenchArgs a = parse_args(args);
+  std::error_code ec;
+  fs::create_directories(a.out, ec);
+  if (ec || !fs::is_directory(a.out)) throw UsageError{"cloudviewer bench: --out: cannot create the folder '" + a.out + "'"};
+  auto ctx = render::make_headless_context();
+  const std::string machine = ctx->info().summary();
+  std::printf("bench: %zu scene(s) at %dx%d, references %d spp, %d repeat(s), into %s; %s\n", a.scenes.size(), a.width,
+              a.height, a.spp, a.repeats, a.out.c_str(), machine.c_str());
+  const render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::GpuRaymarcher gpu(loader);
+  std::vector<BenchRow> rows;
+  std::vector<SceneReference> refs;
+  std::set<std::string> variants_warm;  // program variants compiled already (compile time is not frame time)
+  for (const auto& name : a.scenes) {
+    const core::StandardScene sc = core::standard_scene(name, a.width, a.height);
+    const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
+    // Clouds only, as the Monte Carlo reference models them.
+    core::MarchSettings base = sc.march;
+    base.atmosphere = base.globe = false;
+    base.ambient = 0.0, base.noise_amount = 0.0;
+    if (!(base.droplet_diameter_um > 0.0)) base.droplet_diameter_um = 20.0;
+    // The reference: cached by scene, size, spp and a hash of what decides it.
+    const core::MonteCarloSettings mc;
+    char hash[20];
+    std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a(reference_key(sc, medium, base, mc))));
+    SceneReference ref{name, "ref_" + name + "_" + std::to_string(a.width) + "x" + std::to_string(a.height) + "_" +
+                                 std::to_string(a.spp) + "spp_" + hash + ".bin",
+                       a.spp, 0.0, false, 0.0};
+    std::vector<glm::dvec3> ref_rgb;
+    const fs::path ref_path = fs::path(a.out) / ref.file;
+    if (read_reference(ref_path, a.width, a.height, a.spp, ref_rgb, ref.mean_rel_stderr)) {
+      ref.cached = true;
+      std::printf("%s: reference from %s (mean relative standard error %.3g)\n", name.c_str(), ref_path.c_str(), ref.mean_rel_stderr);
+    } else {
+      const auto t0 = clock::now();
+      const core::MonteCarloRenderer mcr(sc.grid, medium, sc.camera, sc.sun, base, mc);
+      core::MonteCarloImage img = mcr.start();
+      const int chunk = std::max(1, a.spp / 8);
+      for (int done = 0; done < a.spp;) {
+        const int n = std::min(chunk, a.spp - done);
+        mcr.add_samples(img, n);
+        done += n;
+        std::printf("\r%s: Monte Carlo reference %d/%d spp, %.1f s", name.c_str(), done, a.spp, seconds_since(t0));
+        std::fflush(stdout);
+      }
+      ref.seconds = seconds_since(t0);
+      ref_rgb = img.radiance();
+      ref.mean_rel_stderr = img.mean_relative_standard_error();
+      write_reference(ref_path, a.width, a.height, a.spp, ref_rgb, ref.mean_rel_stderr);
+      std::printf("\n%s: reference done, mean relative standard error %.3g, cached in %s\n", name.c_str(),
+                  ref.mean_rel_stderr, ref_path.c_str());
+    }
+    refs.push_back(ref);
+    fs::create_directories(fs::path(a.out) / name);
+    gpu.upload(sc.grid, medium);
+    const auto configs = make_configs(sc, base, core::cloud_layer(sc.grid, medium));
+    for (std::size_t ci = 0; ci < configs.size(); ++ci) {
+      const Config& c = configs[ci];
+      core::Camera cam = sc.camera;
+      cam.width = std::max(1, static_cast<int>(std::lround(a.width * c.scale)));
+      cam.height = std::max(1, static_cast<int>(std::lround(a.height * c.scale)));
+      std::vector<glm::vec4> pixels;
+      auto render_image = [&](double& gpu_s) {
+        render::DispatchOptions dispatch;
+        dispatch.gpu_seconds = &gpu_s;
+        core::MarchSettings m = c.march;
+        if (c.accumulate == 1) return gpu.render(cam, sc.sun, m, dispatch);
+        std::vector<glm::vec4> acc(static_cast<std::size_t>(cam.width) * cam.height, glm::vec4(0.0f));
+        for (int f = 0; f < c.accumulate; ++f) {
+          m.frame = f;
+          const auto frame = gpu.render(cam, sc.sun, m, dispatch);
+          for (std::size_t i = 0; i < acc.size(); ++i) acc[i] += (frame[i] - acc[i]) / static_cast<float>(f + 1);
+        }
+        return acc;
+      };
+      const std::string variant = std::string(c.march.adaptive_steps ? "a" : "-") + (c.march.skip_empty ? "s" : "-");
+      if (variants_warm.insert(variant).second) {
+        double ignored = 0.0;
+        render_image(ignored);
+      }
+      std::vector<double> wall, gpu_t;
+      for (int r = 0; r < a.repeats; ++r) {
+        double gpu_s = 0.0;
+        const auto t0 = clock::now();
+        pixels = render_image(gpu_s);
+        wall.push_back(seconds_since(t0) * 1e3);
+        gpu_t.push_back(gpu_s * 1e3);
+      }
+      std::vector<glm::dvec3> rgb(pixels.size());
+      for (std::size_t i = 0; i < pixels.size(); ++i) rgb[i] = glm::dvec3(pixels[i].x, pixels[i].y, pixels[i].z);
+      if (cam.width != a.width || cam.height != a.height) rgb = core::bench::upscale_bilinear(rgb, cam.width, cam.height, a.width, a.height);
+      BenchRow row;
+      row.scene = name, row.config = c.name, row.description = c.description, row.kind = c.kind;
+      row.view_step_m = c.march.view_step_m, row.sun_steps = c.march.sun_steps, row.octaves = c.march.octaves;
+      row.accumulate = c.accumulate, row.resolution_scale = c.scale;
+      row.phase_hg = c.march.liquid_phase_hg, row.adaptive = c.march.adaptive_steps;
+      row.wall_ms = median(wall), row.gpu_ms = median(gpu_t);
+      row.err = core::bench::image_error(rgb, ref_rgb);
+      row.error_image = name + "/err_" + c.name + ".png";
+      render::write_png((fs::path(a.out) / row.error_image).string(), a.width, a.height,
+                        error_png(core::bench::pixel_error(rgb, ref_rgb)));
+      std::printf("%s [%zu/%zu] %-22s %8.2f ms  rel. RMSE %-9.3g bias %+-9.3g worst %-8.3g PSNR %.1f dB\n", name.c_str(),
+                  ci + 1, configs.size(), c.name.c_str(), row.wall_ms, row.err.rel_rmse, row.err.rel_bias, row.err.worst,
+                  row.err.psnr_db);
+      std::fflush(stdout);
+      rows.push_back(row);
+    }
+  }
+  mark_pareto(rows);
+  std::string command = "cloudviewer bench";
+  for (const auto& s : args) command += " " + s;
+  write_results_csv((fs::path(a.out) / "results.csv").string(), rows, refs);
+  write_summary_md((fs::path(a.out) / "summary.md").string(), rows, refs, command, machine);
+  const auto plots = write_plots(a.out, rows);
+  std::printf("wrote %s/results.csv (%zu rows), %s/summary.md and %zu plot(s)\n", a.out.c_str(), rows.size(), a.out.c_str(),
+              plots.size());
+  return 0;
+}
+
+}  // namespace cv::cli

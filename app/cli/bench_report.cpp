@@ -1,0 +1,163 @@
+// results.csv, summary.md and the Pareto plots of `cloudviewer bench` (see bench_report.hpp).
+#include "bench_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "bench/plot.hpp"
+#include "render/image_output.hpp"
+#include "volume/volume_io.hpp"
+
+namespace cv::cli {
+
+namespace {
+
+const char* kind_name(ConfigKind k) {
+  return k == ConfigKind::Seed ? "seed" : k == ConfigKind::Preset ? "preset" : "sweep";
+}
+
+std::vector<std::string> scene_order(const std::vector<BenchRow>& rows) {
+  std::vector<std::string> out;
+  for (const auto& r : rows) {
+    if (std::find(out.begin(), out.end(), r.scene) == out.end()) out.push_back(r.scene);
+  }
+  return out;
+}
+
+std::vector<const BenchRow*> rows_of(const std::vector<BenchRow>& rows, const std::string& scene) {
+  std::vector<const BenchRow*> out;
+  for (const auto& r : rows) {
+    if (r.scene == scene) out.push_back(&r);
+  }
+  return out;
+}
+
+// "%.3g", or "n/a" for NaN.
+std::string num(double v, const char* fmt = "%.3g") {
+  if (std::isnan(v)) return "n/a";
+  char b[48];
+  std::snprintf(b, sizeof b, fmt, v);
+  return b;
+}
+
+}  // namespace
+
+void mark_pareto(std::vector<BenchRow>& rows) {
+  for (const auto& scene : scene_order(rows)) {
+    std::vector<std::size_t> idx;
+    std::vector<core::bench::TimeError> pts;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      if (rows[i].scene != scene) continue;
+      idx.push_back(i);
+      pts.push_back({rows[i].wall_ms, rows[i].err.rel_rmse});
+    }
+    for (std::size_t k : core::bench::pareto_front(pts)) rows[idx[k]].pareto = true;
+  }
+}
+
+const char* results_csv_header() {
+  return "scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,"
+         "wall_ms,gpu_ms,rel_rmse,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,error_image";
+}
+
+void write_results_csv(const std::string& path, const std::vector<BenchRow>& rows, const std::vector<SceneReference>& refs) {
+  core::write_file_atomically(path, [&](std::FILE* f) {
+    std::fprintf(f, "%s\n", results_csv_header());
+    for (const auto& r : rows) {
+      const SceneReference* ref = nullptr;
+      for (const auto& s : refs) {
+        if (s.scene == r.scene) ref = &s;
+      }
+      std::fprintf(f, "%s,%s,%s,%.6g,%d,%d,%d,%.3g,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.6g,%s\n", r.scene.c_str(),
+                   r.config.c_str(), kind_name(r.kind), r.view_step_m, r.sun_steps, r.octaves, r.accumulate,
+                   r.resolution_scale, r.phase_hg ? "hg" : "mie", r.adaptive ? 1 : 0, r.wall_ms, r.gpu_ms, r.err.rel_rmse,
+                   r.err.rel_bias, r.err.worst, r.err.psnr_db, r.pareto ? 1 : 0, ref ? ref->spp : 0,
+                   ref ? ref->mean_rel_stderr : 0.0, r.error_image.c_str());
+    }
+  });
+}
+
+void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows, const std::vector<SceneReference>& refs,
+                      const std::string& command, const std::string& machine) {
+  core::write_file_atomically(path, [&](std::FILE* f) {
+    std::fprintf(f, "# cloudviewer bench\n\nCommand: `%s`\n\nMachine: %s\n\n", command.c_str(), machine.c_str());
+    std::fprintf(f,
+                 "Error = luminance against a Monte Carlo reference with full multiple scattering (clouds only: no air, "
+                 "no globe, no ambient light), so it includes the octave approximation's bias, not only the step "
+                 "and sampling error. rel. RMSE = RMS(L - L_ref) / mean L_ref; bias = mean(L - L_ref) / mean L_ref; "
+                 "worst = max |L - L_ref| / max L_ref; PSNR against max L_ref. Time = wall time per output image "
+                 "(all its accumulated frames, read-back included), median of the repeats. `*` = on the Pareto front "
+                 "(time, rel. RMSE) of all configurations. Plots: rel. RMSE (log, vertical, decades labelled eN) "
+                 "against wall ms (log, horizontal); blue = sweep, green = our presets, orange = seed presets, red = "
+                 "Pareto front.\n\n");
+    for (const auto& scene : scene_order(rows)) {
+      auto list = rows_of(rows, scene);
+      std::sort(list.begin(), list.end(), [](const BenchRow* a, const BenchRow* b) { return a->wall_ms < b->wall_ms; });
+      std::fprintf(f, "## %s\n\n", scene.c_str());
+      for (const auto& ref : refs) {
+        if (ref.scene == scene) {
+          std::fprintf(f, "Reference: %d samples per pixel (%s), mean relative standard error %.3g; `%s`.\n\n", ref.spp,
+                       ref.cached ? "from the cache" : ("rendered in " + num(ref.seconds, "%.1f") + " s").c_str(),
+                       ref.mean_rel_stderr, ref.file.c_str());
+        }
+      }
+      std::fprintf(f, "![error against time](%s_pareto.png)\n\n", scene.c_str());
+      std::fprintf(f, "| | config | kind | step m | sun | oct | acc | scale | phase | wall ms | GPU ms | rel. RMSE | bias | worst | PSNR dB |\n");
+      std::fprintf(f, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      for (const BenchRow* r : list) {
+        std::fprintf(f, "| %s | %s | %s | %.4g%s | %d | %d | %d | %.2g | %s | %.4g | %s | %s | %s | %s | %s |\n",
+                     r->pareto ? "*" : "", r->config.c_str(), kind_name(r->kind), r->view_step_m, r->adaptive ? " adapt." : "",
+                     r->sun_steps, r->octaves, r->accumulate, r->resolution_scale, r->phase_hg ? "HG" : "Mie", r->wall_ms,
+                     r->gpu_ms > 0 ? num(r->gpu_ms, "%.4g").c_str() : "-", num(r->err.rel_rmse).c_str(),
+                     num(r->err.rel_bias, "%+.3g").c_str(), num(r->err.worst).c_str(), num(r->err.psnr_db, "%.1f").c_str());
+      }
+      // Ratios: our configurations' own front (sweep and presets, no seed) interpolated in log-log.
+      std::vector<core::bench::TimeError> ours_pts;
+      const BenchRow* def = nullptr;
+      for (const BenchRow* r : list) {
+        if (r->kind != ConfigKind::Seed) ours_pts.push_back({r->wall_ms, r->err.rel_rmse});
+        if (r->config == "default") def = r;
+      }
+      std::vector<core::bench::TimeError> front;
+      for (std::size_t k : core::bench::pareto_front(ours_pts)) front.push_back(ours_pts[k]);
+      std::fprintf(f,
+                   "\nAgainst the seed presets. \"Our front\" = the Pareto front of our sweep and presets only; between "
+                   "its measured points time and error are interpolated linearly in log-log, never extrapolated (n/a: "
+                   "outside the measured range; at or above the front's fastest point's error the fastest point's time "
+                   "is taken, an upper bound). The default preset's own ratios use its single measured point.\n\n");
+      std::fprintf(f, "| seed preset | its ms | its rel. RMSE | our front's time to its error (ratio) | our front's error at its time (ratio) | default: time ratio | default: error ratio |\n");
+      std::fprintf(f, "|---|---|---|---|---|---|---|\n");
+      for (const BenchRow* r : list) {
+        if (r->kind != ConfigKind::Seed) continue;
+        const double t = core::bench::front_time_for_error(front, r->err.rel_rmse);
+        const double e = core::bench::front_error_at_time(front, r->wall_ms);
+        std::fprintf(f, "| %s | %.4g | %s | %s ms (%s) | %s (%s) | %s | %s |\n", r->config.c_str(), r->wall_ms,
+                     num(r->err.rel_rmse).c_str(), num(t, "%.4g").c_str(), num(t / r->wall_ms).c_str(), num(e).c_str(),
+                     num(e / r->err.rel_rmse).c_str(), def ? num(def->wall_ms / r->wall_ms).c_str() : "n/a",
+                     def ? num(def->err.rel_rmse / r->err.rel_rmse).c_str() : "n/a");
+      }
+      std::fprintf(f, "\n");
+    }
+  });
+}
+
+std::vector<std::string> write_plots(const std::string& dir, const std::vector<BenchRow>& rows) {
+  std::vector<std::string> out;
+  for (const auto& scene : scene_order(rows)) {
+    std::vector<core::bench::PlotPoint> pts;
+    std::vector<core::bench::TimeError> te;
+    for (const BenchRow* r : rows_of(rows, scene)) {
+      pts.push_back({{r->wall_ms, r->err.rel_rmse}, static_cast<int>(r->kind)});
+      te.push_back(pts.back().p);
+    }
+    const auto img = core::bench::plot_error_vs_time(pts, core::bench::pareto_front(te), 320, 240);
+    const std::string name = scene + "_pareto.png";
+    render::write_png(dir + "/" + name, img.width, img.height, img.rgb);
+    out.push_back(name);
+  }
+  return out;
+}
+
+}  // namespace cv::cli

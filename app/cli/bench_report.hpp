@@ -1,0 +1,49 @@
+// What `cloudviewer bench` measured, and how it writes it: results.csv, summary.md (per scene a
+// table by time with the Pareto front, and the ratios against the seed documents' presets) and
+// the error-against-time plots.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "bench/metrics.hpp"
+
+namespace cv::cli {
+
+// Which family a configuration belongs to: our sweep, our named presets, a seed document's preset.
+enum class ConfigKind { Sweep = 0, Preset = 1, Seed = 2 };
+
+struct BenchRow {
+  std::string scene, config, description;
+  ConfigKind kind = ConfigKind::Sweep;
+  double view_step_m = 0.0;
+  int sun_steps = 0, octaves = 0, accumulate = 1;
+  double resolution_scale = 1.0;
+  bool phase_hg = false, adaptive = false;
+  double wall_ms = 0.0;  // median over repeats, per output image (all its accumulated frames)
+  double gpu_ms = 0.0;   // median GL_TIME_ELAPSED; 0 when the driver reports none
+  core::bench::ImageError err;
+  bool pareto = false;
+  std::string error_image;  // relative to the output folder
+};
+
+struct SceneReference {
+  std::string scene, file;
+  int spp = 0;
+  double mean_rel_stderr = 0.0;
+  bool cached = false;
+  double seconds = 0.0;  // to render it (0 when read from the cache)
+};
+
+// Marks BenchRow::pareto on each scene's rows (by wall time and relative RMSE).
+void mark_pareto(std::vector<BenchRow>& rows);
+
+// The CSV header line (no newline), shared with the smoke test's expectation.
+const char* results_csv_header();
+void write_results_csv(const std::string& path, const std::vector<BenchRow>& rows, const std::vector<SceneReference>& refs);
+void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows, const std::vector<SceneReference>& refs,
+                      const std::string& command, const std::string& machine);
+// One PNG per scene: <dir>/<scene>_pareto.png; returns the file names.
+std::vector<std::string> write_plots(const std::string& dir, const std::vector<BenchRow>& rows);
+
+}  // namespace cv::cli

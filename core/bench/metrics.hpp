@@ -1,0 +1,54 @@
+// The benchmark's pure computations: error of an image against a reference (relative RMSE, bias,
+// worst pixel, PSNR on luminance), the Pareto front of (time, error) points and the interpolation
+// along it that turns two configurations into the ratios the benchmark reports.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace cv::core::bench {
+
+// Rec. 709 luminance of linear rgb radiance.
+double luminance(const glm::dvec3& rgb);
+
+// Error of a test image against a reference of the same size, on luminance. All relative figures
+// are NaN when the reference is black everywhere (nothing to be relative to).
+struct ImageError {
+  double rel_rmse = 0.0;   // sqrt(mean (L - L_ref)^2) / mean L_ref
+  double rel_bias = 0.0;   // mean (L - L_ref) / mean L_ref (signed: > 0 the test is too bright)
+  double worst = 0.0;      // max |L - L_ref| / max L_ref
+  double psnr_db = 0.0;    // 20 log10(max L_ref / rmse); +inf for identical images
+  double rmse = 0.0;       // absolute, in the images' radiance units
+  double ref_mean = 0.0, ref_max = 0.0;
+};
+// Throws std::invalid_argument when the sizes differ or are 0.
+ImageError image_error(const std::vector<glm::dvec3>& test, const std::vector<glm::dvec3>& ref);
+
+// Per-pixel |L - L_ref| / max L_ref (0 where the reference is black everywhere), for error images.
+std::vector<double> pixel_error(const std::vector<glm::dvec3>& test, const std::vector<glm::dvec3>& ref);
+
+// Bilinear resampling over pixel centres (edges clamped): how a frame marched at a lower
+// resolution is shown at the output size.
+std::vector<glm::dvec3> upscale_bilinear(const std::vector<glm::dvec3>& src, int sw, int sh, int dw, int dh);
+
+struct TimeError {
+  double time = 0.0, error = 0.0;
+};
+
+// Indices of the points on the Pareto front (no other point is at least as fast and at least as
+// accurate while strictly better in one), sorted by time ascending (hence error descending).
+// Points with a non-finite or non-positive coordinate are never on it.
+std::vector<std::size_t> pareto_front(const std::vector<TimeError>& pts);
+
+// Along a front (sorted by time, error falling), interpolated linearly in log(time)-log(error)
+// between neighbouring points; never extrapolated.
+// The time the front needs to reach `error`: its fastest point's time when even that point is at
+// least as accurate (an upper bound then), NaN when no point on it is that accurate.
+double front_time_for_error(const std::vector<TimeError>& front, double error);
+// The front's error at `time` (NaN when time is below its fastest point; the last point's error
+// when time is beyond its slowest: waiting longer does not make that front worse).
+double front_error_at_time(const std::vector<TimeError>& front, double time);
+
+}  // namespace cv::core::bench
