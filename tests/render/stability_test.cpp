@@ -200,9 +200,11 @@ TEST(Stability, OpticalDepthFrom1e4PerStepDownToNothing) {
     char name[64];
     std::snprintf(name, sizeof name, "extinction %.0e /m", sigma);
     // At 1e2 /m the light comes from the first centimetre of cloud, lit through exp(-a^i tau_sun)
-    // with tau_sun changing by ~1e2 per metre there: float positions move it (measured 1.6e-3).
+    // with tau_sun changing by ~1e2 per metre there: float positions move it (measured 1.6e-3 of
+    // the brightest pixel, above the 1e-3 the other cases meet). That error is printed, not held
+    // to a bound chosen after seeing it; finiteness and the physical bound still hold.
     st.run_accel(name, b.grid, core::grid_mean_extinction(b.grid, b.data), side_view(0.0, 0.0), sun, clouds_only(),
-                 sigma > 10.0 ? 5e-3 : 1e-3);
+                 sigma > 10.0 ? -1.0 : 1e-3);
   }
   // Extinction 0 everywhere: nothing to march; the image is black and clear.
   Box zero(0.0, 0.0, 0.0);
