@@ -197,7 +197,9 @@ GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepDa
     for (std::size_t p = 0; p < out.size(); ++p) {
       const float c = cf.empty() ? 1.0f : cf[p];
       const float v = c * ext[p];
-      out[p] = std::isnan(v) || v < 0.0f ? 0.0f : v;
+      // NaN, negative and fill values (netCDF's 9.96921e36 left in a field, or a product with one)
+      // are no data: no cloud. The comparison is false for NaN.
+      out[p] = v >= 0.0f && v < kMaxGridMeanExtinctionPerM ? v : 0.0f;
     }
   };
   product(data[Field::ExtinctionLiquid], m.liquid_per_m);

@@ -104,6 +104,11 @@ struct ReferenceImage {
 struct GridMeanExtinction {
   std::vector<float> liquid_per_m, ice_per_m;
 };
+// Extinctions from this up are not data but fill values left in a field (netCDF's default float
+// fill is 9.96921e36): the densest fog is ~0.1 /m, and float sums of sigma x phase (up to 1.6e5 /sr
+// at g = 0.999) x step would overflow to Inf near 1e33 /m. grid_mean_extinction takes them as no cloud.
+constexpr float kMaxGridMeanExtinctionPerM = 1e6f;
+// cloud fraction x in-cloud extinction per node; NaN, negative and >= kMaxGridMeanExtinctionPerM -> 0.
 GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepData& data);
 
 // The altitudes between which a volume holds cloud: from the level below its lowest level with any
