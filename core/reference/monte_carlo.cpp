@@ -200,11 +200,9 @@ void MonteCarloRenderer::majorant_at(const glm::dvec3& p, const glm::dvec3& d, d
   t_valid = std::min(t + sp.extent_m, t_end);
 }
 
-double MonteCarloRenderer::free_path(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng,
-                                     MonteCarloStats& st, double* ground_m) const {
-  double seg[4], t_ground;
-  const int n = shell_parts(p, d, seg, t_ground);
-  if (ground_m) *ground_m = t_ground;
+template <class Visit>
+bool MonteCarloRenderer::tentative_collisions(const glm::dvec3& p, const glm::dvec3& d, const double seg[4], int n,
+                                              PathRng& rng, MonteCarloStats& st, Visit&& visit) const {
   for (int k = 0; k < n; ++k) {
     double t = seg[2 * k];
     const double b = seg[2 * k + 1];
@@ -226,11 +224,28 @@ double MonteCarloRenderer::free_path(const glm::dvec3& p, const glm::dvec3& d, P
       extinction(p + t * d, sl, si);
       const double sigma = sl + si;
       st.majorant_exceeded += sigma > maj * (1.0 + 1e-9);
-      if (rng.uniform() * maj < sigma) return t;
-      ++st.null_collisions;
+      if (visit(t, sigma, maj)) return true;
     }
   }
-  return kInf;
+  return false;
+}
+
+double MonteCarloRenderer::free_path(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng,
+                                     MonteCarloStats& st, double* ground_m) const {
+  double seg[4], t_ground;
+  const int n = shell_parts(p, d, seg, t_ground);
+  if (ground_m) *ground_m = t_ground;
+  // Delta tracking: a tentative collision is real with probability sigma / majorant.
+  double hit = kInf;
+  tentative_collisions(p, d, seg, n, rng, st, [&](double t, double sigma, double maj) {
+    if (rng.uniform() * maj < sigma) {
+      hit = t;
+      return true;
+    }
+    ++st.null_collisions;
+    return false;
+  });
+  return hit;
 }
 
 double MonteCarloRenderer::transmittance(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng,
@@ -238,37 +253,19 @@ double MonteCarloRenderer::transmittance(const glm::dvec3& p, const glm::dvec3& 
   double seg[4], t_ground;
   const int n = shell_parts(p, d, seg, t_ground);
   if (std::isfinite(t_ground)) return 0.0;  // the Earth's shadow
+  // Ratio tracking: each tentative collision keeps the fraction 1 - sigma / majorant.
   double tr = 1.0;
-  for (int k = 0; k < n; ++k) {
-    double t = seg[2 * k];
-    const double b = seg[2 * k + 1];
-    while (t < b) {
-      double maj, lim;
-      majorant_at(p, d, t, b, maj, lim);
-      if (!(maj > 0.0)) {
-        t = lim;
-        continue;
-      }
-      const double s = -std::log1p(-rng.uniform()) / maj;
-      if (t + s >= lim) {
-        t = lim;
-        continue;
-      }
-      t += s;
-      double sl, si;
-      extinction(p + t * d, sl, si);
-      ++st.shadow_lookups;
-      const double sigma = sl + si;
-      st.majorant_exceeded += sigma > maj * (1.0 + 1e-9);
-      tr *= std::max(0.0, 1.0 - sigma / maj);
-      if (tr < kShadowRouletteBelow) {
-        // Survive with probability tr / threshold carrying the threshold: expectation unchanged.
-        if (rng.uniform() * kShadowRouletteBelow >= tr) return 0.0;
-        tr = kShadowRouletteBelow;
-      }
+  const bool stopped = tentative_collisions(p, d, seg, n, rng, st, [&](double, double sigma, double maj) {
+    ++st.shadow_lookups;
+    tr *= std::max(0.0, 1.0 - sigma / maj);
+    if (tr < kShadowRouletteBelow) {
+      // Survive with probability tr / threshold carrying the threshold: expectation unchanged.
+      if (rng.uniform() * kShadowRouletteBelow >= tr) return true;
+      tr = kShadowRouletteBelow;
     }
-  }
-  return tr;
+    return false;
+  });
+  return stopped ? 0.0 : tr;
 }
 
 MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec3 d, PathRng& rng,

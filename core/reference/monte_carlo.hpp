@@ -120,6 +120,12 @@ class MonteCarloRenderer {
   // Majorant valid from t on along the ray and the distance up to which it holds.
   void majorant_at(const glm::dvec3& p, const glm::dvec3& d, double t, double t_end, double& sigma_max,
                    double& t_valid) const;
+  // Walks the tentative collisions of a majorant-driven (delta or ratio) tracking along the shell
+  // parts seg[0..2n): visit(t, sigma, majorant) sees each one and returns true to stop the walk.
+  // Returns whether a visit stopped it.
+  template <class Visit>
+  bool tentative_collisions(const glm::dvec3& p, const glm::dvec3& d, const double seg[4], int n, PathRng& rng,
+                            MonteCarloStats& st, Visit&& visit) const;
   glm::dvec3 sun_light(const glm::dvec3& x, PathRng& rng, MonteCarloStats& st, double& mu_sun_local) const;
   glm::dvec3 pixel_sample(int px, int py, std::uint64_t sample, MonteCarloStats& st) const;
 
