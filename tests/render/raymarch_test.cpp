@@ -25,21 +25,31 @@ struct BubbleOnGpu {
   BubbleOnGpu() { gpu.upload(sc.grid, medium); }
 };
 
+// The bubble seen from 1.5 degrees south, 2 km up, looking 5 degrees up, at width x height.
+core::Camera bubble_camera(int width, int height) {
+  core::Camera cam;
+  cam.lat_deg = -1.5;
+  cam.alt_m = 2000.0;
+  cam.pitch_deg = 5.0;
+  cam.fov_deg = 60.0;
+  cam.width = width;
+  cam.height = height;
+  return cam;
+}
+
+// The sun low in the east of the bubble.
+core::Sun low_eastern_sun() {
+  core::Sun sun;
+  sun.subsolar_lat_deg = 10.0;
+  sun.subsolar_lon_deg = 60.0;
+  return sun;
+}
+
 TEST(Raymarch, GpuMatchesTheCpuReference) {
   BubbleOnGpu g;
   auto& [ctx, loader, gpu, sc, medium] = g;
-  core::Camera cam;
-  cam.lat_deg = -1.5;
-  cam.lon_deg = 0.0;
-  cam.alt_m = 2000.0;
-  cam.heading_deg = 0.0;
-  cam.pitch_deg = 5.0;
-  cam.fov_deg = 60.0;
-  cam.width = 48;
-  cam.height = 27;
-  core::Sun sun;
-  sun.subsolar_lat_deg = 10.0;
-  sun.subsolar_lon_deg = 60.0;             // low in the east
+  const core::Camera cam = bubble_camera(48, 27);
+  core::Sun sun = low_eastern_sun();
   sun.irradiance = glm::dvec3(1.0, 0.8, 0.5);  // distinct channels: a channel mix-up shows
   core::MarchSettings s;
   s.view_step_m = 200.0;
@@ -95,16 +105,8 @@ TEST(Raymarch, GpuMatchesTheCpuReference) {
 TEST(Raymarch, BlueNoiseJitterTilesPastTheMaskOnGpuAsOnCpu) {
   BubbleOnGpu g;
   auto& [ctx, loader, gpu, sc, medium] = g;
-  core::Camera cam;
-  cam.lat_deg = -1.5;
-  cam.alt_m = 2000.0;
-  cam.pitch_deg = 5.0;
-  cam.fov_deg = 60.0;
-  cam.width = 80;
-  cam.height = 70;
-  core::Sun sun;
-  sun.subsolar_lat_deg = 10.0;
-  sun.subsolar_lon_deg = 60.0;
+  const core::Camera cam = bubble_camera(80, 70);
+  const core::Sun sun = low_eastern_sun();
   core::MarchSettings s;
   s.view_step_m = 400.0;  // coarse: the offsets matter, and llvmpipe stays quick on 5600 pixels
   s.sun_steps = 8;
@@ -315,15 +317,8 @@ namespace {
 TEST(Raymarch, LiquidPhaseChoiceMatchesTheReference) {
   BubbleOnGpu g;
   auto& [ctx, loader, gpu, sc, medium] = g;
-  core::Camera cam;
-  cam.lat_deg = -1.5;
-  cam.alt_m = 2000.0;
-  cam.pitch_deg = 5.0;
-  cam.width = 32;
-  cam.height = 18;
-  core::Sun sun;
-  sun.subsolar_lat_deg = 10.0;
-  sun.subsolar_lon_deg = 60.0;
+  const core::Camera cam = bubble_camera(32, 18);
+  const core::Sun sun = low_eastern_sun();
   core::MarchSettings s;
   s.view_step_m = 200.0;
   s.sun_steps = 16;
