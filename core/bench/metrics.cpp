@@ -29,10 +29,16 @@ double loglog(double x0, double y0, double x1, double y1, double x) {
 
 double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 
-ImageError image_error(const std::vector<glm::dvec3>& test, const std::vector<glm::dvec3>& ref) {
+ImageError image_error(const std::vector<glm::dvec3>& test, const std::vector<glm::dvec3>& ref,
+                       const std::vector<double>& ref_lum_variance) {
   check_sizes(test, ref);
+  if (!ref_lum_variance.empty() && ref_lum_variance.size() != ref.size()) {
+    throw std::invalid_argument("image_error: " + std::to_string(ref_lum_variance.size()) + " variances for " +
+                                std::to_string(ref.size()) + " reference pixels, expected one per pixel");
+  }
   const double n = static_cast<double>(ref.size());
-  double sum_ref = 0.0, max_ref = 0.0, sum_d = 0.0, sum_d2 = 0.0, max_d = 0.0;
+  double sum_ref = 0.0, max_ref = 0.0, sum_d = 0.0, sum_d2 = 0.0, max_d = 0.0, sum_var = 0.0;
+  for (double v : ref_lum_variance) sum_var += std::max(v, 0.0);
   for (std::size_t i = 0; i < ref.size(); ++i) {
     const double lr = luminance(ref[i]), d = luminance(test[i]) - lr;
     sum_ref += lr;
@@ -46,10 +52,12 @@ ImageError image_error(const std::vector<glm::dvec3>& test, const std::vector<gl
   e.ref_max = max_ref;
   e.rmse = std::sqrt(sum_d2 / n);
   if (!(e.ref_mean > 0.0)) {
-    e.rel_rmse = e.rel_bias = e.worst = e.psnr_db = kNaN;
+    e.rel_rmse = e.rel_rmse_raw = e.rel_noise_floor = e.rel_bias = e.worst = e.psnr_db = kNaN;
     return e;
   }
-  e.rel_rmse = e.rmse / e.ref_mean;
+  e.rel_rmse_raw = e.rmse / e.ref_mean;
+  e.rel_noise_floor = std::sqrt(sum_var / n) / e.ref_mean;
+  e.rel_rmse = std::sqrt(std::max(sum_d2 - sum_var, 0.0) / n) / e.ref_mean;
   e.rel_bias = sum_d / n / e.ref_mean;
   e.worst = max_d / max_ref;
   e.psnr_db = e.rmse > 0.0 ? 20.0 * std::log10(max_ref / e.rmse) : std::numeric_limits<double>::infinity();

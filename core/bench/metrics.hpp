@@ -16,7 +16,11 @@ double luminance(const glm::dvec3& rgb);
 // Error of a test image against a reference of the same size, on luminance. All relative figures
 // are NaN when the reference is black everywhere (nothing to be relative to).
 struct ImageError {
-  double rel_rmse = 0.0;   // sqrt(mean (L - L_ref)^2) / mean L_ref
+  // sqrt(mean (L - L_ref)^2) / mean L_ref; with the reference's variance given, the noise-corrected
+  // sqrt(max(0, mean ((L - L_ref)^2 - var L_ref))) / mean L_ref (see image_error).
+  double rel_rmse = 0.0;
+  double rel_rmse_raw = 0.0;     // sqrt(mean (L - L_ref)^2) / mean L_ref, noise of the reference included
+  double rel_noise_floor = 0.0;  // sqrt(mean var L_ref) / mean L_ref: the reference's own noise (0 if not given)
   double rel_bias = 0.0;   // mean (L - L_ref) / mean L_ref (signed: > 0 the test is too bright)
   double worst = 0.0;      // max |L - L_ref| / max L_ref
   double psnr_db = 0.0;    // 20 log10(max L_ref / rmse); +inf for identical images
@@ -24,7 +28,15 @@ struct ImageError {
   double ref_mean = 0.0, ref_max = 0.0;
 };
 // Throws std::invalid_argument when the sizes differ or are 0.
-ImageError image_error(const std::vector<glm::dvec3>& test, const std::vector<glm::dvec3>& ref);
+// `ref_lum_variance`, when not empty, is the variance of each reference pixel's luminance (the
+// squared standard error of a Monte Carlo mean). A noisy reference adds its variance to every
+// squared difference: E[(L - L_ref)^2] = (L - L_true)^2 + var L_ref for an unbiased L_ref. Taking the
+// variance out gives an unbiased estimate of the test image's squared error against the true image,
+// so configurations can be ranked with a reference that has not fully converged, as long as their
+// error stands above rel_noise_floor. Bias and worst pixel are not corrected (the bias needs no
+// correction: the noise averages out of the mean).
+ImageError image_error(const std::vector<glm::dvec3>& test, const std::vector<glm::dvec3>& ref,
+                       const std::vector<double>& ref_lum_variance = {});
 
 // Per-pixel |L - L_ref| / max L_ref (0 where the reference is black everywhere), for error images.
 std::vector<double> pixel_error(const std::vector<glm::dvec3>& test, const std::vector<glm::dvec3>& ref);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "bench/metrics.hpp"
 #include "bench/plot.hpp"
@@ -40,6 +41,39 @@ TEST(BenchMetrics, ABlackReferenceGivesNoRelativeErrorAndMismatchedSizesThrow) {
   EXPECT_TRUE(std::isnan(e.rel_rmse));
   EXPECT_NEAR(e.rmse, 1.0, 1e-12);
   EXPECT_THROW(image_error(lit, std::vector<glm::dvec3>(3)), std::invalid_argument);
+}
+
+TEST(BenchMetrics, TheReferencesNoiseIsTakenOutOfTheError) {
+  // Truth: a ramp; the test image is 5 % off everywhere (relative RMSE 0.05 against the truth); the
+  // reference is the truth plus Gaussian noise of a stated variance, 4x the test's error in RMS. The
+  // raw figure measures mostly the noise; the corrected one recovers the 5 %.
+  const int n = 40000;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::vector<glm::dvec3> truth(n), test(n), ref(n);
+  std::vector<double> var(n);
+  double mean_truth = 0.0, mean_var = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double t = 1.0 + static_cast<double>(i % 100) / 50.0;  // 1..3, mean ~2
+    truth[i] = glm::dvec3(t);
+    test[i] = glm::dvec3(t * 1.05);
+    const double sd = 0.2 * t;  // 4x the 5 % offset
+    var[i] = sd * sd;
+    ref[i] = glm::dvec3(t + sd * gauss(rng));
+    mean_truth += t / n;
+    mean_var += var[i] / n;
+  }
+  const ImageError against_truth = image_error(test, truth);
+  const ImageError raw = image_error(test, ref);
+  const ImageError corrected = image_error(test, ref, var);
+  EXPECT_NEAR(raw.rel_rmse, raw.rel_rmse_raw, 1e-15);        // no variance given: no correction
+  EXPECT_GT(raw.rel_rmse, 3.0 * against_truth.rel_rmse);     // the noise dominates the raw figure
+  EXPECT_NEAR(corrected.rel_rmse_raw, raw.rel_rmse, 1e-15);  // the raw figure is still reported
+  // Corrected within 10 % of the truth's figure (the estimate's spread at 40 000 pixels is ~3 %).
+  EXPECT_NEAR(corrected.rel_rmse, against_truth.rel_rmse, 0.1 * against_truth.rel_rmse);
+  const double floor = std::sqrt(mean_var) / mean_truth;
+  EXPECT_NEAR(corrected.rel_noise_floor, floor, 0.01 * floor);  // over the noisy reference's mean
+  EXPECT_THROW(image_error(test, ref, std::vector<double>(3, 0.0)), std::invalid_argument);
 }
 
 TEST(BenchMetrics, LuminanceUsesRec709Weights) {
