@@ -1,0 +1,29 @@
+// The benchmark's Monte Carlo references on disk: the running sums, not just the mean, so a
+// reference can be extended by more samples later (or resumed after an interruption) and gives the
+// same image, bit for bit, as if it had been rendered in one go.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "reference/monte_carlo.hpp"
+
+namespace cv::core::bench {
+
+// File layout (native byte order, doubles): "CVREF2\n", uint64 key, int32 width, int32 height,
+// uint64 spp, 7 uint64 MonteCarloStats counters, then per pixel sum (rgb), sum_sq (rgb), lum_sum,
+// lum_sq, each as one array over all pixels.
+//
+// Reads `path` into `img` when it holds a reference of this key and size. Returns false, with the
+// reason in *why, when the file is missing, of another key or size, or cut short (a bad cache file
+// is never fatal: the caller renders afresh).
+bool read_reference_cache(const std::string& path, std::uint64_t key, int width, int height, MonteCarloImage& img,
+                          std::string* why = nullptr);
+// Writes atomically (a temporary file renamed over the old one): an interrupted run keeps the last
+// complete state. Throws std::runtime_error naming the file when it cannot be written.
+void write_reference_cache(const std::string& path, std::uint64_t key, const MonteCarloImage& img);
+
+// FNV-1a, 64 bit, of a text: the key of everything that decides a reference.
+std::uint64_t reference_key_hash(const std::string& text);
+
+}  // namespace cv::core::bench

@@ -1,0 +1,80 @@
+// The benchmark's resumable Monte Carlo references: a reference read back and extended equals one
+// rendered in one go, bit for bit; a file of other settings, size or length is not taken.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
+
+#include "bench/reference_cache.hpp"
+#include "scene/standard_scenes.hpp"
+
+namespace {
+using namespace cv::core;
+using namespace cv::core::bench;
+namespace fs = std::filesystem;
+
+struct ReferenceCache : ::testing::Test {
+  StandardScene scene = standard_scene("cumulus_field", 12, 7);
+  GridMeanExtinction ext = grid_mean_extinction(scene.grid, scene.data);
+  MonteCarloSettings mc;
+  fs::path dir = fs::temp_directory_path() / ("cv_refcache_" + std::to_string(::getpid()));
+  void SetUp() override { fs::create_directories(dir); }
+  void TearDown() override { fs::remove_all(dir); }
+};
+
+bool same_sums(const MonteCarloImage& a, const MonteCarloImage& b) {
+  return a.spp == b.spp && a.sum == b.sum && a.sum_sq == b.sum_sq && a.lum_sum == b.lum_sum && a.lum_sq == b.lum_sq &&
+         a.stats.paths == b.stats.paths && a.stats.scatterings == b.stats.scatterings &&
+         a.stats.shadow_lookups == b.stats.shadow_lookups;
+}
+
+TEST_F(ReferenceCache, AReferenceExtendedFromItsCacheEqualsOneRenderedInOneGo) {
+  const MonteCarloRenderer r(scene.grid, ext, scene.camera, scene.sun, scene.march, mc);
+  MonteCarloImage first = r.start();
+  r.add_samples(first, 3);
+  const std::string path = (dir / "ref.bin").string();
+  const std::uint64_t key = reference_key_hash("settings A");
+  write_reference_cache(path, key, first);
+
+  MonteCarloImage resumed;
+  std::string why;
+  ASSERT_TRUE(read_reference_cache(path, key, 12, 7, resumed, &why)) << why;
+  EXPECT_TRUE(same_sums(resumed, first));
+  r.add_samples(resumed, 5);
+
+  MonteCarloImage whole = r.start();
+  r.add_samples(whole, 8);
+  EXPECT_TRUE(same_sums(resumed, whole));
+  EXPECT_GT(whole.stats.scatterings, 0u);
+}
+
+TEST_F(ReferenceCache, AFileOfOtherSettingsSizeOrLengthIsNotTaken) {
+  const MonteCarloRenderer r(scene.grid, ext, scene.camera, scene.sun, scene.march, mc);
+  MonteCarloImage img = r.start();
+  r.add_samples(img, 2);
+  const std::string path = (dir / "ref.bin").string();
+  const std::uint64_t key = reference_key_hash("settings A");
+  write_reference_cache(path, key, img);
+  MonteCarloImage out;
+  std::string why;
+  EXPECT_FALSE(read_reference_cache(path, reference_key_hash("settings B"), 12, 7, out, &why));
+  EXPECT_NE(why.find("key"), std::string::npos) << why;
+  EXPECT_FALSE(read_reference_cache(path, key, 13, 7, out, &why));
+  EXPECT_NE(why.find("12x7"), std::string::npos) << why;
+  EXPECT_FALSE(read_reference_cache((dir / "missing.bin").string(), key, 12, 7, out, &why));
+  // Cut short: the last bytes missing.
+  const auto size = fs::file_size(path);
+  fs::resize_file(path, size - 8);
+  EXPECT_FALSE(read_reference_cache(path, key, 12, 7, out, &why));
+  EXPECT_EQ(why, "cut short");
+  // Trailing bytes.
+  fs::resize_file(path, size);
+  { std::ofstream(path, std::ios::app | std::ios::binary) << 'x'; }
+  EXPECT_FALSE(read_reference_cache(path, key, 12, 7, out, &why));
+  EXPECT_EQ(out.spp, 0u);  // nothing taken from a bad file
+}
+
+}  // namespace
