@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "bench/metrics.hpp"
+#include "bench/reference_cache.hpp"
 #include "bench_report.hpp"
 #include "cli_common.hpp"
 #include "geo/geodesy.hpp"
@@ -38,6 +39,7 @@ double seconds_since(clock::time_point t0) { return std::chrono::duration<double
 struct BenchArgs {
   std::vector<std::string> scenes;
   int spp = 64, width = 96, height = 54, repeats = 3;
+  double ref_error = 0.0;  // stop a reference early at this mean relative standard error (0: at spp)
   std::string out = "bench_out";
 };
 
@@ -59,7 +61,14 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
       return args[++i];
     };
     if (s == "--reference-spp") a.spp = parse_int(s, next(), 1, 1 << 20, "an integer in 1..1048576 samples per pixel");
-    else if (s == "--repeats") a.repeats = parse_int(s, next(), 1, 100, "an integer in 1..100");
+    else if (s == "--reference-error") {
+      const std::string v = next();
+      a.ref_error = parse_number(s, v);
+      if (!(a.ref_error > 0.0 && a.ref_error < 1.0)) {
+        throw UsageError{"cloudviewer bench: --reference-error: found '" + v +
+                         "', expected a mean relative standard error between 0 and 1 (such as 0.02)"};
+      }
+    } else if (s == "--repeats") a.repeats = parse_int(s, next(), 1, 100, "an integer in 1..100");
     else if (s == "--out") a.out = next();
     else if (s == "--size") {
       const std::string v = next();
@@ -68,7 +77,7 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
       a.width = parse_int("--size", v.substr(0, x), 8, 4096, "WxH with each in 8..4096");
       a.height = parse_int("--size", v.substr(x + 1), 8, 4096, "WxH with each in 8..4096");
     } else if (!s.empty() && s[0] == '-') {
-      throw UsageError{"cloudviewer bench: unknown option '" + s + "', expected --reference-spp, --size, --repeats or --out"};
+      throw UsageError{"cloudviewer bench: unknown option '" + s + "', expected --reference-spp, --reference-error, --size, --repeats or --out"};
     } else if (std::find(known.begin(), known.end(), s) == known.end()) {
       std::string names;
       for (const auto& n : known) names += (names.empty() ? "" : ", ") + n;
@@ -81,12 +90,6 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
   return a;
 }
 
-// FNV-1a, 64 bit: the cache key of a reference's settings.
-std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ull) {
-  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
-  return h;
-}
-
 // Everything that decides the reference image, as text (the data enter through a checksum).
 std::string reference_key(const core::StandardScene& sc, const core::GridMeanExtinction& medium,
                           const core::MarchSettings& m, const core::MonteCarloSettings& mc) {
@@ -97,7 +100,7 @@ std::string reference_key(const core::StandardScene& sc, const core::GridMeanExt
   const auto& c = sc.camera;
   char b[1024];
   std::snprintf(b, sizeof b,
-                "v1 grid %d %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g data %.17g cam %.17g %.17g %.17g %.17g %.17g "
+                "v2 grid %d %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g data %.17g cam %.17g %.17g %.17g %.17g %.17g "
                 "%.17g %d %d sun %.17g %.17g %.17g %.17g %.17g march d%.17g hg%d ice%.17g noise%.17g mc %d %d %llu",
                 g.lon_deg.count, g.lat_deg.count, g.alt_m.count, g.lon_deg.start, g.lon_deg.step, g.lat_deg.start,
                 g.lat_deg.step, g.alt_m.start, g.alt_m.step, g.earth_radius_m, sum, c.lat_deg, c.lon_deg, c.alt_m,
@@ -106,32 +109,6 @@ std::string reference_key(const core::StandardScene& sc, const core::GridMeanExt
                 m.liquid_phase_hg ? 1 : 0, m.ice_g, m.noise_amount, mc.max_bounces, mc.roulette_after,
                 static_cast<unsigned long long>(mc.seed));
   return b;
-}
-
-// The cache file: "CVREF1\n", int32 width, height, spp, double mean relative standard error, then
-// width*height rgb doubles.
-bool read_reference(const fs::path& p, int w, int h, int spp, std::vector<glm::dvec3>& rgb, double& mrse) {
-  std::ifstream f(p, std::ios::binary);
-  if (!f) return false;
-  char magic[7] = {};
-  std::int32_t dims[3] = {};
-  f.read(magic, 7);
-  f.read(reinterpret_cast<char*>(dims), sizeof dims);
-  f.read(reinterpret_cast<char*>(&mrse), sizeof mrse);
-  if (!f || std::string(magic, 7) != "CVREF1\n" || dims[0] != w || dims[1] != h || dims[2] != spp) return false;
-  rgb.resize(static_cast<std::size_t>(w) * h);
-  f.read(reinterpret_cast<char*>(rgb.data()), static_cast<std::streamsize>(rgb.size() * sizeof(glm::dvec3)));
-  return static_cast<bool>(f);
-}
-
-void write_reference(const fs::path& p, int w, int h, int spp, const std::vector<glm::dvec3>& rgb, double mrse) {
-  core::write_file_atomically(p.string(), [&](std::FILE* f) {
-    const std::int32_t dims[3] = {w, h, spp};
-    std::fwrite("CVREF1\n", 1, 7, f);
-    std::fwrite(dims, sizeof dims, 1, f);
-    std::fwrite(&mrse, sizeof mrse, 1, f);
-    std::fwrite(rgb.data(), sizeof(glm::dvec3), rgb.size(), f);
-  });
 }
 
 struct Config {
@@ -241,9 +218,12 @@ double median(std::vector<double> v) {
 }  // namespace
 
 const char* bench_usage() {
-  return "  bench [SCENE...] [--reference-spp N] [--size WxH] [--repeats R] [--out DIR]\n"
+  return "  bench [SCENE...] [--reference-spp N] [--reference-error E] [--size WxH] [--repeats R] [--out DIR]\n"
          "                           error against run time on the standard scenes (default all, 96x54, 64 spp,\n"
-         "                           3 repeats, into bench_out): results.csv, summary.md, plots and error images\n";
+         "                           3 repeats, into bench_out): results.csv, summary.md, plots and error images.\n"
+         "                           References are cached in DIR with their sums: a larger N extends them, an\n"
+         "                           interrupted one resumes; --reference-error stops one early at that mean\n"
+         "                           relative standard error\n";
 }
 
 int cmd_bench(const std::vector<std::string>& args) {
@@ -268,36 +248,60 @@ int cmd_bench(const std::vector<std::string>& args) {
     base.atmosphere = base.globe = false;
     base.ambient = 0.0, base.noise_amount = 0.0;
     if (!(base.droplet_diameter_um > 0.0)) base.droplet_diameter_um = 20.0;
-    // The reference: cached by scene, size, spp and a hash of what decides it.
+    // The reference: cached by scene, size and a hash of what decides it, with its running sums, so
+    // a later run with more samples (or one resumed after an interruption) extends it.
     const core::MonteCarloSettings mc;
+    const std::uint64_t key = core::bench::reference_key_hash(reference_key(sc, medium, base, mc));
     char hash[20];
-    std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(fnv1a(reference_key(sc, medium, base, mc))));
-    SceneReference ref{name, "ref_" + name + "_" + std::to_string(a.width) + "x" + std::to_string(a.height) + "_" +
-                                 std::to_string(a.spp) + "spp_" + hash + ".bin",
+    std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(key));
+    SceneReference ref{name, "ref_" + name + "_" + std::to_string(a.width) + "x" + std::to_string(a.height) + "_" + hash + ".cvref",
                        a.spp, 0.0, false, 0.0};
-    std::vector<glm::dvec3> ref_rgb;
     const fs::path ref_path = fs::path(a.out) / ref.file;
-    if (read_reference(ref_path, a.width, a.height, a.spp, ref_rgb, ref.mean_rel_stderr)) {
-      ref.cached = true;
-      std::printf("%s: reference from %s (mean relative standard error %.3g)\n", name.c_str(), ref_path.c_str(), ref.mean_rel_stderr);
-    } else {
-      const auto t0 = clock::now();
-      const core::MonteCarloRenderer mcr(sc.grid, medium, sc.camera, sc.sun, base, mc);
-      core::MonteCarloImage img = mcr.start();
-      const int chunk = std::max(1, a.spp / 8);
-      for (int done = 0; done < a.spp;) {
-        const int n = std::min(chunk, a.spp - done);
-        mcr.add_samples(img, n);
-        done += n;
-        std::printf("\r%s: Monte Carlo reference %d/%d spp, %.1f s", name.c_str(), done, a.spp, seconds_since(t0));
-        std::fflush(stdout);
-      }
+    const core::MonteCarloRenderer mcr(sc.grid, medium, sc.camera, sc.sun, base, mc);
+    core::MonteCarloImage img = mcr.start();
+    std::string why;
+    if (core::bench::read_reference_cache(ref_path.string(), key, a.width, a.height, img, &why)) {
+      std::printf("%s: reference %s holds %llu spp (mean relative standard error %.3g)\n", name.c_str(), ref_path.c_str(),
+                  static_cast<unsigned long long>(img.spp), img.mean_relative_standard_error());
+    } else if (why != "no file") {
+      std::printf("%s: not using %s (%s): rendering it afresh\n", name.c_str(), ref_path.c_str(), why.c_str());
+    }
+    const std::uint64_t cached_spp = img.spp;
+    auto converged = [&] {
+      return img.spp >= static_cast<std::uint64_t>(a.spp) ||
+             (a.ref_error > 0.0 && img.spp >= 16 && img.mean_relative_standard_error() <= a.ref_error);
+    };
+    const auto t0 = clock::now();
+    int chunk = 1;  // grows so that each chunk takes about 10 s; every chunk is saved
+    while (!converged()) {
+      const int n = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(chunk), a.spp - img.spp));
+      const auto tc = clock::now();
+      mcr.add_samples(img, n);
+      const double dt = seconds_since(tc);
+      core::bench::write_reference_cache(ref_path.string(), key, img);
+      const double per_spp = dt / n;
+      chunk = static_cast<int>(std::clamp(10.0 / std::max(per_spp, 1e-6), 1.0, 4.0 * n));
+      std::printf("\r%s: Monte Carlo reference %llu/%d spp, mean rel. s.e. %.3g, %.0f s, about %.0f s to go   ",
+                  name.c_str(), static_cast<unsigned long long>(img.spp), a.spp, img.mean_relative_standard_error(),
+                  seconds_since(t0), per_spp * static_cast<double>(a.spp - img.spp));
+      std::fflush(stdout);
+    }
+    if (img.spp > cached_spp) {
       ref.seconds = seconds_since(t0);
-      ref_rgb = img.radiance();
-      ref.mean_rel_stderr = img.mean_relative_standard_error();
-      write_reference(ref_path, a.width, a.height, a.spp, ref_rgb, ref.mean_rel_stderr);
-      std::printf("\n%s: reference done, mean relative standard error %.3g, cached in %s\n", name.c_str(),
-                  ref.mean_rel_stderr, ref_path.c_str());
+      std::printf("\n%s: reference at %llu spp (%llu new, %.1f s), mean relative standard error %.3g, saved in %s\n",
+                  name.c_str(), static_cast<unsigned long long>(img.spp),
+                  static_cast<unsigned long long>(img.spp - cached_spp), ref.seconds, img.mean_relative_standard_error(),
+                  ref_path.c_str());
+    }
+    ref.cached = cached_spp > 0;
+    ref.cached_spp = static_cast<int>(cached_spp);
+    ref.spp = static_cast<int>(img.spp);
+    ref.mean_rel_stderr = img.mean_relative_standard_error();
+    const std::vector<glm::dvec3> ref_rgb = img.radiance();
+    std::vector<double> ref_var(ref_rgb.size());
+    for (std::size_t i = 0; i < ref_var.size(); ++i) {
+      const double se = img.luminance_standard_error(i);
+      ref_var[i] = std::isfinite(se) ? se * se : 0.0;
     }
     refs.push_back(ref);
     fs::create_directories(fs::path(a.out) / name);
@@ -344,13 +348,13 @@ int cmd_bench(const std::vector<std::string>& args) {
       row.accumulate = c.accumulate, row.resolution_scale = c.scale;
       row.phase_hg = c.march.liquid_phase_hg, row.adaptive = c.march.adaptive_steps;
       row.wall_ms = median(wall), row.gpu_ms = median(gpu_t);
-      row.err = core::bench::image_error(rgb, ref_rgb);
+      row.err = core::bench::image_error(rgb, ref_rgb, ref_var);
       row.error_image = name + "/err_" + c.name + ".png";
       render::write_png((fs::path(a.out) / row.error_image).string(), a.width, a.height,
                         error_png(core::bench::pixel_error(rgb, ref_rgb)));
-      std::printf("%s [%zu/%zu] %-22s %8.2f ms  rel. RMSE %-9.3g bias %+-9.3g worst %-8.3g PSNR %.1f dB\n", name.c_str(),
-                  ci + 1, configs.size(), c.name.c_str(), row.wall_ms, row.err.rel_rmse, row.err.rel_bias, row.err.worst,
-                  row.err.psnr_db);
+      std::printf("%s [%zu/%zu] %-22s %8.2f ms  rel. RMSE %-9.3g (raw %-9.3g) bias %+-9.3g worst %-8.3g PSNR %.1f dB\n",
+                  name.c_str(), ci + 1, configs.size(), c.name.c_str(), row.wall_ms, row.err.rel_rmse, row.err.rel_rmse_raw,
+                  row.err.rel_bias, row.err.worst, row.err.psnr_db);
       std::fflush(stdout);
       rows.push_back(row);
     }

@@ -59,7 +59,8 @@ void mark_pareto(std::vector<BenchRow>& rows) {
 
 const char* results_csv_header() {
   return "scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,"
-         "wall_ms,gpu_ms,rel_rmse,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,error_image";
+         "wall_ms,gpu_ms,rel_rmse,rel_rmse_raw,ref_noise_floor,rel_rmse_resolution,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,"
+         "error_image";
 }
 
 void write_results_csv(const std::string& path, const std::vector<BenchRow>& rows, const std::vector<SceneReference>& refs) {
@@ -70,10 +71,10 @@ void write_results_csv(const std::string& path, const std::vector<BenchRow>& row
       for (const auto& s : refs) {
         if (s.scene == r.scene) ref = &s;
       }
-      std::fprintf(f, "%s,%s,%s,%.6g,%d,%d,%d,%.3g,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.6g,%s\n", r.scene.c_str(),
-                   r.config.c_str(), kind_name(r.kind), r.view_step_m, r.sun_steps, r.octaves, r.accumulate,
-                   r.resolution_scale, r.phase_hg ? "hg" : "mie", r.adaptive ? 1 : 0, r.wall_ms, r.gpu_ms, r.err.rel_rmse,
-                   r.err.rel_bias, r.err.worst, r.err.psnr_db, r.pareto ? 1 : 0, ref ? ref->spp : 0,
+      std::fprintf(f, "%s,%s,%s,%.6g,%d,%d,%d,%.3g,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.6g,%s\n",
+                   r.scene.c_str(), r.config.c_str(), kind_name(r.kind), r.view_step_m, r.sun_steps, r.octaves,
+                   r.accumulate, r.resolution_scale, r.phase_hg ? "hg" : "mie", r.adaptive ? 1 : 0, r.wall_ms, r.gpu_ms,
+                   r.err.rel_rmse, r.err.rel_rmse_raw, r.err.rel_noise_floor, r.err.rel_rmse_resolution, r.err.rel_bias, r.err.worst, r.err.psnr_db, r.pareto ? 1 : 0, ref ? ref->spp : 0,
                    ref ? ref->mean_rel_stderr : 0.0, r.error_image.c_str());
     }
   });
@@ -86,7 +87,13 @@ void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows
     std::fprintf(f,
                  "Error = luminance against a Monte Carlo reference with full multiple scattering (clouds only: no air, "
                  "no globe, no ambient light), so it includes the octave approximation's bias, not only the step "
-                 "and sampling error. rel. RMSE = RMS(L - L_ref) / mean L_ref; bias = mean(L - L_ref) / mean L_ref; "
+                 "and sampling error. rel. RMSE = sqrt(mean((L - L_ref)^2 - var L_ref)) / mean L_ref: the reference's "
+                 "own variance (its per-pixel standard error squared) is taken out, which leaves an unbiased estimate "
+                 "of the error against the converged image; raw = without that correction; floor = sqrt(mean var "
+                 "L_ref) / mean L_ref, the reference's noise: a rel. RMSE well below the floor is not resolved by this "
+                 "reference (droplet clouds' Monte Carlo estimates are heavy-tailed, so their standard error can "
+                 "understate the spread); \"< x\" = below x, the smallest error this reference resolves (sqrt of 2 "
+                 "standard errors of the corrected mean square, from the spread over pixels). bias = mean(L - L_ref) / mean L_ref; "
                  "worst = max |L - L_ref| / max L_ref; PSNR against max L_ref. Time = wall time per output image "
                  "(all its accumulated frames, read-back included), median of the repeats. `*` = on the Pareto front "
                  "(time, rel. RMSE) of all configurations. Plots: rel. RMSE (log, vertical, decades labelled eN) "
@@ -98,20 +105,27 @@ void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows
       std::fprintf(f, "## %s\n\n", scene.c_str());
       for (const auto& ref : refs) {
         if (ref.scene == scene) {
+          const std::string origin =
+              ref.cached_spp == ref.spp ? "all from the cache"
+              : ref.cached_spp > 0      ? std::to_string(ref.cached_spp) + " from the cache, " +
+                                         std::to_string(ref.spp - ref.cached_spp) + " added in " +
+                                         num(ref.seconds, "%.1f") + " s"
+                                        : "rendered in " + num(ref.seconds, "%.1f") + " s";
           std::fprintf(f, "Reference: %d samples per pixel (%s), mean relative standard error %.3g; `%s`.\n\n", ref.spp,
-                       ref.cached ? "from the cache" : ("rendered in " + num(ref.seconds, "%.1f") + " s").c_str(),
-                       ref.mean_rel_stderr, ref.file.c_str());
+                       origin.c_str(), ref.mean_rel_stderr, ref.file.c_str());
         }
       }
       std::fprintf(f, "![error against time](%s_pareto.png)\n\n", scene.c_str());
-      std::fprintf(f, "| | config | kind | step m | sun | oct | acc | scale | phase | wall ms | GPU ms | rel. RMSE | bias | worst | PSNR dB |\n");
-      std::fprintf(f, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      std::fprintf(f, "| | config | kind | step m | sun | oct | acc | scale | phase | wall ms | GPU ms | rel. RMSE | raw | floor | bias | worst | PSNR dB |\n");
+      std::fprintf(f, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
       for (const BenchRow* r : list) {
-        std::fprintf(f, "| %s | %s | %s | %.4g%s | %d | %d | %d | %.2g | %s | %.4g | %s | %s | %s | %s | %s |\n",
+        std::fprintf(f, "| %s | %s | %s | %.4g%s | %d | %d | %d | %.2g | %s | %.4g | %s | %s | %s | %s | %s | %s | %s |\n",
                      r->pareto ? "*" : "", r->config.c_str(), kind_name(r->kind), r->view_step_m, r->adaptive ? " adapt." : "",
                      r->sun_steps, r->octaves, r->accumulate, r->resolution_scale, r->phase_hg ? "HG" : "Mie", r->wall_ms,
-                     r->gpu_ms > 0 ? num(r->gpu_ms, "%.4g").c_str() : "-", num(r->err.rel_rmse).c_str(),
-                     num(r->err.rel_bias, "%+.3g").c_str(), num(r->err.worst).c_str(), num(r->err.psnr_db, "%.1f").c_str());
+                     r->gpu_ms > 0 ? num(r->gpu_ms, "%.4g").c_str() : "-",
+                     r->err.rel_rmse < r->err.rel_rmse_resolution ? ("< " + num(r->err.rel_rmse_resolution)).c_str()
+                                                                   : num(r->err.rel_rmse).c_str(),
+                     num(r->err.rel_rmse_raw).c_str(), num(r->err.rel_noise_floor).c_str(), num(r->err.rel_bias, "%+.3g").c_str(), num(r->err.worst).c_str(), num(r->err.psnr_db, "%.1f").c_str());
       }
       // Ratios: our configurations' own front (sweep and presets, no seed) interpolated in log-log.
       std::vector<core::bench::TimeError> ours_pts;
@@ -131,6 +145,12 @@ void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows
       std::fprintf(f, "|---|---|---|---|---|---|---|\n");
       for (const BenchRow* r : list) {
         if (r->kind != ConfigKind::Seed) continue;
+        if (r->err.rel_rmse < r->err.rel_rmse_resolution) {
+          // Its error is not told from zero by this reference: any ratio to it would compare noise.
+          std::fprintf(f, "| %s | %.4g | < %s | not resolved: a reference with more samples is needed | | | |\n",
+                       r->config.c_str(), r->wall_ms, num(r->err.rel_rmse_resolution).c_str());
+          continue;
+        }
         const double t = core::bench::front_time_for_error(front, r->err.rel_rmse);
         const double e = core::bench::front_error_at_time(front, r->wall_ms);
         std::fprintf(f, "| %s | %.4g | %s | %s ms (%s) | %s (%s) | %s | %s |\n", r->config.c_str(), r->wall_ms,

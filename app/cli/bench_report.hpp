@@ -29,10 +29,11 @@ struct BenchRow {
 
 struct SceneReference {
   std::string scene, file;
-  int spp = 0;
+  int spp = 0;         // samples per pixel it holds now
   double mean_rel_stderr = 0.0;
   bool cached = false;
-  double seconds = 0.0;  // to render it (0 when read from the cache)
+  double seconds = 0.0;  // to render the samples added in this run
+  int cached_spp = 0;    // samples per pixel read from the cache
 };
 
 // Marks BenchRow::pareto on each scene's rows (by wall time and relative RMSE).

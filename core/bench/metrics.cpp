@@ -38,9 +38,12 @@ ImageError image_error(const std::vector<glm::dvec3>& test, const std::vector<gl
   }
   const double n = static_cast<double>(ref.size());
   double sum_ref = 0.0, max_ref = 0.0, sum_d = 0.0, sum_d2 = 0.0, max_d = 0.0, sum_var = 0.0;
-  for (double v : ref_lum_variance) sum_var += std::max(v, 0.0);
+  double sum_x2 = 0.0;  // of x = d^2 - var per pixel, for the spread of the corrected mean square
   for (std::size_t i = 0; i < ref.size(); ++i) {
     const double lr = luminance(ref[i]), d = luminance(test[i]) - lr;
+    const double var = ref_lum_variance.empty() ? 0.0 : std::max(ref_lum_variance[i], 0.0);
+    sum_var += var;
+    sum_x2 += (d * d - var) * (d * d - var);
     sum_ref += lr;
     max_ref = std::max(max_ref, lr);
     sum_d += d;
@@ -52,12 +55,19 @@ ImageError image_error(const std::vector<glm::dvec3>& test, const std::vector<gl
   e.ref_max = max_ref;
   e.rmse = std::sqrt(sum_d2 / n);
   if (!(e.ref_mean > 0.0)) {
-    e.rel_rmse = e.rel_rmse_raw = e.rel_noise_floor = e.rel_bias = e.worst = e.psnr_db = kNaN;
+    e.rel_rmse = e.rel_rmse_raw = e.rel_noise_floor = e.rel_rmse_resolution = e.rel_bias = e.worst = e.psnr_db = kNaN;
     return e;
   }
   e.rel_rmse_raw = e.rmse / e.ref_mean;
   e.rel_noise_floor = std::sqrt(sum_var / n) / e.ref_mean;
   e.rel_rmse = std::sqrt(std::max(sum_d2 - sum_var, 0.0) / n) / e.ref_mean;
+  if (!ref_lum_variance.empty() && n > 1.0) {
+    // The corrected mean square is a mean over pixels of x = d^2 - var; its standard error, from the
+    // pixels' own spread of x, says how small an error this reference can tell from zero.
+    const double mean_x = (sum_d2 - sum_var) / n;
+    const double se_x = std::sqrt(std::max(sum_x2 / n - mean_x * mean_x, 0.0) / (n - 1.0));
+    e.rel_rmse_resolution = std::sqrt(2.0 * se_x) / e.ref_mean;
+  }
   e.rel_bias = sum_d / n / e.ref_mean;
   e.worst = max_d / max_ref;
   e.psnr_db = e.rmse > 0.0 ? 20.0 * std::log10(max_ref / e.rmse) : std::numeric_limits<double>::infinity();

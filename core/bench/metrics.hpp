@@ -21,6 +21,10 @@ struct ImageError {
   double rel_rmse = 0.0;
   double rel_rmse_raw = 0.0;     // sqrt(mean (L - L_ref)^2) / mean L_ref, noise of the reference included
   double rel_noise_floor = 0.0;  // sqrt(mean var L_ref) / mean L_ref: the reference's own noise (0 if not given)
+  // The smallest rel_rmse the corrected estimate tells from zero: sqrt(2 standard errors of the
+  // corrected mean square) / mean L_ref, from the spread over pixels (0 when no variance is given).
+  // A rel_rmse below it means "not resolved by this reference", not "this small".
+  double rel_rmse_resolution = 0.0;
   double rel_bias = 0.0;   // mean (L - L_ref) / mean L_ref (signed: > 0 the test is too bright)
   double worst = 0.0;      // max |L - L_ref| / max L_ref
   double psnr_db = 0.0;    // 20 log10(max L_ref / rmse); +inf for identical images

@@ -6,15 +6,22 @@ set -eu
 exe=$1 dir=$2
 rm -rf "$dir"
 "$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --out "$dir"
-header='scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,wall_ms,gpu_ms,rel_rmse,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,error_image'
+header='scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,wall_ms,gpu_ms,rel_rmse,rel_rmse_raw,ref_noise_floor,rel_rmse_resolution,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,error_image'
 test "$(head -n 1 "$dir/results.csv")" = "$header" || { echo "bad header: $(head -n 1 "$dir/results.csv")"; exit 1; }
 rows=$(tail -n +2 "$dir/results.csv" | grep -c '^stratocumulus,')
 test "$rows" -eq 19 || { echo "expected 19 rows, found $rows"; exit 1; }
 for c in low default high costa2023 haggstrom2018 fordsung2024; do
   grep -q "^stratocumulus,$c," "$dir/results.csv" || { echo "no row for $c"; exit 1; }
 done
-test "$(awk -F, 'NR > 1 && $17 == 1' "$dir/results.csv" | wc -l)" -ge 1 || { echo "no configuration on the Pareto front"; exit 1; }
+test "$(awk -F, 'NR > 1 && $20 == 1' "$dir/results.csv" | wc -l)" -ge 1 || { echo "no configuration on the Pareto front"; exit 1; }
 test -s "$dir/summary.md" && test -s "$dir/stratocumulus_pareto.png" && test -s "$dir/stratocumulus/err_default.png"
-"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --out "$dir" | grep -q 'reference from' \
+# (Output to a file first: grep -q on a pipe would end the run early by SIGPIPE.)
+"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --out "$dir" > "$dir/run2.txt"
+grep -q 'holds 2 spp' "$dir/run2.txt" \
   || { echo "the second run did not reuse the cached reference"; exit 1; }
+# A larger --reference-spp extends the cached reference instead of starting over.
+"$exe" bench stratocumulus --size 24x14 --reference-spp 3 --repeats 1 --out "$dir" > "$dir/run3.txt"
+grep -q 'at 3 spp (1 new' "$dir/run3.txt" \
+  || { echo "the third run did not extend the cached reference"; exit 1; }
+test "$(awk -F, 'NR == 2 { print $21 }' "$dir/results.csv")" = 3 || { echo "results.csv does not say 3 spp"; exit 1; }
 echo "bench smoke: $rows rows"

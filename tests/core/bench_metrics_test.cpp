@@ -73,6 +73,14 @@ TEST(BenchMetrics, TheReferencesNoiseIsTakenOutOfTheError) {
   EXPECT_NEAR(corrected.rel_rmse, against_truth.rel_rmse, 0.1 * against_truth.rel_rmse);
   const double floor = std::sqrt(mean_var) / mean_truth;
   EXPECT_NEAR(corrected.rel_noise_floor, floor, 0.01 * floor);  // over the noisy reference's mean
+  // 40 000 pixels resolve errors well below the floor: for Gaussian noise the corrected mean square's
+  // standard error is sqrt(2) var / sqrt(n), so the resolution is ~0.026 here, about half the 5 %.
+  EXPECT_GT(corrected.rel_rmse_resolution, 0.0);
+  EXPECT_LT(corrected.rel_rmse_resolution, corrected.rel_rmse);
+  EXPECT_LT(corrected.rel_rmse_resolution, corrected.rel_noise_floor);
+  // An exact copy of the truth: its corrected error is within the resolution of zero.
+  const ImageError exact = image_error(truth, ref, var);
+  EXPECT_LT(exact.rel_rmse, exact.rel_rmse_resolution);
   EXPECT_THROW(image_error(test, ref, std::vector<double>(3, 0.0)), std::invalid_argument);
 }
 
