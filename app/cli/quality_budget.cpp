@@ -135,7 +135,10 @@ void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const
     std::fflush(stdout);
     return ms;
   };
+  const auto t_choice = clock::now();
   const core::bench::BudgetChoice choice = core::bench::choose_under_budget(src.candidates, budget_ms, measure);
+  std::printf("budget: %zu of %zu candidate(s) timed in %.2f s\n", choice.trials.size(), src.candidates.size(),
+              std::chrono::duration<double>(clock::now() - t_choice).count());
   const FrontConfig& c = src.candidates[choice.index];
   apply_front_config(c, dz_m, render);
   if (choice.met) {
