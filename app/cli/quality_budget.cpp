@@ -24,17 +24,20 @@ using core::bench::FrontConfig;
 // 960x540 candidate is then timed in a fraction of its own frame time).
 constexpr double kCalibrationPixels = 320.0 * 180.0;
 
-const char* kind_name(ConfigKind k) { return k == ConfigKind::Seed ? "seed" : k == ConfigKind::Preset ? "preset" : "sweep"; }
+const char* kind_name(ConfigKind k) {
+  return k == ConfigKind::Seed ? "seed" : k == ConfigKind::Preset ? "preset" : "sweep";
+}
 
 }  // namespace
 
 void write_quality_front(const std::string& out_dir, const std::vector<BenchRow>& rows,
-                         const std::map<std::string, double>& dz_by_scene, const std::string& machine, int width, int height,
-                         const std::string& command, bool cache) {
+                         const std::map<std::string, double>& dz_by_scene, const std::string& machine,
+                         int width, int height, const std::string& command, bool cache) {
   core::bench::QualityFront front;
   front.machine = machine, front.width = width, front.height = height, front.command = command;
   std::map<std::string, std::size_t> index;  // config name -> position in front.configs (first-seen order)
-  std::map<std::string, std::pair<double, int>> log_ratio;  // sum of log(view step / dz) and count, per config
+  std::map<std::string, std::pair<double, int>>
+      log_ratio;  // sum of log(view step / dz) and count, per config
   for (const BenchRow& r : rows) {
     auto [it, fresh] = index.emplace(r.config, front.configs.size());
     if (fresh) {
@@ -64,8 +67,8 @@ void write_quality_front(const std::string& out_dir, const std::vector<BenchRow>
   core::bench::rank_front(front);
   const std::string path = (fs::path(out_dir) / "quality_front.json").string();
   core::bench::save_front(front, path);
-  std::printf("wrote %s (%zu configurations, %zu candidates for --budget-ms)\n", path.c_str(), front.configs.size(),
-              core::bench::front_candidates(front).size());
+  std::printf("wrote %s (%zu configurations, %zu candidates for --budget-ms)\n", path.c_str(),
+              front.configs.size(), core::bench::front_candidates(front).size());
   if (!cache) return;
   const std::string cached = core::bench::front_cache_path();
   if (cached.empty()) {
@@ -74,8 +77,9 @@ void write_quality_front(const std::string& out_dir, const std::vector<BenchRow>
   }
   try {
     core::bench::save_front(front, cached);
-    std::printf("cached it as %s (render --budget-ms and the viewer's frame budget use it; --no-cache to skip)\n",
-                cached.c_str());
+    std::printf(
+        "cached it as %s (render --budget-ms and the viewer's frame budget use it; --no-cache to skip)\n",
+        cached.c_str());
   } catch (const std::exception& e) {
     std::printf("not cached: %s\n", e.what());
   }
@@ -92,8 +96,9 @@ void apply_front_config(const FrontConfig& c, double dz_m, core::RenderSettings&
 }
 
 void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const core::Sun& sun,
-                      const core::MarchSettings& base, double dz_m, double budget_ms, const std::string& front_file,
-                      const std::string& machine, core::RenderSettings& render) {
+                      const core::MarchSettings& base, double dz_m, double budget_ms,
+                      const std::string& front_file, const std::string& machine,
+                      core::RenderSettings& render) {
   core::bench::CandidateSource src;
   try {
     src = core::bench::budget_candidates(front_file, machine);
@@ -130,24 +135,29 @@ void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const
     } else {
       std::printf("  (one frame at %.0fx%.0f", mw, mh);
     }
-    if (c.accumulate > 1) std::printf(", times %d frames)\n", c.accumulate);
-    else std::printf(")\n");
+    if (c.accumulate > 1)
+      std::printf(", times %d frames)\n", c.accumulate);
+    else
+      std::printf(")\n");
     std::fflush(stdout);
     return ms;
   };
   const auto t_choice = clock::now();
-  const core::bench::BudgetChoice choice = core::bench::choose_under_budget(src.candidates, budget_ms, measure);
-  std::printf("budget: %zu of %zu candidate(s) timed in %.2f s\n", choice.trials.size(), src.candidates.size(),
-              std::chrono::duration<double>(clock::now() - t_choice).count());
+  const core::bench::BudgetChoice choice =
+      core::bench::choose_under_budget(src.candidates, budget_ms, measure);
+  std::printf("budget: %zu of %zu candidate(s) timed in %.2f s\n", choice.trials.size(),
+              src.candidates.size(), std::chrono::duration<double>(clock::now() - t_choice).count());
   const FrontConfig& c = src.candidates[choice.index];
   apply_front_config(c, dz_m, render);
   if (choice.met) {
     std::printf("budget %.4g ms: chose %s (%s), measured %.1f ms\n", budget_ms, c.name.c_str(),
                 core::bench::describe_config(c).c_str(), choice.ms);
   } else {
-    std::printf("budget %.4g ms: chose %s (%s), measured %.1f ms: budget not met, %.1f ms (%.0f%%) over; the fastest candidate\n",
-                budget_ms, c.name.c_str(), core::bench::describe_config(c).c_str(), choice.ms, choice.ms - budget_ms,
-                100.0 * (choice.ms - budget_ms) / budget_ms);
+    std::printf(
+        "budget %.4g ms: chose %s (%s), measured %.1f ms: budget not met, %.1f ms (%.0f%%) over; the fastest "
+        "candidate\n",
+        budget_ms, c.name.c_str(), core::bench::describe_config(c).c_str(), choice.ms, choice.ms - budget_ms,
+        100.0 * (choice.ms - budget_ms) / budget_ms);
   }
 }
 

@@ -21,8 +21,8 @@ namespace cv::cli {
 // `cache` is true, copies it to core::bench::front_cache_path(). dz_by_scene: each scene's vertical
 // grid spacing in metres (view steps are stored as multiples of it). Prints where it wrote.
 void write_quality_front(const std::string& out_dir, const std::vector<BenchRow>& rows,
-                         const std::map<std::string, double>& dz_by_scene, const std::string& machine, int width, int height,
-                         const std::string& command, bool cache);
+                         const std::map<std::string, double>& dz_by_scene, const std::string& machine,
+                         int width, int height, const std::string& command, bool cache);
 
 // Sets the quality knobs of `render` to the candidate's on a grid of vertical spacing dz_m.
 void apply_front_config(const core::bench::FrontConfig& c, double dz_m, core::RenderSettings& render);
@@ -33,7 +33,8 @@ void apply_front_config(const core::bench::FrontConfig& c, double dz_m, core::Re
 // `render`. Prints the source, each trial and one line with the choice. A bad --front file throws
 // UsageError.
 void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const core::Sun& sun,
-                      const core::MarchSettings& base, double dz_m, double budget_ms, const std::string& front_file,
-                      const std::string& machine, core::RenderSettings& render);
+                      const core::MarchSettings& base, double dz_m, double budget_ms,
+                      const std::string& front_file, const std::string& machine,
+                      core::RenderSettings& render);
 
 }  // namespace cv::cli

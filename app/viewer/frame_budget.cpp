@@ -8,7 +8,8 @@
 namespace cv::viewer {
 
 FrameBudget::FrameBudget(const std::string& machine)
-    : source_(core::bench::budget_candidates("", machine)), stepper_(source_.candidates.size(), source_.candidates.size() - 1) {}
+    : source_(core::bench::budget_candidates("", machine)),
+      stepper_(source_.candidates.size(), source_.candidates.size() - 1) {}
 
 bool FrameBudget::update(core::RenderSettings& render, double dz_m, double last_frame_ms, bool marched) {
   const bool want = render.budget_ms > 0.0;
@@ -38,7 +39,8 @@ bool FrameBudget::update(core::RenderSettings& render, double dz_m, double last_
 std::string FrameBudget::status() const {
   char b[160];
   const double last = stepper_.last_ms(stepper_.current());
-  std::snprintf(b, sizeof b, "%s (%zu of %zu)", candidate().name.c_str(), stepper_.current() + 1, stepper_.size());
+  std::snprintf(b, sizeof b, "%s (%zu of %zu)", candidate().name.c_str(), stepper_.current() + 1,
+                stepper_.size());
   std::string out = b;
   if (std::isfinite(last)) {
     std::snprintf(b, sizeof b, ", frames %.1f ms", last);

@@ -31,7 +31,8 @@ bool BudgetStepper::observe(double frame_ms, double budget_ms) {
   if (static_cast<int>(since_change_.size()) < kSettleFrames) return false;
   // The median of the settled frames: robust to one slow frame.
   std::vector<double> sorted = since_change_;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2),
+                   sorted.end());
   const double typical = sorted[sorted.size() / 2];
   last_ms_[current_] = typical;
   last_frame_[current_] = frame_;

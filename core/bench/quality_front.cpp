@@ -33,8 +33,10 @@ std::string shown(const json& v) {
 // One object of the file, with its key path for messages.
 class Reader {
  public:
-  Reader(const std::string& source, const json& obj, std::string path) : source_(source), obj_(obj), path_(std::move(path)) {}
-  [[noreturn]] void fail(const std::string& key, const std::string& found, const std::string& expected) const {
+  Reader(const std::string& source, const json& obj, std::string path)
+      : source_(source), obj_(obj), path_(std::move(path)) {}
+  [[noreturn]] void fail(const std::string& key, const std::string& found,
+                         const std::string& expected) const {
     throw FrontError(source_ + ": " + path_ + key + ": found " + found + ", expected " + expected);
   }
   const json& need(const char* key, const std::string& expected) const {
@@ -50,7 +52,8 @@ class Reader {
   int integer(const char* key, int lo, int hi) const {
     const std::string expected = "an integer " + std::to_string(lo) + ".." + std::to_string(hi);
     const json& v = need(key, expected);
-    if (!v.is_number_integer() || v.get<long long>() < lo || v.get<long long>() > hi) fail(key, shown(v), expected);
+    if (!v.is_number_integer() || v.get<long long>() < lo || v.get<long long>() > hi)
+      fail(key, shown(v), expected);
     return static_cast<int>(v.get<long long>());
   }
   bool boolean(const char* key) const {
@@ -74,11 +77,15 @@ class Reader {
 
 // rel_rmse is NaN where the reference is black (clear sky): nothing to be relative to. A value of
 // exactly 0 is floored so that its logarithm stays finite.
-bool usable(const FrontScene& s) { return std::isfinite(s.rel_rmse) && s.rel_rmse >= 0.0 && std::isfinite(s.wall_ms) && s.wall_ms > 0.0; }
+bool usable(const FrontScene& s) {
+  return std::isfinite(s.rel_rmse) && s.rel_rmse >= 0.0 && std::isfinite(s.wall_ms) && s.wall_ms > 0.0;
+}
 
 }  // namespace
 
-double FrontConfig::view_step_m(double dz_m) const { return std::max(view_step_min_m, view_step_dz * std::abs(dz_m)); }
+double FrontConfig::view_step_m(double dz_m) const {
+  return std::max(view_step_min_m, view_step_dz * std::abs(dz_m));
+}
 
 void rank_front(QualityFront& front) {
   for (FrontConfig& c : front.configs) {
@@ -106,14 +113,16 @@ void rank_front(QualityFront& front) {
       if (b.ms <= a.ms && b.error <= a.error && (b.ms < a.ms || b.error < a.error)) dominated[i] = true;
     }
   }
-  for (std::size_t i = 0; i < front.configs.size(); ++i) front.configs[i].candidate = front.configs[i].candidate && !dominated[i];
-  std::stable_sort(front.configs.begin(), front.configs.end(), [](const FrontConfig& a, const FrontConfig& b) {
-    const bool fa = std::isfinite(a.error), fb = std::isfinite(b.error);
-    if (fa != fb) return fa;  // unmeasurable errors last
-    if (fa && a.error != b.error) return a.error < b.error;
-    if (a.ms != b.ms && std::isfinite(a.ms) && std::isfinite(b.ms)) return a.ms < b.ms;
-    return a.name < b.name;
-  });
+  for (std::size_t i = 0; i < front.configs.size(); ++i)
+    front.configs[i].candidate = front.configs[i].candidate && !dominated[i];
+  std::stable_sort(front.configs.begin(), front.configs.end(),
+                   [](const FrontConfig& a, const FrontConfig& b) {
+                     const bool fa = std::isfinite(a.error), fb = std::isfinite(b.error);
+                     if (fa != fb) return fa;  // unmeasurable errors last
+                     if (fa && a.error != b.error) return a.error < b.error;
+                     if (a.ms != b.ms && std::isfinite(a.ms) && std::isfinite(b.ms)) return a.ms < b.ms;
+                     return a.name < b.name;
+                   });
 }
 
 std::vector<FrontConfig> front_candidates(const QualityFront& front) {
@@ -153,8 +162,11 @@ std::string front_to_json(const QualityFront& front) {
   for (const FrontConfig& c : front.configs) {
     ojson scenes = ojson::array();
     for (const FrontScene& s : c.scenes) {
-      scenes.push_back({{"scene", s.scene}, {"view_step_m", s.view_step_m}, {"wall_ms", num(s.wall_ms)},
-                        {"rel_rmse", num(s.rel_rmse)}, {"pareto", s.pareto}});
+      scenes.push_back({{"scene", s.scene},
+                        {"view_step_m", s.view_step_m},
+                        {"wall_ms", num(s.wall_ms)},
+                        {"rel_rmse", num(s.rel_rmse)},
+                        {"pareto", s.pareto}});
     }
     configs.push_back({{"name", c.name},
                        {"kind", c.kind},
@@ -184,7 +196,8 @@ QualityFront front_from_json(const std::string& text, const std::string& source)
     for (char& ch : what) ch = (ch == '\n' ? ' ' : ch);
     throw FrontError(source + ": not valid JSON: " + what);
   }
-  if (!root.is_object()) throw FrontError(source + ": found " + shown(root) + " at the top, expected a JSON object { ... }");
+  if (!root.is_object())
+    throw FrontError(source + ": found " + shown(root) + " at the top, expected a JSON object { ... }");
   const Reader r(source, root, "");
   if (r.string("format", std::string("\"") + kFormat + "\"") != kFormat) {
     r.fail("format", shown(root["format"]), std::string("\"") + kFormat + "\"");
@@ -196,7 +209,8 @@ QualityFront front_from_json(const std::string& text, const std::string& source)
   f.height = r.integer("height", 1, 16384);
   f.command = r.string("command");
   const json& configs = r.need("configs", "an array of configurations");
-  if (!configs.is_array() || configs.empty()) r.fail("configs", shown(configs), "a non-empty array of configurations");
+  if (!configs.is_array() || configs.empty())
+    r.fail("configs", shown(configs), "a non-empty array of configurations");
   // A null figure is one that could not be measured (NaN when written).
   auto maybe_number = [](const Reader& rr, const json& obj, const char* key, const std::string& expected) {
     const auto it = obj.find(key);
@@ -281,7 +295,9 @@ CandidateSource budget_candidates(const std::string& front_file, const std::stri
     check_machine(f, machine, path);
     rank_front(f);  // the file's order and flags are recomputed, not trusted
     out.candidates = front_candidates(f);
-    if (out.candidates.empty()) throw FrontError(path + ": configs: found no candidate, expected at least one configuration on a scene's front");
+    if (out.candidates.empty())
+      throw FrontError(
+          path + ": configs: found no candidate, expected at least one configuration on a scene's front");
     out.source = "the measured front " + path + " (" + std::to_string(out.candidates.size()) + " candidates)";
   };
   if (!front_file.empty()) {
@@ -309,7 +325,8 @@ BudgetChoice choose_under_budget(const std::vector<FrontConfig>& cands, double b
   // The one that is always measured when nothing fits: the fastest the front predicts.
   std::size_t fastest = cands.size() - 1;
   for (std::size_t i = 0; i < cands.size(); ++i) {
-    if (std::isfinite(cands[i].ms) && (!std::isfinite(cands[fastest].ms) || cands[i].ms < cands[fastest].ms)) fastest = i;
+    if (std::isfinite(cands[i].ms) && (!std::isfinite(cands[fastest].ms) || cands[i].ms < cands[fastest].ms))
+      fastest = i;
   }
   BudgetChoice out;
   double scale = kNaN;  // measured / predicted, from the last candidate measured that has a prediction
@@ -335,8 +352,11 @@ std::string describe_config(const FrontConfig& c) {
   char b[256];
   char floor_text[48] = "";
   if (c.view_step_min_m > 0.0) std::snprintf(floor_text, sizeof floor_text, " (>= %g m)", c.view_step_min_m);
-  std::snprintf(b, sizeof b, "view step %.3g dz%s, %d sun steps, %d octave(s), %d frame(s), resolution scale %g, adaptive %s",
-                c.view_step_dz, floor_text, c.sun_steps, c.octaves, c.accumulate, c.resolution_scale, c.adaptive ? "on" : "off");
+  std::snprintf(
+      b, sizeof b,
+      "view step %.3g dz%s, %d sun steps, %d octave(s), %d frame(s), resolution scale %g, adaptive %s",
+      c.view_step_dz, floor_text, c.sun_steps, c.octaves, c.accumulate, c.resolution_scale,
+      c.adaptive ? "on" : "off");
   return b;
 }
 

@@ -30,7 +30,7 @@ struct FrontScene {
 // A configuration: the quality knobs of MarchSettings/RenderSettings it sets, and its measurements.
 struct FrontConfig {
   std::string name;
-  std::string kind = "sweep";   // "sweep", "preset" or "seed" (a seed document's method)
+  std::string kind = "sweep";  // "sweep", "preset" or "seed" (a seed document's method)
   // View step as a multiple of the grid's vertical spacing dz (the geometric mean over the scenes
   // it was measured on), never below view_step_min_m: steps in metres do not carry from one grid
   // to another, multiples of dz do.
@@ -42,8 +42,8 @@ struct FrontConfig {
   bool phase_hg = false;  // Henyey-Greenstein for liquid: a change of physics, not of quality
   std::vector<FrontScene> scenes;
   // From rank_front:
-  double error = 0.0;      // geometric mean of rel_rmse over the scenes with a finite positive error (NaN: none)
-  double ms = 0.0;         // geometric mean of wall_ms over the same scenes (NaN: none)
+  double error = 0.0;  // geometric mean of rel_rmse over the scenes with a finite error (NaN: none)
+  double ms = 0.0;     // geometric mean of wall_ms over the same scenes (NaN: none)
   bool candidate = false;  // may be chosen under a budget (see rank_front)
 
   // The view step in metres on a grid of vertical spacing dz_m.
@@ -52,9 +52,9 @@ struct FrontConfig {
 
 struct QualityFront {
   static constexpr int kVersion = 1;
-  std::string machine;     // GlInfo::summary() of the machine that measured it
-  int width = 0, height = 0;  // the bench's image size, pixels
-  std::string command;     // the bench command line
+  std::string machine;               // GL renderer, vendor and version that measured it
+  int width = 0, height = 0;         // the bench's image size, pixels
+  std::string command;               // the bench command line
   std::vector<FrontConfig> configs;  // after rank_front: most accurate first
 };
 

@@ -32,7 +32,8 @@ QualityFront sample_front() {
   f.configs.push_back(config("coarse", "sweep", {{"a", 1000, 10, 0.08, true}, {"b", 400, 12, 0.02, true}}));
   f.configs.push_back(config("fine", "preset", {{"a", 250, 40, 0.01, true}, {"b", 100, 48, 0.005, true}}));
   f.configs.push_back(config("mid", "sweep", {{"a", 500, 20, 0.04, true}, {"b", 200, 25, 0.01, false}}));
-  f.configs.push_back(config("slow_bad", "sweep", {{"a", 500, 60, 0.09, false}, {"b", 200, 70, 0.03, false}}));
+  f.configs.push_back(
+      config("slow_bad", "sweep", {{"a", 500, 60, 0.09, false}, {"b", 200, 70, 0.03, false}}));
   f.configs.push_back(config("seed", "seed", {{"a", 100, 30, 0.005, true}, {"b", 50, 30, 0.004, true}}));
   f.configs[1].view_step_dz = 0.5, f.configs[1].view_step_min_m = 25.0, f.configs[1].sun_steps = 32;
   f.configs[1].octaves = 8, f.configs[1].accumulate = 4;
@@ -144,13 +145,19 @@ TEST(QualityFront, BadFilesNameFileAndKeyOnOneLine) {
   } cases[] = {
       {"{ not json", "front.json: not valid JSON"},
       {"[1, 2]", "front.json: found [1,2] at the top, expected a JSON object"},
-      {with("\"cloudviewer-quality-front\"", "\"something-else\""), "front.json: format: found \"something-else\""},
+      {with("\"cloudviewer-quality-front\"", "\"something-else\""),
+       "front.json: format: found \"something-else\""},
       {with("\"version\": 1", "\"version\": 7"), "front.json: version: found 7, expected an integer 1..1"},
-      {with("\"machine\"", "\"machina\""), "front.json: machine: found nothing, expected the renderer string"},
-      {with("\"sun_steps\": 16", "\"sun_steps\": \"x\""), "front.json: configs[0].sun_steps: found \"x\", expected an integer 1..1024"},
-      {with("\"kind\": \"sweep\"", "\"kind\": \"fast\""), "front.json: configs[0].kind: found \"fast\", expected \"sweep\", \"preset\" or \"seed\""},
-      {with("\"wall_ms\": 10.0", "\"wall_ms\": -3"), "front.json: configs[0].scenes[0].wall_ms: found -3, expected a time in ms"},
-      {with("\"resolution_scale\": 0.5", "\"resolution_scale\": 2"), "front.json: configs[0].resolution_scale: found 2, expected"},
+      {with("\"machine\"", "\"machina\""),
+       "front.json: machine: found nothing, expected the renderer string"},
+      {with("\"sun_steps\": 16", "\"sun_steps\": \"x\""),
+       "front.json: configs[0].sun_steps: found \"x\", expected an integer 1..1024"},
+      {with("\"kind\": \"sweep\"", "\"kind\": \"fast\""),
+       "front.json: configs[0].kind: found \"fast\", expected \"sweep\", \"preset\" or \"seed\""},
+      {with("\"wall_ms\": 10.0", "\"wall_ms\": -3"),
+       "front.json: configs[0].scenes[0].wall_ms: found -3, expected a time in ms"},
+      {with("\"resolution_scale\": 0.5", "\"resolution_scale\": 2"),
+       "front.json: configs[0].resolution_scale: found 2, expected"},
   };
   for (const auto& c : cases) {
     const std::string e = error_of(c.text);
@@ -295,8 +302,10 @@ TEST(BudgetChoice, TiesInErrorGoToTheFasterAndTiesInTimeToTheMoreAccurate) {
 
 TEST(BudgetChoice, RejectsNoCandidatesAndBadBudgets) {
   EXPECT_THROW(choose_under_budget({}, 10.0, [](std::size_t) { return 1.0; }), std::invalid_argument);
-  EXPECT_THROW(choose_under_budget(ladder_with_ms({1}), 0.0, [](std::size_t) { return 1.0; }), std::invalid_argument);
-  EXPECT_THROW(choose_under_budget(ladder_with_ms({1}), -5.0, [](std::size_t) { return 1.0; }), std::invalid_argument);
+  EXPECT_THROW(choose_under_budget(ladder_with_ms({1}), 0.0, [](std::size_t) { return 1.0; }),
+               std::invalid_argument);
+  EXPECT_THROW(choose_under_budget(ladder_with_ms({1}), -5.0, [](std::size_t) { return 1.0; }),
+               std::invalid_argument);
 }
 
 // Feeds `n` frames of `ms` each; returns how many changes happened.
