@@ -172,6 +172,8 @@ TEST(SceneJson, OutOfRangeValuesAreRefused) {
             "scene.json: sun.datetime_utc: found \"2024-02-30T00:00:00Z\", expected a UTC date-time YYYY-MM-DDThh:mm:ssZ");
   EXPECT_EQ(error_of(R"({"version": 1, "render": {"quality": "ultra"}})"),
             "scene.json: render.quality: found \"ultra\", expected one of low, default, high, custom");
+  EXPECT_EQ(error_of(R"({"version": 1, "render": {"budget_ms": -5}})"),
+            "scene.json: render.budget_ms: found -5, expected a frame-time budget in ms 0..1e7 (0: off)");
 }
 
 TEST(SceneJson, UnknownKeysAreNamedSoTyposAreCaught) {
