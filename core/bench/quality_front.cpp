@@ -322,13 +322,27 @@ BudgetChoice choose_under_budget(const std::vector<FrontConfig>& cands, double b
                                  const std::function<double(std::size_t)>& measure_ms) {
   if (cands.empty()) throw std::invalid_argument("choose_under_budget: no candidates");
   if (!(budget_ms > 0.0)) throw std::invalid_argument("choose_under_budget: the budget must be > 0 ms");
+  BudgetChoice out;
+  const bool predicted = std::any_of(cands.begin(), cands.end(), [](const FrontConfig& c) { return std::isfinite(c.ms); });
+  if (!predicted) {
+    // The preset ladder: each step more accurate costs more by construction (half the step, twice
+    // the sun steps), so from the fastest up, stopping at the first that does not fit, never times
+    // a candidate that cannot be chosen (the most accurate preset costs ~10x the next one).
+    for (std::size_t k = cands.size(); k-- > 0;) {
+      const double ms = measure_ms(k);
+      out.trials.push_back({k, ms});
+      if (ms > budget_ms) break;
+      out.index = k, out.ms = ms, out.met = true;
+    }
+    if (!out.met) out.index = out.trials.front().index, out.ms = out.trials.front().ms;
+    return out;
+  }
   // The one that is always measured when nothing fits: the fastest the front predicts.
   std::size_t fastest = cands.size() - 1;
   for (std::size_t i = 0; i < cands.size(); ++i) {
     if (std::isfinite(cands[i].ms) && (!std::isfinite(cands[fastest].ms) || cands[i].ms < cands[fastest].ms))
       fastest = i;
   }
-  BudgetChoice out;
   double scale = kNaN;  // measured / predicted, from the last candidate measured that has a prediction
   for (std::size_t i = 0; i < cands.size(); ++i) {
     const double predicted = scale * cands[i].ms;

@@ -100,12 +100,14 @@ struct CandidateSource {
 CandidateSource budget_candidates(const std::string& front_file, const std::string& machine);
 
 // The budget choice. Candidates are ordered most accurate first; measure_ms(i) renders candidate i
-// and returns its time. Candidates are measured in order until one fits (ms <= budget_ms): the most
-// accurate that fits is chosen. Once one has been measured, the front's times (FrontConfig::ms)
-// scaled by measured / predicted predict the rest, and a candidate predicted above twice the budget
-// is skipped without rendering, except the one predicted fastest (the last when nothing is
-// predicted), which is always measured when nothing fitted. When none fits, the fastest measured is
-// chosen and `met` is false.
+// and returns its time; the most accurate whose time fits (ms <= budget_ms) is chosen.
+// With a measured front (FrontConfig::ms set): candidates are measured from the most accurate down
+// until one fits. Once one has been measured, the front's times scaled by measured / predicted
+// predict the rest, and a candidate predicted above twice the budget is skipped without rendering,
+// except the one predicted fastest, which is always measured when nothing fitted.
+// Without predictions (the preset ladder, whose cost rises with accuracy by construction): from the
+// fastest up, stopping at the first that does not fit.
+// When none fits, the fastest measured is chosen and `met` is false.
 struct BudgetTrial {
   std::size_t index = 0;
   double ms = 0.0;

@@ -274,16 +274,28 @@ TEST(BudgetChoice, PredictionSkipsHopelessCandidates) {
   EXPECT_EQ(asked, (std::vector<std::size_t>{0, 2}));  // c1 predicted at 90 > 30: not rendered
 }
 
-TEST(BudgetChoice, WithoutPredictionsEveryCandidateIsTriedInOrder) {
-  const auto cands = preset_ladder();  // errors and times unknown
+TEST(BudgetChoice, LadderIsClimbedFromTheFastestUntilOneDoesNotFit) {
+  const auto cands = preset_ladder();  // high, default, low; errors and times unknown
+  const std::vector<double> here = {50.0, 4.0, 2.0};
   std::vector<std::size_t> asked;
-  const BudgetChoice c = choose_under_budget(cands, 1.0, [&](std::size_t i) {
+  auto measure = [&](std::size_t i) {
     asked.push_back(i);
-    return 5.0 - static_cast<double>(i);  // high 5, default 4, low 3 ms: none fits
-  });
+    return here[i];
+  };
+  BudgetChoice c = choose_under_budget(cands, 10.0, measure);
+  EXPECT_TRUE(c.met);
+  EXPECT_EQ(cands[c.index].name, "default");
+  EXPECT_EQ(c.ms, 4.0);
+  EXPECT_EQ(asked, (std::vector<std::size_t>{2, 1, 0}));
+  asked.clear();
+  c = choose_under_budget(cands, 1000.0, measure);
+  EXPECT_EQ(cands[c.index].name, "high");
+  asked.clear();
+  c = choose_under_budget(cands, 1.0, measure);  // not even low fits: high is never timed
   EXPECT_FALSE(c.met);
   EXPECT_EQ(cands[c.index].name, "low");
-  EXPECT_EQ(asked, (std::vector<std::size_t>{0, 1, 2}));
+  EXPECT_EQ(c.ms, 2.0);
+  EXPECT_EQ(asked, (std::vector<std::size_t>{2}));
 }
 
 TEST(BudgetChoice, TiesInErrorGoToTheFasterAndTiesInTimeToTheMoreAccurate) {
@@ -294,7 +306,7 @@ TEST(BudgetChoice, TiesInErrorGoToTheFasterAndTiesInTimeToTheMoreAccurate) {
   rank_front(f);
   ASSERT_EQ(f.configs[0].name, "fast");
   // Equal measured times over the budget: the first (more accurate) of the fastest is chosen.
-  const auto cands = ladder_with_ms({std::nan(""), std::nan("")});
+  const auto cands = ladder_with_ms({5.0, 5.0});
   const BudgetChoice c = choose_under_budget(cands, 1.0, [](std::size_t) { return 3.0; });
   EXPECT_FALSE(c.met);
   EXPECT_EQ(c.index, 0u);
