@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 namespace cv::viewer {
 
@@ -21,6 +22,11 @@ bool FrameBudget::update(core::RenderSettings& render, double dz_m, double last_
   if (!on_) {  // just switched on: from the fastest, with nothing known
     on_ = true;
     stepper_ = core::bench::BudgetStepper(source_.candidates.size(), source_.candidates.size() - 1);
+    // The bench's times per marched frame predict the ratios between candidates (the viewer
+    // accumulates frames progressively, so a candidate's accumulate does not slow a frame).
+    std::vector<double> costs;
+    for (const auto& c : source_.candidates) costs.push_back(c.ms / c.accumulate);
+    stepper_.set_predicted_costs(costs);
     apply = true;
   } else if (marched) {
     apply = stepper_.observe(last_frame_ms, render.budget_ms);

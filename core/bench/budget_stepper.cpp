@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace cv::core::bench {
 
@@ -22,6 +23,11 @@ double BudgetStepper::last_ms(std::size_t i) const {
 void BudgetStepper::reset_times() {
   std::fill(last_ms_.begin(), last_ms_.end(), std::numeric_limits<double>::quiet_NaN());
   since_change_.clear();
+}
+
+void BudgetStepper::set_predicted_costs(std::vector<double> costs) {
+  costs_ = std::move(costs);
+  costs_.resize(last_ms_.size(), std::numeric_limits<double>::quiet_NaN());
 }
 
 bool BudgetStepper::observe(double frame_ms, double budget_ms) {
@@ -44,7 +50,15 @@ bool BudgetStepper::observe(double frame_ms, double budget_ms) {
     if (current_ + 1 < last_ms_.size()) next = current_ + 1;
   } else if (current_ > 0) {
     const double up = last_ms(current_ - 1);
-    const bool fits = std::isfinite(up) ? up <= kUpMargin * budget_ms : typical <= kProbeMargin * budget_ms;
+    const bool predicted = !costs_.empty() && std::isfinite(costs_[current_ - 1]) &&
+                           std::isfinite(costs_[current_]) && costs_[current_] > 0.0;
+    bool fits = false;
+    if (std::isfinite(up))
+      fits = up <= kUpMargin * budget_ms;
+    else if (predicted)
+      fits = typical * costs_[current_ - 1] / costs_[current_] <= kUpMargin * budget_ms;
+    else
+      fits = typical <= kProbeMargin * budget_ms;
     if (fits) next = current_ - 1;
   }
   if (next == current_) return false;

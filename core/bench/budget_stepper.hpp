@@ -16,7 +16,8 @@ class BudgetStepper {
   // Step up only when the more accurate candidate's last time is at most this fraction of the
   // budget: a candidate just over the line would otherwise be left and taken again every few frames.
   static constexpr double kUpMargin = 0.8;
-  // With no time known for the more accurate candidate, try it only with this much headroom.
+  // With no time known or predicted for the more accurate candidate, try it only with this much
+  // headroom.
   static constexpr double kProbeMargin = 0.5;
   // A candidate's last time is forgotten after this many frames (the view changes what frames cost).
   static constexpr int kForgetFrames = 300;
@@ -37,12 +38,17 @@ class BudgetStepper {
   double last_ms(std::size_t i) const;
   // Forgets what was measured (on a change of scene or window: old times no longer apply).
   void reset_times();
+  // Relative frame costs of the candidates (the bench's times; NaN where unknown). With both known,
+  // a more accurate candidate not yet measured is predicted as the current frame time scaled by
+  // their ratio, and taken when that fits with kUpMargin, instead of probing at kProbeMargin.
+  void set_predicted_costs(std::vector<double> costs);
 
  private:
   std::size_t current_;
   std::vector<double> last_ms_;
   std::vector<long long> last_frame_;  // frame counter when last_ms_ was measured
   std::vector<double> since_change_;   // frame times since the last change
+  std::vector<double> costs_;          // relative frame costs, or empty
   long long frame_ = 0;
 };
 

@@ -375,6 +375,20 @@ TEST(BudgetStepper, StepsUpWhenTheMoreAccurateFitsWithMargin) {
   EXPECT_EQ(s.current(), 1u);
 }
 
+TEST(BudgetStepper, PredictedCostsDecideWhetherToTryTheMoreAccurate) {
+  // Candidate 0 is predicted at 3x candidate 1. At 4 ms a frame, 0 is predicted at 12 ms, within
+  // 80 % of 20 ms: taken. At 6 ms it is predicted at 18 ms: not taken, although 6 ms leaves the
+  // 50 % headroom that probing without a prediction asks for.
+  BudgetStepper a(2, 1);
+  a.set_predicted_costs({30.0, 10.0});
+  EXPECT_EQ(feed(a, BudgetStepper::kSettleFrames, 4.0, 20.0), 1);
+  BudgetStepper b(2, 1);
+  b.set_predicted_costs({30.0, 10.0});
+  EXPECT_EQ(feed(b, 50, 6.0, 20.0), 0);
+  BudgetStepper c(2, 1);  // the same without predictions probes
+  EXPECT_EQ(feed(c, BudgetStepper::kSettleFrames, 6.0, 20.0), 1);
+}
+
 TEST(BudgetStepper, OffDoesNothing) {
   BudgetStepper s(3);
   EXPECT_EQ(feed(s, 50, 1000.0, 0.0), 0);
