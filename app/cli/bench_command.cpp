@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <stdexcept>
 
@@ -16,10 +17,12 @@
 #include "bench/reference_cache.hpp"
 #include "bench_report.hpp"
 #include "cli_common.hpp"
+#include "quality_budget.hpp"
 #include "geo/geodesy.hpp"
 #include "reference/monte_carlo.hpp"
 #include "render/context.hpp"
 #include "render/image_output.hpp"
+#include "render/machine_id.hpp"
 #include "render/raymarcher.hpp"
 #include "scene/quality.hpp"
 #include "scene/standard_scenes.hpp"
@@ -41,6 +44,7 @@ struct BenchArgs {
   int spp = 64, width = 96, height = 54, repeats = 3;
   double ref_error = 0.0;  // stop a reference early at this mean relative standard error (0: at spp)
   std::string out = "bench_out";
+  bool cache = true;  // copy quality_front.json to the per-user cache
 };
 
 int parse_int(const std::string& opt, const std::string& text, int lo, int hi, const char* expected) {
@@ -70,6 +74,7 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
       }
     } else if (s == "--repeats") a.repeats = parse_int(s, next(), 1, 100, "an integer in 1..100");
     else if (s == "--out") a.out = next();
+    else if (s == "--no-cache") a.cache = false;
     else if (s == "--size") {
       const std::string v = next();
       const auto x = v.find('x');
@@ -77,7 +82,8 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
       a.width = parse_int("--size", v.substr(0, x), 8, 4096, "WxH with each in 8..4096");
       a.height = parse_int("--size", v.substr(x + 1), 8, 4096, "WxH with each in 8..4096");
     } else if (!s.empty() && s[0] == '-') {
-      throw UsageError{"cloudviewer bench: unknown option '" + s + "', expected --reference-spp, --reference-error, --size, --repeats or --out"};
+      throw UsageError{"cloudviewer bench: unknown option '" + s +
+                       "', expected --reference-spp, --reference-error, --size, --repeats, --out or --no-cache"};
     } else if (std::find(known.begin(), known.end(), s) == known.end()) {
       std::string names;
       for (const auto& n : known) names += (names.empty() ? "" : ", ") + n;
@@ -218,9 +224,10 @@ double median(std::vector<double> v) {
 }  // namespace
 
 const char* bench_usage() {
-  return "  bench [SCENE...] [--reference-spp N] [--reference-error E] [--size WxH] [--repeats R] [--out DIR]\n"
+  return "  bench [SCENE...] [--reference-spp N] [--reference-error E] [--size WxH] [--repeats R] [--out DIR] [--no-cache]\n"
          "                           error against run time on the standard scenes (default all, 96x54, 64 spp,\n"
-         "                           3 repeats, into bench_out): results.csv, summary.md, plots and error images.\n"
+         "                           3 repeats, into bench_out): results.csv, summary.md, plots and error images,\n"
+         "                           quality_front.json (also cached per user for --budget-ms unless --no-cache).\n"
          "                           References are cached in DIR with their sums: a larger N extends them, an\n"
          "                           interrupted one resumes; --reference-error stops one early at that mean\n"
          "                           relative standard error\n";
@@ -239,10 +246,12 @@ int cmd_bench(const std::vector<std::string>& args) {
   render::GpuRaymarcher gpu(loader);
   std::vector<BenchRow> rows;
   std::vector<SceneReference> refs;
+  std::map<std::string, double> dz_by_scene;  // for the front file: view steps as multiples of dz
   std::set<std::string> variants_warm;  // program variants compiled already (compile time is not frame time)
   for (const auto& name : a.scenes) {
     const core::StandardScene sc = core::standard_scene(name, a.width, a.height);
     const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
+    dz_by_scene[name] = std::abs(sc.grid.alt_m.step);
     // Clouds only, as the Monte Carlo reference models them.
     core::MarchSettings base = sc.march;
     base.atmosphere = base.globe = false;
@@ -365,6 +374,7 @@ int cmd_bench(const std::vector<std::string>& args) {
   write_results_csv((fs::path(a.out) / "results.csv").string(), rows, refs);
   write_summary_md((fs::path(a.out) / "summary.md").string(), rows, refs, command, machine);
   const auto plots = write_plots(a.out, rows);
+  write_quality_front(a.out, rows, dz_by_scene, render::machine_id(ctx->info()), a.width, a.height, command, a.cache);
   std::printf("wrote %s/results.csv (%zu rows), %s/summary.md and %zu plot(s)\n", a.out.c_str(), rows.size(), a.out.c_str(),
               plots.size());
   return 0;

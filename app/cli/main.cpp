@@ -41,9 +41,11 @@ void print_usage() {
       "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"
       "%s"
       "%s"
-      "  view INPUT [--size WxH] [--time N] [--scale S] [--hide-ui] [--frames N --screenshot OUT.png]\n"
+      "  view INPUT [--size WxH] [--time N] [--scale S] [--hide-ui] [--frame-budget MS]\n"
+      "             [--frames N --screenshot OUT.png]\n"
       "                           the interactive viewer (GLFW window); with --frames it renders N frames,\n"
-      "                           saves the window to OUT.png and exits\n"
+      "                           saves the window to OUT.png and exits; --frame-budget: the quality panel's\n"
+      "                           frame budget (0 off)\n"
       "  --version                print the version\n",
       cv::cli::render_usage(), cv::cli::bench_usage());
 }

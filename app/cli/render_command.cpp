@@ -17,9 +17,11 @@
 #include "cli_common.hpp"
 #include "importer.hpp"
 #include "noise/noise.hpp"
+#include "quality_budget.hpp"
 #include "render/albedo_map.hpp"
 #include "render/context.hpp"
 #include "render/image_output.hpp"
+#include "render/machine_id.hpp"
 #include "render/raymarcher.hpp"
 #include "render/shader_loader.hpp"
 #include "scene/framing.hpp"
@@ -47,7 +49,9 @@ double seconds_since(clock::time_point t0) { return std::chrono::duration<double
 // What the options ask for, applied on top of the scene file (or the defaults) in one place.
 struct RenderArgs {
   std::string input, out, pfm, save_scene;
+  std::string front;              // --front FILE: the measured quality front for --budget-ms
   bool march_overridden = false;  // --steps, --sun-steps, --octaves or --accumulate: quality becomes custom
+  bool quality_given = false, adaptive_given = false, budget_given = false;
 };
 
 int parse_int(const std::string& option, const std::string& text, int lo, int hi, const std::string& what) {
@@ -124,6 +128,7 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
         scene.render.quality = v;
       } else if (core::find_quality(v)) {
         core::apply_quality(v, scene.render);
+        r.quality_given = true;
       } else {
         throw UsageError{"cloudviewer render: --quality: found '" + v + "', expected one of " + core::quality_names()};
       }
@@ -154,10 +159,19 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
       m.skip_empty = false;
     } else if (a == "--adaptive") {
       m.adaptive_steps = true;
+      r.adaptive_given = true;
       m.max_step_optical_depth = parse_number(a, v);
       if (!(m.max_step_optical_depth > 0)) {
         throw UsageError{"cloudviewer render: --adaptive: found '" + v + "', expected the optical depth per substep, a number > 0"};
       }
+    } else if (a == "--budget-ms") {
+      scene.render.budget_ms = parse_number(a, v);
+      if (!(scene.render.budget_ms > 0 && scene.render.budget_ms <= 1e7)) {
+        throw UsageError{"cloudviewer render: --budget-ms: found '" + v + "', expected a time budget in milliseconds, > 0 and <= 1e7"};
+      }
+      r.budget_given = true;
+    } else if (a == "--front") {
+      r.front = v;
     } else if (a == "--no-sky") {
       m.atmosphere = m.globe = false;
       m.ambient = 0.0;
@@ -181,6 +195,19 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
     }
   }
   if (r.out.empty()) throw UsageError{"cloudviewer render: expected -o OUT.png"};
+  // The budget chooses the quality knobs: given together on the command line they contradict each
+  // other; options override a scene file's budget as they override its other keys.
+  if (r.budget_given && (r.march_overridden || r.quality_given || r.adaptive_given)) {
+    throw UsageError{"cloudviewer render: --budget-ms: found it with --quality, --steps, --sun-steps, --octaves, --accumulate or "
+                     "--adaptive, expected one or the other (the budget chooses those settings)"};
+  }
+  if (!r.budget_given && scene.render.budget_ms > 0 && (r.march_overridden || r.quality_given || r.adaptive_given)) {
+    std::printf("the scene's render.budget_ms (%g ms) is off: quality options on the command line override it\n", scene.render.budget_ms);
+    scene.render.budget_ms = 0.0;
+  }
+  if (!r.front.empty() && !(scene.render.budget_ms > 0)) {
+    throw UsageError{"cloudviewer render: --front: found it without a budget, expected --budget-ms MS (or render.budget_ms in the scene)"};
+  }
   if (scene.data.path.empty()) {
     throw UsageError{"cloudviewer render: " + r.input + ": data.path: found nothing, expected the NetCDF or .cvvol file to render"};
   }
@@ -216,6 +243,8 @@ const char* render_usage() {
          "         [--exposure E] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N] [--pfm OUT.pfm]\n"
          "         [--noise AMOUNT] [--noise-scale METRES] [--no-sky] [--no-skip] [--adaptive TAU]\n"
          "         [--save-scene OUT.json]  (the effective scene, camera and sun resolved, to reproduce the image)\n"
+         "         [--budget-ms MS [--front quality_front.json]]  the most accurate settings of the measured front\n"
+         "                           (from bench; else its cached copy, else the presets) that render within MS here\n"
          "                           the sun stands where it stood at the valid time unless --sun or --sun-time\n";
 }
 
@@ -252,11 +281,32 @@ int cmd_render(const std::vector<std::string>& args) {
               : scene.sun.mode == core::SunMode::DateTime ? scene.sun.datetime_utc.c_str()
               : known_time                                ? "from the valid time"
                                                           : "default");
+  auto ctx = render::make_headless_context();
+  const render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::GpuRaymarcher gpu(loader);
+  t0 = clock::now();
+  gpu.upload(g, medium);
+  if (scene.render.march.noise_amount > 0.0) {  // generated, compiled and bound only when used
+    const auto t_noise = clock::now();
+    gpu.upload_noise(core::make_erosion_noise());
+    std::printf("erosion noise %.2f, tile %.0f m: generated and uploaded in %.2f s\n", scene.render.march.noise_amount,
+                scene.render.march.noise_scale_m, seconds_since(t_noise));
+  }
+  glFinish();
+  const double t_upload = seconds_since(t0);
   scene.render.march.view_step_m = core::resolve_view_step_m(scene.render, g);
   if (ra.march_overridden) scene.render.quality = "custom";
   scene.camera = cam;
   scene.sun.mode = core::SunMode::Manual;
   scene.sun.subsolar_lat_deg = sun.subsolar_lat_deg, scene.sun.subsolar_lon_deg = sun.subsolar_lon_deg;
+  if (scene.render.budget_ms > 0.0) {  // the quality knobs chosen here, on this scene at this size
+    core::MarchSettings base = scene.render.march;
+    if (!(base.droplet_diameter_um > 0.0)) base.droplet_diameter_um = 2.0 * vol.liquid_r_eff_um;
+    base.ground_texture = render::resolve_ground_texture(base.ground_texture);
+    choose_by_budget(gpu, cam, sun, base, g.alt_m.step, scene.render.budget_ms, ra.front, render::machine_id(ctx->info()),
+                     scene.render);
+    scene.render.budget_ms = 0.0;  // a saved scene holds the chosen settings, so it renders this image again
+  }
   if (!ra.save_scene.empty()) {
     core::Scene saved = scene;
     // Data beside or below the saved scene: a path relative to its folder (as load_scene resolves
@@ -281,19 +331,6 @@ int cmd_render(const std::vector<std::string>& args) {
               scene.data.path.c_str(), scene.time_step, vt.iso_utc.c_str(), cam.width, cam.height,
               mw != cam.width || mh != cam.height ? (" marched at " + std::to_string(mw) + "x" + std::to_string(mh)).c_str() : "",
               rs.quality.c_str(), march.view_step_m, march.sun_steps, march.octaves, rs.accumulate);
-  auto ctx = render::make_headless_context();
-  const render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
-  render::GpuRaymarcher gpu(loader);
-  t0 = clock::now();
-  gpu.upload(g, medium);
-  if (march.noise_amount > 0.0) {  // generated, compiled and bound only when used
-    const auto t_noise = clock::now();
-    gpu.upload_noise(core::make_erosion_noise());
-    std::printf("erosion noise %.2f, tile %.0f m: generated and uploaded in %.2f s\n", march.noise_amount, march.noise_scale_m,
-                seconds_since(t_noise));
-  }
-  glFinish();
-  const double t_upload = seconds_since(t0);
 
   t0 = clock::now();
   double gpu_s = 0.0;

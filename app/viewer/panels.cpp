@@ -114,7 +114,7 @@ void lighting_panel(ViewerState& s) {
   }
 }
 
-void quality_panel(ViewerState& s) {
+void quality_panel(ViewerState& s, const PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Quality")) return;
   {
     core::RenderSettings& r = s.scene.render;
@@ -129,6 +129,9 @@ void quality_panel(ViewerState& s) {
     slider_double("resolution scale", &r.resolution_scale, 0.1, 1.0, "%.2f");
     ImGui::SliderInt("accumulate (frames)", &r.accumulate, 1, 1024, "%d", ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
     slider_double("exposure", &r.exposure, 0.1, 64.0, "%.2f", ImGuiSliderFlags_Logarithmic);
+    // 0 is off; on, the budget sets the step, sun steps, octaves, adaptive and scale above.
+    drag_double("frame budget (ms)", &r.budget_ms, 1.0, 0.0, 1e7, r.budget_ms > 0.0 ? "%.0f" : "off");
+    if (r.budget_ms > 0.0 && !ctx.budget_text.empty()) ImGui::TextWrapped("budget: %s", ctx.budget_text.c_str());
   }
 }
 
@@ -177,7 +180,7 @@ void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats)
     camera_panel(state, ctx);
     sun_panel(state, ctx);
     lighting_panel(state);
-    quality_panel(state);
+    quality_panel(state, ctx);
     scene_panel(state, ctx);
     ImGui::TextDisabled("F1 hides the panels; %s", stats.renderer.c_str());
   }

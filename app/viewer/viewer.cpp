@@ -18,9 +18,11 @@
 #include "noise/noise.hpp"
 #include "render/albedo_map.hpp"
 #include "render/context.hpp"
+#include "render/machine_id.hpp"
 #include "render/presenter.hpp"
 #include "render/raymarcher.hpp"
 #include "viewer/camera_controller.hpp"
+#include "viewer/frame_budget.hpp"
 #include "viewer/panels.hpp"
 #include "viewer/scene_io.hpp"
 #include "scene/framing.hpp"
@@ -158,6 +160,18 @@ int cmd_view(const std::vector<std::string>& args) {
         if (!(o.scale >= 0.1 && o.scale <= 1.0)) {
           throw ViewerInputError("cloudviewer view: --scale: found '" + v + "', expected a resolution scale in 0.1..1");
         }
+      } else if (a == "--frame-budget") {
+        const std::string v = next();
+        try {
+          std::size_t used = 0;
+          o.frame_budget_ms = std::stod(v, &used);
+          if (used != v.size()) o.frame_budget_ms = -1.0;
+        } catch (const std::exception&) {
+          o.frame_budget_ms = -1.0;
+        }
+        if (!(o.frame_budget_ms >= 0.0 && o.frame_budget_ms <= 1e7)) {
+          throw ViewerInputError("cloudviewer view: --frame-budget: found '" + v + "', expected a frame time in ms 0..1e7 (0: off)");
+        }
       } else if (a == "--hide-ui") {
         o.hide_ui = true;
       } else if (!a.empty() && a[0] == '-') {
@@ -217,6 +231,7 @@ int run_viewer(const ViewerOptions& o) {
   if (!(s.scene.render.march.droplet_diameter_um > 0.0)) s.scene.render.march.droplet_diameter_um = 2.0 * s.volume.liquid_r_eff_um;
   if (o.frames > 0) s.scene.render.accumulate = o.frames;
   if (!o.scene || o.scale_given) s.scene.render.resolution_scale = o.scale;
+  if (o.frame_budget_ms >= 0.0) s.scene.render.budget_ms = o.frame_budget_ms;
 
   auto win = render::make_window_context(o.width, o.height, "cloudviewer - " + o.input);
   glfwSwapInterval(o.frames > 0 ? 0 : 1);
@@ -238,6 +253,9 @@ int run_viewer(const ViewerOptions& o) {
     }
   } imgui_guard;
 
+  FrameBudget budget(render::machine_id(win->info()));
+  if (!budget.warning().empty()) std::printf("frame budget: %s\n", budget.warning().c_str());
+  bool marched_last = false;
   PanelContext ctx;
   FrameStats stats;
   stats.renderer = win->info().renderer;
@@ -254,6 +272,7 @@ int run_viewer(const ViewerOptions& o) {
     glfwPollEvents();
     const auto now = clock::now();
     const double dt = std::min(0.25, std::chrono::duration<double>(now - last).count());
+    const double frame_ms = std::chrono::duration<double, std::milli>(now - last).count();  // the last frame, uncapped
     last = now;
     int fbw = 0, fbh = 0;
     glfwGetFramebufferSize(win->window(), &fbw, &fbh);
@@ -278,6 +297,14 @@ int run_viewer(const ViewerOptions& o) {
     navigate(win->window(), s, dt);
     if (show_ui) draw_panels(s, ctx, stats);
 
+    // The frame budget steps along its candidates from the last frame's time (after the panels, so
+    // that switching it on in the panel takes effect this frame).
+    const bool budget_was_on = budget.on();
+    if (budget.update(s.scene.render, g.alt_m.step, frame_ms, marched_last)) {
+      if (!budget_was_on) std::printf("frame budget %g ms: candidates from %s\n", s.scene.render.budget_ms, budget.source().c_str());
+      if (o.frames > 0) std::printf("frame budget %g ms: frame %d: %s\n", s.scene.render.budget_ms, frame, budget.status().c_str());
+    }
+    ctx.budget_text = budget.on() ? budget.status() + "; from " + budget.source() : "";
     // The march size follows the window and the resolution scale; the camera renders at it.
     int mw = 0, mh = 0;
     march_size(s.scene, fbw, fbh, mw, mh);
@@ -301,7 +328,8 @@ int run_viewer(const ViewerOptions& o) {
 
     // One more jittered frame into the mean until the target; a target of 1 marches at step middles
     // exactly as `render` does without --accumulate.
-    if (accumulated < s.scene.render.accumulate) {
+    marched_last = accumulated < s.scene.render.accumulate;
+    if (marched_last) {
       core::MarchSettings m = s.scene.render.march;
       m.ground_texture = render::resolve_ground_texture(m.ground_texture);
       m.frame = s.scene.render.accumulate == 1 ? -1 : accumulated;
@@ -341,6 +369,7 @@ int run_viewer(const ViewerOptions& o) {
       std::printf("wrote %s (%d x %d window, %d frame(s) accumulated in %.2f s wall, GPU march %.1f ms per frame on %s)\n",
                   o.screenshot.c_str(), fbw, fbh, accumulated, std::chrono::duration<double>(clock::now() - start).count(),
                   stats.march_ms, stats.renderer.c_str());
+      if (budget.on()) std::printf("frame budget %g ms: ended on %s\n", s.scene.render.budget_ms, budget.status().c_str());
     }
     win->swap_buffers();
     ++fps_frames;

@@ -20,6 +20,7 @@ struct ViewerOptions {
   std::string screenshot;   // PNG of the window's framebuffer after the last frame
   bool hide_ui = false;     // start with the panels hidden (F1 toggles them)
   double scale = 1.0;       // resolution scale: march at this fraction of the window size
+  double frame_budget_ms = -1.0;  // --frame-budget: the scene's render.budget_ms (0 off); < 0: not given
 };
 
 // Parses the `view` arguments and runs; returns the exit code (2 with one line for bad arguments).

@@ -214,7 +214,7 @@ void read_march(const Reader& r, MarchSettings& m) {
 }
 
 void read_render(const Reader& r, RenderSettings& s) {
-  r.only({"quality", "march", "accumulate", "resolution_scale", "exposure"});
+  r.only({"quality", "march", "accumulate", "resolution_scale", "exposure", "budget_ms"});
   // The preset first: march keys written in the file then override its values.
   std::string quality = s.quality;
   r.string("quality", quality);
@@ -229,6 +229,7 @@ void read_render(const Reader& r, RenderSettings& s) {
   r.integer("accumulate", s.accumulate, 1, 4096);
   r.number("resolution_scale", s.resolution_scale, 0.01, 1.0, "a fraction of the output size 0.01..1");
   r.number("exposure", s.exposure, 1e-300, kHuge, "an exposure > 0");
+  r.number("budget_ms", s.budget_ms, 0.0, 1e7, "a frame-time budget in ms 0..1e7 (0: off)");
 }
 
 }  // namespace
@@ -305,6 +306,7 @@ std::string scene_to_json(const Scene& s) {
                     {"accumulate", s.render.accumulate},
                     {"resolution_scale", s.render.resolution_scale},
                     {"exposure", s.render.exposure},
+                    {"budget_ms", s.render.budget_ms},
                     {"march",
                      {{"view_step_m", m.view_step_m},
                       {"sun_steps", m.sun_steps},

@@ -1,10 +1,13 @@
 #!/bin/sh
 # Smoke test of `cloudviewer bench`: one scene, tiny size and spp, into a fresh folder; the CSV must
 # have the expected header and one row per configuration, the summary and plot must exist, and a
-# second run must reuse the cached reference.
+# second run must reuse the cached reference. The quality front is written beside them and into the
+# per-user cache (here a folder of the run's own, so that a test never touches the real one).
 set -eu
 exe=$1 dir=$2
 rm -rf "$dir"
+XDG_CACHE_HOME=$dir/cache
+export XDG_CACHE_HOME
 "$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --out "$dir"
 header='scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,wall_ms,gpu_ms,rel_rmse,rel_rmse_raw,ref_noise_floor,rel_rmse_resolution,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,error_image'
 test "$(head -n 1 "$dir/results.csv")" = "$header" || { echo "bad header: $(head -n 1 "$dir/results.csv")"; exit 1; }
@@ -19,6 +22,12 @@ test -s "$dir/summary.md" && test -s "$dir/stratocumulus_pareto.png" && test -s 
 "$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --out "$dir" > "$dir/run2.txt"
 grep -q 'holds 2 spp' "$dir/run2.txt" \
   || { echo "the second run did not reuse the cached reference"; exit 1; }
+grep -q '"format": "cloudviewer-quality-front"' "$dir/quality_front.json" || { echo "no quality_front.json"; exit 1; }
+grep -q '"candidate": true' "$dir/quality_front.json" || { echo "no candidate in quality_front.json"; exit 1; }
+cmp -s "$dir/quality_front.json" "$dir/cache/cloudviewer/quality_front.json" || { echo "the front was not cached"; exit 1; }
+rm "$dir/cache/cloudviewer/quality_front.json"
+"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --out "$dir" --no-cache >/dev/null
+test ! -e "$dir/cache/cloudviewer/quality_front.json" || { echo "--no-cache wrote the cache"; exit 1; }
 # A larger --reference-spp extends the cached reference instead of starting over.
 "$exe" bench stratocumulus --size 24x14 --reference-spp 3 --repeats 1 --out "$dir" > "$dir/run3.txt"
 grep -q 'at 3 spp (1 new' "$dir/run3.txt" \

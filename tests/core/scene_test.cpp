@@ -47,7 +47,7 @@ Scene full_scene() {
   s.render.march.blue_noise = false;  // not the default, so the round trip shows it is stored
   s.render.march.noise_amount = 0.35, s.render.march.noise_scale_m = 12345.0;
   s.render.march.liquid_phase_hg = true;
-  s.render.accumulate = 8, s.render.resolution_scale = 0.5, s.render.exposure = 6.25;
+  s.render.accumulate = 8, s.render.resolution_scale = 0.5, s.render.exposure = 6.25, s.render.budget_ms = 40.0;
   s.overlays = {"coastlines"};
   return s;
 }
@@ -95,6 +95,7 @@ void expect_equal(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.render.accumulate, b.render.accumulate);
   EXPECT_EQ(a.render.resolution_scale, b.render.resolution_scale);
   EXPECT_EQ(a.render.exposure, b.render.exposure);
+  EXPECT_EQ(a.render.budget_ms, b.render.budget_ms);
   EXPECT_EQ(a.overlays, b.overlays);
 }
 
@@ -171,6 +172,8 @@ TEST(SceneJson, OutOfRangeValuesAreRefused) {
             "scene.json: sun.datetime_utc: found \"2024-02-30T00:00:00Z\", expected a UTC date-time YYYY-MM-DDThh:mm:ssZ");
   EXPECT_EQ(error_of(R"({"version": 1, "render": {"quality": "ultra"}})"),
             "scene.json: render.quality: found \"ultra\", expected one of low, default, high, custom");
+  EXPECT_EQ(error_of(R"({"version": 1, "render": {"budget_ms": -5}})"),
+            "scene.json: render.budget_ms: found -5, expected a frame-time budget in ms 0..1e7 (0: off)");
 }
 
 TEST(SceneJson, UnknownKeysAreNamedSoTyposAreCaught) {

@@ -1,0 +1,164 @@
+// The front file from `bench`'s rows, and the budget choice of `render`: each candidate rendered
+// once on this scene at this size, the most accurate that fits kept.
+#include "quality_budget.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include "cli_common.hpp"
+#include "render/raymarcher.hpp"
+#include "scene/quality.hpp"
+
+namespace cv::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using core::bench::FrontConfig;
+
+// Calibration frames larger than this many pixels are marched at a reduced size of about this many
+// pixels, and their time scaled by the pixel count (march time grows with the pixels marched; a
+// 960x540 candidate is then timed in a fraction of its own frame time).
+constexpr double kCalibrationPixels = 320.0 * 180.0;
+
+const char* kind_name(ConfigKind k) {
+  return k == ConfigKind::Seed ? "seed" : k == ConfigKind::Preset ? "preset" : "sweep";
+}
+
+}  // namespace
+
+void write_quality_front(const std::string& out_dir, const std::vector<BenchRow>& rows,
+                         const std::map<std::string, double>& dz_by_scene, const std::string& machine,
+                         int width, int height, const std::string& command, bool cache) {
+  core::bench::QualityFront front;
+  front.machine = machine, front.width = width, front.height = height, front.command = command;
+  std::map<std::string, std::size_t> index;  // config name -> position in front.configs (first-seen order)
+  std::map<std::string, std::pair<double, int>>
+      log_ratio;  // sum of log(view step / dz) and count, per config
+  for (const BenchRow& r : rows) {
+    auto [it, fresh] = index.emplace(r.config, front.configs.size());
+    if (fresh) {
+      FrontConfig c;
+      c.name = r.config, c.kind = kind_name(r.kind);
+      c.sun_steps = r.sun_steps, c.octaves = r.octaves, c.accumulate = r.accumulate;
+      c.resolution_scale = r.resolution_scale, c.adaptive = r.adaptive, c.phase_hg = r.phase_hg;
+      front.configs.push_back(c);
+    }
+    FrontConfig& c = front.configs[it->second];
+    c.scenes.push_back({r.scene, r.view_step_m, r.wall_ms, r.err.rel_rmse, r.pareto});
+    const auto dz = dz_by_scene.find(r.scene);
+    if (dz != dz_by_scene.end() && dz->second > 0.0 && r.view_step_m > 0.0) {
+      auto& lr = log_ratio[r.config];
+      lr.first += std::log(r.view_step_m / dz->second);
+      ++lr.second;
+    }
+  }
+  for (FrontConfig& c : front.configs) {
+    const core::QualityPreset* p = c.kind == "preset" ? core::find_quality(c.name) : nullptr;
+    if (p) {  // a preset's own definition, floor included
+      c.view_step_dz = p->view_step_dz_fraction, c.view_step_min_m = p->view_step_min_m;
+    } else if (const auto lr = log_ratio.find(c.name); lr != log_ratio.end() && lr->second.second > 0) {
+      c.view_step_dz = std::exp(lr->second.first / lr->second.second);
+    }
+  }
+  core::bench::rank_front(front);
+  const std::string path = (fs::path(out_dir) / "quality_front.json").string();
+  core::bench::save_front(front, path);
+  std::printf("wrote %s (%zu configurations, %zu candidates for --budget-ms)\n", path.c_str(),
+              front.configs.size(), core::bench::front_candidates(front).size());
+  if (!cache) return;
+  const std::string cached = core::bench::front_cache_path();
+  if (cached.empty()) {
+    std::printf("not cached: neither XDG_CACHE_HOME nor HOME is set\n");
+    return;
+  }
+  try {
+    core::bench::save_front(front, cached);
+    std::printf(
+        "cached it as %s (render --budget-ms and the viewer's frame budget use it; --no-cache to skip)\n",
+        cached.c_str());
+  } catch (const std::exception& e) {
+    std::printf("not cached: %s\n", e.what());
+  }
+}
+
+void apply_front_config(const FrontConfig& c, double dz_m, core::RenderSettings& render) {
+  render.quality = c.kind == "preset" && core::find_quality(c.name) ? c.name : "custom";
+  render.march.view_step_m = c.view_step_m(dz_m);
+  render.march.sun_steps = c.sun_steps;
+  render.march.octaves = c.octaves;
+  render.march.adaptive_steps = c.adaptive;
+  render.accumulate = c.accumulate;
+  render.resolution_scale = c.resolution_scale;
+}
+
+void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const core::Sun& sun,
+                      const core::MarchSettings& base, double dz_m, double budget_ms,
+                      const std::string& front_file, const std::string& machine,
+                      core::RenderSettings& render) {
+  core::bench::CandidateSource src;
+  try {
+    src = core::bench::budget_candidates(front_file, machine);
+  } catch (const core::bench::FrontError& e) {
+    throw UsageError{std::string("cloudviewer render: --front: ") + e.what()};
+  }
+  if (!src.warning.empty()) std::printf("budget: %s\n", src.warning.c_str());
+  std::printf("budget %.4g ms: candidates from %s\n", budget_ms, src.source.c_str());
+  std::set<std::string> warm;  // program variants compiled already (compiling is not frame time)
+  using clock = std::chrono::steady_clock;
+  auto measure = [&](std::size_t i) {
+    const FrontConfig& c = src.candidates[i];
+    core::RenderSettings rs = render;
+    apply_front_config(c, dz_m, rs);
+    core::MarchSettings m = base;
+    m.view_step_m = rs.march.view_step_m, m.sun_steps = rs.march.sun_steps, m.octaves = rs.march.octaves;
+    m.adaptive_steps = rs.march.adaptive_steps;
+    m.frame = c.accumulate > 1 ? 0 : -1;
+    const double mw = std::max(1.0, std::round(cam.width * c.resolution_scale));
+    const double mh = std::max(1.0, std::round(cam.height * c.resolution_scale));
+    const double shrink = std::min(1.0, std::sqrt(kCalibrationPixels / (mw * mh)));
+    core::Camera cal = cam;
+    cal.width = std::max(1, static_cast<int>(std::lround(mw * shrink)));
+    cal.height = std::max(1, static_cast<int>(std::lround(mh * shrink)));
+    const std::string variant = std::string(m.adaptive_steps ? "a" : "-") + (m.skip_empty ? "s" : "-");
+    if (warm.insert(variant).second) gpu.render(cal, sun, m);
+    const auto t0 = clock::now();
+    gpu.render(cal, sun, m);
+    const double frame_ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
+    const double ms = frame_ms * (mw * mh) / (static_cast<double>(cal.width) * cal.height) * c.accumulate;
+    std::printf("budget: %-24s %9.1f ms", c.name.c_str(), ms);
+    if (cal.width != static_cast<int>(mw) || cal.height != static_cast<int>(mh)) {
+      std::printf("  (one frame at %dx%d, scaled by pixel count to %.0fx%.0f", cal.width, cal.height, mw, mh);
+    } else {
+      std::printf("  (one frame at %.0fx%.0f", mw, mh);
+    }
+    if (c.accumulate > 1)
+      std::printf(", times %d frames)\n", c.accumulate);
+    else
+      std::printf(")\n");
+    std::fflush(stdout);
+    return ms;
+  };
+  const auto t_choice = clock::now();
+  const core::bench::BudgetChoice choice =
+      core::bench::choose_under_budget(src.candidates, budget_ms, measure);
+  std::printf("budget: %zu of %zu candidate(s) timed in %.2f s\n", choice.trials.size(),
+              src.candidates.size(), std::chrono::duration<double>(clock::now() - t_choice).count());
+  const FrontConfig& c = src.candidates[choice.index];
+  apply_front_config(c, dz_m, render);
+  if (choice.met) {
+    std::printf("budget %.4g ms: chose %s (%s), measured %.1f ms\n", budget_ms, c.name.c_str(),
+                core::bench::describe_config(c).c_str(), choice.ms);
+  } else {
+    std::printf(
+        "budget %.4g ms: chose %s (%s), measured %.1f ms: budget not met, %.1f ms (%.0f%%) over; the fastest "
+        "candidate\n",
+        budget_ms, c.name.c_str(), core::bench::describe_config(c).c_str(), choice.ms, choice.ms - budget_ms,
+        100.0 * (choice.ms - budget_ms) / budget_ms);
+  }
+}
+
+}  // namespace cv::cli
