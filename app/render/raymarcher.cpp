@@ -10,6 +10,7 @@
 #include "noise/blue_noise.hpp"
 #include "render/albedo_map.hpp"
 #include "physics/physics.hpp"
+#include "volume/column_depth.hpp"
 #include "volume/sampler.hpp"
 
 namespace cv::render {
@@ -65,6 +66,7 @@ GpuRaymarcher::~GpuRaymarcher() {
   if (textures_[0]) glDeleteTextures(2, textures_);
   if (ground_) glDeleteTextures(1, &ground_);
   if (jitter_mask_) glDeleteTextures(1, &jitter_mask_);
+  if (column_tau_) glDeleteTextures(1, &column_tau_);
   if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
   if (pyramid_buffer_) glDeleteBuffers(1, &pyramid_buffer_);
   if (stats_buffer_) glDeleteBuffers(1, &stats_buffer_);
@@ -107,6 +109,13 @@ void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExt
                         GL_FLOAT, fields[i]->data());
   }
   check_gl("uploading the volume's extinction textures");
+  // The octave gate's column optical depths, once per volume (texelFetch: interpolated in the shader).
+  const core::ColumnDepth columns = core::column_depth(grid, medium.liquid_per_m, medium.ice_per_m);
+  if (column_tau_) glDeleteTextures(1, &column_tau_);
+  glCreateTextures(GL_TEXTURE_2D, 1, &column_tau_);
+  glTextureStorage2D(column_tau_, 1, GL_R32F, columns.nx, columns.ny);
+  glTextureSubImage2D(column_tau_, 0, 0, 0, columns.nx, columns.ny, GL_RED, GL_FLOAT, columns.tau.data());
+  check_gl("uploading the column optical depths");
   grid_ = grid;
   layer_ = core::cloud_layer(grid, medium);
   // The pyramid for empty-space skipping and adapted steps, all levels in one buffer.
@@ -152,6 +161,7 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glProgramUniform1i(p, loc(p, "u_sun_steps"), s.sun_steps);
   glProgramUniform1i(p, loc(p, "u_octaves"), s.octaves);
   set3(p, "u_octave_abc", {s.octave_a, s.octave_b, s.octave_c});
+  glProgramUniform1i(p, loc(p, "u_octave_gate"), s.octave_gate ? 1 : 0);
   glProgramUniform1f(p, loc(p, "u_droplet_um"), static_cast<float>(s.droplet_diameter_um));
   glProgramUniform1i(p, loc(p, "u_liquid_phase_hg"), s.liquid_phase_hg ? 1 : 0);
   glProgramUniform1f(p, loc(p, "u_ice_g"), static_cast<float>(s.ice_g));
@@ -226,6 +236,7 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glBindTextureUnit(2, textures_[1]);
   glBindTextureUnit(5, ground_);  // 3 and 4 are the noise textures
   glBindTextureUnit(6, jitter_mask_);
+  glBindTextureUnit(7, column_tau_);
   glUseProgram(p);
   const int tile = dispatch.rows_per_tile > 0 ? (dispatch.rows_per_tile + 7) / 8 * 8 : cam.height;
   GLuint query = 0;

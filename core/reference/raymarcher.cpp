@@ -10,6 +10,7 @@
 #include "geo/geodesy.hpp"
 #include "noise/blue_noise.hpp"
 #include "physics/physics.hpp"
+#include "volume/column_depth.hpp"
 #include "volume/extinction_pyramid.hpp"
 #include "volume/sampler.hpp"
 
@@ -295,6 +296,10 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
   const p64::MieParams mie = p64::mie_params(s.droplet_diameter_um);
   const double liquid_g = p64::mie_mean_cosine(mie);  // for liquid_phase_hg
   const glm::dvec3 up_cam = glm::normalize(o);
+  // The octave gate's column optical depths (only when there are octaves to gate).
+  const bool gate = s.octave_gate && s.octaves > 1;
+  const ColumnDepth columns = gate ? column_depth(grid, ext.liquid_per_m, ext.ice_per_m) : ColumnDepth();
+  const double gate_tol = gate ? p64::CV_OCTAVE_GATE_TOL : 0.0;
   for (int py = 0; py < cam.height; ++py) {
     for (int px = 0; px < cam.width; ++px) {
       const glm::dvec3 d = camera_ray(cam, px, py);
@@ -350,13 +355,21 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
                                                        : glm::dvec3(1.0);
         const glm::dvec3 ambient = s.atmosphere ? s.ambient * p64::sky_irradiance(sun_air, mu_sun) * (sigma / p64::CV_TWO_PI)
                                                 : glm::dvec3(0.0);
-        // In-scattered radiance per metre: the octave sums of both phases (clouds do not absorb).
-        const double liquid = s.liquid_phase_hg
-                                  ? p64::ms_octaves_hg(sl, mu, liquid_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c)
-                                  : p64::ms_octaves_mie(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c);
-        const double scatter = lit ? liquid +
-                                         p64::ms_octaves_hg(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c)
-                                   : 0.0;
+        // In-scattered radiance per metre: the octave sums of both phases (clouds do not absorb),
+        // gated by the column's optical depth when the gate is on.
+        double w = 1.0;
+        if (gate && lit) {
+          const glm::dvec3 g = p64::ecef_to_sphere(p, r0);
+          w = p64::octave_gate_weight(columns.at(grid, g.x / kDeg, g.y / kDeg));
+        }
+        const double liquid =
+            s.liquid_phase_hg
+                ? p64::ms_octaves_hg_gated(sl, mu, liquid_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c, w, gate_tol)
+                : p64::ms_octaves_mie_gated(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c, w, gate_tol);
+        const double scatter =
+            lit ? liquid + p64::ms_octaves_hg_gated(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c, w,
+                                                    gate_tol)
+                : 0.0;
         radiance += transmittance * p64::segment_integral(sun.irradiance * (sun_air * scatter + ambient), sigma, ds);
         // The light the step takes out of the view, T (1 - exp(-sigma ds)), formed as the GPU forms it.
         const double taken = transmittance * p64::segment_integral(sigma, sigma, ds);

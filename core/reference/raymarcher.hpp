@@ -36,6 +36,9 @@ struct MarchSettings {
   int sun_steps = 32;          // steps of the secondary march toward the sun
   int octaves = 1;             // 1 = single scattering
   double octave_a = 0.5, octave_b = 0.5, octave_c = 0.5;
+  // Octave gate (shaders/common/octaves.glsl): octave i >= 1 weighted by w^i, w = 1 - exp(-tau_col)
+  // from the column's vertical optical depth, so thin cloud is not brightened as if it were thick.
+  bool octave_gate = false;
   double droplet_diameter_um = 20.0;  // approximate Mie phase for liquid
   // The liquid phase function: the approximate Mie fit (Jendersie & d'Eon 2023), or Henyey-Greenstein
   // with the same mean cosine (the choice of the documents this product grew from, for comparison).

@@ -166,7 +166,7 @@ void read_sun(const Reader& r, SunSpec& s) {
 }
 
 void read_march(const Reader& r, MarchSettings& m) {
-  r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "droplet_diameter_um", "liquid_phase", "ice_g", "frame",
+  r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "octave_gate", "droplet_diameter_um", "liquid_phase", "ice_g", "frame",
           "blue_noise", "noise_amount", "noise_scale_m", "atmosphere", "globe", "ambient", "sky_steps", "atmo_sun_steps",
           "ground_albedo", "ground_texture", "skip_empty", "adaptive_steps", "max_step_optical_depth",
           "min_transmittance"});
@@ -176,6 +176,7 @@ void read_march(const Reader& r, MarchSettings& m) {
   r.number("octave_a", m.octave_a, 0.0, 1.0, "a number 0..1");
   r.number("octave_b", m.octave_b, 0.0, 1.0, "a number 0..1");
   r.number("octave_c", m.octave_c, 0.0, 1.0, "a number 0..1");
+  r.boolean("octave_gate", m.octave_gate);
   r.number("droplet_diameter_um", m.droplet_diameter_um, 0.0, 50.0, "a droplet diameter in um 0.01..50, or 0: from the data");
   if (m.droplet_diameter_um > 0.0 && m.droplet_diameter_um < 0.01) {
     r.fail("droplet_diameter_um", std::to_string(m.droplet_diameter_um), "a droplet diameter in um 0.01..50, or 0: from the data");
@@ -312,6 +313,7 @@ std::string scene_to_json(const Scene& s) {
                       {"octave_a", m.octave_a},
                       {"octave_b", m.octave_b},
                       {"octave_c", m.octave_c},
+                      {"octave_gate", m.octave_gate},
                       {"droplet_diameter_um", m.droplet_diameter_um},
                       {"liquid_phase", m.liquid_phase_hg ? "hg" : "mie"},
                       {"ice_g", m.ice_g},

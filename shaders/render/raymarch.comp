@@ -51,6 +51,9 @@ uniform bool u_cloudless;     // no cloud anywhere: nothing to march
 uniform int u_sun_steps;
 uniform int u_octaves;
 uniform vec3 u_octave_abc;
+uniform bool u_octave_gate;   // weight octave i >= 1 by w^i from the column's optical depth (octaves.glsl)
+// Vertical optical depth per grid column (core/volume/column_depth), fetched texel by texel.
+layout(binding = 7) uniform sampler2D u_column_tau;
 uniform float u_droplet_um;
 uniform bool u_liquid_phase_hg;  // Henyey-Greenstein with the Mie fit's mean cosine instead of the fit
 uniform float u_ice_g;
@@ -159,6 +162,26 @@ void erode_at(vec3 p, inout float sl, inout float si) {
   si = erode_extinction(si, e, feature_m);
 }
 #endif
+
+// The column's vertical optical depth at p, bilinear with the 3-D fetch's horizontal rules
+// (wrap, pole clamp, regional border 0), as core::ColumnDepth::at.
+float column_tau(vec3 p) {
+  vec3 g = ecef_to_sphere(p, u_r0);
+  vec3 f;
+  if (!volume_coords(g.x / kDeg, g.y / kDeg, u_grid_start.z, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return 0.0;
+  ivec2 n = ivec2(u_grid_count.xy);
+  float wx;
+  float wy;
+  int x0 = volume_fetch_index(f.x, n.x, wx);
+  int y0 = volume_fetch_index(f.y, n.y, wy);
+  int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
+  int y1 = y0 + 1;
+  float c00 = x0 < 0 || x0 >= n.x || y0 < 0 || y0 >= n.y ? 0.0 : texelFetch(u_column_tau, ivec2(x0, y0), 0).r;
+  float c10 = x1 < 0 || x1 >= n.x || y0 < 0 || y0 >= n.y ? 0.0 : texelFetch(u_column_tau, ivec2(x1, y0), 0).r;
+  float c01 = x0 < 0 || x0 >= n.x || y1 < 0 || y1 >= n.y ? 0.0 : texelFetch(u_column_tau, ivec2(x0, y1), 0).r;
+  float c11 = x1 < 0 || x1 >= n.x || y1 < 0 || y1 >= n.y ? 0.0 : texelFetch(u_column_tau, ivec2(x1, y1), 0).r;
+  return mix(mix(c00, c10, wx), mix(c01, c11, wx), wy);
+}
 
 float node_sum(int x, int y, int z) { return node(u_liquid, x, y, z) + node(u_ice, x, y, z); }
 
@@ -303,11 +326,14 @@ void march_sample(vec3 p, float alt_p, float t, float ds, float mu, MieParams mi
   // Sunlight reaches the sample through the air (reddened when low), and the sky lights it too.
   vec3 sun_air = u_atmosphere && lit ? atmo_transmittance(u_r0, alt_p, mu_sun, nu_sun, u_atmo_sun_steps) : vec3(1.0);
   vec3 ambient = u_atmosphere ? u_ambient * sky_irradiance(sun_air, mu_sun) * (sigma / CV_TWO_PI) : vec3(0.0);
-  float liquid = u_liquid_phase_hg ? ms_octaves_hg(sl, mu, mie_mean_cosine(mie), tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
-                                   : ms_octaves_mie(sl, mu, mie, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z);
-  float scatter = lit ? liquid +
-                            ms_octaves_hg(si, mu, u_ice_g, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
-                      : 0.0;
+  // The octave gate (octaves.glsl): w from the column's optical depth; off, the classic sum.
+  bool gate = u_octave_gate && u_octaves > 1 && lit;
+  float w = gate ? octave_gate_weight(column_tau(p)) : 1.0;
+  float tol = gate ? CV_OCTAVE_GATE_TOL : 0.0;
+  vec3 abc = u_octave_abc;
+  float liquid = u_liquid_phase_hg ? ms_octaves_hg_gated(sl, mu, mie_mean_cosine(mie), tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol)
+                                   : ms_octaves_mie_gated(sl, mu, mie, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
+  float scatter = lit ? liquid + ms_octaves_hg_gated(si, mu, u_ice_g, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol) : 0.0;
   radiance += t_view * segment_integral(u_irradiance * (sun_air * scatter + ambient), sigma, ds);
   // The light the step takes out of the view, t_view (1 - exp(-sigma ds)), without the
   // cancellation of t_view - t_next: in float that is a multiple of 6e-8, which left faint cloud
