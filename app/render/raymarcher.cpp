@@ -10,6 +10,7 @@
 #include "noise/blue_noise.hpp"
 #include "render/albedo_map.hpp"
 #include "physics/physics.hpp"
+#include "reference/earth_shadow.hpp"
 #include "volume/column_depth.hpp"
 #include "volume/sampler.hpp"
 
@@ -146,7 +147,11 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   set3(p, "u_right", c.right);
   set3(p, "u_upv", c.up);
   glProgramUniform1f(p, loc(p, "u_tan_half"), static_cast<float>(c.tan_half));
-  set3(p, "u_to_sun", glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0)));
+  const glm::dvec3 to_sun = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0));
+  set3(p, "u_to_sun", to_sun);
+  // Night over the whole cloud layer: decided here once, in double, with a margin (earth_shadow.hpp).
+  sun_down_ = s.leave_out_night && core::layer_in_earth_shadow(grid_, layer_, to_sun);
+  glProgramUniform1i(p, loc(p, "u_sun_down"), sun_down_ ? 1 : 0);
   set3(p, "u_irradiance", sun.irradiance);
   glProgramUniform1f(p, loc(p, "u_r0"), static_cast<float>(r0));
   set3(p, "u_grid_start", {grid_.lon_deg.start, grid_.lat_deg.start, grid_.alt_m.start});
@@ -285,7 +290,7 @@ const core::MarchStats& GpuRaymarcher::last_stats() {
     GLuint counts[12] = {};
     glGetNamedBufferSubData(stats_buffer_, 0, sizeof(counts), counts);
     auto count = [&](int k) { return (std::uint64_t(counts[2 * k + 1]) << 32) | counts[2 * k]; };
-    stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5)};
+    stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5), sun_down_};
     stats_read_ = true;
   }
   return stats_;
@@ -308,7 +313,7 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   GLuint counts[12] = {};
   glGetNamedBufferSubData(stats_buffer_, 0, sizeof(counts), counts);
   auto count = [&](int k) { return (std::uint64_t(counts[2 * k + 1]) << 32) | counts[2 * k]; };
-  stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5)};
+  stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5), sun_down_};
   check_gl("running the raymarcher");
   return pixels;
 }

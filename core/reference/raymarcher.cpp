@@ -10,6 +10,7 @@
 #include "geo/geodesy.hpp"
 #include "noise/blue_noise.hpp"
 #include "physics/physics.hpp"
+#include "reference/earth_shadow.hpp"
 #include "volume/column_depth.hpp"
 #include "volume/extinction_pyramid.hpp"
 #include "volume/sampler.hpp"
@@ -116,6 +117,7 @@ struct Medium {
   bool skip_empty = false;
   double sun_tau_limit = 3.0e38;
   MarchStats* stats = nullptr;
+  bool sun_down = false;  // the whole layer is in the Earth's shadow: no sun march can find cloud
 };
 
 // The air and the ground around the clouds, as sky_and_ground in shaders/render/sky_ground.glsl:
@@ -159,7 +161,10 @@ glm::dvec4 sky_and_ground(const Medium& medium, const MarchSettings& s, const Al
       e_sky = p64::sky_irradiance(sun_air, mu_sg);
     }
     // The clouds' shadow: the same sun march the cloud samples use.
-    const double shadow = mu_sg > 0.0 ? p64::transmittance(medium.sun_depth(pg, 0.0, mu_sg, nu_sg, to_sun, s.sun_steps)) : 0.0;
+    // With the whole layer in the Earth's shadow no sunlit ray crosses cloud (a point on a sunlit
+    // ray is sunlit): the march would find none, and is left out.
+    const double shadow = mu_sg > 0.0 ? medium.sun_down ? 1.0 : p64::transmittance(medium.sun_depth(pg, 0.0, mu_sg, nu_sg, to_sun, s.sun_steps))
+                                      : 0.0;
     const glm::dvec3 ll = p64::ecef_to_sphere(pg, r0);
     const glm::dvec3 albedo = map ? map->at(ll.x, ll.y) : s.ground_albedo;
     ground = irradiance * p64::ground_radiance(albedo, mu_sg, sun_air * shadow, e_sky);
@@ -273,6 +278,10 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
   // Only the layer that holds cloud is marched (and nothing when none does).
   const CloudLayer layer = cloud_layer(grid, ext);
   const bool use_pyramid = s.skip_empty || s.adaptive_steps;
+  const double r0 = grid.earth_radius_m;
+  const glm::dvec3 to_sun = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0));
+  // Night over the whole layer: every sample's own test would find it unlit.
+  img.stats.sun_down = s.leave_out_night && layer_in_earth_shadow(grid, layer, to_sun);
   const ExtinctionPyramid pyramid =
       use_pyramid ? ExtinctionPyramid(grid, ext.liquid_per_m, ext.ice_per_m) : ExtinctionPyramid();
   const VolumeSampler liquid_sampler(grid, ext.liquid_per_m);
@@ -288,11 +297,10 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
                       &pyramid,
                       s.skip_empty,
                       p64::sun_march_tau_limit(s.octaves, s.octave_a, s.min_transmittance),
-                      &img.stats};
-  const double r0 = grid.earth_radius_m;
+                      &img.stats,
+                      img.stats.sun_down};
   const double hb = layer.bottom_m, ht = layer.top_m;
   const glm::dvec3 o = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);
-  const glm::dvec3 to_sun = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0));
   const p64::MieParams mie = p64::mie_params(s.droplet_diameter_um);
   const double liquid_g = p64::mie_mean_cosine(mie);  // for liquid_phase_hg
   const glm::dvec3 up_cam = glm::normalize(o);
@@ -347,7 +355,7 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
         const double alt_p = glm::length(p) - r0;
         const double mu_sun = glm::dot(to_sun, up_p), nu_sun = glm::length(glm::cross(to_sun, up_p));
         double e0, e1;
-        const bool lit = !(p64::ray_sphere_rel_nu(r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
+        const bool lit = !medium.sun_down && !(p64::ray_sphere_rel_nu(r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
         const double tau_sun = lit ? medium.sun_depth(p, alt_p, mu_sun, nu_sun, to_sun, s.sun_steps) : 0.0;
         // Sunlight reaches the sample through the air (reddened when low), and the sky lights it
         // too: isotropic irradiance E_sky scattered as sigma_s E_sky / (2 pi) (docs/physics.md).
@@ -357,19 +365,19 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
                                                 : glm::dvec3(0.0);
         // In-scattered radiance per metre: the octave sums of both phases (clouds do not absorb),
         // gated by the column's optical depth when the gate is on.
-        double w = 1.0;
-        if (gate && lit) {
-          const glm::dvec3 g = p64::ecef_to_sphere(p, r0);
-          w = p64::octave_gate_weight(columns.at(grid, g.x / kDeg, g.y / kDeg));
+        double scatter = 0.0;  // left out where the sun is down (the octave sums cost as much as the rest)
+        if (lit) {
+          double w = 1.0;
+          if (gate) {
+            const glm::dvec3 g = p64::ecef_to_sphere(p, r0);
+            w = p64::octave_gate_weight(columns.at(grid, g.x / kDeg, g.y / kDeg));
+          }
+          scatter = (s.liquid_phase_hg ? p64::ms_octaves_hg_gated(sl, mu, liquid_g, tau_sun, s.octaves, s.octave_a, s.octave_b,
+                                                                 s.octave_c, w, gate_tol)
+                                       : p64::ms_octaves_mie_gated(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b,
+                                                                   s.octave_c, w, gate_tol)) +
+                    p64::ms_octaves_hg_gated(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c, w, gate_tol);
         }
-        const double liquid =
-            s.liquid_phase_hg
-                ? p64::ms_octaves_hg_gated(sl, mu, liquid_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c, w, gate_tol)
-                : p64::ms_octaves_mie_gated(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c, w, gate_tol);
-        const double scatter =
-            lit ? liquid + p64::ms_octaves_hg_gated(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c, w,
-                                                    gate_tol)
-                : 0.0;
         radiance += transmittance * p64::segment_integral(sun.irradiance * (sun_air * scatter + ambient), sigma, ds);
         // The light the step takes out of the view, T (1 - exp(-sigma ds)), formed as the GPU forms it.
         const double taken = transmittance * p64::segment_integral(sigma, sigma, ds);

@@ -74,6 +74,10 @@ struct MarchSettings {
   double max_step_optical_depth = 1.0;
   // View rays stop below this transmittance, sun marches once every octave's attenuation is below it.
   double min_transmittance = 1e-6;
+  // When the whole cloud layer over the data is in the Earth's shadow (layer_in_earth_shadow,
+  // decided once per frame), leave out every sun march and octave sum: the image is the one the
+  // per-sample test gives (false: test each sample, as before).
+  bool leave_out_night = true;
 };
 
 // An equirectangular ground albedo image: linear rgb per texel, rows from latitude 90 down to -90,
@@ -93,6 +97,7 @@ struct MarchStats {
   std::uint64_t sun_samples = 0;    // medium lookups along sun rays
   std::uint64_t sun_skipped = 0;    // sun step positions jumped over or cut off by sun_march_tau_limit
   std::uint64_t rays_missed = 0;    // pixels whose ray never crossed the cloud shell
+  bool sun_down = false;  // the whole cloud layer was in the Earth's shadow: no sun march or octave sum ran
 };
 
 struct ReferenceImage {

@@ -48,6 +48,7 @@ uniform bool u_global_lat;
 uniform float u_view_step;
 uniform vec2 u_layer;         // altitudes (m) between which the data holds cloud (core::cloud_layer)
 uniform bool u_cloudless;     // no cloud anywhere: nothing to march
+uniform bool u_sun_down;      // the whole cloud layer is in the Earth's shadow (core::layer_in_earth_shadow)
 uniform int u_sun_steps;
 uniform int u_octaves;
 uniform vec3 u_octave_abc;
@@ -321,19 +322,23 @@ void march_sample(vec3 p, float alt_p, float t, float ds, float mu, MieParams mi
   float nu_sun = length(cross(u_to_sun, up_p));
   float e0;
   float e1;
-  bool lit = !(ray_sphere_rel_nu(u_r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
+  bool lit = !u_sun_down && !(ray_sphere_rel_nu(u_r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
   float tau_sun = lit ? cloud_sun_depth(p, alt_p, mu_sun, nu_sun) : 0.0;
   // Sunlight reaches the sample through the air (reddened when low), and the sky lights it too.
   vec3 sun_air = u_atmosphere && lit ? atmo_transmittance(u_r0, alt_p, mu_sun, nu_sun, u_atmo_sun_steps) : vec3(1.0);
   vec3 ambient = u_atmosphere ? u_ambient * sky_irradiance(sun_air, mu_sun) * (sigma / CV_TWO_PI) : vec3(0.0);
-  // The octave gate (octaves.glsl): w from the column's optical depth; off, the classic sum.
-  bool gate = u_octave_gate && u_octaves > 1 && lit;
-  float w = gate ? octave_gate_weight(column_tau(p)) : 1.0;
-  float tol = gate ? CV_OCTAVE_GATE_TOL : 0.0;
-  vec3 abc = u_octave_abc;
-  float liquid = u_liquid_phase_hg ? ms_octaves_hg_gated(sl, mu, mie_mean_cosine(mie), tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol)
-                                   : ms_octaves_mie_gated(sl, mu, mie, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
-  float scatter = lit ? liquid + ms_octaves_hg_gated(si, mu, u_ice_g, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol) : 0.0;
+  // The octave sums, only where the sun shines (llvmpipe runs masked code: a ternary would not save them).
+  float scatter = 0.0;
+  if (lit) {
+    // The octave gate (octaves.glsl): w from the column's optical depth; off, the classic sum.
+    bool gate = u_octave_gate && u_octaves > 1;
+    float w = gate ? octave_gate_weight(column_tau(p)) : 1.0;
+    float tol = gate ? CV_OCTAVE_GATE_TOL : 0.0;
+    vec3 abc = u_octave_abc;
+    float liquid = u_liquid_phase_hg ? ms_octaves_hg_gated(sl, mu, mie_mean_cosine(mie), tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol)
+                                     : ms_octaves_mie_gated(sl, mu, mie, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
+    scatter = liquid + ms_octaves_hg_gated(si, mu, u_ice_g, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
+  }
   radiance += t_view * segment_integral(u_irradiance * (sun_air * scatter + ambient), sigma, ds);
   // The light the step takes out of the view, t_view (1 - exp(-sigma ds)), without the
   // cancellation of t_view - t_next: in float that is a multiple of 6e-8, which left faint cloud
