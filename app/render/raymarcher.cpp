@@ -119,6 +119,7 @@ void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExt
   check_gl("uploading the column optical depths");
   grid_ = grid;
   layer_ = core::cloud_layer(grid, medium);
+  sigma_max_ = core::largest_extinction(medium);
   // The pyramid for empty-space skipping and adapted steps, all levels in one buffer.
   pyramid_ = core::ExtinctionPyramid(grid, medium.liquid_per_m, medium.ice_per_m);
   std::vector<glm::vec2> packed;
@@ -164,6 +165,8 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glProgramUniform2f(p, loc(p, "u_layer"), static_cast<float>(layer_.bottom_m), static_cast<float>(layer_.top_m));
   glProgramUniform1i(p, loc(p, "u_cloudless"), layer_.empty ? 1 : 0);
   glProgramUniform1i(p, loc(p, "u_sun_steps"), s.sun_steps);
+  glProgramUniform1f(p, loc(p, "u_sigma_max"), static_cast<float>(sigma_max_));
+  glProgramUniform1f(p, loc(p, "u_sun_step_tau"), static_cast<float>(s.max_sun_step_optical_depth));
   glProgramUniform1i(p, loc(p, "u_octaves"), s.octaves);
   set3(p, "u_octave_abc", {s.octave_a, s.octave_b, s.octave_c});
   glProgramUniform1i(p, loc(p, "u_octave_gate"), s.octave_gate ? 1 : 0);

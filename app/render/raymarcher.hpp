@@ -99,6 +99,7 @@ class GpuRaymarcher {
   core::ExtinctionPyramid pyramid_;
   core::CloudLayer layer_;  // the altitudes that hold cloud: the shell the march intersects
   bool stats_read_ = true;
+  double sigma_max_ = 0.0;  // the volume's largest extinction, 1/m: sizes the sun marches' steps
   bool sun_down_ = false;  // the last render left out the sun (core::layer_in_earth_shadow)
   core::VolumeGrid grid_;
   core::MarchStats stats_;

@@ -79,17 +79,20 @@ struct Medium {
     glm::dvec4 sseg;
     const int sn = layer.empty ? 0 : p64::ray_shell_rel_nu(grid.earth_radius_m, alt_p, mu_sun, nu_sun, layer.bottom_m, layer.top_m, sseg);
     double tau = 0.0;
+    int steps[2] = {0, 0};
+    for (int q = 0; q < sn; ++q) steps[q] = p64::sun_march_steps(sigma_max, sseg[2 * q + 1] - sseg[2 * q], sun_step_tau, sun_steps);
     for (int q = 0; q < sn; ++q) {
-      const double ds = (sseg[2 * q + 1] - sseg[2 * q]) / sun_steps;
+      const int n = steps[q];
+      const double ds = (sseg[2 * q + 1] - sseg[2 * q]) / n;
       double known_end = -1.0;
-      for (int j = 0; j < sun_steps;) {
+      for (int j = 0; j < n;) {
         const double t_rel = (j + 0.5) * ds;
         const glm::dvec3 ps = p + (sseg[2 * q] + t_rel) * to_sun;
         if (skip_empty && !(t_rel < known_end)) {
           const ExtinctionPyramid::Space sp = pyramid->at(ps, to_sun);
           if (sp.empty) {
             const int next = p64::march_resume_index(j, sp.extent_m, ds);
-            stats->sun_skipped += static_cast<std::uint64_t>(std::min(next, sun_steps) - j);
+            stats->sun_skipped += static_cast<std::uint64_t>(std::min(next, n) - j);
             stats->bricks_jumped += next - j > 1;
             j = next;
             continue;
@@ -102,7 +105,7 @@ struct Medium {
         ++stats->sun_samples;
         ++j;
         if (tau > sun_tau_limit) {
-          stats->sun_skipped += static_cast<std::uint64_t>((sn - q - 1) * sun_steps + sun_steps - j);
+          stats->sun_skipped += static_cast<std::uint64_t>((q == 0 ? steps[1] : 0) + n - j);
           return tau;
         }
       }
@@ -118,6 +121,8 @@ struct Medium {
   double sun_tau_limit = 3.0e38;
   MarchStats* stats = nullptr;
   bool sun_down = false;  // the whole layer is in the Earth's shadow: no sun march can find cloud
+  double sigma_max = 0.0;     // the volume's largest extinction (1/m): sizes the sun marches' steps
+  double sun_step_tau = 0.0;  // MarchSettings::max_sun_step_optical_depth
 };
 
 // The air and the ground around the clouds, as sky_and_ground in shaders/render/sky_ground.glsl:
@@ -181,6 +186,15 @@ double step_offset(const MarchSettings& s, int px, int py) {
 }
 
 }  // namespace
+
+double largest_extinction(const GridMeanExtinction& medium) {
+  double m = 0.0;
+  for (std::size_t i = 0; i < std::max(medium.liquid_per_m.size(), medium.ice_per_m.size()); ++i) {
+    m = std::max(m, (i < medium.liquid_per_m.size() ? double(medium.liquid_per_m[i]) : 0.0) +
+                        (i < medium.ice_per_m.size() ? double(medium.ice_per_m[i]) : 0.0));
+  }
+  return m;
+}
 
 glm::dvec3 AlbedoMap::at(double lat_rad, double lon_rad) const {
   const glm::dvec4 c = p64::equirect_texel(lat_rad, lon_rad, width, height);
@@ -298,7 +312,9 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
                       s.skip_empty,
                       p64::sun_march_tau_limit(s.octaves, s.octave_a, s.min_transmittance),
                       &img.stats,
-                      img.stats.sun_down};
+                      img.stats.sun_down,
+                      largest_extinction(ext),
+                      s.max_sun_step_optical_depth};
   const double hb = layer.bottom_m, ht = layer.top_m;
   const glm::dvec3 o = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);
   const p64::MieParams mie = p64::mie_params(s.droplet_diameter_um);

@@ -34,6 +34,9 @@ struct Sun {
 struct MarchSettings {
   double view_step_m = 100.0;  // march step along view rays
   int sun_steps = 32;          // steps of the secondary march toward the sun
+  // Fewer sun steps where the volume is thin: a sun segment takes only as many steps as keep each
+  // below this optical depth at the volume's largest extinction (sun_march_steps); 0: sun_steps always.
+  double max_sun_step_optical_depth = 0.05;
   int octaves = 1;             // 1 = single scattering
   double octave_a = 0.5, octave_b = 0.5, octave_c = 0.5;
   // Octave gate (shaders/common/octaves.glsl): octave i >= 1 weighted by w^i, w = 1 - exp(-tau_col)
@@ -129,6 +132,10 @@ struct CloudLayer {
   bool empty = true;
 };
 CloudLayer cloud_layer(const VolumeGrid& grid, const GridMeanExtinction& medium);
+
+// The largest extinction (liquid + ice, 1/m) of any node: a bound on what sampling can return,
+// which sizes the sun marches' steps (MarchSettings::max_sun_step_optical_depth).
+double largest_extinction(const GridMeanExtinction& medium);
 
 // A camera's orientation in Earth-centred coordinates, and its half-width: pixel (px, py) looks
 // along forward + x right + y up with x, y in [-tan_half, tan_half] (y scaled by the aspect).

@@ -50,6 +50,8 @@ uniform vec2 u_layer;         // altitudes (m) between which the data holds clou
 uniform bool u_cloudless;     // no cloud anywhere: nothing to march
 uniform bool u_sun_down;      // the whole cloud layer is in the Earth's shadow (core::layer_in_earth_shadow)
 uniform int u_sun_steps;
+uniform float u_sigma_max;      // the volume's largest extinction, 1/m (core::largest_extinction)
+uniform float u_sun_step_tau;   // optical depth a sun step may hold at u_sigma_max (sun_march_steps)
 uniform int u_octaves;
 uniform vec3 u_octave_abc;
 uniform bool u_octave_gate;   // weight octave i >= 1 by w^i from the column's optical depth (octaves.glsl)
@@ -268,15 +270,19 @@ float cloud_sun_depth(vec3 p, float alt_p, float mu_sun, float nu_sun) {
   float tau_sun = 0.0;
   vec4 sseg;
   int sn = u_cloudless ? 0 : ray_shell_rel_nu(u_r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
-  int total = sn * u_sun_steps;
+  // Steps per segment as core/reference/raymarcher.cpp sun_depth: fewer where the volume is thin.
+  int n0 = sn > 0 ? sun_march_steps(u_sigma_max, sseg.y - sseg.x, u_sun_step_tau, u_sun_steps) : 0;
+  int n1 = sn > 1 ? sun_march_steps(u_sigma_max, sseg.w - sseg.z, u_sun_step_tau, u_sun_steps) : 0;
+  int total = n0 + n1;
   float known_end = -1.0;  // what the pyramid said holds below this distance into the segment
   for (int k = 0; k < total;) {
-    int q = k / u_sun_steps;
-    int j = k - q * u_sun_steps;
+    int q = k < n0 ? 0 : 1;
+    int nq = q == 0 ? n0 : n1;
+    int j = q == 0 ? k : k - n0;
     if (j == 0) known_end = -1.0;
     float s0 = q == 0 ? sseg.x : sseg.z;
     float s1 = q == 0 ? sseg.y : sseg.w;
-    float ds = (s1 - s0) / float(u_sun_steps);
+    float ds = (s1 - s0) / float(nq);
     float t_rel = (float(j) + 0.5) * ds;
     vec3 ps = p + (s0 + t_rel) * u_to_sun;
     float alt_s = ray_altitude(u_r0, alt_p, mu_sun, s0 + t_rel);
@@ -284,7 +290,7 @@ float cloud_sun_depth(vec3 p, float alt_p, float mu_sun, float nu_sun) {
       float extent;
       float smax;
       if (space_at(ps, alt_s, u_to_sun, extent, smax)) {
-        int next = min(march_resume_index(j, extent, ds), u_sun_steps);
+        int next = min(march_resume_index(j, extent, ds), nq);
         g_stats[kStatSunSkipped] += uint(next - j);
         g_stats[kStatBricksJumped] += next - j > 1 ? 1u : 0u;
         k += next - j;
