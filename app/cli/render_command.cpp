@@ -368,6 +368,7 @@ int cmd_render(const std::vector<std::string>& args) {
               static_cast<unsigned long long>(ms.view_skipped), static_cast<unsigned long long>(ms.bricks_jumped),
               static_cast<unsigned long long>(ms.sun_samples), static_cast<unsigned long long>(ms.sun_skipped),
               static_cast<unsigned long long>(ms.rays_missed), mw * mh, march.skip_empty ? "" : " (skipping off)");
+  if (ms.sun_down) std::printf("the sun is below the horizon for the whole cloud layer: sun marches and octave sums left out\n");
 
   t0 = clock::now();
   if (mw != cam.width || mh != cam.height) pixels = upscale(pixels, mw, mh, cam.width, cam.height);

@@ -10,6 +10,8 @@
 #include "noise/blue_noise.hpp"
 #include "render/albedo_map.hpp"
 #include "physics/physics.hpp"
+#include "reference/earth_shadow.hpp"
+#include "volume/column_depth.hpp"
 #include "volume/sampler.hpp"
 
 namespace cv::render {
@@ -65,6 +67,7 @@ GpuRaymarcher::~GpuRaymarcher() {
   if (textures_[0]) glDeleteTextures(2, textures_);
   if (ground_) glDeleteTextures(1, &ground_);
   if (jitter_mask_) glDeleteTextures(1, &jitter_mask_);
+  if (column_tau_) glDeleteTextures(1, &column_tau_);
   if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
   if (pyramid_buffer_) glDeleteBuffers(1, &pyramid_buffer_);
   if (stats_buffer_) glDeleteBuffers(1, &stats_buffer_);
@@ -107,8 +110,16 @@ void GpuRaymarcher::upload(const core::VolumeGrid& grid, const core::GridMeanExt
                         GL_FLOAT, fields[i]->data());
   }
   check_gl("uploading the volume's extinction textures");
+  // The octave gate's column optical depths, once per volume (texelFetch: interpolated in the shader).
+  const core::ColumnDepth columns = core::column_depth(grid, medium.liquid_per_m, medium.ice_per_m);
+  if (column_tau_) glDeleteTextures(1, &column_tau_);
+  glCreateTextures(GL_TEXTURE_2D, 1, &column_tau_);
+  glTextureStorage2D(column_tau_, 1, GL_R32F, columns.nx, columns.ny);
+  glTextureSubImage2D(column_tau_, 0, 0, 0, columns.nx, columns.ny, GL_RED, GL_FLOAT, columns.tau.data());
+  check_gl("uploading the column optical depths");
   grid_ = grid;
   layer_ = core::cloud_layer(grid, medium);
+  sigma_max_ = core::largest_extinction(medium);
   // The pyramid for empty-space skipping and adapted steps, all levels in one buffer.
   pyramid_ = core::ExtinctionPyramid(grid, medium.liquid_per_m, medium.ice_per_m);
   std::vector<glm::vec2> packed;
@@ -137,7 +148,11 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   set3(p, "u_right", c.right);
   set3(p, "u_upv", c.up);
   glProgramUniform1f(p, loc(p, "u_tan_half"), static_cast<float>(c.tan_half));
-  set3(p, "u_to_sun", glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0)));
+  const glm::dvec3 to_sun = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0));
+  set3(p, "u_to_sun", to_sun);
+  // Night over the whole cloud layer: decided here once, in double, with a margin (earth_shadow.hpp).
+  sun_down_ = s.leave_out_night && core::layer_in_earth_shadow(grid_, layer_, to_sun);
+  glProgramUniform1i(p, loc(p, "u_sun_down"), sun_down_ ? 1 : 0);
   set3(p, "u_irradiance", sun.irradiance);
   glProgramUniform1f(p, loc(p, "u_r0"), static_cast<float>(r0));
   set3(p, "u_grid_start", {grid_.lon_deg.start, grid_.lat_deg.start, grid_.alt_m.start});
@@ -150,8 +165,11 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glProgramUniform2f(p, loc(p, "u_layer"), static_cast<float>(layer_.bottom_m), static_cast<float>(layer_.top_m));
   glProgramUniform1i(p, loc(p, "u_cloudless"), layer_.empty ? 1 : 0);
   glProgramUniform1i(p, loc(p, "u_sun_steps"), s.sun_steps);
+  glProgramUniform1f(p, loc(p, "u_sigma_max"), static_cast<float>(sigma_max_));
+  glProgramUniform1f(p, loc(p, "u_sun_step_tau"), static_cast<float>(s.max_sun_step_optical_depth));
   glProgramUniform1i(p, loc(p, "u_octaves"), s.octaves);
   set3(p, "u_octave_abc", {s.octave_a, s.octave_b, s.octave_c});
+  glProgramUniform1i(p, loc(p, "u_octave_gate"), s.octave_gate ? 1 : 0);
   glProgramUniform1f(p, loc(p, "u_droplet_um"), static_cast<float>(s.droplet_diameter_um));
   glProgramUniform1i(p, loc(p, "u_liquid_phase_hg"), s.liquid_phase_hg ? 1 : 0);
   glProgramUniform1f(p, loc(p, "u_ice_g"), static_cast<float>(s.ice_g));
@@ -226,6 +244,7 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glBindTextureUnit(2, textures_[1]);
   glBindTextureUnit(5, ground_);  // 3 and 4 are the noise textures
   glBindTextureUnit(6, jitter_mask_);
+  glBindTextureUnit(7, column_tau_);
   glUseProgram(p);
   const int tile = dispatch.rows_per_tile > 0 ? (dispatch.rows_per_tile + 7) / 8 * 8 : cam.height;
   GLuint query = 0;
@@ -274,7 +293,7 @@ const core::MarchStats& GpuRaymarcher::last_stats() {
     GLuint counts[12] = {};
     glGetNamedBufferSubData(stats_buffer_, 0, sizeof(counts), counts);
     auto count = [&](int k) { return (std::uint64_t(counts[2 * k + 1]) << 32) | counts[2 * k]; };
-    stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5)};
+    stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5), sun_down_};
     stats_read_ = true;
   }
   return stats_;
@@ -297,7 +316,7 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   GLuint counts[12] = {};
   glGetNamedBufferSubData(stats_buffer_, 0, sizeof(counts), counts);
   auto count = [&](int k) { return (std::uint64_t(counts[2 * k + 1]) << 32) | counts[2 * k]; };
-  stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5)};
+  stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5), sun_down_};
   check_gl("running the raymarcher");
   return pixels;
 }

@@ -88,6 +88,7 @@ class GpuRaymarcher {
   std::unique_ptr<GlProgram> programs_[2][2][2];  // [noise][skip][adaptive]
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
+  GLuint column_tau_ = 0;           // vertical optical depth per column (R32F), for the octave gate
   GLuint jitter_mask_ = 0;          // the blue-noise mask (R32F), uploaded at construction
   GLuint ground_ = 0;               // linear albedo (RGB32F), loaded from ground_path_
   GLuint state_[2] = {0, 0};        // the march's state between dispatches (RGBA32F, image-sized)
@@ -98,6 +99,8 @@ class GpuRaymarcher {
   core::ExtinctionPyramid pyramid_;
   core::CloudLayer layer_;  // the altitudes that hold cloud: the shell the march intersects
   bool stats_read_ = true;
+  double sigma_max_ = 0.0;  // the volume's largest extinction, 1/m: sizes the sun marches' steps
+  bool sun_down_ = false;  // the last render left out the sun (core::layer_in_earth_shadow)
   core::VolumeGrid grid_;
   core::MarchStats stats_;
 };

@@ -103,6 +103,7 @@ void lighting_panel(ViewerState& s) {
   slider_double("octave a (scattering)", &m.octave_a, 0.0, 1.0, "%.2f");
   slider_double("octave b (extinction)", &m.octave_b, 0.0, 1.0, "%.2f");
   slider_double("octave c (phase)", &m.octave_c, 0.0, 1.0, "%.2f");
+  ImGui::Checkbox("octave gate (thin cloud: fewer octaves)", &m.octave_gate);
   int phase = m.liquid_phase_hg ? 1 : 0;
   if (ImGui::Combo("liquid phase", &phase, "approximate Mie\0Henyey-Greenstein (same mean cosine)\0")) m.liquid_phase_hg = phase == 1;
   ImGui::Checkbox("air (sun colour, sky, ambient)", &m.atmosphere);

@@ -10,6 +10,8 @@
 #include "geo/geodesy.hpp"
 #include "noise/blue_noise.hpp"
 #include "physics/physics.hpp"
+#include "reference/earth_shadow.hpp"
+#include "volume/column_depth.hpp"
 #include "volume/extinction_pyramid.hpp"
 #include "volume/sampler.hpp"
 
@@ -77,17 +79,20 @@ struct Medium {
     glm::dvec4 sseg;
     const int sn = layer.empty ? 0 : p64::ray_shell_rel_nu(grid.earth_radius_m, alt_p, mu_sun, nu_sun, layer.bottom_m, layer.top_m, sseg);
     double tau = 0.0;
+    int steps[2] = {0, 0};
+    for (int q = 0; q < sn; ++q) steps[q] = p64::sun_march_steps(sigma_max, sseg[2 * q + 1] - sseg[2 * q], sun_step_tau, sun_steps);
     for (int q = 0; q < sn; ++q) {
-      const double ds = (sseg[2 * q + 1] - sseg[2 * q]) / sun_steps;
+      const int n = steps[q];
+      const double ds = (sseg[2 * q + 1] - sseg[2 * q]) / n;
       double known_end = -1.0;
-      for (int j = 0; j < sun_steps;) {
+      for (int j = 0; j < n;) {
         const double t_rel = (j + 0.5) * ds;
         const glm::dvec3 ps = p + (sseg[2 * q] + t_rel) * to_sun;
         if (skip_empty && !(t_rel < known_end)) {
           const ExtinctionPyramid::Space sp = pyramid->at(ps, to_sun);
           if (sp.empty) {
             const int next = p64::march_resume_index(j, sp.extent_m, ds);
-            stats->sun_skipped += static_cast<std::uint64_t>(std::min(next, sun_steps) - j);
+            stats->sun_skipped += static_cast<std::uint64_t>(std::min(next, n) - j);
             stats->bricks_jumped += next - j > 1;
             j = next;
             continue;
@@ -100,7 +105,7 @@ struct Medium {
         ++stats->sun_samples;
         ++j;
         if (tau > sun_tau_limit) {
-          stats->sun_skipped += static_cast<std::uint64_t>((sn - q - 1) * sun_steps + sun_steps - j);
+          stats->sun_skipped += static_cast<std::uint64_t>((q == 0 ? steps[1] : 0) + n - j);
           return tau;
         }
       }
@@ -115,6 +120,9 @@ struct Medium {
   bool skip_empty = false;
   double sun_tau_limit = 3.0e38;
   MarchStats* stats = nullptr;
+  bool sun_down = false;  // the whole layer is in the Earth's shadow: no sun march can find cloud
+  double sigma_max = 0.0;     // the volume's largest extinction (1/m): sizes the sun marches' steps
+  double sun_step_tau = 0.0;  // MarchSettings::max_sun_step_optical_depth
 };
 
 // The air and the ground around the clouds, as sky_and_ground in shaders/render/sky_ground.glsl:
@@ -158,7 +166,10 @@ glm::dvec4 sky_and_ground(const Medium& medium, const MarchSettings& s, const Al
       e_sky = p64::sky_irradiance(sun_air, mu_sg);
     }
     // The clouds' shadow: the same sun march the cloud samples use.
-    const double shadow = mu_sg > 0.0 ? p64::transmittance(medium.sun_depth(pg, 0.0, mu_sg, nu_sg, to_sun, s.sun_steps)) : 0.0;
+    // With the whole layer in the Earth's shadow no sunlit ray crosses cloud (a point on a sunlit
+    // ray is sunlit): the march would find none, and is left out.
+    const double shadow = mu_sg > 0.0 ? medium.sun_down ? 1.0 : p64::transmittance(medium.sun_depth(pg, 0.0, mu_sg, nu_sg, to_sun, s.sun_steps))
+                                      : 0.0;
     const glm::dvec3 ll = p64::ecef_to_sphere(pg, r0);
     const glm::dvec3 albedo = map ? map->at(ll.x, ll.y) : s.ground_albedo;
     ground = irradiance * p64::ground_radiance(albedo, mu_sg, sun_air * shadow, e_sky);
@@ -175,6 +186,15 @@ double step_offset(const MarchSettings& s, int px, int py) {
 }
 
 }  // namespace
+
+double largest_extinction(const GridMeanExtinction& medium) {
+  double m = 0.0;
+  for (std::size_t i = 0; i < std::max(medium.liquid_per_m.size(), medium.ice_per_m.size()); ++i) {
+    m = std::max(m, (i < medium.liquid_per_m.size() ? double(medium.liquid_per_m[i]) : 0.0) +
+                        (i < medium.ice_per_m.size() ? double(medium.ice_per_m[i]) : 0.0));
+  }
+  return m;
+}
 
 glm::dvec3 AlbedoMap::at(double lat_rad, double lon_rad) const {
   const glm::dvec4 c = p64::equirect_texel(lat_rad, lon_rad, width, height);
@@ -272,6 +292,10 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
   // Only the layer that holds cloud is marched (and nothing when none does).
   const CloudLayer layer = cloud_layer(grid, ext);
   const bool use_pyramid = s.skip_empty || s.adaptive_steps;
+  const double r0 = grid.earth_radius_m;
+  const glm::dvec3 to_sun = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0));
+  // Night over the whole layer: every sample's own test would find it unlit.
+  img.stats.sun_down = s.leave_out_night && layer_in_earth_shadow(grid, layer, to_sun);
   const ExtinctionPyramid pyramid =
       use_pyramid ? ExtinctionPyramid(grid, ext.liquid_per_m, ext.ice_per_m) : ExtinctionPyramid();
   const VolumeSampler liquid_sampler(grid, ext.liquid_per_m);
@@ -287,14 +311,19 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
                       &pyramid,
                       s.skip_empty,
                       p64::sun_march_tau_limit(s.octaves, s.octave_a, s.min_transmittance),
-                      &img.stats};
-  const double r0 = grid.earth_radius_m;
+                      &img.stats,
+                      img.stats.sun_down,
+                      largest_extinction(ext),
+                      s.max_sun_step_optical_depth};
   const double hb = layer.bottom_m, ht = layer.top_m;
   const glm::dvec3 o = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);
-  const glm::dvec3 to_sun = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0));
   const p64::MieParams mie = p64::mie_params(s.droplet_diameter_um);
   const double liquid_g = p64::mie_mean_cosine(mie);  // for liquid_phase_hg
   const glm::dvec3 up_cam = glm::normalize(o);
+  // The octave gate's column optical depths (only when there are octaves to gate).
+  const bool gate = s.octave_gate && s.octaves > 1;
+  const ColumnDepth columns = gate ? column_depth(grid, ext.liquid_per_m, ext.ice_per_m) : ColumnDepth();
+  const double gate_tol = gate ? p64::CV_OCTAVE_GATE_TOL : 0.0;
   for (int py = 0; py < cam.height; ++py) {
     for (int px = 0; px < cam.width; ++px) {
       const glm::dvec3 d = camera_ray(cam, px, py);
@@ -342,7 +371,7 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
         const double alt_p = glm::length(p) - r0;
         const double mu_sun = glm::dot(to_sun, up_p), nu_sun = glm::length(glm::cross(to_sun, up_p));
         double e0, e1;
-        const bool lit = !(p64::ray_sphere_rel_nu(r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
+        const bool lit = !medium.sun_down && !(p64::ray_sphere_rel_nu(r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
         const double tau_sun = lit ? medium.sun_depth(p, alt_p, mu_sun, nu_sun, to_sun, s.sun_steps) : 0.0;
         // Sunlight reaches the sample through the air (reddened when low), and the sky lights it
         // too: isotropic irradiance E_sky scattered as sigma_s E_sky / (2 pi) (docs/physics.md).
@@ -350,13 +379,21 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
                                                        : glm::dvec3(1.0);
         const glm::dvec3 ambient = s.atmosphere ? s.ambient * p64::sky_irradiance(sun_air, mu_sun) * (sigma / p64::CV_TWO_PI)
                                                 : glm::dvec3(0.0);
-        // In-scattered radiance per metre: the octave sums of both phases (clouds do not absorb).
-        const double liquid = s.liquid_phase_hg
-                                  ? p64::ms_octaves_hg(sl, mu, liquid_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c)
-                                  : p64::ms_octaves_mie(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c);
-        const double scatter = lit ? liquid +
-                                         p64::ms_octaves_hg(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c)
-                                   : 0.0;
+        // In-scattered radiance per metre: the octave sums of both phases (clouds do not absorb),
+        // gated by the column's optical depth when the gate is on.
+        double scatter = 0.0;  // left out where the sun is down (the octave sums cost as much as the rest)
+        if (lit) {
+          double w = 1.0;
+          if (gate) {
+            const glm::dvec3 g = p64::ecef_to_sphere(p, r0);
+            w = p64::octave_gate_weight(columns.at(grid, g.x / kDeg, g.y / kDeg));
+          }
+          scatter = (s.liquid_phase_hg ? p64::ms_octaves_hg_gated(sl, mu, liquid_g, tau_sun, s.octaves, s.octave_a, s.octave_b,
+                                                                 s.octave_c, w, gate_tol)
+                                       : p64::ms_octaves_mie_gated(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b,
+                                                                   s.octave_c, w, gate_tol)) +
+                    p64::ms_octaves_hg_gated(si, mu, s.ice_g, tau_sun, s.octaves, s.octave_a, s.octave_b, s.octave_c, w, gate_tol);
+        }
         radiance += transmittance * p64::segment_integral(sun.irradiance * (sun_air * scatter + ambient), sigma, ds);
         // The light the step takes out of the view, T (1 - exp(-sigma ds)), formed as the GPU forms it.
         const double taken = transmittance * p64::segment_integral(sigma, sigma, ds);

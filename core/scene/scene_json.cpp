@@ -166,16 +166,21 @@ void read_sun(const Reader& r, SunSpec& s) {
 }
 
 void read_march(const Reader& r, MarchSettings& m) {
-  r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "droplet_diameter_um", "liquid_phase", "ice_g", "frame",
+  r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "octave_gate", "droplet_diameter_um", "liquid_phase", "ice_g", "frame",
           "blue_noise", "noise_amount", "noise_scale_m", "atmosphere", "globe", "ambient", "sky_steps", "atmo_sun_steps",
           "ground_albedo", "ground_texture", "skip_empty", "adaptive_steps", "max_step_optical_depth",
-          "min_transmittance"});
+          "min_transmittance", "leave_out_night",
+          "max_sun_step_optical_depth"});
   r.number("view_step_m", m.view_step_m, 0.0, 1e7, "a view step in metres 0..1e7 (0: from the grid)");
   r.integer("sun_steps", m.sun_steps, 1, 1024);
   r.integer("octaves", m.octaves, 1, 16);
   r.number("octave_a", m.octave_a, 0.0, 1.0, "a number 0..1");
   r.number("octave_b", m.octave_b, 0.0, 1.0, "a number 0..1");
   r.number("octave_c", m.octave_c, 0.0, 1.0, "a number 0..1");
+  r.boolean("octave_gate", m.octave_gate);
+  r.boolean("leave_out_night", m.leave_out_night);
+  r.number("max_sun_step_optical_depth", m.max_sun_step_optical_depth, 0.0, 1000.0,
+           "an optical depth per sun step 0..1000 (0: always sun_steps)");
   r.number("droplet_diameter_um", m.droplet_diameter_um, 0.0, 50.0, "a droplet diameter in um 0.01..50, or 0: from the data");
   if (m.droplet_diameter_um > 0.0 && m.droplet_diameter_um < 0.01) {
     r.fail("droplet_diameter_um", std::to_string(m.droplet_diameter_um), "a droplet diameter in um 0.01..50, or 0: from the data");
@@ -314,6 +319,9 @@ std::string scene_to_json(const Scene& s) {
                       {"octave_a", m.octave_a},
                       {"octave_b", m.octave_b},
                       {"octave_c", m.octave_c},
+                      {"octave_gate", m.octave_gate},
+                      {"leave_out_night", m.leave_out_night},
+                      {"max_sun_step_optical_depth", m.max_sun_step_optical_depth},
                       {"droplet_diameter_um", m.droplet_diameter_um},
                       {"liquid_phase", m.liquid_phase_hg ? "hg" : "mie"},
                       {"ice_g", m.ice_g},

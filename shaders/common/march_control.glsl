@@ -112,6 +112,16 @@ CV_FN int march_substeps(real sigma_max_per_m, real dt_m, real max_tau) {
   return int(clamp(n, real(1), real(64)));
 }
 
+// Steps of a sun march over a shell segment of len_m on which no extinction exceeds sigma_max_per_m
+// (the volume's largest): enough that no step holds more than max_step_tau of optical depth, and
+// at most sun_steps. Thin cloud then pays for a few steps where the towering cell needs them all;
+// the transmittance error this adds is measured in docs/physics.md. max_step_tau <= 0: sun_steps.
+CV_FN int sun_march_steps(real sigma_max_per_m, real len_m, real max_step_tau, int sun_steps) {
+  if (!(max_step_tau > real(0))) return sun_steps;
+  real n = ceil(sigma_max_per_m * len_m / max_step_tau);
+  return int(clamp(n, real(1), real(max(sun_steps, 1))));
+}
+
 // The optical depth at which a sun march may stop: beyond it every octave's exp(-a^i tau_sun) is
 // below min_transmittance (the weakest attenuation is the last octave's, a^(n-1) for a < 1), so the
 // rest of the path changes the light by less than that fraction. min_transmittance <= 0: never

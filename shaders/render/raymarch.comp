@@ -48,9 +48,15 @@ uniform bool u_global_lat;
 uniform float u_view_step;
 uniform vec2 u_layer;         // altitudes (m) between which the data holds cloud (core::cloud_layer)
 uniform bool u_cloudless;     // no cloud anywhere: nothing to march
+uniform bool u_sun_down;      // the whole cloud layer is in the Earth's shadow (core::layer_in_earth_shadow)
 uniform int u_sun_steps;
+uniform float u_sigma_max;      // the volume's largest extinction, 1/m (core::largest_extinction)
+uniform float u_sun_step_tau;   // optical depth a sun step may hold at u_sigma_max (sun_march_steps)
 uniform int u_octaves;
 uniform vec3 u_octave_abc;
+uniform bool u_octave_gate;   // weight octave i >= 1 by w^i from the column's optical depth (octaves.glsl)
+// Vertical optical depth per grid column (core/volume/column_depth), fetched texel by texel.
+layout(binding = 7) uniform sampler2D u_column_tau;
 uniform float u_droplet_um;
 uniform bool u_liquid_phase_hg;  // Henyey-Greenstein with the Mie fit's mean cosine instead of the fit
 uniform float u_ice_g;
@@ -160,6 +166,26 @@ void erode_at(vec3 p, inout float sl, inout float si) {
 }
 #endif
 
+// The column's vertical optical depth at p, bilinear with the 3-D fetch's horizontal rules
+// (wrap, pole clamp, regional border 0), as core::ColumnDepth::at.
+float column_tau(vec3 p) {
+  vec3 g = ecef_to_sphere(p, u_r0);
+  vec3 f;
+  if (!volume_coords(g.x / kDeg, g.y / kDeg, u_grid_start.z, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return 0.0;
+  ivec2 n = ivec2(u_grid_count.xy);
+  float wx;
+  float wy;
+  int x0 = volume_fetch_index(f.x, n.x, wx);
+  int y0 = volume_fetch_index(f.y, n.y, wy);
+  int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
+  int y1 = y0 + 1;
+  float c00 = x0 < 0 || x0 >= n.x || y0 < 0 || y0 >= n.y ? 0.0 : texelFetch(u_column_tau, ivec2(x0, y0), 0).r;
+  float c10 = x1 < 0 || x1 >= n.x || y0 < 0 || y0 >= n.y ? 0.0 : texelFetch(u_column_tau, ivec2(x1, y0), 0).r;
+  float c01 = x0 < 0 || x0 >= n.x || y1 < 0 || y1 >= n.y ? 0.0 : texelFetch(u_column_tau, ivec2(x0, y1), 0).r;
+  float c11 = x1 < 0 || x1 >= n.x || y1 < 0 || y1 >= n.y ? 0.0 : texelFetch(u_column_tau, ivec2(x1, y1), 0).r;
+  return mix(mix(c00, c10, wx), mix(c01, c11, wx), wy);
+}
+
 float node_sum(int x, int y, int z) { return node(u_liquid, x, y, z) + node(u_ice, x, y, z); }
 
 // The largest extinction (1/m, liquid + ice) that trilinear sampling can return in the grid cell
@@ -244,15 +270,19 @@ float cloud_sun_depth(vec3 p, float alt_p, float mu_sun, float nu_sun) {
   float tau_sun = 0.0;
   vec4 sseg;
   int sn = u_cloudless ? 0 : ray_shell_rel_nu(u_r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
-  int total = sn * u_sun_steps;
+  // Steps per segment as core/reference/raymarcher.cpp sun_depth: fewer where the volume is thin.
+  int n0 = sn > 0 ? sun_march_steps(u_sigma_max, sseg.y - sseg.x, u_sun_step_tau, u_sun_steps) : 0;
+  int n1 = sn > 1 ? sun_march_steps(u_sigma_max, sseg.w - sseg.z, u_sun_step_tau, u_sun_steps) : 0;
+  int total = n0 + n1;
   float known_end = -1.0;  // what the pyramid said holds below this distance into the segment
   for (int k = 0; k < total;) {
-    int q = k / u_sun_steps;
-    int j = k - q * u_sun_steps;
+    int q = k < n0 ? 0 : 1;
+    int nq = q == 0 ? n0 : n1;
+    int j = q == 0 ? k : k - n0;
     if (j == 0) known_end = -1.0;
     float s0 = q == 0 ? sseg.x : sseg.z;
     float s1 = q == 0 ? sseg.y : sseg.w;
-    float ds = (s1 - s0) / float(u_sun_steps);
+    float ds = (s1 - s0) / float(nq);
     float t_rel = (float(j) + 0.5) * ds;
     vec3 ps = p + (s0 + t_rel) * u_to_sun;
     float alt_s = ray_altitude(u_r0, alt_p, mu_sun, s0 + t_rel);
@@ -260,7 +290,7 @@ float cloud_sun_depth(vec3 p, float alt_p, float mu_sun, float nu_sun) {
       float extent;
       float smax;
       if (space_at(ps, alt_s, u_to_sun, extent, smax)) {
-        int next = min(march_resume_index(j, extent, ds), u_sun_steps);
+        int next = min(march_resume_index(j, extent, ds), nq);
         g_stats[kStatSunSkipped] += uint(next - j);
         g_stats[kStatBricksJumped] += next - j > 1 ? 1u : 0u;
         k += next - j;
@@ -298,16 +328,23 @@ void march_sample(vec3 p, float alt_p, float t, float ds, float mu, MieParams mi
   float nu_sun = length(cross(u_to_sun, up_p));
   float e0;
   float e1;
-  bool lit = !(ray_sphere_rel_nu(u_r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
+  bool lit = !u_sun_down && !(ray_sphere_rel_nu(u_r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
   float tau_sun = lit ? cloud_sun_depth(p, alt_p, mu_sun, nu_sun) : 0.0;
   // Sunlight reaches the sample through the air (reddened when low), and the sky lights it too.
   vec3 sun_air = u_atmosphere && lit ? atmo_transmittance(u_r0, alt_p, mu_sun, nu_sun, u_atmo_sun_steps) : vec3(1.0);
   vec3 ambient = u_atmosphere ? u_ambient * sky_irradiance(sun_air, mu_sun) * (sigma / CV_TWO_PI) : vec3(0.0);
-  float liquid = u_liquid_phase_hg ? ms_octaves_hg(sl, mu, mie_mean_cosine(mie), tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
-                                   : ms_octaves_mie(sl, mu, mie, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z);
-  float scatter = lit ? liquid +
-                            ms_octaves_hg(si, mu, u_ice_g, tau_sun, u_octaves, u_octave_abc.x, u_octave_abc.y, u_octave_abc.z)
-                      : 0.0;
+  // The octave sums, only where the sun shines (llvmpipe runs masked code: a ternary would not save them).
+  float scatter = 0.0;
+  if (lit) {
+    // The octave gate (octaves.glsl): w from the column's optical depth; off, the classic sum.
+    bool gate = u_octave_gate && u_octaves > 1;
+    float w = gate ? octave_gate_weight(column_tau(p)) : 1.0;
+    float tol = gate ? CV_OCTAVE_GATE_TOL : 0.0;
+    vec3 abc = u_octave_abc;
+    float liquid = u_liquid_phase_hg ? ms_octaves_hg_gated(sl, mu, mie_mean_cosine(mie), tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol)
+                                     : ms_octaves_mie_gated(sl, mu, mie, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
+    scatter = liquid + ms_octaves_hg_gated(si, mu, u_ice_g, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
+  }
   radiance += t_view * segment_integral(u_irradiance * (sun_air * scatter + ambient), sigma, ds);
   // The light the step takes out of the view, t_view (1 - exp(-sigma ds)), without the
   // cancellation of t_view - t_next: in float that is a multiple of 6e-8, which left faint cloud

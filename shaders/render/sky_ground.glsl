@@ -70,7 +70,8 @@ vec4 sky_and_ground(vec3 d, vec3 cloud_l, float cloud_t, bool has_cloud, vec3 p_
       e_sky = sky_irradiance(sun_air, mu_sg);
     }
     // The clouds' shadow: the same sun march the cloud samples use.
-    float shadow = mu_sg > 0.0 ? transmittance(cloud_sun_depth(pg, 0.0, mu_sg, nu_sg)) : 0.0;
+    // With the whole layer in the Earth's shadow no sunlit ray crosses cloud: left out (u_sun_down).
+    float shadow = mu_sg > 0.0 ? (u_sun_down ? 1.0 : transmittance(cloud_sun_depth(pg, 0.0, mu_sg, nu_sg))) : 0.0;
     vec3 ll = ecef_to_sphere(pg, u_r0);
     ground = u_irradiance * ground_radiance(ground_albedo(ll.x, ll.y), mu_sg, sun_air * shadow, e_sky);
   }

@@ -248,7 +248,10 @@ TEST(MonteCarlo, MeasuresTheOctaveApproximation) {
   // Printed, not asserted: it is a property of the approximation, not a check of either code. The
   // thin cirrus converges fast; the stratocumulus's droplet forward peak (g_HG ~ 0.995) makes
   // next-event estimation heavy-tailed, and its figure carries the standard error printed with it.
-  for (const auto& [name, spp] : {std::pair<const char*, int>{"thin_cirrus", 4096}, {"stratocumulus", 256}}) {
+  // The octave gate (octave_gate) is printed off and on for each: it should take the thin cirrus's
+  // excess out and leave the thick scenes' sums nearly as they were.
+  for (const auto& [name, spp] :
+       {std::pair<const char*, int>{"thin_cirrus", 4096}, {"cumulus_field", 256}, {"stratocumulus", 256}}) {
     const SceneCase c(name, 16, 9);
     MarchSettings m = c.scene.march;
     MonteCarloSettings mc;
@@ -271,8 +274,9 @@ TEST(MonteCarlo, MeasuresTheOctaveApproximation) {
         static_cast<unsigned long long>(img.stats.truncated),
         static_cast<unsigned long long>(img.stats.paths), mc.max_bounces);
     ASSERT_GT(mc_lum, 0.0);
-    for (int octaves : {1, 4, 8}) {
+    for (const auto& [octaves, gate] : {std::pair{1, false}, {4, false}, {4, true}, {8, false}, {8, true}}) {
       m.octaves = octaves;
+      m.octave_gate = gate;
       const ReferenceImage ref = render_reference(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m);
       double ref_lum = 0.0, sq = 0.0;
       for (std::size_t i = 0; i < ref.radiance.size(); ++i) {
@@ -284,9 +288,9 @@ TEST(MonteCarlo, MeasuresTheOctaveApproximation) {
       // so what remains is the octaves' error.
       const double rmse = std::sqrt(std::max(sq - noise_var, 0.0) / npx) / (mc_lum / npx);
       std::printf(
-          "  octaves %d: mean luminance %.4g (bias %+.1f %% of the Monte Carlo mean), relative RMSE %.1f %% "
+          "  octaves %d, gate %s: mean luminance %.4g (bias %+.1f %% of the Monte Carlo mean), relative RMSE %.1f %% "
           "(noise removed; raw %.1f %%)\n",
-          octaves, ref_lum / npx, 100.0 * (ref_lum - mc_lum) / mc_lum, 100.0 * rmse,
+          octaves, gate ? "on " : "off", ref_lum / npx, 100.0 * (ref_lum - mc_lum) / mc_lum, 100.0 * rmse,
           100.0 * std::sqrt(sq / npx) / (mc_lum / npx));
     }
   }

@@ -47,6 +47,9 @@ Scene full_scene() {
   s.render.march.blue_noise = false;  // not the default, so the round trip shows it is stored
   s.render.march.noise_amount = 0.35, s.render.march.noise_scale_m = 12345.0;
   s.render.march.liquid_phase_hg = true;
+  // The leave-out switches, off their defaults.
+  s.render.march.octave_gate = false, s.render.march.leave_out_night = false;
+  s.render.march.max_sun_step_optical_depth = 0.0125;
   s.render.accumulate = 8, s.render.resolution_scale = 0.5, s.render.exposure = 6.25, s.render.budget_ms = 40.0;
   s.overlays = {"coastlines"};
   return s;
@@ -92,6 +95,9 @@ void expect_equal(const Scene& a, const Scene& b) {
   EXPECT_EQ(m.noise_amount, n.noise_amount);
   EXPECT_EQ(m.liquid_phase_hg, n.liquid_phase_hg);
   EXPECT_EQ(m.noise_scale_m, n.noise_scale_m);
+  EXPECT_EQ(m.octave_gate, n.octave_gate);
+  EXPECT_EQ(m.leave_out_night, n.leave_out_night);
+  EXPECT_EQ(m.max_sun_step_optical_depth, n.max_sun_step_optical_depth);
   EXPECT_EQ(a.render.accumulate, b.render.accumulate);
   EXPECT_EQ(a.render.resolution_scale, b.render.resolution_scale);
   EXPECT_EQ(a.render.exposure, b.render.exposure);
@@ -179,9 +185,10 @@ TEST(SceneJson, OutOfRangeValuesAreRefused) {
 TEST(SceneJson, UnknownKeysAreNamedSoTyposAreCaught) {
   EXPECT_EQ(error_of(R"({"version": 1, "render": {"march": {"sun_step": 8}}})"),
             "scene.json: render.march.sun_step: unknown key, expected one of view_step_m, sun_steps, octaves, octave_a, "
-            "octave_b, octave_c, droplet_diameter_um, liquid_phase, ice_g, frame, blue_noise, noise_amount, noise_scale_m, atmosphere, "
+            "octave_b, octave_c, octave_gate, droplet_diameter_um, liquid_phase, ice_g, frame, blue_noise, noise_amount, noise_scale_m, atmosphere, "
             "globe, ambient, sky_steps, atmo_sun_steps, ground_albedo, ground_texture, skip_empty, adaptive_steps, "
-            "max_step_optical_depth, min_transmittance");
+            "max_step_optical_depth, min_transmittance, leave_out_night, "
+            "max_sun_step_optical_depth");
   EXPECT_EQ(error_of(R"({"version": 1, "camra": {}})"),
             "scene.json: camra: unknown key, expected one of version, data, time_step, camera, width, height, sun, render, "
             "overlays");

@@ -53,4 +53,57 @@ TEST(Octaves, MoreOctavesBrightenThickCloudsAndStayFinite) {
   EXPECT_TRUE(std::isfinite(f32::ms_octaves_mie(0.05f, 1.0f, f32::mie_params(20.0f), 1e4f, 16, 0.5f, 0.5f, 0.5f)));
 }
 
+// The octave gate (octaves.glsl): w -> 0 leaves single scattering exactly, w = 1 the classic sum
+// exactly, and in between octave i carries (b w)^i until that falls below the tolerance.
+TEST(OctaveGate, NoColumnDepthLeavesSingleScatteringExactly) {
+  EXPECT_EQ(f64::octave_gate_weight(0.0), 0.0);
+  const double tol = f64::CV_OCTAVE_GATE_TOL;
+  for (double tau : {0.0, 0.7, 4.0}) {
+    EXPECT_EQ(f64::ms_octaves_hg_gated(0.02, 0.4, 0.8, tau, 8, 0.5, 0.5, 0.5, 0.0, tol),
+              f64::ms_octaves_hg(0.02, 0.4, 0.8, tau, 1, 0.5, 0.5, 0.5));
+    const f64::MieParams p = f64::mie_params(20.0);
+    EXPECT_EQ(f64::ms_octaves_mie_gated(0.02, -0.2, p, tau, 8, 0.5, 0.5, 0.5, f64::octave_gate_weight(0.0), tol),
+              f64::ms_octaves_mie(0.02, -0.2, p, tau, 1, 0.5, 0.5, 0.5));
+  }
+}
+
+TEST(OctaveGate, FullWeightIsTheClassicSumExactly) {
+  // Thick cloud: w = 1 - exp(-tau_col) rounds to 1 in double from tau_col ~ 37.
+  EXPECT_EQ(f64::octave_gate_weight(50.0), 1.0);
+  const double w = f64::octave_gate_weight(50.0), tol = f64::CV_OCTAVE_GATE_TOL;
+  const f64::MieParams p = f64::mie_params(20.0);
+  for (int n : {1, 4, 8}) {
+    // Against the sum written out here, and against the ungated function, bit for bit.
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+      sum += std::pow(0.5, i) * f64::phase_hg(0.3, std::pow(0.5, i) * 0.8) * std::exp(-std::pow(0.5, i) * 2.0);
+    }
+    const double gated = f64::ms_octaves_hg_gated(0.05, 0.3, 0.8, 2.0, n, 0.5, 0.5, 0.5, w, tol);
+    EXPECT_NEAR(gated, 0.05 * sum, 1e-15) << n;
+    EXPECT_EQ(gated, f64::ms_octaves_hg(0.05, 0.3, 0.8, 2.0, n, 0.5, 0.5, 0.5)) << n;
+    EXPECT_EQ(f64::ms_octaves_mie_gated(0.05, 0.3, p, 2.0, n, 0.5, 0.5, 0.5, w, tol),
+              f64::ms_octaves_mie(0.05, 0.3, p, 2.0, n, 0.5, 0.5, 0.5))
+        << n;
+  }
+}
+
+TEST(OctaveGate, ThinColumnsWeightOctavesAndStopEarly) {
+  // b w = 0.2: weights 1, 0.2, 0.04, 0.008, 0.0016, then 0.00032 < 1e-3 ends the sum at 5 octaves.
+  const double a = 0.5, b = 0.5, c = 0.5, w = 0.4, tau = 0.3, g = 0.75, mu = 0.1;
+  double five = 0.0;
+  for (int i = 0; i < 5; ++i) {
+    five += std::pow(b * w, i) * f64::phase_hg(mu, std::pow(c, i) * g) * std::exp(-std::pow(a, i) * tau);
+  }
+  const double tol = f64::CV_OCTAVE_GATE_TOL;
+  EXPECT_NEAR(f64::ms_octaves_hg_gated(1.0, mu, g, tau, 16, a, b, c, w, tol), five, 1e-15);
+  EXPECT_NEAR(f64::ms_octaves_hg_gated(1.0, mu, g, tau, 5, a, b, c, w, tol), five, 1e-15);
+  // Without the tolerance the sixth octave is there.
+  EXPECT_GT(f64::ms_octaves_hg_gated(1.0, mu, g, tau, 16, a, b, c, w, 0.0), five + 1e-5);
+  // Thin cirrus (tau_col 0.2): the second octave carries b w = 0.5 (1 - e^-0.2) = 0.09 of the first.
+  EXPECT_NEAR(f64::octave_gate_weight(0.2), 1.0 - std::exp(-0.2), 1e-15);
+  // The float instantiation (the GPU's) agrees.
+  EXPECT_NEAR(f32::ms_octaves_hg_gated(1.0f, 0.1f, 0.75f, 0.3f, 16, 0.5f, 0.5f, 0.5f, 0.4f, f32::CV_OCTAVE_GATE_TOL), five,
+              1e-6 * five);
+}
+
 }  // namespace

@@ -1,0 +1,23 @@
+// Whether the sun is below the horizon for a whole cloud layer: then no sample of it can be
+// sunlit, and both marchers leave out every sun march and octave sum for the frame (ambient sky
+// light still applies). Decided once per frame on the CPU, conservatively.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include "reference/raymarcher.hpp"
+
+namespace cv::core {
+
+// True only when every point of the layer (altitudes layer.bottom_m..top_m) over the grid's
+// domain, the one-cell border a regional grid fades into included, lies in the Earth's shadow
+// (the sphere of grid.earth_radius_m, sun at infinity along to_sun, a unit vector). Global grids
+// always have a lit side: false. Empty layers: false (there is nothing to leave out).
+//
+// A point at radius r is in the shadow when its angular distance from the antisolar point is
+// below asin(R / r); the layer's top is the hardest. The largest distance over a lon/lat box lies
+// on its boundary unless the subsolar point is inside (then it is lit), so the boundary is sampled
+// densely and the result kept off the threshold by the sampling spacing plus a float margin.
+bool layer_in_earth_shadow(const VolumeGrid& grid, const CloudLayer& layer, const glm::dvec3& to_sun);
+
+}  // namespace cv::core

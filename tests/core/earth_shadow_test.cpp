@@ -1,0 +1,99 @@
+// The whole-layer night test (core/reference/earth_shadow): whenever it says the layer is in the
+// Earth's shadow, no point of the layer over the domain is sunlit by the marchers' own per-sample
+// test; it does say so on the night side; and night leaves the reference image as it was.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include <glm/glm.hpp>
+
+#include "geo/geodesy.hpp"
+#include "physics/physics.hpp"
+#include "reference/earth_shadow.hpp"
+#include "scene/standard_scenes.hpp"
+
+#include "night_sun.hpp"
+
+namespace {
+using namespace cv::core;
+namespace geo = cv::geo;
+namespace p64 = cv::physics::f64;
+using cv::test::sun_at;
+using cv::test::sun_just_down;
+// Whether the raymarchers' per-sample test finds a point sunlit (raymarcher.cpp march_sample).
+bool sunlit(const glm::dvec3& p, double r0, const glm::dvec3& to_sun) {
+  const glm::dvec3 up = glm::normalize(p);
+  const double alt = glm::length(p) - r0, mu = glm::dot(to_sun, up), nu = glm::length(glm::cross(to_sun, up));
+  double e0, e1;
+  return !(p64::ray_sphere_rel_nu(r0, alt, mu, nu, 0.0, e0, e1) && e1 > 0.0);
+}
+
+TEST(EarthShadow, NeverCallsALitLayerDark) {
+  VolumeGrid g;
+  g.lon_deg = {170.0, 0.5, 31};  // 170..185 E: across the date line
+  g.lat_deg = {50.0, 0.5, 21};   // 50..60 N
+  g.alt_m = {0.0, 500.0, 25};
+  CloudLayer layer;
+  layer.empty = false;
+  layer.bottom_m = 1000.0;
+  layer.top_m = 11000.0;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int dark = 0, lit = 0;
+  for (double azimuth : {0.0, 90.0, 135.0, 180.0, 270.0}) {
+    for (double theta = 88.0; theta <= 110.0; theta += 0.25) {
+      const glm::dvec3 sun = sun_at(55.0, 177.5, theta, azimuth);
+      if (!layer_in_earth_shadow(g, layer, sun)) {
+        ++lit;
+        continue;
+      }
+      ++dark;
+      // Random points over the domain and its border cell, at the layer's top (the hardest) and inside it.
+      for (int n = 0; n < 4000; ++n) {
+        const double lon = 169.5 + 16.0 * u(rng), lat = 49.5 + 11.0 * u(rng);
+        const double alt = n % 2 ? layer.top_m : layer.bottom_m + u(rng) * (layer.top_m - layer.bottom_m);
+        ASSERT_FALSE(sunlit(geo::sphere_to_ecef({lat, lon, alt}, g.earth_radius_m), g.earth_radius_m, sun))
+            << "azimuth " << azimuth << " theta " << theta << " at " << lat << ", " << lon << ", " << alt;
+      }
+    }
+  }
+  // Both answers occur: the sweep crosses the terminator of the box.
+  EXPECT_GT(dark, 20);
+  EXPECT_GT(lit, 20);
+  // The antisolar point at the box's centre: night. The subsolar point inside: day.
+  EXPECT_TRUE(layer_in_earth_shadow(g, layer, sun_at(55.0, 177.5, 180.0, 0.0)));
+  EXPECT_FALSE(layer_in_earth_shadow(g, layer, sun_at(55.0, 177.5, 0.0, 0.0)));
+  // A global grid always has a lit side; an empty layer has nothing to leave out.
+  VolumeGrid global = g;
+  global.lon_deg = {0.0, 1.0, 360};
+  EXPECT_FALSE(layer_in_earth_shadow(global, layer, sun_at(55.0, 177.5, 180.0, 0.0)));
+  EXPECT_FALSE(layer_in_earth_shadow(g, CloudLayer{}, sun_at(55.0, 177.5, 180.0, 0.0)));
+}
+
+TEST(EarthShadow, NightLeavesTheReferenceImageAsThePerSampleTestMadeIt) {
+  StandardScene sc = standard_scene("cumulus_field", 32, 18);
+  sc.sun = sun_just_down(sc);
+  sc.march.atmosphere = sc.march.globe = true;
+  sc.march.ambient = 1.0;
+  const GridMeanExtinction medium = grid_mean_extinction(sc.grid, sc.data);
+  sc.march.leave_out_night = false;
+  const ReferenceImage per_sample = render_reference(sc.grid, medium, sc.camera, sc.sun, sc.march);
+  sc.march.leave_out_night = true;
+  const ReferenceImage night = render_reference(sc.grid, medium, sc.camera, sc.sun, sc.march);
+  EXPECT_FALSE(per_sample.stats.sun_down);
+  EXPECT_TRUE(night.stats.sun_down);
+  double brightest = 0.0;
+  for (std::size_t i = 0; i < night.radiance.size(); ++i) {
+    ASSERT_EQ(night.radiance[i], per_sample.radiance[i]) << i;
+    ASSERT_EQ(night.transmittance[i], per_sample.transmittance[i]) << i;
+    brightest = std::max(brightest, night.radiance[i].z);
+  }
+  EXPECT_GT(brightest, 0.0) << "the twilight sky should show";
+  EXPECT_EQ(night.stats.sun_samples, 0u);
+  std::printf("cumulus_field at night: same image; sun samples %llu per sample, %llu left out\n",
+              static_cast<unsigned long long>(per_sample.stats.sun_samples),
+              static_cast<unsigned long long>(night.stats.sun_samples));
+}
+
+}  // namespace
