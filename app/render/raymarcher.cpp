@@ -53,12 +53,15 @@ GpuRaymarcher::GpuRaymarcher(const ShaderLoader& loader) : loader_(loader) {
 
 const GlProgram& GpuRaymarcher::program_for(const core::MarchSettings& s) {
   const bool noise = s.noise_amount > 0.0;
-  std::unique_ptr<GlProgram>& p = programs_[noise ? 1 : 0][s.skip_empty ? 1 : 0][s.adaptive_steps ? 1 : 0];
+  std::unique_ptr<GlProgram>& p = programs_[noise ? 1 : 0][s.skip_empty ? 1 : 0][s.adaptive_steps ? 1 : 0]
+                                           [s.atmosphere ? 1 : 0][s.globe ? 1 : 0];
   if (!p) {
     p = std::make_unique<GlProgram>(load_compute(loader_, ShaderLoader::default_shader_dir() / "render" / "raymarch.comp",
                                                  noise ? ShaderFeatures{ShaderFeature::NoiseDetail} : ShaderFeatures{},
                                                  {{"CV_SKIP_EMPTY", s.skip_empty ? "1" : "0"},
-                                                  {"CV_ADAPTIVE", s.adaptive_steps ? "1" : "0"}}));
+                                                  {"CV_ADAPTIVE", s.adaptive_steps ? "1" : "0"},
+                                                  {"CV_ATMOSPHERE", s.atmosphere ? "1" : "0"},
+                                                  {"CV_GLOBE", s.globe ? "1" : "0"}}));
   }
   return *p;
 }
@@ -184,8 +187,6 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
     glBindTextureUnit(3, noise_textures_[0]);
     glBindTextureUnit(4, noise_textures_[1]);
   }
-  glProgramUniform1i(p, loc(p, "u_atmosphere"), s.atmosphere ? 1 : 0);
-  glProgramUniform1i(p, loc(p, "u_globe"), s.globe ? 1 : 0);
   glProgramUniform1f(p, loc(p, "u_ambient"), static_cast<float>(s.ambient));
   glProgramUniform1i(p, loc(p, "u_sky_steps"), s.sky_steps);
   glProgramUniform1i(p, loc(p, "u_atmo_sun_steps"), s.atmo_sun_steps);

@@ -85,7 +85,7 @@ class GpuRaymarcher {
   // first use (the noise variants need upload_noise first).
   const GlProgram& program_for(const core::MarchSettings& s);
   const ShaderLoader& loader_;
-  std::unique_ptr<GlProgram> programs_[2][2][2];  // [noise][skip][adaptive]
+  std::unique_ptr<GlProgram> programs_[2][2][2][2][2];  // [noise][skip][adaptive][atmosphere][globe]
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
   GLuint column_tau_ = 0;           // vertical optical depth per column (R32F), for the octave gate

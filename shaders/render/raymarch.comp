@@ -64,8 +64,6 @@ uniform int u_frame;  // -1: step middles; else the accumulation frame whose jit
 uniform bool u_blue_noise;  // the jitter from the blue-noise mask (blue_noise_jitter), else the hash
 // The blue-noise mask (core/noise/blue_noise), rank / n^2 per texel, tiled over the image.
 layout(binding = 6) uniform sampler2D u_jitter_mask;
-uniform bool u_atmosphere;    // sun colour through air, sky in-scatter, ambient sky light
-uniform bool u_globe;         // shade the ground where a ray meets it
 uniform float u_ambient;      // strength of the isotropic sky light on clouds
 uniform int u_sky_steps;      // steps of a sky in-scatter integral
 uniform int u_atmo_sun_steps; // steps of an atmospheric transmittance toward the sun
@@ -81,8 +79,18 @@ layout(binding = 5) uniform sampler2D u_ground;  // linear albedo, equirectangul
 #ifndef CV_ADAPTIVE
 #define CV_ADAPTIVE 0
 #endif
+// The air (sun colour through it, sky in-scatter, ambient sky light) and the globe (the ground where
+// a ray meets it): a scene without them runs a program without their code.
+#ifndef CV_ATMOSPHERE
+#define CV_ATMOSPHERE 1
+#endif
+#ifndef CV_GLOBE
+#define CV_GLOBE 1
+#endif
 const bool kSkipEmpty = CV_SKIP_EMPTY != 0;
 const bool kAdaptive = CV_ADAPTIVE != 0;
+const bool kAtmosphere = CV_ATMOSPHERE != 0;
+const bool kGlobe = CV_GLOBE != 0;
 uniform float u_max_step_tau;     // optical depth a view substep may hold (adaptive steps)
 uniform float u_min_t;            // view rays stop below this transmittance
 uniform float u_sun_tau_limit;    // sun marches stop past this optical depth (sun_march_tau_limit)
@@ -331,8 +339,8 @@ void march_sample(vec3 p, float alt_p, float t, float ds, float mu, MieParams mi
   bool lit = !u_sun_down && !(ray_sphere_rel_nu(u_r0, alt_p, mu_sun, nu_sun, 0.0, e0, e1) && e1 > 0.0);
   float tau_sun = lit ? cloud_sun_depth(p, alt_p, mu_sun, nu_sun) : 0.0;
   // Sunlight reaches the sample through the air (reddened when low), and the sky lights it too.
-  vec3 sun_air = u_atmosphere && lit ? atmo_transmittance(u_r0, alt_p, mu_sun, nu_sun, u_atmo_sun_steps) : vec3(1.0);
-  vec3 ambient = u_atmosphere ? u_ambient * sky_irradiance(sun_air, mu_sun) * (sigma / CV_TWO_PI) : vec3(0.0);
+  vec3 sun_air = kAtmosphere && lit ? atmo_transmittance(u_r0, alt_p, mu_sun, nu_sun, u_atmo_sun_steps) : vec3(1.0);
+  vec3 ambient = kAtmosphere ? u_ambient * sky_irradiance(sun_air, mu_sun) * (sigma / CV_TWO_PI) : vec3(0.0);
   // The octave sums, only where the sun shines (llvmpipe runs masked code: a ternary would not save them).
   float scatter = 0.0;
   if (lit) {
@@ -489,7 +497,7 @@ void main() {
     imageStore(u_state_depth, px, vec4(depth_w, depth_t, ended ? 1.0 : 0.0, float(next_step)));
     return;
   }
-  if (u_atmosphere || u_globe) {
+  if (kAtmosphere || kGlobe) {
     // The cloud stands, for the air around it, at the mean depth of the light it takes out.
     vec3 p_cloud = origin + (depth_w > 0.0 ? depth_t / depth_w : 0.0) * d;
     imageStore(u_out, px, sky_and_ground(d, radiance, t_view, depth_w > 1e-6, p_cloud));

@@ -48,7 +48,7 @@ vec4 sky_and_ground(vec3 d, vec3 cloud_l, float cloud_t, bool has_cloud, vec3 p_
   vec3 sky_back = vec3(0.0);
   vec3 tr_front = vec3(1.0);
   vec3 tr_back = vec3(1.0);
-  if (u_atmosphere) {
+  if (kAtmosphere) {
     float mu_s = dot(u_to_sun, up);
     float nu_vs = dot(d, u_to_sun);
     sky_front = u_irradiance * atmo_inscatter(u_r0, h, mu, mu_s, nu_vs, 0.0, t_cloud, u_sky_steps, u_atmo_sun_steps, tr_front);
@@ -57,7 +57,7 @@ vec4 sky_and_ground(vec3 d, vec3 cloud_l, float cloud_t, bool has_cloud, vec3 p_
     }
   }
   vec3 ground = vec3(0.0);
-  bool globe = hits_ground && u_globe;
+  bool globe = hits_ground && kGlobe;
   if (globe) {
     vec3 pg = normalize(o + t_end * d) * u_r0;
     vec3 n = normalize(pg);
@@ -65,7 +65,7 @@ vec4 sky_and_ground(vec3 d, vec3 cloud_l, float cloud_t, bool has_cloud, vec3 p_
     float nu_sg = length(cross(u_to_sun, n));
     vec3 sun_air = vec3(mu_sg > 0.0 ? 1.0 : 0.0);
     vec3 e_sky = vec3(0.0);
-    if (u_atmosphere) {
+    if (kAtmosphere) {
       sun_air = atmo_transmittance(u_r0, 0.0, mu_sg, nu_sg, u_atmo_sun_steps);
       e_sky = sky_irradiance(sun_air, mu_sg);
     }
