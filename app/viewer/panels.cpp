@@ -100,8 +100,8 @@ void lighting_panel(ViewerState& s) {
   slider_double("droplet diameter (um)", &m.droplet_diameter_um, 1.0, 50.0, "%.1f");
   slider_double("ice g", &m.ice_g, 0.0, 0.99, "%.2f");
   ImGui::SliderInt("octaves N", &m.octaves, 1, 16, "%d", ImGuiSliderFlags_AlwaysClamp);
-  slider_double("octave a (scattering)", &m.octave_a, 0.0, 1.0, "%.2f");
-  slider_double("octave b (extinction)", &m.octave_b, 0.0, 1.0, "%.2f");
+  slider_double("octave a (extinction)", &m.octave_a, 0.0, 1.0, "%.2f");
+  slider_double("octave b (scattering)", &m.octave_b, 0.0, 1.0, "%.2f");
   slider_double("octave c (phase)", &m.octave_c, 0.0, 1.0, "%.2f");
   ImGui::Checkbox("octave gate (thin cloud: fewer octaves)", &m.octave_gate);
   int phase = m.liquid_phase_hg ? 1 : 0;
