@@ -175,28 +175,36 @@ std::vector<Config> make_configs(const core::StandardScene& sc, const core::Marc
   }
   for (int s : {4, 8, 32}) add("sun_" + std::to_string(s), [&](Config& c) { c.march.sun_steps = s; });
   for (int o : {1, 8}) add("octaves_" + std::to_string(o), [&](Config& c) { c.march.octaves = o; });
+  add("octave_gate_off", [](Config& c) { c.march.octave_gate = false; });  // the classic octave sum
   add("accumulate_4", [](Config& c) { c.accumulate = 4; });
   add("scale_0.5", [](Config& c) { c.scale = 0.5; });
   add("adaptive", [](Config& c) { c.march.adaptive_steps = true; });
   add("fast_2dz_sun8_scale0.5", [&](Config& c) {
     c.march.view_step_m = std::max(25.0, 2.0 * dz), c.march.sun_steps = 8, c.scale = 0.5;
   });
-  // The seed documents' methods (../shared/seeds), as near as our march's settings come.
+  // The seed documents' methods (../shared/seeds), as near as our march's settings come: the classic
+  // octave sum (no gate by column optical depth) and a fixed count of sun steps (no fewer in thin
+  // cloud), since those are ours; empty-space skipping stays on (it does not change the image).
   const double chord = central_chord_m(sc, layer);
-  add("costa2023", [&](Config& c) {
+  const auto seed = [](Config& c) {
     c.kind = ConfigKind::Seed;
+    c.march.octave_gate = false;
+    c.march.max_sun_step_optical_depth = 0.0;
+  };
+  add("costa2023", [&](Config& c) {
+    seed(c);
     c.description = "64 view steps over the central ray's chord of the cloud shell, 32 light steps, HG, single scattering";
     c.march.view_step_m = chord > 0.0 ? chord / 64.0 : std::max(25.0, (layer.top_m - layer.bottom_m) / 64.0);
     c.march.sun_steps = 32, c.march.octaves = 1, c.march.liquid_phase_hg = true;
   });
   add("haggstrom2018", [&](Config& c) {
-    c.kind = ConfigKind::Seed;
+    seed(c);
     c.description = "long steps of 2 dz split into short ones in dense cloud (adaptive), 4 sun steps, HG";
     c.march.view_step_m = std::max(50.0, 2.0 * dz), c.march.adaptive_steps = true;
     c.march.sun_steps = 4, c.march.octaves = 1, c.march.liquid_phase_hg = true;
   });
   add("fordsung2024", [&](Config& c) {
-    c.kind = ConfigKind::Seed;
+    seed(c);
     c.description = "100 m steps, 8 octaves, approximate Mie at 20 um, 8 accumulated frames";
     c.march.view_step_m = 100.0, c.march.octaves = 8, c.march.droplet_diameter_um = 20.0, c.accumulate = 8;
   });

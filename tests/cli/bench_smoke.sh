@@ -12,7 +12,7 @@ export XDG_CACHE_HOME
 header='scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,wall_ms,gpu_ms,rel_rmse,rel_rmse_raw,ref_noise_floor,rel_rmse_resolution,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,error_image'
 test "$(head -n 1 "$dir/results.csv")" = "$header" || { echo "bad header: $(head -n 1 "$dir/results.csv")"; exit 1; }
 rows=$(tail -n +2 "$dir/results.csv" | grep -c '^stratocumulus,')
-test "$rows" -eq 19 || { echo "expected 19 rows, found $rows"; exit 1; }
+test "$rows" -eq 20 || { echo "expected 20 rows, found $rows"; exit 1; }
 for c in low default high costa2023 haggstrom2018 fordsung2024; do
   grep -q "^stratocumulus,$c," "$dir/results.csv" || { echo "no row for $c"; exit 1; }
 done
