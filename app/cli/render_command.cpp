@@ -369,6 +369,11 @@ int cmd_render(const std::vector<std::string>& args) {
               static_cast<unsigned long long>(ms.sun_samples), static_cast<unsigned long long>(ms.sun_skipped),
               static_cast<unsigned long long>(ms.rays_missed), mw * mh, march.skip_empty ? "" : " (skipping off)");
   if (ms.sun_down) std::printf("the sun is below the horizon for the whole cloud layer: sun marches and octave sums left out\n");
+  if (ms.octave_terms_full > ms.octave_terms) {
+    std::printf("octave gate: %llu of %llu octave terms evaluated at sunlit samples (%.1f %% left out where the cloud is thin)\n",
+                static_cast<unsigned long long>(ms.octave_terms), static_cast<unsigned long long>(ms.octave_terms_full),
+                100.0 * static_cast<double>(ms.octave_terms_full - ms.octave_terms) / static_cast<double>(ms.octave_terms_full));
+  }
 
   t0 = clock::now();
   if (mw != cam.width || mh != cam.height) pixels = upscale(pixels, mw, mh, cam.width, cam.height);

@@ -225,9 +225,9 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glProgramUniform1iv(p, loc(p, "u_level_offset"), core::ExtinctionPyramid::kMaxLevels, offsets);
   if (!stats_buffer_) {
     glCreateBuffers(1, &stats_buffer_);
-    glNamedBufferStorage(stats_buffer_, 12 * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
+    glNamedBufferStorage(stats_buffer_, 2 * kStatCounters * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
   }
-  const GLuint zeros[12] = {};
+  const GLuint zeros[2 * kStatCounters] = {};
   glNamedBufferSubData(stats_buffer_, 0, sizeof(zeros), zeros);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, pyramid_buffer_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, stats_buffer_);
@@ -288,13 +288,21 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   check_gl("running the raymarcher");
 }
 
+void GpuRaymarcher::read_stats() {
+  GLuint counts[2 * kStatCounters] = {};
+  glGetNamedBufferSubData(stats_buffer_, 0, sizeof(counts), counts);
+  auto count = [&](int k) { return (std::uint64_t(counts[2 * k + 1]) << 32) | counts[2 * k]; };
+  stats_ = core::MarchStats{};
+  stats_.view_samples = count(0), stats_.view_skipped = count(1), stats_.bricks_jumped = count(2);
+  stats_.sun_samples = count(3), stats_.sun_skipped = count(4), stats_.rays_missed = count(5);
+  stats_.sun_down = sun_down_;
+  stats_.octave_terms = count(6), stats_.octave_terms_full = count(7);
+}
+
 const core::MarchStats& GpuRaymarcher::last_stats() {
   // Read on demand: reading waits for the march, which the viewer should not do every frame.
   if (!stats_read_ && stats_buffer_) {
-    GLuint counts[12] = {};
-    glGetNamedBufferSubData(stats_buffer_, 0, sizeof(counts), counts);
-    auto count = [&](int k) { return (std::uint64_t(counts[2 * k + 1]) << 32) | counts[2 * k]; };
-    stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5), sun_down_};
+    read_stats();
     stats_read_ = true;
   }
   return stats_;
@@ -314,10 +322,7 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   std::vector<glm::vec4> pixels(static_cast<std::size_t>(cam.width) * cam.height);
   glGetTextureImage(out, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(pixels.size() * sizeof(glm::vec4)), pixels.data());
   glDeleteTextures(1, &out);
-  GLuint counts[12] = {};
-  glGetNamedBufferSubData(stats_buffer_, 0, sizeof(counts), counts);
-  auto count = [&](int k) { return (std::uint64_t(counts[2 * k + 1]) << 32) | counts[2 * k]; };
-  stats_ = core::MarchStats{count(0), count(1), count(2), count(3), count(4), count(5), sun_down_};
+  read_stats();
   check_gl("running the raymarcher");
   return pixels;
 }

@@ -76,11 +76,13 @@ class GpuRaymarcher {
   void render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings,
                    const DispatchOptions& dispatch = {});
 
-  // The counts of the last render (samples taken and skipped, rays that missed the shell).
-  // What the last march did (view and sun samples, what was skipped); waits for it to finish.
+  // What the last march did (view and sun samples, what was skipped, octave terms); waits for it to
+  // finish.
   const core::MarchStats& last_stats();
 
  private:
+  static constexpr int kStatCounters = 8;  // 64-bit counters in the Stats buffer (kStatCount in raymarch.comp)
+  void read_stats();  // the Stats buffer into stats_
   // The program for a march's switches (noise detail, skip_empty, adaptive_steps), compiled on
   // first use (the noise variants need upload_noise first).
   const GlProgram& program_for(const core::MarchSettings& s);

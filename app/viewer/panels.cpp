@@ -204,6 +204,9 @@ void draw_stats_overlay(const FrameStats& s, int target) {
     ImGui::Text("sun samples %llu, skipped or cut off %llu", static_cast<unsigned long long>(m.sun_samples),
                 static_cast<unsigned long long>(m.sun_skipped));
     ImGui::Text("rays missing the cloud layer %llu", static_cast<unsigned long long>(m.rays_missed));
+    ImGui::Text("octave terms %llu of %llu (the gate left out the rest)", static_cast<unsigned long long>(m.octave_terms),
+                static_cast<unsigned long long>(m.octave_terms_full));
+    if (m.sun_down) ImGui::Text("night over the whole cloud layer: sun marches left out");
   }
   ImGui::End();
 }

@@ -388,6 +388,8 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
             const glm::dvec3 g = p64::ecef_to_sphere(p, r0);
             w = p64::octave_gate_weight(columns.at(grid, g.x / kDeg, g.y / kDeg));
           }
+          img.stats.octave_terms += static_cast<std::uint64_t>(p64::octave_terms(s.octaves, s.octave_b, w, gate_tol));
+          img.stats.octave_terms_full += static_cast<std::uint64_t>(std::max(s.octaves, 0));
           scatter = (s.liquid_phase_hg ? p64::ms_octaves_hg_gated(sl, mu, liquid_g, tau_sun, s.octaves, s.octave_a, s.octave_b,
                                                                  s.octave_c, w, gate_tol)
                                        : p64::ms_octaves_mie_gated(sl, mu, mie, tau_sun, s.octaves, s.octave_a, s.octave_b,

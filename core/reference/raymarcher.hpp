@@ -101,6 +101,10 @@ struct MarchStats {
   std::uint64_t sun_skipped = 0;    // sun step positions jumped over or cut off by sun_march_tau_limit
   std::uint64_t rays_missed = 0;    // pixels whose ray never crossed the cloud shell
   bool sun_down = false;  // the whole cloud layer was in the Earth's shadow: no sun march or octave sum ran
+  // Octave terms evaluated at sunlit samples (octave_terms in octaves.glsl, per sample once for both
+  // phases), and what the classic sum would have taken there (octaves per sunlit sample): the
+  // difference is what the octave gate left out.
+  std::uint64_t octave_terms = 0, octave_terms_full = 0;
 };
 
 struct ReferenceImage {

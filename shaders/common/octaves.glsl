@@ -16,6 +16,19 @@ const real CV_OCTAVE_GATE_TOL = real(1e-3);
 // The gate's weight from the vertical optical depth of the column (liquid + ice), in [0, 1).
 CV_FN real octave_gate_weight(real tau_col) { return real(1) - exp(-max(tau_col, real(0))); }
 
+// How many octaves the gated sums evaluate (the first whose weight b^i w^i is below tol ends them):
+// what the statistics count, so the output says how many the gate left out.
+CV_FN int octave_terms(int n, real b, real w, real tol) {
+  int k = 0;
+  real bi = real(1);
+  for (int i = 0; i < n; ++i) {
+    if (bi < tol) break;
+    bi *= b * w;
+    ++k;
+  }
+  return k;
+}
+
 CV_FN real ms_octaves_hg_gated(real sigma_s_per_m, real mu, real g, real tau_sun, int n, real a, real b, real c, real w,
                                real tol) {
   real sum = real(0);

@@ -110,7 +110,10 @@ const int kStatBricksJumped = 2;
 const int kStatSunSamples = 3;
 const int kStatSunSkipped = 4;
 const int kStatRaysMissed = 5;
-uint g_stats[6] = uint[6](0u, 0u, 0u, 0u, 0u, 0u);
+const int kStatOctaveTerms = 6;
+const int kStatOctaveTermsFull = 7;
+const int kStatCount = 8;
+uint g_stats[kStatCount] = uint[kStatCount](0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u);
 
 const float kDeg = 0.017453292519943295;
 
@@ -349,6 +352,8 @@ void march_sample(vec3 p, float alt_p, float t, float ds, float mu, MieParams mi
     float w = gate ? octave_gate_weight(column_tau(p)) : 1.0;
     float tol = gate ? CV_OCTAVE_GATE_TOL : 0.0;
     vec3 abc = u_octave_abc;
+    g_stats[kStatOctaveTerms] += uint(octave_terms(u_octaves, abc.y, w, tol));
+    g_stats[kStatOctaveTermsFull] += uint(max(u_octaves, 0));
     float liquid = u_liquid_phase_hg ? ms_octaves_hg_gated(sl, mu, mie_mean_cosine(mie), tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol)
                                      : ms_octaves_mie_gated(sl, mu, mie, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
     scatter = liquid + ms_octaves_hg_gated(si, mu, u_ice_g, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
@@ -373,7 +378,7 @@ float step_offset(ivec2 px) {
 }
 
 void flush_stats() {
-  for (int k = 0; k < 6; ++k) {
+  for (int k = 0; k < kStatCount; ++k) {
     if (g_stats[k] == 0u) continue;
     uint old = atomicAdd(u_stats[2 * k], g_stats[k]);
     if (old > 0xFFFFFFFFu - g_stats[k]) atomicAdd(u_stats[2 * k + 1], 1u);

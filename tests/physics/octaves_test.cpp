@@ -97,6 +97,11 @@ TEST(OctaveGate, ThinColumnsWeightOctavesAndStopEarly) {
   const double tol = f64::CV_OCTAVE_GATE_TOL;
   EXPECT_NEAR(f64::ms_octaves_hg_gated(1.0, mu, g, tau, 16, a, b, c, w, tol), five, 1e-15);
   EXPECT_NEAR(f64::ms_octaves_hg_gated(1.0, mu, g, tau, 5, a, b, c, w, tol), five, 1e-15);
+  // The statistics' count is the sum's: 5 terms here, all of them without the gate, 1 at w = 0.
+  EXPECT_EQ(f64::octave_terms(16, b, w, tol), 5);
+  EXPECT_EQ(f32::octave_terms(16, 0.5f, 0.4f, f32::CV_OCTAVE_GATE_TOL), 5);
+  EXPECT_EQ(f64::octave_terms(4, b, 1.0, 0.0), 4);
+  EXPECT_EQ(f64::octave_terms(4, b, 0.0, tol), 1);
   // Without the tolerance the sixth octave is there.
   EXPECT_GT(f64::ms_octaves_hg_gated(1.0, mu, g, tau, 16, a, b, c, w, 0.0), five + 1e-5);
   // Thin cirrus (tau_col 0.2): the second octave carries b w = 0.5 (1 - e^-0.2) = 0.09 of the first.

@@ -95,3 +95,36 @@ TEST(LeaveOut, ThinCloudTakesFewerSunStepsOnTheGpu) {
 }
 
 }  // namespace
+
+namespace {
+// The octave gate's leave-out is counted: on thin cirrus the GPU evaluates fewer octave terms than
+// the classic sum would (the count is the CPU reference's, to the few samples float rounding tips),
+// and with the gate off it evaluates them all.
+TEST(LeaveOut, TheGateCountsTheOctaveTermsItLeavesOut) {
+  core::StandardScene sc = core::standard_scene("thin_cirrus", 32, 18);
+  sc.march.octaves = 4;
+  auto ctx = render::make_headless_context();
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::GpuRaymarcher gpu(loader);
+  const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
+  gpu.upload(sc.grid, medium);
+  sc.march.octave_gate = true;
+  gpu.render(sc.camera, sc.sun, sc.march);
+  const core::MarchStats gated = gpu.last_stats();
+  const core::ReferenceImage cpu = core::render_reference(sc.grid, medium, sc.camera, sc.sun, sc.march);
+  std::printf("thin cirrus 32x18, 4 octaves: GPU %llu of %llu octave terms, CPU %llu of %llu\n",
+              static_cast<unsigned long long>(gated.octave_terms), static_cast<unsigned long long>(gated.octave_terms_full),
+              static_cast<unsigned long long>(cpu.stats.octave_terms),
+              static_cast<unsigned long long>(cpu.stats.octave_terms_full));
+  ASSERT_GT(gated.octave_terms_full, 0u);
+  EXPECT_LT(gated.octave_terms, gated.octave_terms_full);  // optical depth 0.1-0.25: fewer than 4 per sample
+  EXPECT_GE(gated.octave_terms * 4, gated.octave_terms_full);  // never fewer than the first octave
+  EXPECT_NEAR(double(gated.octave_terms), double(cpu.stats.octave_terms), 1e-3 * double(cpu.stats.octave_terms));
+  EXPECT_NEAR(double(gated.octave_terms_full), double(cpu.stats.octave_terms_full), 1e-3 * double(cpu.stats.octave_terms_full));
+  sc.march.octave_gate = false;
+  gpu.render(sc.camera, sc.sun, sc.march);
+  const core::MarchStats classic = gpu.last_stats();
+  EXPECT_EQ(classic.octave_terms, classic.octave_terms_full);
+  EXPECT_EQ(classic.octave_terms_full, gated.octave_terms_full);  // the same sunlit samples
+}
+}  // namespace
