@@ -199,13 +199,15 @@ double sun_step_limit_m(const VolumeGrid& grid, const CloudLayer& layer, const M
 }
 
 int max_sun_march_steps(int sun_steps, double max_step_m, double r0_m, double bottom_m, double top_m) {
-  const int fixed = 2 * std::max(sun_steps, 1);
-  if (!(max_step_m > 0.0)) return fixed;
+  const int ss = std::max(sun_steps, 1);
+  if (!(max_step_m > 0.0)) return 2 * ss;
   const double rb = r0_m + std::max(bottom_m, 0.0), rt = r0_m + std::max(top_m, bottom_m);
   const double chord_m = 2.0 * std::sqrt(std::max(rt * rt - rb * rb, 0.0));
-  const double by_length = std::ceil(chord_m / max_step_m) + 4.0;
-  const int cap = 2 * std::max(p64::CV_SUN_SEGMENT_STEPS_MAX, std::max(sun_steps, 1));
-  return static_cast<int>(std::min(static_cast<double>(cap), fixed + by_length));
+  // Segments of lengths L0 + L1 <= chord: both at sun_steps (2 ss), one of them longer
+  // (ss + L/step + 1), or both (chord/step + 2); 2 more for float rounding on the GPU.
+  const double by_length = static_cast<double>(ss) + std::ceil(chord_m / max_step_m) + 4.0;
+  const int cap = 2 * std::max(p64::CV_SUN_SEGMENT_STEPS_MAX, ss);
+  return static_cast<int>(std::min(static_cast<double>(cap), std::max(2.0 * ss, by_length)));
 }
 
 double largest_extinction(const GridMeanExtinction& medium) {

@@ -150,7 +150,8 @@ double sun_step_limit_m(const VolumeGrid& grid, const CloudLayer& layer, const M
 // [bottom_m, top_m] above the sphere of radius r0_m: each segment takes sun_steps or
 // ceil(length / max_step_m) (at most CV_SUN_SEGMENT_STEPS_MAX), and the two segments of a line
 // through a shell are together no longer than its chord tangent to the floor,
-// 2 sqrt(r_top^2 - r_bottom^2); two steps more per segment for rounding. Sizes llvmpipe's dispatches.
+// 2 sqrt(r_top^2 - r_bottom^2), so at most max(2 sun_steps, sun_steps + chord / max_step_m + 2),
+// 2 more for rounding. Sizes llvmpipe's dispatches.
 int max_sun_march_steps(int sun_steps, double max_step_m, double r0_m, double bottom_m, double top_m);
 
 // A camera's orientation in Earth-centred coordinates, and its half-width: pixel (px, py) looks

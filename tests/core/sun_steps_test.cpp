@@ -143,15 +143,39 @@ TEST(SunSteps, AGrazingSunMatchesTheFineMarch) {
     for (const auto& l : img.radiance) sum += 0.2126 * l.x + 0.7152 * l.y + 0.0722 * l.z;
     return sum / static_cast<double>(img.radiance.size());
   };
-  ReferenceImage a, b;
-  const double l_default = mean_luminance(m, a), l_fine = mean_luminance(fine, b);
+  MarchSettings fixed = m;  // the march before the length limit: 16 steps per segment however long
+  fixed.max_sun_step_m = 1e7;
+  ReferenceImage a, b, c;
+  const double l_default = mean_luminance(m, a), l_fine = mean_luminance(fine, b), l_fixed = mean_luminance(fixed, c);
   std::printf("sunset 64x36, 1 octave: mean luminance %.5f at %d sun steps (steps <= %.0f m), %.5f at 1024 (%+.2f %%); "
               "sun samples %llu against %llu\n",
               l_default, m.sun_steps, sun_step_limit_m(sc.grid, cloud_layer(sc.grid, ext), m), l_fine,
               100.0 * (l_default / l_fine - 1.0), static_cast<unsigned long long>(a.stats.sun_samples),
               static_cast<unsigned long long>(b.stats.sun_samples));
+  std::printf("without the length limit (16 steps per segment): mean luminance %.5f (%.1fx), sun samples %llu\n", l_fixed,
+              l_fixed / l_fine, static_cast<unsigned long long>(c.stats.sun_samples));
   ASSERT_GT(l_fine, 0.0);
   EXPECT_NEAR(l_default / l_fine, 1.0, 0.02);
+  EXPECT_GT(l_fixed / l_fine, 2.0);  // the scene does show the fault the limit removes
+}
+
+// Where the sun is high, every segment's sun_steps are already shorter than the grid's cell: the
+// image is the one without the limit, bit for bit (cumulus_field: sun 65 deg up, 3.5 km layer).
+TEST(SunSteps, AHighSunsImageIsUnchanged) {
+  const StandardScene sc = standard_scene("cumulus_field", 48, 27);
+  const GridMeanExtinction ext = grid_mean_extinction(sc.grid, sc.data);
+  MarchSettings off = sc.march;
+  off.max_sun_step_m = 1e7;
+  const ReferenceImage a = render_reference(sc.grid, ext, sc.camera, sc.sun, sc.march);
+  const ReferenceImage b = render_reference(sc.grid, ext, sc.camera, sc.sun, off);
+  ASSERT_EQ(a.radiance.size(), b.radiance.size());
+  double brightest = 0.0;
+  for (std::size_t i = 0; i < a.radiance.size(); ++i) {
+    brightest = std::max({brightest, a.radiance[i].x, a.radiance[i].y, a.radiance[i].z});
+    ASSERT_EQ(a.radiance[i], b.radiance[i]) << "pixel " << i;
+  }
+  EXPECT_GT(brightest, 0.0);  // there is cloud in the image
+  EXPECT_EQ(a.stats.sun_samples, b.stats.sun_samples);
 }
 
 }  // namespace
