@@ -35,7 +35,7 @@ struct MarchSettings {
   double view_step_m = 100.0;  // march step along view rays
   int sun_steps = 32;          // steps of the secondary march toward the sun
   // Fewer sun steps where the volume is thin: a sun segment takes only as many steps as keep each
-  // below this optical depth at the volume's largest extinction (sun_march_steps); 0: sun_steps always.
+  // below this optical depth at the volume's largest extinction (sun_march_steps); 0: no such lowering.
   double max_sun_step_optical_depth = 0.05;
   // The longest a sun step may be (m): a segment takes more than sun_steps where its steps would be
   // longer (a low sun's 200 km segments jumped over whole cumuli). 0: the grid's horizontal cell
