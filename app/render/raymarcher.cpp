@@ -22,16 +22,18 @@ void set3(GLuint p, const char* n, const glm::dvec3& v) {
 }
 }  // namespace
 
-int loop_iterations_per_view_step(const core::MarchSettings& s) {
-  const int sun = 3 + 2 * (std::max(s.sun_steps, 0) + 1);
+int loop_iterations_per_view_step(const core::MarchSettings& s, int sun_march_steps) {
+  // The sun march (cloud_sun_depth): at most sun_march_steps over both segments, never fewer than
+  // the 2 sun_steps budgeted before the length limit; 5 for the tests that end its loops.
+  const int sun = 3 + 2 + std::max(sun_march_steps, 2 * std::max(s.sun_steps, 0));
   const int air = std::max(s.atmo_sun_steps, 0) + 2;
   const int octaves = 2 * (std::max(s.octaves, 0) + 1);
   const int substeps = s.adaptive_steps ? 64 : 1;  // march_substeps divides a step at most 64 times
   return substeps * (1 + sun + air + octaves);
 }
 
-int view_steps_per_dispatch(const core::MarchSettings& s) {
-  return std::max(1, (kLlvmpipeLoopBudget - kLoopReserve) / loop_iterations_per_view_step(s));
+int view_steps_per_dispatch(const core::MarchSettings& s, int sun_march_steps) {
+  return std::max(1, (kLlvmpipeLoopBudget - kLoopReserve) / loop_iterations_per_view_step(s, sun_march_steps));
 }
 
 int max_view_steps(double r0_m, double top_m, double view_step_m) {
@@ -170,6 +172,8 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glProgramUniform1i(p, loc(p, "u_sun_steps"), s.sun_steps);
   glProgramUniform1f(p, loc(p, "u_sigma_max"), static_cast<float>(sigma_max_));
   glProgramUniform1f(p, loc(p, "u_sun_step_tau"), static_cast<float>(s.max_sun_step_optical_depth));
+  const double sun_step_max_m = core::sun_step_limit_m(grid_, layer_, s);
+  glProgramUniform1f(p, loc(p, "u_sun_step_max"), static_cast<float>(sun_step_max_m));
   glProgramUniform1i(p, loc(p, "u_octaves"), s.octaves);
   set3(p, "u_octave_abc", {s.octave_a, s.octave_b, s.octave_c});
   glProgramUniform1i(p, loc(p, "u_octave_gate"), s.octave_gate ? 1 : 0);
@@ -254,7 +258,8 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   // dispatch exceeds llvmpipe's loop budget (see loop_iterations_per_view_step).
   const double top_m = layer_.empty ? grid_.alt_m.last() : layer_.top_m;
   const int total_steps = max_view_steps(r0, top_m, s.view_step_m);
-  const int chunk = view_steps_per_dispatch(s);
+  const int chunk = view_steps_per_dispatch(
+      s, core::max_sun_march_steps(s.sun_steps, core::sun_step_limit_m(grid_, layer_, s), r0, layer_.bottom_m, top_m));
   glProgramUniform1i(p, loc(p, "u_step_count"), chunk);
   for (int row = 0; row < cam.height; row += tile) {
     const int rows = std::min(tile, cam.height - row);

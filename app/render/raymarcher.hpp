@@ -31,16 +31,17 @@ struct DispatchOptions {
 inline constexpr int kLlvmpipeLoopBudget = 65535;
 
 // An upper bound on the loop iterations one view step of raymarch.comp costs on llvmpipe: the step
-// itself, the sun march (up to two shell segments of sun_steps), the atmosphere's transmittance
+// itself, the sun march (sun_march_steps over its two shell segments: core::max_sun_march_steps,
+// at least 2 sun_steps), the atmosphere's transmittance
 // toward the sun (two loops, atmo_sun_steps in all) and the two octave sums, times the substeps a
 // step may take with adaptive steps. Every loop counts one iteration more than its trip count (the
 // test that ends it), and a loop that no lane needs still runs once (llvmpipe executes masked code).
-int loop_iterations_per_view_step(const core::MarchSettings& settings);
+int loop_iterations_per_view_step(const core::MarchSettings& settings, int sun_march_steps);
 
 // How many view steps one dispatch of the march takes: the budget, less kLoopReserve for the loops
 // outside the steps (the two shell segments, the counters), over the bound above.
 inline constexpr int kLoopReserve = 1024;
-int view_steps_per_dispatch(const core::MarchSettings& settings);
+int view_steps_per_dispatch(const core::MarchSettings& settings, int sun_march_steps);
 
 // At most how many view steps any ray takes through a cloud shell whose top is top_m above the
 // sphere of radius r0_m: a ray that stays above the ground spends at most the chord of the top

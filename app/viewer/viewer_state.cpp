@@ -33,7 +33,7 @@ bool same_camera(const std::optional<core::Camera>& a, const std::optional<core:
 }
 bool same_settings(const core::MarchSettings& a, const core::MarchSettings& b) {
   // Every setting that changes the marched image; `frame` is the accumulation's own counter.
-  return a.view_step_m == b.view_step_m && a.sun_steps == b.sun_steps && a.octaves == b.octaves && a.octave_a == b.octave_a &&
+  return a.view_step_m == b.view_step_m && a.sun_steps == b.sun_steps && a.max_sun_step_m == b.max_sun_step_m && a.octaves == b.octaves && a.octave_a == b.octave_a &&
          a.octave_b == b.octave_b && a.octave_c == b.octave_c && a.octave_gate == b.octave_gate && a.droplet_diameter_um == b.droplet_diameter_um &&
          a.liquid_phase_hg == b.liquid_phase_hg && a.ice_g == b.ice_g && a.blue_noise == b.blue_noise &&
          a.noise_amount == b.noise_amount && a.noise_scale_m == b.noise_scale_m && a.atmosphere == b.atmosphere &&

@@ -72,7 +72,8 @@ struct Medium {
     return m;
   }
   // Optical depth of the clouds from p (altitude alt_p) toward the sun (cosine mu_sun, sine nu_sun
-  // with the local up at p): sun_steps per shell segment, empty bricks jumped, stopped past
+  // with the local up at p): sun_steps per shell segment, more where the segment is long
+  // (sun_step_max_m), fewer in thin cloud (sun_march_steps), empty bricks jumped, stopped past
   // sun_tau_limit, as cloud_sun_depth in raymarch.comp. Counts into *stats.
   double sun_depth(const glm::dvec3& p, double alt_p, double mu_sun, double nu_sun, const glm::dvec3& to_sun,
                    int sun_steps) const {
@@ -80,7 +81,8 @@ struct Medium {
     const int sn = layer.empty ? 0 : p64::ray_shell_rel_nu(grid.earth_radius_m, alt_p, mu_sun, nu_sun, layer.bottom_m, layer.top_m, sseg);
     double tau = 0.0;
     int steps[2] = {0, 0};
-    for (int q = 0; q < sn; ++q) steps[q] = p64::sun_march_steps(sigma_max, sseg[2 * q + 1] - sseg[2 * q], sun_step_tau, sun_steps);
+    for (int q = 0; q < sn; ++q) steps[q] = p64::sun_march_steps(sigma_max, sseg[2 * q + 1] - sseg[2 * q], sun_step_tau, sun_steps,
+                                                         sun_step_max_m);
     for (int q = 0; q < sn; ++q) {
       const int n = steps[q];
       const double ds = (sseg[2 * q + 1] - sseg[2 * q]) / n;
@@ -123,6 +125,7 @@ struct Medium {
   bool sun_down = false;  // the whole layer is in the Earth's shadow: no sun march can find cloud
   double sigma_max = 0.0;     // the volume's largest extinction (1/m): sizes the sun marches' steps
   double sun_step_tau = 0.0;  // MarchSettings::max_sun_step_optical_depth
+  double sun_step_max_m = 0.0;  // the longest sun step (m): sun_step_limit_m of MarchSettings::max_sun_step_m
 };
 
 // The air and the ground around the clouds, as sky_and_ground in shaders/render/sky_ground.glsl:
@@ -186,6 +189,26 @@ double step_offset(const MarchSettings& s, int px, int py) {
 }
 
 }  // namespace
+
+double sun_step_limit_m(const VolumeGrid& grid, const CloudLayer& layer, const MarchSettings& settings) {
+  const glm::dvec3 start(grid.lon_deg.start, grid.lat_deg.start, grid.alt_m.start);
+  const glm::dvec3 step(grid.lon_deg.step, grid.lat_deg.step, grid.alt_m.step);
+  const glm::dvec3 count(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
+  const double floor_m = layer.empty ? grid.alt_m.start : layer.bottom_m;
+  return p64::sun_step_limit_m(settings.max_sun_step_m, start, step, count, grid.earth_radius_m + std::max(floor_m, 0.0));
+}
+
+int max_sun_march_steps(int sun_steps, double max_step_m, double r0_m, double bottom_m, double top_m) {
+  const int ss = std::max(sun_steps, 1);
+  if (!(max_step_m > 0.0)) return 2 * ss;
+  const double rb = r0_m + std::max(bottom_m, 0.0), rt = r0_m + std::max(top_m, bottom_m);
+  const double chord_m = 2.0 * std::sqrt(std::max(rt * rt - rb * rb, 0.0));
+  // Segments of lengths L0 + L1 <= chord: both at sun_steps (2 ss), one of them longer
+  // (ss + L/step + 1), or both (chord/step + 2); 2 more for float rounding on the GPU.
+  const double by_length = static_cast<double>(ss) + std::ceil(chord_m / max_step_m) + 4.0;
+  const int cap = 2 * std::max(p64::CV_SUN_SEGMENT_STEPS_MAX, ss);
+  return static_cast<int>(std::min(static_cast<double>(cap), std::max(2.0 * ss, by_length)));
+}
 
 double largest_extinction(const GridMeanExtinction& medium) {
   double m = 0.0;
@@ -314,7 +337,8 @@ ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction
                       &img.stats,
                       img.stats.sun_down,
                       largest_extinction(ext),
-                      s.max_sun_step_optical_depth};
+                      s.max_sun_step_optical_depth,
+                      sun_step_limit_m(grid, layer, s)};
   const double hb = layer.bottom_m, ht = layer.top_m;
   const glm::dvec3 o = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);
   const p64::MieParams mie = p64::mie_params(s.droplet_diameter_um);

@@ -35,8 +35,12 @@ struct MarchSettings {
   double view_step_m = 100.0;  // march step along view rays
   int sun_steps = 32;          // steps of the secondary march toward the sun
   // Fewer sun steps where the volume is thin: a sun segment takes only as many steps as keep each
-  // below this optical depth at the volume's largest extinction (sun_march_steps); 0: sun_steps always.
+  // below this optical depth at the volume's largest extinction (sun_march_steps); 0: no such lowering.
   double max_sun_step_optical_depth = 0.05;
+  // The longest a sun step may be (m): a segment takes more than sun_steps where its steps would be
+  // longer (a low sun's 200 km segments jumped over whole cumuli). 0: the grid's horizontal cell
+  // size (sun_step_limit_m in shaders/common/march_control.glsl), so no step skips a cell.
+  double max_sun_step_m = 0.0;
   int octaves = 1;             // 1 = single scattering
   double octave_a = 0.5, octave_b = 0.5, octave_c = 0.5;
   // Octave gate (shaders/common/octaves.glsl): octave i >= 1 weighted by w^i, w = 1 - exp(-tau_col)
@@ -140,6 +144,19 @@ CloudLayer cloud_layer(const VolumeGrid& grid, const GridMeanExtinction& medium)
 // The largest extinction (liquid + ice, 1/m) of any node: a bound on what sampling can return,
 // which sizes the sun marches' steps (MarchSettings::max_sun_step_optical_depth).
 double largest_extinction(const GridMeanExtinction& medium);
+
+// The longest a sun step may be (m) for this grid and layer: settings.max_sun_step_m, or where
+// that is 0 the grid's horizontal cell size at the layer's floor (sun_step_limit_m in
+// shaders/common/march_control.glsl). Both marchers take it from here, once per frame.
+double sun_step_limit_m(const VolumeGrid& grid, const CloudLayer& layer, const MarchSettings& settings);
+
+// At most how many sun steps one sun march takes over both its shell segments through the layer
+// [bottom_m, top_m] above the sphere of radius r0_m: each segment takes sun_steps or
+// ceil(length / max_step_m) (at most CV_SUN_SEGMENT_STEPS_MAX), and the two segments of a line
+// through a shell are together no longer than its chord tangent to the floor,
+// 2 sqrt(r_top^2 - r_bottom^2), so at most max(2 sun_steps, sun_steps + chord / max_step_m + 2),
+// 2 more for rounding. Sizes llvmpipe's dispatches.
+int max_sun_march_steps(int sun_steps, double max_step_m, double r0_m, double bottom_m, double top_m);
 
 // A camera's orientation in Earth-centred coordinates, and its half-width: pixel (px, py) looks
 // along forward + x right + y up with x, y in [-tan_half, tan_half] (y scaled by the aspect).

@@ -170,7 +170,7 @@ void read_march(const Reader& r, MarchSettings& m) {
           "blue_noise", "noise_amount", "noise_scale_m", "atmosphere", "globe", "ambient", "sky_steps", "atmo_sun_steps",
           "ground_albedo", "ground_texture", "skip_empty", "adaptive_steps", "max_step_optical_depth",
           "min_transmittance", "leave_out_night",
-          "max_sun_step_optical_depth"});
+          "max_sun_step_optical_depth", "max_sun_step_m"});
   r.number("view_step_m", m.view_step_m, 0.0, 1e7, "a view step in metres 0..1e7 (0: from the grid)");
   r.integer("sun_steps", m.sun_steps, 1, 1024);
   r.integer("octaves", m.octaves, 1, 16);
@@ -181,6 +181,7 @@ void read_march(const Reader& r, MarchSettings& m) {
   r.boolean("leave_out_night", m.leave_out_night);
   r.number("max_sun_step_optical_depth", m.max_sun_step_optical_depth, 0.0, 1000.0,
            "an optical depth per sun step 0..1000 (0: always sun_steps)");
+  r.number("max_sun_step_m", m.max_sun_step_m, 0.0, 1e7, "a sun step length in metres 0..1e7 (0: the grid's horizontal cell)");
   r.number("droplet_diameter_um", m.droplet_diameter_um, 0.0, 50.0, "a droplet diameter in um 0.01..50, or 0: from the data");
   if (m.droplet_diameter_um > 0.0 && m.droplet_diameter_um < 0.01) {
     r.fail("droplet_diameter_um", std::to_string(m.droplet_diameter_um), "a droplet diameter in um 0.01..50, or 0: from the data");
@@ -322,6 +323,7 @@ std::string scene_to_json(const Scene& s) {
                       {"octave_gate", m.octave_gate},
                       {"leave_out_night", m.leave_out_night},
                       {"max_sun_step_optical_depth", m.max_sun_step_optical_depth},
+                      {"max_sun_step_m", m.max_sun_step_m},
                       {"droplet_diameter_um", m.droplet_diameter_um},
                       {"liquid_phase", m.liquid_phase_hg ? "hg" : "mie"},
                       {"ice_g", m.ice_g},

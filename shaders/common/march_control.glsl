@@ -112,14 +112,43 @@ CV_FN int march_substeps(real sigma_max_per_m, real dt_m, real max_tau) {
   return int(clamp(n, real(1), real(64)));
 }
 
+// The most steps one shell segment of a sun march takes for the length limit below. 256 keeps one
+// view step within llvmpipe's loop budget even with 64 adaptive substeps, each with a full sun march
+// over two segments: 64 x (2 x 257 + the other loops' ~25) = ~34 500 of 64 511 iterations (512
+// would not fit). At 256 a grazing sun segment through a 10 km layer (~360 km) still takes 1.4 km
+// steps; loop_iterations_per_view_step (app/render/raymarcher.cpp) budgets for it.
+const int CV_SUN_SEGMENT_STEPS_MAX = 256;
+
+// The longest a sun step may be (m): setting_m where > 0, else the grid's horizontal cell size at
+// radius r_m (the layer's floor): the smaller of the latitude spacing and the longitude spacing at
+// the grid's highest |latitude|, whose cosine is floored at 0.5 (60 deg) so that a grid reaching
+// the poles, whose cells shrink to nothing there, does not send every sun march to the cap. A
+// cloud spans at least a cell (the data cannot hold less), so a step no longer than a cell cannot
+// jump over one, which a fixed count of steps along a grazing 200 km segment does.
+CV_FN real sun_step_limit_m(real setting_m, real3 start, real3 step, real3 count, real r_m) {
+  if (setting_m > real(0)) return setting_m;
+  const real kDegToRad = real(0.017453292519943295);
+  real lat_far_deg = min(max(abs(start.y), abs(start.y + (count.y - real(1)) * step.y)), real(90));
+  real lat_m = abs(step.y) * kDegToRad * r_m;
+  real lon_m = abs(step.x) * kDegToRad * r_m * max(cos(lat_far_deg * kDegToRad), real(0.5));
+  return max(min(lat_m, lon_m), real(1));
+}
+
 // Steps of a sun march over a shell segment of len_m on which no extinction exceeds sigma_max_per_m
-// (the volume's largest): enough that no step holds more than max_step_tau of optical depth, and
-// at most sun_steps. Thin cloud then pays for a few steps where the towering cell needs them all;
-// the transmittance error this adds is measured in docs/physics.md. max_step_tau <= 0: sun_steps.
-CV_FN int sun_march_steps(real sigma_max_per_m, real len_m, real max_step_tau, int sun_steps) {
-  if (!(max_step_tau > real(0))) return sun_steps;
-  real n = ceil(sigma_max_per_m * len_m / max_step_tau);
-  return int(clamp(n, real(1), real(max(sun_steps, 1))));
+// (the volume's largest): sun_steps, or more where steps of len_m / sun_steps would be longer than
+// max_step_m (a grazing sun; at most CV_SUN_SEGMENT_STEPS_MAX; max_step_m <= 0: no length limit);
+// then only as many as keep every step below max_step_tau of optical depth (thin cloud pays for a
+// few steps where the towering cell needs them all; max_step_tau <= 0: no such rule). The
+// transmittance errors are measured in docs/physics.md.
+CV_FN int sun_march_steps(real sigma_max_per_m, real len_m, real max_step_tau, int sun_steps, real max_step_m) {
+  int n = max(sun_steps, 1);
+  if (max_step_m > real(0)) {
+    real by_length = min(ceil(len_m / max_step_m), real(CV_SUN_SEGMENT_STEPS_MAX));
+    n = max(n, int(by_length));
+  }
+  if (!(max_step_tau > real(0))) return n;
+  real by_tau = ceil(sigma_max_per_m * len_m / max_step_tau);
+  return int(clamp(by_tau, real(1), real(n)));
 }
 
 // The optical depth at which a sun march may stop: beyond it every octave's exp(-a^i tau_sun) is

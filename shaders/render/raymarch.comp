@@ -52,6 +52,7 @@ uniform bool u_sun_down;      // the whole cloud layer is in the Earth's shadow 
 uniform int u_sun_steps;
 uniform float u_sigma_max;      // the volume's largest extinction, 1/m (core::largest_extinction)
 uniform float u_sun_step_tau;   // optical depth a sun step may hold at u_sigma_max (sun_march_steps)
+uniform float u_sun_step_max;   // the longest a sun step may be, m (core::sun_step_limit_m)
 uniform int u_octaves;
 uniform vec3 u_octave_abc;
 uniform bool u_octave_gate;   // weight octave i >= 1 by w^i from the column's optical depth (octaves.glsl)
@@ -272,7 +273,7 @@ bool space_at(vec3 p, float alt_m, vec3 dir, out float extent_m, out float sigma
 }
 
 // Optical depth of the clouds from p (at altitude alt_p, m) toward the sun, whose cosine and sine
-// with the local up at p are mu_sun and nu_sun: sun_steps per shell segment, empty bricks jumped,
+// with the local up at p are mu_sun and nu_sun: sun_march_steps per shell segment, empty bricks jumped,
 // stopped past u_sun_tau_limit. The shell's (at most two) segments and their steps run as one loop
 // (see space_at on loop counts). The cloud samples and the ground's shadow both use it.
 float cloud_sun_depth(vec3 p, float alt_p, float mu_sun, float nu_sun) {
@@ -281,9 +282,10 @@ float cloud_sun_depth(vec3 p, float alt_p, float mu_sun, float nu_sun) {
   float tau_sun = 0.0;
   vec4 sseg;
   int sn = u_cloudless ? 0 : ray_shell_rel_nu(u_r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
-  // Steps per segment as core/reference/raymarcher.cpp sun_depth: fewer where the volume is thin.
-  int n0 = sn > 0 ? sun_march_steps(u_sigma_max, sseg.y - sseg.x, u_sun_step_tau, u_sun_steps) : 0;
-  int n1 = sn > 1 ? sun_march_steps(u_sigma_max, sseg.w - sseg.z, u_sun_step_tau, u_sun_steps) : 0;
+  // Steps per segment as core/reference/raymarcher.cpp sun_depth: more where the segment is long
+  // (a low sun), fewer where the volume is thin.
+  int n0 = sn > 0 ? sun_march_steps(u_sigma_max, sseg.y - sseg.x, u_sun_step_tau, u_sun_steps, u_sun_step_max) : 0;
+  int n1 = sn > 1 ? sun_march_steps(u_sigma_max, sseg.w - sseg.z, u_sun_step_tau, u_sun_steps, u_sun_step_max) : 0;
   int total = n0 + n1;
   float known_end = -1.0;  // what the pyramid said holds below this distance into the segment
   for (int k = 0; k < total;) {

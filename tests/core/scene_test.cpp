@@ -50,6 +50,7 @@ Scene full_scene() {
   // The leave-out switches, off their defaults.
   s.render.march.octave_gate = false, s.render.march.leave_out_night = false;
   s.render.march.max_sun_step_optical_depth = 0.0125;
+  s.render.march.max_sun_step_m = 850.0;  // the sun step's length limit, off its default (0: the grid's cell)
   s.render.accumulate = 8, s.render.resolution_scale = 0.5, s.render.exposure = 6.25, s.render.budget_ms = 40.0;
   s.overlays = {"coastlines"};
   return s;
@@ -98,6 +99,7 @@ void expect_equal(const Scene& a, const Scene& b) {
   EXPECT_EQ(m.octave_gate, n.octave_gate);
   EXPECT_EQ(m.leave_out_night, n.leave_out_night);
   EXPECT_EQ(m.max_sun_step_optical_depth, n.max_sun_step_optical_depth);
+  EXPECT_EQ(m.max_sun_step_m, n.max_sun_step_m);
   EXPECT_EQ(a.render.accumulate, b.render.accumulate);
   EXPECT_EQ(a.render.resolution_scale, b.render.resolution_scale);
   EXPECT_EQ(a.render.exposure, b.render.exposure);
@@ -188,7 +190,10 @@ TEST(SceneJson, UnknownKeysAreNamedSoTyposAreCaught) {
             "octave_b, octave_c, octave_gate, droplet_diameter_um, liquid_phase, ice_g, frame, blue_noise, noise_amount, noise_scale_m, atmosphere, "
             "globe, ambient, sky_steps, atmo_sun_steps, ground_albedo, ground_texture, skip_empty, adaptive_steps, "
             "max_step_optical_depth, min_transmittance, leave_out_night, "
-            "max_sun_step_optical_depth");
+            "max_sun_step_optical_depth, max_sun_step_m");
+  EXPECT_EQ(error_of(R"({"version": 1, "render": {"march": {"max_sun_step_m": -1}}})"),
+            "scene.json: render.march.max_sun_step_m: found -1, expected a sun step length in metres 0..1e7 (0: the grid's "
+            "horizontal cell)");
   EXPECT_EQ(error_of(R"({"version": 1, "camra": {}})"),
             "scene.json: camra: unknown key, expected one of version, data, time_step, camera, width, height, sun, render, "
             "overlays");
