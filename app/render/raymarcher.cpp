@@ -259,7 +259,8 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   const double top_m = layer_.empty ? grid_.alt_m.last() : layer_.top_m;
   const int total_steps = max_view_steps(r0, top_m, s.view_step_m);
   const int chunk = view_steps_per_dispatch(
-      s, core::max_sun_march_steps(s.sun_steps, core::sun_step_limit_m(grid_, layer_, s), r0, layer_.bottom_m, top_m));
+      s, core::max_sun_march_steps(s.sun_steps, core::sun_step_limit_m(grid_, layer_, s), r0, layer_.bottom_m, top_m,
+                                   core::smallest_sun_cosine(grid_, to_sun)));
   glProgramUniform1i(p, loc(p, "u_step_count"), chunk);
   for (int row = 0; row < cam.height; row += tile) {
     const int rows = std::min(tile, cam.height - row);

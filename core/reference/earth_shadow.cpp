@@ -18,21 +18,64 @@ constexpr int kEdgeSamples = 2048;
 // each sample's light in float, whose positions near the Earth round to ~0.5 m and whose
 // directions to ~1e-7 rad; a layer this close to the terminator is simply marched per sample.
 constexpr double kFloatMargin = 1e-3;
+
+// The domain with the border cell the sampler fades over; false for a grid all the way round.
+struct Box {
+  double west, east, south, north;
+};
+bool domain_box(const VolumeGrid& grid, Box& b) {
+  if (grid.wraps_lon() || grid.lon_deg.count < 1 || grid.lat_deg.count < 1) return false;
+  b.west = grid.lon_deg.start - grid.lon_deg.step, b.east = grid.lon_deg.last() + grid.lon_deg.step;
+  b.south = std::max(grid.lat_deg.start - grid.lat_deg.step, -90.0);
+  b.north = std::min(grid.lat_deg.last() + grid.lat_deg.step, 90.0);
+  return b.east - b.west < 360.0;
+}
+
+// Whether a point (lat, lon in degrees) lies in the box, longitudes taken east of its west side.
+bool in_box(const Box& b, double lat_deg, double lon_deg) {
+  const double east_of_west = std::fmod(std::fmod(lon_deg - b.west, 360.0) + 360.0, 360.0);
+  return lat_deg >= b.south && lat_deg <= b.north && east_of_west <= b.east - b.west;
+}
+
+// Visits kEdgeSamples + 1 points along each side of the box; returns the longest spacing between
+// neighbours (radians of arc): a meridian step, or a step along the parallel nearest the equator.
+template <class Visit>
+double visit_boundary(const Box& b, Visit&& visit) {
+  for (int i = 0; i <= kEdgeSamples; ++i) {
+    const double f = static_cast<double>(i) / kEdgeSamples;
+    const double lon = b.west + f * (b.east - b.west), lat = b.south + f * (b.north - b.south);
+    visit(b.south, lon);
+    visit(b.north, lon);
+    visit(lat, b.west);
+    visit(lat, b.east);
+  }
+  const double equator_lat = b.south > 0.0 ? b.south : (b.north < 0.0 ? b.north : 0.0);
+  return std::max((b.north - b.south), (b.east - b.west) * std::cos(equator_lat * kDeg)) * kDeg / kEdgeSamples;
+}
+
 }  // namespace
 
+double smallest_sun_cosine(const VolumeGrid& grid, const glm::dvec3& to_sun) {
+  Box b;
+  if (!domain_box(grid, b)) return -1.0;
+  const glm::dvec3 sun = glm::normalize(to_sun);
+  // The largest angle from the subsolar point over a box lies on its boundary unless the
+  // antisolar point is inside it.
+  if (in_box(b, -std::asin(std::clamp(sun.z, -1.0, 1.0)) / kDeg, std::atan2(-sun.y, -sun.x) / kDeg)) return -1.0;
+  double largest = 0.0;
+  const double spacing = visit_boundary(b, [&](double lat_deg, double lon_deg) {
+    const glm::dvec3 u = geo::sphere_to_ecef({lat_deg, lon_deg, 0.0}, 1.0);
+    largest = std::max(largest, std::acos(std::clamp(glm::dot(u, sun), -1.0, 1.0)));
+  });
+  return std::cos(std::min(largest + spacing + kFloatMargin, kPi));
+}
+
 bool layer_in_earth_shadow(const VolumeGrid& grid, const CloudLayer& layer, const glm::dvec3& to_sun) {
-  if (layer.empty || grid.wraps_lon() || grid.lon_deg.count < 1 || grid.lat_deg.count < 1) return false;
-  // The domain with the border cell the sampler fades over.
-  const double west = grid.lon_deg.start - grid.lon_deg.step, east = grid.lon_deg.last() + grid.lon_deg.step;
-  const double south = std::max(grid.lat_deg.start - grid.lat_deg.step, -90.0);
-  const double north = std::min(grid.lat_deg.last() + grid.lat_deg.step, 90.0);
-  if (east - west >= 360.0) return false;
+  Box b;
+  if (layer.empty || !domain_box(grid, b)) return false;
   const glm::dvec3 sun = glm::normalize(to_sun);
   // The subsolar point inside the box: lit.
-  const double sun_lat = std::asin(std::clamp(sun.z, -1.0, 1.0)) / kDeg;
-  const double sun_lon = std::atan2(sun.y, sun.x) / kDeg;
-  const double sun_east = std::fmod(std::fmod(sun_lon - west, 360.0) + 360.0, 360.0);  // degrees east of the west side
-  if (sun_lat >= south && sun_lat <= north && sun_east <= east - west) return false;
+  if (in_box(b, std::asin(std::clamp(sun.z, -1.0, 1.0)) / kDeg, std::atan2(sun.y, sun.x) / kDeg)) return false;
   // In the shadow at radius r: angle from the antisolar point below asin(R / r), i.e. the angle
   // theta from the subsolar point above pi - asin(R / r). The layer's top is the hardest.
   const double r0 = grid.earth_radius_m, r = r0 + std::max(layer.top_m, 0.0);
@@ -40,21 +83,10 @@ bool layer_in_earth_shadow(const VolumeGrid& grid, const CloudLayer& layer, cons
   // The smallest angle from the subsolar point over the boundary, sampled; a point between two
   // samples is within half their spacing of one (the angle is 1-Lipschitz along the boundary).
   double smallest = kPi;
-  auto visit = [&](double lat_deg, double lon_deg) {
+  const double spacing = visit_boundary(b, [&](double lat_deg, double lon_deg) {
     const glm::dvec3 u = geo::sphere_to_ecef({lat_deg, lon_deg, 0.0}, 1.0);
     smallest = std::min(smallest, std::acos(std::clamp(glm::dot(u, sun), -1.0, 1.0)));
-  };
-  for (int i = 0; i <= kEdgeSamples; ++i) {
-    const double f = static_cast<double>(i) / kEdgeSamples;
-    const double lon = west + f * (east - west), lat = south + f * (north - south);
-    visit(south, lon);
-    visit(north, lon);
-    visit(lat, west);
-    visit(lat, east);
-  }
-  // The longest spacing: a meridian step, or a step along the parallel nearest the equator.
-  const double equator_lat = south > 0.0 ? south : (north < 0.0 ? north : 0.0);
-  const double spacing = std::max((north - south), (east - west) * std::cos(equator_lat * kDeg)) * kDeg / kEdgeSamples;
+  });
   return smallest - spacing - kFloatMargin > theta_min;
 }
 

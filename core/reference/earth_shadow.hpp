@@ -20,4 +20,11 @@ namespace cv::core {
 // densely and the result kept off the threshold by the sampling spacing plus a float margin.
 bool layer_in_earth_shadow(const VolumeGrid& grid, const CloudLayer& layer, const glm::dvec3& to_sun);
 
+// A lower bound of the cosine between the local vertical and the sun direction over the grid's
+// domain (the border cell included): the lowest the sun stands anywhere a sample can hold cloud.
+// -1 for global grids and when the antisolar point is inside the box. Sampled as above, with the
+// largest angle raised by the spacing and the float margin. Bounds the length of a sun march
+// (max_sun_march_steps), so a high sun does not size llvmpipe's dispatches for a grazing one.
+double smallest_sun_cosine(const VolumeGrid& grid, const glm::dvec3& to_sun);
+
 }  // namespace cv::core

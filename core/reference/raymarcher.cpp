@@ -198,10 +198,18 @@ double sun_step_limit_m(const VolumeGrid& grid, const CloudLayer& layer, const M
   return p64::sun_step_limit_m(settings.max_sun_step_m, start, step, count, grid.earth_radius_m + std::max(floor_m, 0.0));
 }
 
-int max_sun_march_steps(int sun_steps, double max_step_m, double r0_m, double bottom_m, double top_m) {
+int max_sun_march_steps(int sun_steps, double max_step_m, double r0_m, double bottom_m, double top_m,
+                        double mu_sun_min) {
   const int ss = std::max(sun_steps, 1);
-  if (!(max_step_m > 0.0)) return 2 * ss;
   const double rb = r0_m + std::max(bottom_m, 0.0), rt = r0_m + std::max(top_m, bottom_m);
+  if (mu_sun_min > 0.0) {
+    // One segment, up through the top; 2 more steps for float rounding on the GPU.
+    const double mu = std::min(mu_sun_min, 1.0);
+    const double len_m = -rb * mu + std::sqrt(std::max(rb * rb * mu * mu + rt * rt - rb * rb, 0.0));
+    const double steps = max_step_m > 0.0 ? std::max(static_cast<double>(ss), std::ceil(len_m / max_step_m)) : ss;
+    return static_cast<int>(std::min(steps, static_cast<double>(std::max(p64::CV_SUN_SEGMENT_STEPS_MAX, ss)))) + 2;
+  }
+  if (!(max_step_m > 0.0)) return 2 * ss;
   const double chord_m = 2.0 * std::sqrt(std::max(rt * rt - rb * rb, 0.0));
   // Segments of lengths L0 + L1 <= chord: both at sun_steps (2 ss), one of them longer
   // (ss + L/step + 1), or both (chord/step + 2); 2 more for float rounding on the GPU.

@@ -156,7 +156,12 @@ double sun_step_limit_m(const VolumeGrid& grid, const CloudLayer& layer, const M
 // through a shell are together no longer than its chord tangent to the floor,
 // 2 sqrt(r_top^2 - r_bottom^2), so at most max(2 sun_steps, sun_steps + chord / max_step_m + 2),
 // 2 more for rounding. Sizes llvmpipe's dispatches.
-int max_sun_march_steps(int sun_steps, double max_step_m, double r0_m, double bottom_m, double top_m);
+// mu_sun_min > 0 (smallest_sun_cosine in reference/earth_shadow.hpp): every sample that holds cloud
+// sees the sun at least that high, so its sun ray leaves the shell through the top in one segment
+// no longer than the path from the floor at that cosine, -rb mu + sqrt(rb^2 mu^2 + rt^2 - rb^2):
+// a high sun then sizes the dispatches for its own short marches, not for a grazing one.
+int max_sun_march_steps(int sun_steps, double max_step_m, double r0_m, double bottom_m, double top_m,
+                        double mu_sun_min = -1.0);
 
 // A camera's orientation in Earth-centred coordinates, and its half-width: pixel (px, py) looks
 // along forward + x right + y up with x, y in [-tan_half, tan_half] (y scaled by the aspect).

@@ -71,6 +71,36 @@ TEST(EarthShadow, NeverCallsALitLayerDark) {
   EXPECT_FALSE(layer_in_earth_shadow(g, CloudLayer{}, sun_at(55.0, 177.5, 180.0, 0.0)));
 }
 
+// The lowest sun over the domain bounds every point's sun cosine from below (it sizes llvmpipe's
+// dispatches for the longest sun march), stays within the sampling margin of the true lowest, and
+// is -1 where the sun can be anywhere (global grid, antisolar point inside).
+TEST(EarthShadow, TheSmallestSunCosineBoundsEveryPointOfTheDomain) {
+  VolumeGrid g;
+  g.lon_deg = {170.0, 0.5, 31};  // across the date line
+  g.lat_deg = {50.0, 0.5, 21};
+  g.alt_m = {0.0, 500.0, 25};
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (double azimuth : {0.0, 120.0, 250.0}) {
+    for (double theta : {0.0, 20.0, 60.0, 85.0, 95.0}) {
+      const glm::dvec3 sun = sun_at(55.0, 177.5, theta, azimuth);
+      const double bound = smallest_sun_cosine(g, sun);
+      double lowest = 1.0;
+      for (int n = 0; n < 20000; ++n) {
+        const double lon = 169.5 + 16.0 * u(rng), lat = 49.5 + 11.0 * u(rng);
+        const glm::dvec3 up = geo::sphere_to_ecef({lat, lon, 0.0}, 1.0);
+        lowest = std::min(lowest, glm::dot(up, sun));
+      }
+      EXPECT_LE(bound, lowest) << "theta " << theta << " azimuth " << azimuth;
+      EXPECT_GT(bound, lowest - 0.01) << "theta " << theta << " azimuth " << azimuth;
+    }
+  }
+  EXPECT_EQ(smallest_sun_cosine(g, sun_at(55.0, 177.5, 180.0, 0.0)), -1.0);  // antisolar point at the centre
+  VolumeGrid global = g;
+  global.lon_deg = {0.0, 1.0, 360};
+  EXPECT_EQ(smallest_sun_cosine(global, sun_at(55.0, 177.5, 0.0, 0.0)), -1.0);
+}
+
 TEST(EarthShadow, NightLeavesTheReferenceImageAsThePerSampleTestMadeIt) {
   StandardScene sc = standard_scene("cumulus_field", 32, 18);
   sc.sun = sun_just_down(sc);

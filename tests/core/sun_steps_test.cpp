@@ -124,6 +124,34 @@ TEST(SunSteps, TheBoundCoversEverySunMarch) {
   }
 }
 
+// With the sun at least mu_min above every sample's horizon, one segment up through the top: the
+// bound follows it and is far below the grazing (chord) bound when the sun is high.
+TEST(SunSteps, AHighSunsBoundCoversItsMarchesAndIsTighter) {
+  const double r0 = 6371000.0, hb = 500.0, ht = 4000.0, max_step = 1112.0;
+  const int sun_steps = 16;
+  const int grazing = max_sun_march_steps(sun_steps, max_step, r0, hb, ht);
+  for (double mu_min : {0.02, 0.1, 0.42, 0.9}) {
+    const int bound = max_sun_march_steps(sun_steps, max_step, r0, hb, ht, mu_min);
+    int worst = 0;
+    for (double h = hb; h <= ht; h += (ht - hb) / 16.0) {
+      for (int i = 0; i <= 4000; ++i) {
+        const double mu = mu_min + (1.0 - mu_min) * i / 4000.0, nu = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+        glm::dvec4 seg;
+        const int n = p64::ray_shell_rel_nu(r0, h, mu, nu, hb, ht, seg);
+        ASSERT_EQ(n, 1) << "a sun above the horizon leaves through the top";
+        worst = std::max(worst, p64::sun_march_steps(1.0, seg[1] - seg[0], 0.0, sun_steps, max_step));
+      }
+    }
+    std::printf("sun at least %.2f (cosine) above the horizon: the most sun steps %d, bound %d (grazing bound %d)\n", mu_min,
+                worst, bound, grazing);
+    EXPECT_LE(worst, bound);
+    EXPECT_LE(bound, worst + 3);
+    EXPECT_LE(bound, grazing);
+  }
+  // mu_min 0.42 (the sun 25 degrees up): a 3.5 km layer is at most 8.3 km long on its sun ray, 16 steps.
+  EXPECT_EQ(max_sun_march_steps(sun_steps, max_step, r0, hb, ht, 0.42), 18);
+}
+
 // The sunset scene (sun on the horizon, looking toward it): with a fixed 16 steps per segment a
 // grazing sun segment (~160 km through the 3.5 km layer) took ~10 km steps over 2 km cumuli, and the
 // single-scattered image was 29x too bright (mean luminance 0.196 against 0.00681 with 1024 steps).
