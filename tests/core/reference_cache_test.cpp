@@ -21,8 +21,18 @@ struct ReferenceCache : ::testing::Test {
   GridMeanExtinction ext = grid_mean_extinction(scene.grid, scene.data);
   MonteCarloSettings mc;
   fs::path dir = fs::temp_directory_path() / ("cv_refcache_" + std::to_string(::getpid()));
+  MonteCarloRenderer renderer{scene.grid, ext, scene.camera, scene.sun, scene.march, mc};
+  std::string path = (dir / "ref.bin").string();
+  std::uint64_t key = reference_key_hash("settings A");
   void SetUp() override { fs::create_directories(dir); }
   void TearDown() override { fs::remove_all(dir); }
+  // A reference of spp samples per pixel, written to `path` under `key`.
+  MonteCarloImage written(int spp) {
+    MonteCarloImage img = renderer.start();
+    renderer.add_samples(img, spp);
+    write_reference_cache(path, key, img);
+    return img;
+  }
 };
 
 bool same_sums(const MonteCarloImage& a, const MonteCarloImage& b) {
@@ -32,12 +42,8 @@ bool same_sums(const MonteCarloImage& a, const MonteCarloImage& b) {
 }
 
 TEST_F(ReferenceCache, AReferenceExtendedFromItsCacheEqualsOneRenderedInOneGo) {
-  const MonteCarloRenderer r(scene.grid, ext, scene.camera, scene.sun, scene.march, mc);
-  MonteCarloImage first = r.start();
-  r.add_samples(first, 3);
-  const std::string path = (dir / "ref.bin").string();
-  const std::uint64_t key = reference_key_hash("settings A");
-  write_reference_cache(path, key, first);
+  const MonteCarloImage first = written(3);
+  const MonteCarloRenderer& r = renderer;
 
   MonteCarloImage resumed;
   std::string why;
@@ -52,12 +58,7 @@ TEST_F(ReferenceCache, AReferenceExtendedFromItsCacheEqualsOneRenderedInOneGo) {
 }
 
 TEST_F(ReferenceCache, AFileOfOtherSettingsSizeOrLengthIsNotTaken) {
-  const MonteCarloRenderer r(scene.grid, ext, scene.camera, scene.sun, scene.march, mc);
-  MonteCarloImage img = r.start();
-  r.add_samples(img, 2);
-  const std::string path = (dir / "ref.bin").string();
-  const std::uint64_t key = reference_key_hash("settings A");
-  write_reference_cache(path, key, img);
+  written(2);
   MonteCarloImage out;
   std::string why;
   EXPECT_FALSE(read_reference_cache(path, reference_key_hash("settings B"), 12, 7, out, &why));
