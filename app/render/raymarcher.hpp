@@ -10,8 +10,9 @@
 
 #include <glm/vec4.hpp>
 
+#include "kernel/march_params.hpp"
+#include "kernel/prepared_volume.hpp"
 #include "reference/raymarcher.hpp"
-#include "volume/extinction_pyramid.hpp"
 #include "render/shader_loader.hpp"
 
 namespace cv::render {
@@ -58,7 +59,9 @@ class GpuRaymarcher {
   GpuRaymarcher(const GpuRaymarcher&) = delete;
   GpuRaymarcher& operator=(const GpuRaymarcher&) = delete;
 
-  // Uploads one time step (replacing the previous one).
+  // Uploads one prepared time step (replacing the previous one), keeping it for the frame's parameters.
+  void upload(std::shared_ptr<const core::PreparedVolume> volume);
+  // Prepares a time step and uploads it.
   void upload(const core::VolumeGrid& grid, const core::GridMeanExtinction& medium);
 
   // Uploads the erosion noise textures and compiles the noise variant of the raymarcher: needed
@@ -82,13 +85,12 @@ class GpuRaymarcher {
   const core::MarchStats& last_stats();
 
  private:
-  static constexpr int kStatCounters = 8;  // 64-bit counters in the Stats buffer (kStatCount in raymarch.comp)
+  static constexpr int kStatCounters = 8;  // 64-bit counters in the Stats buffer (CV_STAT_COUNT, kernel/march_stats.glsl)
   void read_stats();  // the Stats buffer into stats_
-  // The program for a march's switches (noise detail, skip_empty, adaptive_steps), compiled on
-  // first use (the noise variants need upload_noise first).
-  const GlProgram& program_for(const core::MarchSettings& s);
+  // The program of a march variant, compiled on first use (the noise variants need upload_noise first).
+  const GlProgram& program_for(const kernel::MarchVariant& v);
   const ShaderLoader& loader_;
-  std::unique_ptr<GlProgram> programs_[2][2][2][2][2];  // [noise][skip][adaptive][atmosphere][globe]
+  std::unique_ptr<GlProgram> programs_[kernel::MarchVariant::kCount];  // by MarchVariant::key
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
   GLuint column_tau_ = 0;           // vertical optical depth per column (R32F), for the octave gate
@@ -99,12 +101,10 @@ class GpuRaymarcher {
   int ground_w_ = 0, ground_h_ = 0;
   std::string ground_path_;
   GLuint pyramid_buffer_ = 0, stats_buffer_ = 0;
-  core::ExtinctionPyramid pyramid_;
-  core::CloudLayer layer_;  // the altitudes that hold cloud: the shell the march intersects
+  GLuint params_buffer_ = 0;  // the kernel's uniform block (kernel::MarchParamsStd140)
+  std::shared_ptr<const core::PreparedVolume> volume_;  // the time step uploaded
   bool stats_read_ = true;
-  double sigma_max_ = 0.0;  // the volume's largest extinction, 1/m: sizes the sun marches' steps
   bool sun_down_ = false;  // the last render left out the sun (core::layer_in_earth_shadow)
-  core::VolumeGrid grid_;
   core::MarchStats stats_;
 };
 

@@ -1,5 +1,4 @@
-// The CPU reference raymarcher: double precision, through the same physics functions
-// (shaders/common) and the same sampling of the data (volume/sampler) as the GPU will use, so
+// The CPU reference raymarcher: the GPU's march kernel (shaders/kernel) run in double precision, so
 // tests can hold the GPU image against it. Single scattering toward the sun with the
 // multiple-scattering octaves, sunlight through the atmosphere, an ambient sky term, the sky's
 // in-scatter around the clouds and the globe with the clouds' shadows.
@@ -178,10 +177,15 @@ glm::dvec3 camera_ray(const Camera& cam, int px, int py);
 // anchor (noise_anchor) for this grid, the same on the CPU and the GPU.
 glm::dvec3 grid_centre_ecef(const VolumeGrid& grid);
 
-// Renders one time step of a volume. `noise` is needed when settings.noise_amount > 0
-// (std::invalid_argument otherwise) and is not read when it is 0. The globe takes its albedo from
-// `ground` when given (the caller loads settings.ground_texture: core reads no images), else from
-// settings.ground_albedo.
+struct PreparedVolume;  // kernel/prepared_volume.hpp
+
+// Renders one time step of a volume through the march kernel (shaders/kernel/march.glsl) in
+// double. `noise` is needed when settings.noise_amount > 0 (std::invalid_argument otherwise) and is
+// not read when it is 0. The globe takes its albedo from `ground` when given (the caller loads
+// settings.ground_texture: core reads no images), else from settings.ground_albedo.
+ReferenceImage render_reference(const PreparedVolume& volume, const Camera& cam, const Sun& sun, const MarchSettings& settings,
+                                const ErosionNoise* noise = nullptr, const AlbedoMap* ground = nullptr);
+// The same, preparing the volume first (prepare_volume).
 ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction& medium, const Camera& cam, const Sun& sun,
                                 const MarchSettings& settings, const ErosionNoise* noise = nullptr,
                                 const AlbedoMap* ground = nullptr);

@@ -1,0 +1,67 @@
+// The march kernel (shaders/kernel/march.glsl) compiled as C++ in double: the CPU reference runs the
+// very code the GPU runs. Textures are small views with GLSL's texelFetch and textureSize; the
+// parameters are MarchParams' members, read by their GLSL names; the counters and the program
+// switches are members too.
+#pragma once
+
+#include <cstddef>
+
+#include <glm/glm.hpp>
+
+#include "kernel/march_params.hpp"
+#include "kernel/march_stats.glsl"
+#include "physics/physics.hpp"
+
+namespace cv::kernel {
+
+// A single-channel 3-D texture of floats, x fastest (an R32F texture on the GPU).
+struct sampler3D {
+  const float* texels = nullptr;
+  glm::ivec3 size{0};
+};
+// A 2-D texture of floats with 1 or 3 channels, x fastest, row 0 first (R32F or RGB32F on the GPU).
+struct sampler2D {
+  const float* texels = nullptr;
+  glm::ivec2 size{0};
+  int channels = 1;
+};
+// As GLSL: a missing channel reads 0, alpha 1. Indices are the kernel's to keep in range.
+inline glm::dvec4 texelFetch(const sampler3D& t, glm::ivec3 p, int) {
+  const std::size_t i = (static_cast<std::size_t>(p.z) * t.size.y + p.y) * t.size.x + p.x;
+  return glm::dvec4(t.texels[i], 0.0, 0.0, 1.0);
+}
+inline glm::dvec4 texelFetch(const sampler2D& t, glm::ivec2 p, int) {
+  const std::size_t i = (static_cast<std::size_t>(p.y) * t.size.x + p.x) * t.channels;
+  if (t.channels == 1) return glm::dvec4(t.texels[i], 0.0, 0.0, 1.0);
+  return glm::dvec4(t.texels[i], t.texels[i + 1], t.texels[i + 2], 1.0);
+}
+inline glm::ivec3 textureSize(const sampler3D& t, int) { return t.size; }
+inline glm::ivec2 textureSize(const sampler2D& t, int) { return t.size; }
+
+namespace f64 {
+using namespace cv::physics::f64;
+
+#define CV_FN inline
+#define CV_IN(T) const T&
+#define CV_OUT(T) T&
+#define CV_INOUT(T) T&
+
+struct MarchKernel : MarchParams {
+  sampler3D u_liquid, u_ice, u_noise_low, u_noise_high;
+  sampler2D u_column_tau, u_jitter_mask, u_ground;
+  const glm::vec2* u_min_max = nullptr;
+  // The program switches (compile-time constants on the GPU).
+  bool kSkipEmpty = true, kAdaptive = false, kAtmosphere = false, kGlobe = false, kNoise = false;
+
+#include "kernel/march.glsl"
+
+  uint g_stats[CV_STAT_COUNT] = {};
+};
+
+#undef CV_FN
+#undef CV_IN
+#undef CV_OUT
+#undef CV_INOUT
+
+}  // namespace f64
+}  // namespace cv::kernel

@@ -1,0 +1,41 @@
+// Packing the march parameters for the GPU, and the program variant of a march's settings.
+#include "kernel/march_params.hpp"
+
+#include "reference/raymarcher.hpp"
+
+namespace cv::kernel {
+
+namespace params {
+MarchParamsStd140 pack_std140(const MarchParams& p) {
+  MarchParamsStd140 o{};
+#define CV_PARAM(T, name) o.name = std140::Map<T>::convert(p.name);
+#define CV_PARAM_ARRAY(T, name, N) \
+  for (int i = 0; i < (N); ++i) o.name[i] = std140::Map<T>::convert(p.name[i]);
+#include "kernel/march_params.glsl"
+#undef CV_PARAM
+#undef CV_PARAM_ARRAY
+  return o;
+}
+}  // namespace params
+
+MarchVariant MarchVariant::of(const core::MarchSettings& s) {
+  MarchVariant v;
+  v.noise = s.noise_amount > 0.0;
+  v.skip_empty = s.skip_empty;
+  v.adaptive = s.adaptive_steps;
+  v.atmosphere = s.atmosphere;
+  v.globe = s.globe;
+  return v;
+}
+
+unsigned MarchVariant::key() const {
+  return (noise ? 1u : 0u) | (skip_empty ? 2u : 0u) | (adaptive ? 4u : 0u) | (atmosphere ? 8u : 0u) | (globe ? 16u : 0u);
+}
+
+std::vector<std::pair<std::string, std::string>> MarchVariant::defines() const {
+  auto b = [](bool on) { return std::string(on ? "1" : "0"); };
+  return {{"CV_NOISE", b(noise)}, {"CV_SKIP_EMPTY", b(skip_empty)}, {"CV_ADAPTIVE", b(adaptive)},
+          {"CV_ATMOSPHERE", b(atmosphere)}, {"CV_GLOBE", b(globe)}};
+}
+
+}  // namespace cv::kernel

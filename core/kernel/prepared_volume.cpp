@@ -1,0 +1,105 @@
+// Preparing a time step for the march, and the kernel's per-frame parameters.
+#include "kernel/prepared_volume.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include "geo/geodesy.hpp"
+#include "noise/noise.hpp"
+#include "physics/physics.hpp"
+#include "reference/earth_shadow.hpp"
+#include "volume/sampler.hpp"
+
+namespace cv::core {
+
+PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinction) {
+  PreparedVolume v;
+  v.grid = grid;
+  v.extinction = std::move(extinction);
+  // A field left empty is no cloud: the kernel fetches every node of both.
+  for (std::vector<float>* f : {&v.extinction.liquid_per_m, &v.extinction.ice_per_m}) {
+    if (f->empty()) f->assign(grid.points(), 0.0f);
+  }
+  const GridMeanExtinction& e = v.extinction;
+  v.layer = cloud_layer(grid, e);
+  v.sigma_max_per_m = largest_extinction(e);
+  v.wraps = grid.wraps_lon();
+  v.global_lat = VolumeSampler(grid, e.liquid_per_m).global_lat();
+  v.columns = column_depth(grid, e.liquid_per_m, e.ice_per_m);
+  v.pyramid = ExtinctionPyramid(grid, e.liquid_per_m, e.ice_per_m);
+  int offset = 0;
+  const auto& levels = v.pyramid.levels();
+  for (std::size_t l = 0; l < levels.size(); ++l) {
+    v.level_offset[l] = offset;
+    offset += static_cast<int>(levels[l].min_max.size());
+    v.pyramid_packed.insert(v.pyramid_packed.end(), levels[l].min_max.begin(), levels[l].min_max.end());
+  }
+  return v;
+}
+
+kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, const Sun& sun, const MarchSettings& s,
+                                 glm::ivec2 ground_size) {
+  const VolumeGrid& grid = v.grid;
+  const double r0 = grid.earth_radius_m;
+  const CameraFrame c = camera_frame(cam);
+  kernel::MarchParams p;
+  p.u_size = {cam.width, cam.height};
+  p.u_cam_ecef = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);
+  p.u_cam_alt = cam.alt_m;
+  p.u_cam_up = geo::sphere_enu(cam.lat_deg, cam.lon_deg).up;
+  p.u_forward = c.forward;
+  p.u_right = c.right;
+  p.u_upv = c.up;
+  p.u_tan_half = c.tan_half;
+  p.u_to_sun = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0));
+  // Night over the whole cloud layer: decided here once, in double, with a margin (earth_shadow.hpp).
+  p.u_sun_down = s.leave_out_night && layer_in_earth_shadow(grid, v.layer, p.u_to_sun);
+  p.u_irradiance = sun.irradiance;
+  p.u_r0 = r0;
+  p.u_grid_start = {grid.lon_deg.start, grid.lat_deg.start, grid.alt_m.start};
+  p.u_grid_step = {grid.lon_deg.step, grid.lat_deg.step, grid.alt_m.step};
+  p.u_grid_count = {double(grid.lon_deg.count), double(grid.lat_deg.count), double(grid.alt_m.count)};
+  p.u_wraps = v.wraps;
+  p.u_global_lat = v.global_lat;
+  p.u_view_step = s.view_step_m;
+  p.u_layer = {v.layer.bottom_m, v.layer.top_m};
+  p.u_cloudless = v.layer.empty;
+  p.u_sun_steps = s.sun_steps;
+  p.u_sigma_max = v.sigma_max_per_m;
+  p.u_sun_step_tau = s.max_sun_step_optical_depth;
+  p.u_sun_step_max = sun_step_limit_m(grid, v.layer, s);
+  p.u_octaves = s.octaves;
+  p.u_octave_abc = {s.octave_a, s.octave_b, s.octave_c};
+  p.u_octave_gate = s.octave_gate;
+  p.u_droplet_um = s.droplet_diameter_um;
+  p.u_liquid_phase_hg = s.liquid_phase_hg;
+  p.u_ice_g = s.ice_g;
+  p.u_frame = s.frame;
+  p.u_blue_noise = s.blue_noise;
+  if (s.noise_amount > 0.0) {
+    const NoiseAnchor a = noise_anchor(grid_centre_ecef(grid), s.noise_scale_m);
+    p.u_noise_anchor = a.ecef_m;  // float-exact by construction
+    p.u_noise_anchor_frac = a.frac;
+    p.u_noise_period = s.noise_scale_m;
+    p.u_noise_amount = s.noise_amount;
+  }
+  p.u_ambient = s.ambient;
+  p.u_sky_steps = s.sky_steps;
+  p.u_atmo_sun_steps = s.atmo_sun_steps;
+  p.u_ground_albedo = s.ground_albedo;
+  p.u_ground_size = ground_size;
+  p.u_max_step_tau = s.max_step_optical_depth;
+  p.u_min_t = s.min_transmittance;
+  // Float's largest finite value bounds it, so the GPU's copy is never Inf.
+  p.u_sun_tau_limit = std::min(3.0e38, physics::f64::sun_march_tau_limit(s.octaves, s.octave_a, s.min_transmittance));
+  const auto& levels = v.pyramid.levels();
+  p.u_levels = static_cast<int>(levels.size());
+  for (std::size_t l = 0; l < levels.size(); ++l) {
+    p.u_bricks[l] = {levels[l].nx, levels[l].ny, levels[l].nz, 0};
+    p.u_level_nodes[static_cast<int>(l)] = levels[l].nodes;
+    p.u_level_offset[static_cast<int>(l)] = v.level_offset[l];
+  }
+  return p;
+}
+
+}  // namespace cv::core

@@ -1,0 +1,16 @@
+// Binding points of the march's textures, images and buffers, named once for GLSL and C++
+// (app/render/raymarcher.cpp binds by these names). Texture units, image units, uniform and
+// storage buffer bindings are separate name spaces in OpenGL.
+#define CV_TEX_LIQUID 1
+#define CV_TEX_ICE 2
+#define CV_TEX_NOISE_LOW 3
+#define CV_TEX_NOISE_HIGH 4
+#define CV_TEX_GROUND 5
+#define CV_TEX_JITTER_MASK 6
+#define CV_TEX_COLUMN_TAU 7
+#define CV_IMAGE_OUT 0
+#define CV_IMAGE_STATE_L 6
+#define CV_IMAGE_STATE_DEPTH 7
+#define CV_SSBO_PYRAMID 3
+#define CV_SSBO_STATS 4
+#define CV_UBO_MARCH 0

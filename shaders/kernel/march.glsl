@@ -1,0 +1,501 @@
+// The march kernel, written once in the shared dialect: the GPU driver (shaders/render/raymarch.comp)
+// runs it in float, the CPU reference (core/kernel/march_kernel.hpp) in double. It reads the medium
+// through typed volumes (a sampler3D in GLSL; a small C++ class with the same texelFetch), walks the
+// extinction pyramid, marches toward the sun, sums the sample source and advances the view march as
+// a state, then composites sky and ground. The parameters are shaders/kernel/march_params.glsl.
+//
+// What the including side declares before this file: the parameters (u_*), the textures u_liquid,
+// u_ice (sampler3D, grid-mean extinction 1/m), u_column_tau, u_jitter_mask, u_ground (sampler2D),
+// u_noise_low, u_noise_high (sampler3D), the pyramid u_min_max (vec2 per brick, levels one after
+// the other), the counters g_stats[CV_STAT_COUNT] (uint, indices in march_stats.glsl) and the switches kSkipEmpty, kAdaptive,
+// kAtmosphere, kGlobe and kNoise (compile-time constants on the GPU, where llvmpipe runs both sides
+// of a branch under masks; plain members in C++).
+//
+// Loops are shaped for Mesa's llvmpipe: all loops of one invocation share a budget of 65 535
+// iterations (LP_MAX_TGSI_LOOP_ITERATIONS in gallivm), after which every loop runs its body once
+// and stops, silently. So the pyramid's levels and a cell's 8 nodes are written out, a view march
+// takes one loop iteration per sample (substeps included), and the march advances over a range of
+// steps (march_advance) that the GPU driver sizes to fit a dispatch (app/render/raymarcher.cpp).
+
+#define CV_KDEG real(0.017453292519943295)
+
+// Trilinear over texel centres: no data reads as 0, and so do the border nodes (index -1 or n) a
+// regional grid fades into.
+CV_FN real node(sampler3D tex, int x, int y, int z) {
+  ivec3 n = ivec3(u_grid_count);
+  return x < 0 || x >= n.x || y < 0 || y >= n.y ? real(0.0) : real(texelFetch(tex, ivec3(x, y, z), 0).r);
+}
+
+CV_FN real fetch(sampler3D tex, real3 f) {
+  ivec3 n = ivec3(u_grid_count);
+  real wx;
+  real wy;
+  real wz;
+  int x0 = volume_fetch_index(f.x, n.x, wx);
+  int y0 = volume_fetch_index(f.y, n.y, wy);
+  int z0 = volume_fetch_index(f.z, n.z, wz);
+  int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
+  int y1 = y0 + 1;
+  int z1 = min(z0 + 1, n.z - 1);
+  real c00 = mix(node(tex, x0, y0, z0), node(tex, x1, y0, z0), wx);
+  real c10 = mix(node(tex, x0, y1, z0), node(tex, x1, y1, z0), wx);
+  real c01 = mix(node(tex, x0, y0, z1), node(tex, x1, y0, z1), wx);
+  real c11 = mix(node(tex, x0, y1, z1), node(tex, x1, y1, z1), wx);
+  return mix(mix(c00, c10, wy), mix(c01, c11, wy), wz);
+}
+
+// Trilinear with wrap-around over a periodic noise tile (x, then y, then z).
+CV_FN real fetch_noise(sampler3D tex, real3 t) {
+  int n = textureSize(tex, 0).x;
+  ivec3 i0;
+  ivec3 i1;
+  real3 w;
+  noise_texel_pair(t.x, n, i0.x, i1.x, w.x);
+  noise_texel_pair(t.y, n, i0.y, i1.y, w.y);
+  noise_texel_pair(t.z, n, i0.z, i1.z, w.z);
+  real c00 = mix(real(texelFetch(tex, ivec3(i0.x, i0.y, i0.z), 0).r), real(texelFetch(tex, ivec3(i1.x, i0.y, i0.z), 0).r), w.x);
+  real c10 = mix(real(texelFetch(tex, ivec3(i0.x, i1.y, i0.z), 0).r), real(texelFetch(tex, ivec3(i1.x, i1.y, i0.z), 0).r), w.x);
+  real c01 = mix(real(texelFetch(tex, ivec3(i0.x, i0.y, i1.z), 0).r), real(texelFetch(tex, ivec3(i1.x, i0.y, i1.z), 0).r), w.x);
+  real c11 = mix(real(texelFetch(tex, ivec3(i0.x, i1.y, i1.z), 0).r), real(texelFetch(tex, ivec3(i1.x, i1.y, i1.z), 0).r), w.x);
+  return mix(mix(c00, c10, w.y), mix(c01, c11, w.y), w.z);
+}
+
+// Sub-grid erosion (shaders/common/erosion.glsl) of both extinctions at p.
+CV_FN void erode_at(real3 p, CV_INOUT(real) sl, CV_INOUT(real) si) {
+  real3 t = noise_tile_coords(p - u_noise_anchor, u_noise_anchor_frac, u_noise_period);
+  real e = erosion_threshold(fetch_noise(u_noise_low, t), fetch_noise(u_noise_high, noise_high_coords(t)), u_noise_amount);
+  real feature_m = noise_feature_m(u_noise_period);
+  sl = erode_extinction(sl, e, feature_m);
+  si = erode_extinction(si, e, feature_m);
+}
+
+// The column's vertical optical depth at p, bilinear with the 3-D fetch's horizontal rules (wrap,
+// pole clamp, regional border 0), from the prepared volume's column map.
+CV_FN real column_tau(real3 p) {
+  real3 g = ecef_to_sphere(p, u_r0);
+  real3 f;
+  if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, u_grid_start.z, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return real(0.0);
+  ivec2 n = ivec2(u_grid_count);
+  real wx;
+  real wy;
+  int x0 = volume_fetch_index(f.x, n.x, wx);
+  int y0 = volume_fetch_index(f.y, n.y, wy);
+  int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
+  int y1 = y0 + 1;
+  real c00 = x0 < 0 || x0 >= n.x || y0 < 0 || y0 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x0, y0), 0).r);
+  real c10 = x1 < 0 || x1 >= n.x || y0 < 0 || y0 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x1, y0), 0).r);
+  real c01 = x0 < 0 || x0 >= n.x || y1 < 0 || y1 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x0, y1), 0).r);
+  real c11 = x1 < 0 || x1 >= n.x || y1 < 0 || y1 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x1, y1), 0).r);
+  return mix(mix(c00, c10, wx), mix(c01, c11, wx), wy);
+}
+
+CV_FN real node_sum(int x, int y, int z) { return node(u_liquid, x, y, z) + node(u_ice, x, y, z); }
+
+// The largest extinction (1/m, liquid + ice) that trilinear sampling can return in the grid cell
+// around p (altitude alt_m): the largest of the 8 nodes fetch reads there; 0 outside the grid.
+CV_FN real cell_max(real3 p, real alt_m) {
+  real3 g = ecef_to_sphere(p, u_r0);
+  real3 f;
+  if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return real(0.0);
+  ivec3 n = ivec3(u_grid_count);
+  real w;
+  int x0 = volume_fetch_index(f.x, n.x, w);
+  int y0 = volume_fetch_index(f.y, n.y, w);
+  int z0 = volume_fetch_index(f.z, n.z, w);
+  int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
+  int y1 = y0 + 1;
+  int z1 = min(z0 + 1, n.z - 1);
+  // Written out, not looped (llvmpipe's loop budget).
+  real m = max(max(node_sum(x0, y0, z0), node_sum(x1, y0, z0)), max(node_sum(x0, y1, z0), node_sum(x1, y1, z0)));
+  m = max(m, max(max(node_sum(x0, y0, z1), node_sum(x1, y0, z1)), max(node_sum(x0, y1, z1), node_sum(x1, y1, z1))));
+  return m;
+}
+
+// The medium at Earth-centred point p whose altitude alt_m the caller knows better than |p| - r0
+// (ray_altitude): latitude and longitude come from p. Eroded by the noise where it is on.
+CV_FN void medium_at(real3 p, real alt_m, CV_OUT(real) sl, CV_OUT(real) si) {
+  sl = real(0.0);
+  si = real(0.0);
+  real3 g = ecef_to_sphere(p, u_r0);
+  real3 f;
+  if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
+  sl = fetch(u_liquid, f);
+  si = fetch(u_ice, f);
+  if (kNoise && sl + si > real(0.0)) erode_at(p, sl, si);
+}
+
+// One level of the pyramid at grid index g (see space_at): true when its brick there is empty, with
+// the distance the ray may jump; else the brick's largest extinction, and the distance it holds.
+CV_FN bool level_empty(int l, real3 g, real lat, real r, real mu_up, CV_OUT(real) extent_m, CV_OUT(real) brick_max) {
+  real3 nb = real3(u_bricks[l]);
+  real nodes = real(u_level_nodes[l]);
+  real3 b = march_brick(g, nodes);
+  extent_m = march_brick_exit_m(lat, r, mu_up, g, b, nodes, nb, u_grid_start, u_grid_step, u_global_lat, u_r0);
+  brick_max = real(0.0);
+  if (march_brick_inside(b, nb)) {
+    ivec3 bi = ivec3(b);
+    brick_max = real(u_min_max[u_level_offset[l] + (bi.z * u_bricks[l].y + bi.y) * u_bricks[l].x + bi.x].y);
+  }
+  return !(brick_max > real(0.0));
+}
+
+// What a ray along dir learns about the space around p, at altitude alt_m: true when empty, with
+// the distance (m) it may jump; else the finest brick's largest extinction (1/m) and the distance
+// over which that holds. The levels are visited without a loop (llvmpipe's loop budget: this runs
+// inside both marches).
+CV_FN bool space_at(real3 p, real alt_m, real3 dir, CV_OUT(real) extent_m, CV_OUT(real) sigma_max) {
+  extent_m = real(0.0);
+  sigma_max = real(0.0);
+  if (u_levels <= 0) return false;
+  real3 g3 = ecef_to_sphere(p, u_r0);
+  real lat = g3.x / CV_KDEG;
+  real r = u_r0 + alt_m;
+  real mu_up = dot(dir, p) / length(p);
+  real3 g = march_grid_index(lat, g3.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat);
+  real unused;
+  if (u_levels > 3 && level_empty(3, g, lat, r, mu_up, extent_m, unused)) return true;
+  if (u_levels > 2 && level_empty(2, g, lat, r, mu_up, extent_m, unused)) return true;
+  if (u_levels > 1 && level_empty(1, g, lat, r, mu_up, extent_m, unused)) return true;
+  return level_empty(0, g, lat, r, mu_up, extent_m, sigma_max);
+}
+
+// Optical depth of the clouds from p (at altitude alt_p, m) toward the sun, whose cosine and sine
+// with the local up at p are mu_sun and nu_sun: sun_march_steps per shell segment (more where the
+// segment is long, a low sun; fewer where the volume is thin), empty bricks jumped, stopped past
+// u_sun_tau_limit. The shell's (at most two) segments and their steps run as one loop. The cloud
+// samples and the ground's shadow both use it.
+CV_FN real cloud_sun_depth(real3 p, real alt_p, real mu_sun, real nu_sun) {
+  real hb = u_layer.x;
+  real ht = u_layer.y;
+  real tau_sun = real(0.0);
+  real4 sseg;
+  int sn = u_cloudless ? 0 : ray_shell_rel_nu(u_r0, alt_p, mu_sun, nu_sun, hb, ht, sseg);
+  int n0 = sn > 0 ? sun_march_steps(u_sigma_max, sseg.y - sseg.x, u_sun_step_tau, u_sun_steps, u_sun_step_max) : 0;
+  int n1 = sn > 1 ? sun_march_steps(u_sigma_max, sseg.w - sseg.z, u_sun_step_tau, u_sun_steps, u_sun_step_max) : 0;
+  int total = n0 + n1;
+  real known_end = real(-1.0);  // what the pyramid said holds below this distance into the segment
+  for (int k = 0; k < total;) {
+    int q = k < n0 ? 0 : 1;
+    int nq = q == 0 ? n0 : n1;
+    int j = q == 0 ? k : k - n0;
+    if (j == 0) known_end = real(-1.0);
+    real s0 = q == 0 ? sseg.x : sseg.z;
+    real s1 = q == 0 ? sseg.y : sseg.w;
+    real ds = (s1 - s0) / real(nq);
+    real t_rel = (real(j) + real(0.5)) * ds;
+    real3 ps = p + (s0 + t_rel) * u_to_sun;
+    real alt_s = ray_altitude(u_r0, alt_p, mu_sun, s0 + t_rel);
+    if (kSkipEmpty && !(t_rel < known_end)) {
+      real extent;
+      real smax;
+      if (space_at(ps, alt_s, u_to_sun, extent, smax)) {
+        int next = min(march_resume_index(j, extent, ds), nq);
+        g_stats[CV_STAT_SUN_SKIPPED] += uint(next - j);
+        g_stats[CV_STAT_BRICKS_JUMPED] += next - j > 1 ? 1u : 0u;
+        k += next - j;
+        continue;
+      }
+      known_end = t_rel + extent;
+    }
+    real a;
+    real b;
+    medium_at(ps, alt_s, a, b);
+    tau_sun += (a + b) * ds;
+    g_stats[CV_STAT_SUN_SAMPLES] += 1u;
+    ++k;
+    if (tau_sun > u_sun_tau_limit) {
+      g_stats[CV_STAT_SUN_SKIPPED] += uint(total - k);
+      break;
+    }
+  }
+  return tau_sun;
+}
+
+// A view march's progress: the radiance gathered and the view transmittance so far, where the
+// light was taken out of the view (depth_w, depth_t: the cloud's mean depth for the air around
+// it), whether it has ended, and the next view step (counted over both shell segments).
+struct MarchState {
+  real3 radiance;
+  real t_view;
+  real depth_w;
+  real depth_t;
+  bool ended;
+  int next_step;
+};
+
+// One view sample at p (altitude alt_p, distance t along the ray) standing for a step of ds:
+// in-scattered light (sun through the air, ambient sky light) and attenuation.
+CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real mu, MieParams mie, CV_INOUT(MarchState) s) {
+  real sl;
+  real si;
+  medium_at(p, alt_p, sl, si);
+  g_stats[CV_STAT_VIEW_SAMPLES] += 1u;
+  real sigma = sl + si;
+  if (sigma <= real(0.0)) return;
+  real3 up_p = normalize(p);
+  real mu_sun = dot(u_to_sun, up_p);
+  real nu_sun = length(cross(u_to_sun, up_p));
+  real e0;
+  real e1;
+  bool lit = !u_sun_down && !(ray_sphere_rel_nu(u_r0, alt_p, mu_sun, nu_sun, real(0.0), e0, e1) && e1 > real(0.0));
+  real tau_sun = lit ? cloud_sun_depth(p, alt_p, mu_sun, nu_sun) : real(0.0);
+  // Sunlight reaches the sample through the air (reddened when low), and the sky lights it too:
+  // isotropic irradiance E_sky scattered as sigma_s E_sky / (2 pi) (docs/physics.md).
+  real3 sun_air = kAtmosphere && lit ? atmo_transmittance(u_r0, alt_p, mu_sun, nu_sun, u_atmo_sun_steps) : real3(1.0);
+  real3 ambient = kAtmosphere ? u_ambient * sky_irradiance(sun_air, mu_sun) * (sigma / CV_TWO_PI) : real3(0.0);
+  // The octave sums of both phases (clouds do not absorb), only where the sun shines (llvmpipe runs
+  // masked code: a ternary would not save them).
+  real scatter = real(0.0);
+  if (lit) {
+    // The octave gate (octaves.glsl): w from the column's optical depth; off, the classic sum.
+    bool gate = u_octave_gate && u_octaves > 1;
+    real w = gate ? octave_gate_weight(column_tau(p)) : real(1.0);
+    real tol = gate ? CV_OCTAVE_GATE_TOL : real(0.0);
+    real3 abc = u_octave_abc;
+    g_stats[CV_STAT_OCTAVE_TERMS] += uint(octave_terms(u_octaves, abc.y, w, tol));
+    g_stats[CV_STAT_OCTAVE_TERMS_FULL] += uint(max(u_octaves, 0));
+    real liquid = u_liquid_phase_hg ? ms_octaves_hg_gated(sl, mu, mie_mean_cosine(mie), tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol)
+                                    : ms_octaves_mie_gated(sl, mu, mie, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
+    scatter = liquid + ms_octaves_hg_gated(si, mu, u_ice_g, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
+  }
+  s.radiance += s.t_view * segment_integral(u_irradiance * (sun_air * scatter + ambient), sigma, ds);
+  // The light the step takes out of the view, t_view (1 - exp(-sigma ds)), without the cancellation
+  // of t_view - t_next: in float that is a multiple of 6e-8, which left faint cloud with a mean
+  // depth tens of kilometres off.
+  real taken = s.t_view * segment_integral(sigma, sigma, ds);
+  s.depth_w += taken;
+  s.depth_t += taken * t;
+  s.t_view *= transmittance(sigma * ds);
+}
+
+// Where in its step a pixel's view samples lie (0..1): step middles without a frame, else the
+// frame's jitter from the blue-noise mask (or the white-noise hash).
+CV_FN real step_offset(ivec2 px) {
+  if (u_frame < 0) return real(0.5);
+  if (!u_blue_noise) return step_jitter(uint(px.x), uint(px.y), uint(u_frame));
+  ivec2 n = textureSize(u_jitter_mask, 0);
+  return blue_noise_jitter(real(texelFetch(u_jitter_mask, px % n, 0).r), uint(u_frame));
+}
+
+// A pixel's view ray, from the camera or, for a camera above the cloud shell, from where the ray
+// enters it, placed on the exact sphere: positions near the Earth keep their digits (at 4e8 m a
+// float position is +-32 m), and nu = |d x up| keeps near-nadir and near-tangent rays right where
+// mu rounds to +-1.
+struct MarchRay {
+  real3 d;
+  real3 origin;
+  real h;
+  real mu_up;
+  real nu_up;
+  int n;         // shell segments the ray crosses (0: it misses the shell, or nothing holds cloud)
+  real4 seg;     // their (entry, exit) distances from origin
+  real t_ground; // where the ground ends the ray (3e38: never)
+};
+
+CV_FN real3 pixel_direction(ivec2 px) {
+  real x = (real(2.0) * (real(px.x) + real(0.5)) / real(u_size.x) - real(1.0)) * u_tan_half;
+  real y = (real(1.0) - real(2.0) * (real(px.y) + real(0.5)) / real(u_size.y)) * u_tan_half * real(u_size.y) / real(u_size.x);
+  return normalize(u_forward + x * u_right + y * u_upv);
+}
+
+CV_FN MarchRay march_ray(ivec2 px) {
+  MarchRay r;
+  r.d = pixel_direction(px);
+  real ht = u_layer.y;
+  r.origin = u_cam_ecef;
+  r.h = u_cam_alt;
+  real3 up = u_cam_up;
+  r.mu_up = dot(r.d, up);
+  r.nu_up = length(cross(r.d, up));
+  bool in_shell = true;  // false: the ray misses the cloud shell (the sky may still show)
+  if (r.h > ht) {
+    real e0;
+    real e1;
+    if (!ray_sphere_rel_nu(u_r0, r.h, r.mu_up, r.nu_up, ht, e0, e1) || e1 < real(0.0)) {
+      in_shell = false;
+    } else if (e0 > real(0.0)) {
+      r.origin = normalize(r.origin + e0 * r.d) * (u_r0 + ht);
+      r.h = ht;
+      up = normalize(r.origin);
+      r.mu_up = dot(r.d, up);
+      r.nu_up = length(cross(r.d, up));
+    }
+  }
+  r.n = in_shell && !u_cloudless ? ray_shell_rel_nu(u_r0, r.h, r.mu_up, r.nu_up, u_layer.x, ht, r.seg) : 0;
+  real tg0;
+  real tg1;
+  r.t_ground = ray_sphere_rel_nu(u_r0, r.h, r.mu_up, r.nu_up, real(0.0), tg0, tg1) && tg1 > real(0.0) ? max(tg0, real(0.0)) : real(3.0e38);
+  return r;
+}
+
+CV_FN MarchState march_start() {
+  MarchState s;
+  s.radiance = real3(0.0);
+  s.t_view = real(1.0);
+  s.depth_w = real(0.0);
+  s.depth_t = real(0.0);
+  s.ended = false;
+  s.next_step = 0;
+  return s;
+}
+
+// Advances the view march of ray r (pixel px) over the view steps [step_begin, step_begin +
+// step_count), counted over both shell segments; a jump over an empty brick may carry past the
+// range's end, and the next range starts there. The march ends when the view transmittance falls
+// below u_min_t or the range reaches past the last step. The first range counts a ray that never
+// crosses the shell.
+CV_FN void march_advance(MarchRay r, ivec2 px, int step_begin, int step_count, CV_INOUT(MarchState) s) {
+  // Sunlight propagates along -to_sun and leaves toward the camera along -d: the scattering cosine
+  // between the two propagation directions is dot(d, to_sun).
+  real mu = dot(r.d, u_to_sun);
+  MieParams mie = mie_params(u_droplet_um);
+  int next_step = max(step_begin, s.next_step);
+  int range_end = step_begin + step_count;
+  int base = 0;  // steps of the segments before segment k
+  bool crossed = false;
+  for (int k = 0; k < (s.ended ? 0 : r.n) && s.t_view > u_min_t; ++k) {
+    real t_start = k == 0 ? r.seg.x : r.seg.z;
+    real t_end = min(k == 0 ? r.seg.y : r.seg.w, r.t_ground);
+    if (!(t_end > t_start)) continue;
+    crossed = true;
+    int steps = max(1, int(ceil((t_end - t_start) / u_view_step)));
+    real dt = (t_end - t_start) / real(steps);
+    real offset = step_offset(px);
+    int i_end = min(range_end - base, steps);
+    int i = max(next_step - base, 0);
+    base += steps;
+    if (i >= i_end) continue;
+    // What the pyramid said about the brick ahead: valid for sample distances below known_end.
+    real known_end = real(-1.0);
+    real sigma_max = real(0.0);
+    // One loop iteration per sample, substeps included: sample j of the substeps of step i.
+    int j = 0;
+    int substeps = 1;
+    while (i < i_end && s.t_view > u_min_t) {
+      if (j == 0) {
+        real t_rel = (real(i) + offset) * dt;
+        if ((kSkipEmpty || kAdaptive) && !(t_rel < known_end)) {
+          real extent;
+          real t_q = t_start + t_rel;
+          bool empty = space_at(r.origin + t_q * r.d, ray_altitude(u_r0, r.h, r.mu_up, t_q), r.d, extent, sigma_max);
+          if (empty && kSkipEmpty) {
+            int next = march_resume_index(i, extent, dt);
+            g_stats[CV_STAT_VIEW_SKIPPED] += uint(min(next, steps) - i);
+            g_stats[CV_STAT_BRICKS_JUMPED] += next - i > 1 ? 1u : 0u;
+            i = next;
+            next_step = base - steps + min(next, steps);  // where the march goes on, maybe in a later range
+            continue;
+          }
+          known_end = t_rel + extent;
+        }
+        substeps = 1;
+        if (kAdaptive && march_substeps(sigma_max, dt, u_max_step_tau) > 1) {
+          // The brick's bound is loose (a brick spans 4 cells and more): bound the step by the
+          // cells at its two ends instead, so only steps near thick cloud are divided.
+          real ta = t_start + real(i) * dt;
+          real tb = t_start + real(i + 1) * dt;
+          real bound = max(cell_max(r.origin + ta * r.d, ray_altitude(u_r0, r.h, r.mu_up, ta)),
+                           cell_max(r.origin + tb * r.d, ray_altitude(u_r0, r.h, r.mu_up, tb)));
+          substeps = march_substeps(bound, dt, u_max_step_tau);
+        }
+      }
+      real ds = dt / real(substeps);
+      real t = t_start + (real(i) + (real(j) + offset) / real(substeps)) * dt;
+      march_sample(r.origin + t * r.d, ray_altitude(u_r0, r.h, r.mu_up, t), t, ds, mu, mie, s);
+      if (++j == substeps) {
+        j = 0;
+        ++i;
+        next_step = base - steps + i;
+      }
+    }
+  }
+  if (step_begin == 0) g_stats[CV_STAT_RAYS_MISSED] += crossed ? 0u : 1u;
+  s.ended = !(s.t_view > u_min_t) || s.ended || range_end >= base;
+  s.next_step = next_step;
+}
+
+// Linear albedo at a ground point, bilinear over texel centres.
+CV_FN real3 ground_albedo_at(real lat_rad, real lon_rad) {
+  if (u_ground_size.x <= 0) return u_ground_albedo;
+  real4 c = equirect_texel(lat_rad, lon_rad, u_ground_size.x, u_ground_size.y);
+  int x0 = int(c.x);
+  int y0 = int(c.y);
+  int x1 = (x0 + 1) % u_ground_size.x;
+  int y1 = min(y0 + 1, u_ground_size.y - 1);
+  real3 a = mix(real3(texelFetch(u_ground, ivec2(x0, y0), 0)), real3(texelFetch(u_ground, ivec2(x1, y0), 0)), c.z);
+  real3 b = mix(real3(texelFetch(u_ground, ivec2(x0, y1), 0)), real3(texelFetch(u_ground, ivec2(x1, y1), 0)), c.z);
+  return mix(a, b, c.w);
+}
+
+// Radiance and alpha of a pixel whose view ray d carries cloud radiance cloud_l and cloud
+// transmittance cloud_t, the cloud (when has_cloud) standing at p_cloud for the air:
+// sky in front + T (cloud + cloud_t (sky behind + T ground)). Alpha: 0 where the globe shows,
+// else the cloud's times the air's (green) transmittance, for the background behind.
+CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, bool has_cloud, real3 p_cloud) {
+  real top = CV_ATMO_TOP_M;
+  // The air's own frame: a camera above the atmosphere starts from where its ray enters it, on the
+  // exact sphere (as march_ray).
+  real3 o = u_cam_ecef;
+  real h = u_cam_alt;
+  real3 up = u_cam_up;
+  real mu = dot(d, up);
+  real nu = length(cross(d, up));
+  real a0;
+  real a1;
+  if (!ray_sphere_rel_nu(u_r0, h, mu, nu, top, a0, a1) || a1 < real(0.0)) return real4(cloud_l, cloud_t);
+  if (h > top && a0 > real(0.0)) {
+    o = normalize(o + a0 * d) * (u_r0 + top);
+    h = top;
+    up = normalize(o);
+    mu = dot(d, up);
+    nu = length(cross(d, up));
+    ray_sphere_rel_nu(u_r0, h, mu, nu, top, a0, a1);
+  }
+  real g0;
+  real g1;
+  bool hits_ground = ray_sphere_rel_nu(u_r0, h, mu, nu, real(0.0), g0, g1) && g1 > real(0.0);
+  real t_end = hits_ground ? max(g0, real(0.0)) : a1;
+  real t_cloud = has_cloud ? clamp(dot(p_cloud - o, d), real(0.0), t_end) : t_end;
+  real3 sky_front = real3(0.0);
+  real3 sky_back = real3(0.0);
+  real3 tr_front = real3(1.0);
+  real3 tr_back = real3(1.0);
+  if (kAtmosphere) {
+    real mu_s = dot(u_to_sun, up);
+    real nu_vs = dot(d, u_to_sun);
+    sky_front = u_irradiance * atmo_inscatter(u_r0, h, mu, mu_s, nu_vs, real(0.0), t_cloud, u_sky_steps, u_atmo_sun_steps, tr_front);
+    if (t_end > t_cloud) {
+      sky_back = u_irradiance * atmo_inscatter(u_r0, h, mu, mu_s, nu_vs, t_cloud, t_end, u_sky_steps, u_atmo_sun_steps, tr_back);
+    }
+  }
+  real3 ground = real3(0.0);
+  bool globe = hits_ground && kGlobe;
+  if (globe) {
+    real3 pg = normalize(o + t_end * d) * u_r0;
+    real3 n = normalize(pg);
+    real mu_sg = dot(u_to_sun, n);
+    real nu_sg = length(cross(u_to_sun, n));
+    real3 sun_air = real3(mu_sg > real(0.0) ? real(1.0) : real(0.0));
+    real3 e_sky = real3(0.0);
+    if (kAtmosphere) {
+      sun_air = atmo_transmittance(u_r0, real(0.0), mu_sg, nu_sg, u_atmo_sun_steps);
+      e_sky = sky_irradiance(sun_air, mu_sg);
+    }
+    // The clouds' shadow: the same sun march the cloud samples use. With the whole layer in the
+    // Earth's shadow no sunlit ray crosses cloud: left out (u_sun_down).
+    real shadow = mu_sg > real(0.0) ? (u_sun_down ? real(1.0) : transmittance(cloud_sun_depth(pg, real(0.0), mu_sg, nu_sg))) : real(0.0);
+    real3 ll = ecef_to_sphere(pg, u_r0);
+    ground = u_irradiance * ground_radiance(ground_albedo_at(ll.x, ll.y), mu_sg, sun_air * shadow, e_sky);
+  }
+  real3 l = sky_front + tr_front * (cloud_l + cloud_t * (sky_back + tr_back * ground));
+  return real4(l, globe ? real(0.0) : cloud_t * tr_front.y * tr_back.y);
+}
+
+// The pixel's radiance (rgb) and alpha once its march has ended: the march's own where the scene
+// has neither air nor globe, else the air and the ground composited around it, the cloud standing
+// for the air at the mean depth of the light it takes out.
+CV_FN real4 march_finish(MarchRay r, MarchState s) {
+  if (!(kAtmosphere || kGlobe)) return real4(s.radiance, s.t_view);
+  real3 p_cloud = r.origin + (s.depth_w > real(0.0) ? s.depth_t / s.depth_w : real(0.0)) * r.d;
+  return sky_and_ground(r.d, s.radiance, s.t_view, s.depth_w > real(1e-6), p_cloud);
+}

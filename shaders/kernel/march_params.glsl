@@ -1,0 +1,54 @@
+// The march kernel's parameters, one line each: CV_PARAM(type, name) in the shared dialect's types.
+// Included three times: as the members of the GLSL uniform block (shaders/render/raymarch.comp), as
+// the double-precision members of the C++ kernel (core/kernel/march_kernel.hpp), and as the float
+// std140 struct the host uploads (core/kernel/march_params.hpp, its layout checked there). The
+// order is the std140 packing: each vec3 is followed by a scalar that fills its fourth slot.
+// Everything here is per frame; nothing per dispatch (the driver's own uniforms hold that).
+CV_PARAM(real3, u_cam_ecef)          // metres (float: 0.5 m near the Earth, +-32 m at 4e8 m; rays re-anchor)
+CV_PARAM(real, u_cam_alt)            // metres, from double on the CPU
+CV_PARAM(real3, u_cam_up)            // local vertical at the camera
+CV_PARAM(real, u_tan_half)           // of the horizontal field of view
+CV_PARAM(real3, u_forward)
+CV_PARAM(real, u_r0)                 // the sphere's radius, m
+CV_PARAM(real3, u_right)
+CV_PARAM(real, u_view_step)          // view step, m
+CV_PARAM(real3, u_upv)
+CV_PARAM(real, u_sigma_max)          // the volume's largest extinction, 1/m (PreparedVolume)
+CV_PARAM(real3, u_to_sun)
+CV_PARAM(real, u_sun_step_tau)       // optical depth a sun step may hold at u_sigma_max (sun_march_steps)
+CV_PARAM(real3, u_irradiance)
+CV_PARAM(real, u_sun_step_max)       // the longest a sun step may be, m (core::sun_step_limit_m)
+CV_PARAM(real3, u_grid_start)        // (lon deg, lat deg, alt m)
+CV_PARAM(real, u_max_step_tau)       // optical depth a view substep may hold (adaptive steps)
+CV_PARAM(real3, u_grid_step)
+CV_PARAM(real, u_min_t)              // view rays stop below this transmittance
+CV_PARAM(real3, u_grid_count)
+CV_PARAM(real, u_sun_tau_limit)      // sun marches stop past this optical depth (sun_march_tau_limit)
+CV_PARAM(real3, u_octave_abc)
+CV_PARAM(real, u_droplet_um)
+CV_PARAM(real3, u_ground_albedo)     // linear, when there is no ground texture
+CV_PARAM(real, u_ice_g)
+CV_PARAM(real3, u_noise_anchor)      // metres, Earth-centred, a float-exact point near the data
+CV_PARAM(real, u_noise_period)       // metres, the low-frequency tile
+CV_PARAM(real3, u_noise_anchor_frac) // the anchor's position in tiles, from double on the CPU
+CV_PARAM(real, u_noise_amount)
+CV_PARAM(real2, u_layer)             // altitudes (m) between which the data holds cloud (CloudLayer)
+CV_PARAM(ivec2, u_size)              // image size, pixels
+CV_PARAM(ivec2, u_ground_size)       // of the albedo texture; (0, 0): constant albedo
+CV_PARAM(real, u_ambient)            // strength of the isotropic sky light on clouds
+CV_PARAM(int, u_sun_steps)
+CV_PARAM(int, u_octaves)
+CV_PARAM(int, u_frame)               // -1: step middles; else the accumulation frame whose jitter places the samples
+CV_PARAM(int, u_sky_steps)           // steps of a sky in-scatter integral
+CV_PARAM(int, u_atmo_sun_steps)      // steps of an atmospheric transmittance toward the sun
+CV_PARAM(int, u_levels)              // pyramid levels, 0: no pyramid
+CV_PARAM(bool, u_wraps)
+CV_PARAM(bool, u_global_lat)
+CV_PARAM(bool, u_cloudless)          // no cloud anywhere: nothing to march
+CV_PARAM(bool, u_sun_down)           // the whole cloud layer is in the Earth's shadow (layer_in_earth_shadow)
+CV_PARAM(bool, u_octave_gate)        // weight octave i >= 1 by w^i from the column's optical depth
+CV_PARAM(bool, u_liquid_phase_hg)    // Henyey-Greenstein with the Mie fit's mean cosine instead of the fit
+CV_PARAM(bool, u_blue_noise)         // the jitter from the blue-noise mask, else the hash
+CV_PARAM(ivec4, u_level_nodes)       // grid nodes per brick side, finest level first
+CV_PARAM(ivec4, u_level_offset)      // first brick of each level in u_min_max
+CV_PARAM_ARRAY(ivec4, u_bricks, 4)   // bricks per axis (xyz), finest level first
