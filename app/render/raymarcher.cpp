@@ -59,6 +59,7 @@ const GlProgram& GpuRaymarcher::program_for(const kernel::MarchVariant& v) {
 
 GpuRaymarcher::~GpuRaymarcher() {
   if (textures_[0]) glDeleteTextures(2, textures_);
+  if (state_[0]) glDeleteTextures(4, state_);
   if (ground_) glDeleteTextures(1, &ground_);
   if (jitter_mask_) glDeleteTextures(1, &jitter_mask_);
   if (column_tau_) glDeleteTextures(1, &column_tau_);
@@ -129,7 +130,7 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
 }
 
 void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
-                                const DispatchOptions& dispatch) {
+                                const DispatchOptions& dispatch, const OpaqueInput& opaque) {
   if (!volume_) throw GlError("render needs upload() first");
   const bool noise = s.noise_amount > 0.0;
   if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
@@ -152,8 +153,10 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
     ground_path_ = s.ground_texture;
   }
   // The kernel's parameters, built as the CPU kernel builds them, packed into the uniform block.
-  const kernel::MarchParams params =
+  kernel::MarchParams params =
       core::march_params(v, cam, sun, s, textured ? glm::ivec2(ground_w_, ground_h_) : glm::ivec2(0));
+  params.u_has_depth = opaque.depth != 0;
+  params.u_has_opaque_color = opaque.depth != 0 && opaque.color != 0;
   const kernel::MarchParamsStd140 block = kernel::pack_std140(params);
   if (!params_buffer_) {
     glCreateBuffers(1, &params_buffer_);
@@ -177,15 +180,22 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PYRAMID, pyramid_buffer_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_STATS, stats_buffer_);
   if (!state_[0] || state_w_ != cam.width || state_h_ != cam.height) {
-    if (state_[0]) glDeleteTextures(2, state_);
-    glCreateTextures(GL_TEXTURE_2D, 2, state_);
-    for (GLuint t : state_) glTextureStorage2D(t, 1, GL_RGBA32F, cam.width, cam.height);
+    if (state_[0]) glDeleteTextures(4, state_);
+    glCreateTextures(GL_TEXTURE_2D, 4, state_);
+    glTextureStorage2D(state_[0], 1, GL_RGBA32F, cam.width, cam.height);
+    glTextureStorage2D(state_[1], 1, GL_RGBA32F, cam.width, cam.height);
+    glTextureStorage2D(state_[2], 1, GL_R32F, cam.width, cam.height);
+    glTextureStorage2D(state_[3], 1, GL_R32F, cam.width, cam.height);  // the cloud depth, kept after the frame
     state_w_ = cam.width;
     state_h_ = cam.height;
   }
   glBindImageTexture(CV_IMAGE_OUT, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glBindImageTexture(CV_IMAGE_STATE_L, state_[0], 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(CV_IMAGE_STATE_DEPTH, state_[1], 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  glBindImageTexture(CV_IMAGE_STATE_HALF, state_[2], 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+  glBindImageTexture(CV_IMAGE_CLOUD_DEPTH, state_[3], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glBindTextureUnit(CV_TEX_DEPTH, opaque.depth);
+  glBindTextureUnit(CV_TEX_OPAQUE, opaque.color);
   glBindTextureUnit(CV_TEX_LIQUID, textures_[0]);
   glBindTextureUnit(CV_TEX_ICE, textures_[1]);
   glBindTextureUnit(CV_TEX_GROUND, ground_);
@@ -256,8 +266,16 @@ const core::MarchStats& GpuRaymarcher::last_stats() {
   return stats_;
 }
 
+std::vector<float> GpuRaymarcher::read_cloud_depth() const {
+  std::vector<float> depth(static_cast<std::size_t>(state_w_) * state_h_);
+  if (state_[3]) {
+    glGetTextureImage(state_[3], 0, GL_RED, GL_FLOAT, static_cast<GLsizei>(depth.size() * sizeof(float)), depth.data());
+  }
+  return depth;
+}
+
 std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
-                                             const DispatchOptions& dispatch) {
+                                             const DispatchOptions& dispatch, const OpaqueInput& opaque) {
   // The read-back takes its byte count as a GLsizei.
   if (static_cast<double>(cam.width) * cam.height * sizeof(glm::vec4) >= 2147483647.0) {
     throw GlError("an image of " + std::to_string(cam.width) + " x " + std::to_string(cam.height) +
@@ -266,7 +284,7 @@ std::vector<glm::vec4> GpuRaymarcher::render(const core::Camera& cam, const core
   GLuint out = 0;
   glCreateTextures(GL_TEXTURE_2D, 1, &out);
   glTextureStorage2D(out, 1, GL_RGBA32F, cam.width, cam.height);
-  render_into(out, cam, sun, s, dispatch);
+  render_into(out, cam, sun, s, dispatch, opaque);
   std::vector<glm::vec4> pixels(static_cast<std::size_t>(cam.width) * cam.height);
   glGetTextureImage(out, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(pixels.size() * sizeof(glm::vec4)), pixels.data());
   glDeleteTextures(1, &out);

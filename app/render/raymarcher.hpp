@@ -26,6 +26,16 @@ struct DispatchOptions {
   double* gpu_seconds = nullptr;  // if set, the dispatches' GPU time (GL_TIME_ELAPSED queries) is added
 };
 
+// Opaque geometry drawn by another pass, for the march to stop at (shaders/kernel/march.glsl): an
+// R32F texture of the image's size holding the distance (m) from the camera along each pixel's ray
+// (0: none there), and optionally an RGBA32F texture of the geometry's radiance, which the march then
+// composites behind the clouds and the air (alpha 0); without it alpha is the transmittance in front
+// of the geometry, for the caller to composite. 0: no such texture.
+struct OpaqueInput {
+  GLuint depth = 0;
+  GLuint color = 0;
+};
+
 // Mesa's llvmpipe lets the loops of one shader invocation run 65 535 iterations in all
 // (LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop and never reset); past it, each loop runs its
 // body once and stops, without an error. Other drivers have no such limit.
@@ -73,12 +83,18 @@ class GpuRaymarcher {
   // bound. With settings.globe and a ground_texture, the image is loaded (once per path) with
   // load_albedo_map; a file that cannot be read throws std::runtime_error.
   std::vector<glm::vec4> render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings,
-                                const DispatchOptions& dispatch = {});
+                                const DispatchOptions& dispatch = {}, const OpaqueInput& opaque = {});
 
   // Renders into `out`, an RGBA32F 2-D texture of at least cam.width x cam.height that stays on
   // the GPU (the viewer draws and accumulates it there; nothing is read back).
   void render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings,
-                   const DispatchOptions& dispatch = {});
+                   const DispatchOptions& dispatch = {}, const OpaqueInput& opaque = {});
+
+  // The last frame's cloud depth, for later passes: an R32F texture of its size holding the distance
+  // (m) from the camera at which the view transmittance fell to 0.5 (3e38 where it never did).
+  GLuint cloud_depth_texture() const { return state_[3]; }
+  // The same, read back (rows top to bottom).
+  std::vector<float> read_cloud_depth() const;
 
   // What the last march did (view and sun samples, what was skipped, octave terms); waits for it to
   // finish.
@@ -96,7 +112,9 @@ class GpuRaymarcher {
   GLuint column_tau_ = 0;           // vertical optical depth per column (R32F), for the octave gate
   GLuint jitter_mask_ = 0;          // the blue-noise mask (R32F), uploaded at construction
   GLuint ground_ = 0;               // linear albedo (RGB32F), loaded from ground_path_
-  GLuint state_[2] = {0, 0};        // the march's state between dispatches (RGBA32F, image-sized)
+  // The march's state between dispatches (image-sized: two RGBA32F, one R32F) and the cloud depth it
+  // writes (R32F).
+  GLuint state_[4] = {0, 0, 0, 0};
   int state_w_ = 0, state_h_ = 0;
   int ground_w_ = 0, ground_h_ = 0;
   std::string ground_path_;

@@ -19,7 +19,7 @@ struct sampler3D {
   const float* texels = nullptr;
   glm::ivec3 size{0};
 };
-// A 2-D texture of floats with 1 or 3 channels, x fastest, row 0 first (R32F or RGB32F on the GPU).
+// A 2-D texture of floats with 1, 3 or 4 channels, x fastest, row 0 first (R32F, RGB32F or RGBA32F).
 struct sampler2D {
   const float* texels = nullptr;
   glm::ivec2 size{0};
@@ -33,7 +33,8 @@ inline glm::dvec4 texelFetch(const sampler3D& t, glm::ivec3 p, int) {
 inline glm::dvec4 texelFetch(const sampler2D& t, glm::ivec2 p, int) {
   const std::size_t i = (static_cast<std::size_t>(p.y) * t.size.x + p.x) * t.channels;
   if (t.channels == 1) return glm::dvec4(t.texels[i], 0.0, 0.0, 1.0);
-  return glm::dvec4(t.texels[i], t.texels[i + 1], t.texels[i + 2], 1.0);
+  if (t.channels == 3) return glm::dvec4(t.texels[i], t.texels[i + 1], t.texels[i + 2], 1.0);
+  return glm::dvec4(t.texels[i], t.texels[i + 1], t.texels[i + 2], t.texels[i + 3]);
 }
 inline glm::ivec3 textureSize(const sampler3D& t, int) { return t.size; }
 inline glm::ivec2 textureSize(const sampler2D& t, int) { return t.size; }
@@ -48,7 +49,7 @@ using namespace cv::physics::f64;
 
 struct MarchKernel : MarchParams {
   sampler3D u_liquid, u_ice, u_noise_low, u_noise_high;
-  sampler2D u_column_tau, u_jitter_mask, u_ground;
+  sampler2D u_column_tau, u_jitter_mask, u_ground, u_depth, u_opaque;
   const glm::vec2* u_min_max = nullptr;
   // The program switches (compile-time constants on the GPU).
   bool kSkipEmpty = true, kAdaptive = false, kAtmosphere = false, kGlobe = false, kNoise = false;

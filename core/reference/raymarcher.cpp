@@ -134,6 +134,34 @@ glm::dvec3 camera_ray(const Camera& cam, int px, int py) {
   return glm::normalize(c.forward + x * c.right + y * c.up);
 }
 
+glm::dvec3 camera_ecef(const Camera& cam, double r0_m) {
+  return geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0_m);
+}
+
+glm::dmat4 camera_view_matrix(const Camera& cam) {
+  const CameraFrame c = camera_frame(cam);
+  // Rows: right, up, -forward (glm is column-major: m[column][row]).
+  glm::dmat4 m(1.0);
+  for (int i = 0; i < 3; ++i) {
+    m[i][0] = c.right[i];
+    m[i][1] = c.up[i];
+    m[i][2] = -c.forward[i];
+  }
+  return m;
+}
+
+glm::dmat4 camera_projection_matrix(const Camera& cam, double near_m, double far_m) {
+  const CameraFrame c = camera_frame(cam);
+  const double aspect = static_cast<double>(cam.height) / cam.width;
+  glm::dmat4 m(0.0);
+  m[0][0] = 1.0 / c.tan_half;
+  m[1][1] = -1.0 / (c.tan_half * aspect);  // row 0 at the top
+  m[2][2] = -(far_m + near_m) / (far_m - near_m);
+  m[2][3] = -1.0;
+  m[3][2] = -2.0 * far_m * near_m / (far_m - near_m);
+  return m;
+}
+
 glm::dvec3 grid_centre_ecef(const VolumeGrid& grid) {
   const double lat = grid.lat_deg.start + 0.5 * (grid.lat_deg.last() - grid.lat_deg.start);
   const double lon = grid.lon_deg.start + 0.5 * (grid.lon_deg.last() - grid.lon_deg.start);
@@ -141,7 +169,11 @@ glm::dvec3 grid_centre_ecef(const VolumeGrid& grid) {
 }
 
 ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, const Sun& sun, const MarchSettings& s,
-                                const ErosionNoise* noise, const AlbedoMap* ground_map) {
+                                const ErosionNoise* noise, const AlbedoMap* ground_map, const OpaqueLayer* opaque) {
+  const std::size_t pixels = static_cast<std::size_t>(cam.width) * cam.height;
+  if (opaque && (opaque->distance_m.size() != pixels || (!opaque->radiance_rgba.empty() && opaque->radiance_rgba.size() != 4 * pixels))) {
+    throw std::invalid_argument("render_reference: the opaque layer is not of the image's size");
+  }
   const bool eroded = s.noise_amount > 0.0;
   if (eroded && !noise) throw std::invalid_argument("render_reference: noise_amount > 0 needs the erosion noise textures");
   if (eroded && !(s.noise_scale_m > 0.0)) throw std::invalid_argument("render_reference: noise_scale_m must be > 0");
@@ -162,6 +194,12 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
     k.u_noise_high = {noise->high.texels.data(), glm::ivec3(noise->high.n)};
   }
   k.u_min_max = v.pyramid_packed.data();
+  if (opaque) {
+    k.u_has_depth = true;
+    k.u_depth = {opaque->distance_m.data(), {cam.width, cam.height}, 1};
+    k.u_has_opaque_color = !opaque->radiance_rgba.empty();
+    if (k.u_has_opaque_color) k.u_opaque = {opaque->radiance_rgba.data(), {cam.width, cam.height}, 4};
+  }
   k.kSkipEmpty = s.skip_empty;
   k.kAdaptive = s.adaptive_steps;
   k.kAtmosphere = s.atmosphere;
@@ -173,6 +211,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   img.height = cam.height;
   img.radiance.assign(static_cast<std::size_t>(cam.width) * cam.height, glm::dvec3(0.0));
   img.transmittance.assign(img.radiance.size(), 1.0);
+  img.cloud_depth_m.assign(img.radiance.size(), 3.0e38);
   img.stats.sun_down = k.u_sun_down;
   // Rows in stripes over the cores, each with its own copy of the kernel (its counters); the image
   // does not depend on the thread count.
@@ -188,10 +227,11 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
         const auto ray = kt.march_ray(pixel);
         auto state = kt.march_start();
         kt.march_advance(ray, pixel, 0, std::numeric_limits<int>::max(), state);
-        const glm::dvec4 out = kt.march_finish(ray, state);
+        const glm::dvec4 out = kt.march_finish(ray, pixel, state);
         const std::size_t idx = static_cast<std::size_t>(py) * cam.width + px;
         img.radiance[idx] = glm::dvec3(out);
         img.transmittance[idx] = out.w;
+        img.cloud_depth_m[idx] = state.t_half;
         for (int i = 0; i < CV_STAT_COUNT; ++i) c[i] += kt.g_stats[i], kt.g_stats[i] = 0;
       }
     }

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
 #include "noise/noise.hpp"
@@ -114,7 +115,17 @@ struct ReferenceImage {
   int width = 0, height = 0;
   std::vector<glm::dvec3> radiance;    // scattered toward the camera, per pixel
   std::vector<double> transmittance;   // of the view ray through the clouds (and air); 0 on the globe
+  // The distance (m) from the camera at which the view transmittance fell to 0.5 (3e38: never).
+  std::vector<double> cloud_depth_m;
   MarchStats stats;
+};
+
+// Opaque geometry for the march to stop at, per pixel (rows top to bottom): the distance (m) from
+// the camera along the pixel's ray (0: none there) and, optionally, the geometry's radiance (see
+// render::OpaqueInput: composited behind the clouds when given, else alpha is the transmittance).
+struct OpaqueLayer {
+  std::vector<float> distance_m;
+  std::vector<float> radiance_rgba;  // 4 floats per pixel, or empty
 };
 
 // The renderer's medium: grid-box-mean extinction (cloud fraction x in-cloud extinction) of
@@ -173,6 +184,18 @@ CameraFrame camera_frame(const Camera& cam);
 // The direction of a pixel's ray in Earth-centred coordinates.
 glm::dvec3 camera_ray(const Camera& cam, int px, int py);
 
+// Matrices for geometry that other passes draw with the clouds, camera-relative: a vertex is given
+// as its Earth-centred position minus camera_ecef, formed in double (float then keeps its digits at
+// any distance). The view matrix turns such an offset into eye space (x right, y up, looking down
+// -z); the projection maps eye space to OpenGL clip space so that a point on the ray of pixel
+// (px, py) lands on that pixel's centre in the renderer's row order (row 0 at the top, as every image
+// the march writes: y is flipped against OpenGL's window rows, so front faces wind clockwise), with
+// depth from near_m to far_m. The march's depth input is the distance along the ray, which a
+// fragment shader takes as the length of the camera-relative position.
+glm::dvec3 camera_ecef(const Camera& cam, double r0_m);
+glm::dmat4 camera_view_matrix(const Camera& cam);
+glm::dmat4 camera_projection_matrix(const Camera& cam, double near_m, double far_m);
+
 // The centre of a volume on the sphere (altitude 0), Earth-centred, metres: the erosion noise's
 // anchor (noise_anchor) for this grid, the same on the CPU and the GPU.
 glm::dvec3 grid_centre_ecef(const VolumeGrid& grid);
@@ -184,7 +207,8 @@ struct PreparedVolume;  // kernel/prepared_volume.hpp
 // not read when it is 0. The globe takes its albedo from `ground` when given (the caller loads
 // settings.ground_texture: core reads no images), else from settings.ground_albedo.
 ReferenceImage render_reference(const PreparedVolume& volume, const Camera& cam, const Sun& sun, const MarchSettings& settings,
-                                const ErosionNoise* noise = nullptr, const AlbedoMap* ground = nullptr);
+                                const ErosionNoise* noise = nullptr, const AlbedoMap* ground = nullptr,
+                                const OpaqueLayer* opaque = nullptr);
 // The same, preparing the volume first (prepare_volume).
 ReferenceImage render_reference(const VolumeGrid& grid, const GridMeanExtinction& medium, const Camera& cam, const Sun& sun,
                                 const MarchSettings& settings, const ErosionNoise* noise = nullptr,

@@ -8,9 +8,13 @@
 #define CV_TEX_GROUND 5
 #define CV_TEX_JITTER_MASK 6
 #define CV_TEX_COLUMN_TAU 7
+#define CV_TEX_DEPTH 8
+#define CV_TEX_OPAQUE 9
 #define CV_IMAGE_OUT 0
 #define CV_IMAGE_STATE_L 6
 #define CV_IMAGE_STATE_DEPTH 7
+#define CV_IMAGE_STATE_HALF 5
+#define CV_IMAGE_CLOUD_DEPTH 4
 #define CV_SSBO_PYRAMID 3
 #define CV_SSBO_STATS 4
 #define CV_UBO_MARCH 0

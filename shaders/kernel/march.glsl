@@ -5,7 +5,8 @@
 // a state, then composites sky and ground. The parameters are shaders/kernel/march_params.glsl.
 //
 // What the including side declares before this file: the parameters (u_*), the textures u_liquid,
-// u_ice (sampler3D, grid-mean extinction 1/m), u_column_tau, u_jitter_mask, u_ground (sampler2D),
+// u_ice (sampler3D, grid-mean extinction 1/m), u_column_tau, u_jitter_mask, u_ground, u_depth (the
+// distance to opaque geometry per pixel, m), u_opaque (that geometry's radiance) (sampler2D),
 // u_noise_low, u_noise_high (sampler3D), the pyramid u_min_max (vec2 per brick, levels one after
 // the other), the counters g_stats[CV_STAT_COUNT] (uint, indices in march_stats.glsl) and the switches kSkipEmpty, kAdaptive,
 // kAtmosphere, kGlobe and kNoise (compile-time constants on the GPU, where llvmpipe runs both sides
@@ -221,11 +222,14 @@ struct MarchState {
   real depth_t;
   bool ended;
   int next_step;
+  real t_half;  // distance from the camera where the view transmittance fell to 0.5 (3e38: never)
 };
 
-// One view sample at p (altitude alt_p, distance t along the ray) standing for a step of ds:
-// in-scattered light (sun through the air, ambient sky light) and attenuation.
-CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real mu, MieParams mie, CV_INOUT(MarchState) s) {
+// One view sample at p (altitude alt_p, distance t along the ray) standing for a step of ds that
+// begins t_entry from the camera: in-scattered light (sun through the air, ambient sky light),
+// attenuation, and where the view transmittance falls to 0.5 (exactly, for the step's constant
+// extinction).
+CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real mu, MieParams mie, CV_INOUT(MarchState) s) {
   real sl;
   real si;
   medium_at(p, alt_p, sl, si);
@@ -265,7 +269,9 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real mu, MieParams
   real taken = s.t_view * segment_integral(sigma, sigma, ds);
   s.depth_w += taken;
   s.depth_t += taken * t;
+  real t_before = s.t_view;
   s.t_view *= transmittance(sigma * ds);
+  if (t_before > real(0.5) && !(s.t_view > real(0.5))) s.t_half = t_entry + min(log(real(2.0) * t_before) / sigma, ds);
 }
 
 // Where in its step a pixel's view samples lie (0..1): step middles without a frame, else the
@@ -289,8 +295,18 @@ struct MarchRay {
   real nu_up;
   int n;         // shell segments the ray crosses (0: it misses the shell, or nothing holds cloud)
   real4 seg;     // their (entry, exit) distances from origin
-  real t_ground; // where the ground ends the ray (3e38: never)
+  real t_ground; // where the ground or opaque geometry ends the ray, from origin (3e38: never)
+  real t_offset; // the distance from the camera to origin
+  real t_opaque; // the distance from the camera to opaque geometry (the depth input; 3e38: none)
 };
+
+// The depth input at a pixel: the distance (m) from the camera along its ray to opaque geometry
+// drawn by another pass; 0 or less, or no depth input, is none.
+CV_FN real opaque_distance(ivec2 px) {
+  if (!u_has_depth) return real(3.0e38);
+  real t = real(texelFetch(u_depth, px, 0).r);
+  return t > real(0.0) ? t : real(3.0e38);
+}
 
 CV_FN real3 pixel_direction(ivec2 px) {
   real x = (real(2.0) * (real(px.x) + real(0.5)) / real(u_size.x) - real(1.0)) * u_tan_half;
@@ -304,6 +320,8 @@ CV_FN MarchRay march_ray(ivec2 px) {
   real ht = u_layer.y;
   r.origin = u_cam_ecef;
   r.h = u_cam_alt;
+  r.t_offset = real(0.0);
+  r.t_opaque = opaque_distance(px);
   real3 up = u_cam_up;
   r.mu_up = dot(r.d, up);
   r.nu_up = length(cross(r.d, up));
@@ -315,6 +333,7 @@ CV_FN MarchRay march_ray(ivec2 px) {
       in_shell = false;
     } else if (e0 > real(0.0)) {
       r.origin = normalize(r.origin + e0 * r.d) * (u_r0 + ht);
+      r.t_offset = e0;
       r.h = ht;
       up = normalize(r.origin);
       r.mu_up = dot(r.d, up);
@@ -325,6 +344,8 @@ CV_FN MarchRay march_ray(ivec2 px) {
   real tg0;
   real tg1;
   r.t_ground = ray_sphere_rel_nu(u_r0, r.h, r.mu_up, r.nu_up, real(0.0), tg0, tg1) && tg1 > real(0.0) ? max(tg0, real(0.0)) : real(3.0e38);
+  // Opaque geometry stops the march where it stands.
+  r.t_ground = min(r.t_ground, r.t_opaque - r.t_offset);
   return r;
 }
 
@@ -336,6 +357,7 @@ CV_FN MarchState march_start() {
   s.depth_t = real(0.0);
   s.ended = false;
   s.next_step = 0;
+  s.t_half = real(3.0e38);
   return s;
 }
 
@@ -401,7 +423,7 @@ CV_FN void march_advance(MarchRay r, ivec2 px, int step_begin, int step_count, C
       }
       real ds = dt / real(substeps);
       real t = t_start + (real(i) + (real(j) + offset) / real(substeps)) * dt;
-      march_sample(r.origin + t * r.d, ray_altitude(u_r0, r.h, r.mu_up, t), t, ds, mu, mie, s);
+      march_sample(r.origin + t * r.d, ray_altitude(u_r0, r.h, r.mu_up, t), t, ds, r.t_offset + t - offset * ds, mu, mie, s);
       if (++j == substeps) {
         j = 0;
         ++i;
@@ -427,11 +449,20 @@ CV_FN real3 ground_albedo_at(real lat_rad, real lon_rad) {
   return mix(a, b, c.w);
 }
 
+// Radiance l with transmittance t in front of the opaque geometry (when opaque): with the
+// geometry's radiance given (u_has_opaque_color), composited behind and alpha 0; else alpha is the
+// transmittance, for the pass that draws the geometry to composite it (l + alpha geometry).
+CV_FN real4 over_opaque(real3 l, real t, bool opaque, real3 opaque_l) {
+  return opaque && u_has_opaque_color ? real4(l + t * opaque_l, real(0.0)) : real4(l, t);
+}
+
 // Radiance and alpha of a pixel whose view ray d carries cloud radiance cloud_l and cloud
 // transmittance cloud_t, the cloud (when has_cloud) standing at p_cloud for the air:
-// sky in front + T (cloud + cloud_t (sky behind + T ground)). Alpha: 0 where the globe shows,
-// else the cloud's times the air's (green) transmittance, for the background behind.
-CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, bool has_cloud, real3 p_cloud) {
+// sky in front + T (cloud + cloud_t (sky behind + T ground)), the ground replaced by opaque
+// geometry t_opaque from the camera where that is nearer (radiance opaque_l, see over_opaque).
+// Alpha: 0 where the globe shows, else the cloud's times the air's (green) transmittance, for the
+// background behind.
+CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, bool has_cloud, real3 p_cloud, real t_opaque, real3 opaque_l) {
   real top = CV_ATMO_TOP_M;
   // The air's own frame: a camera above the atmosphere starts from where its ray enters it, on the
   // exact sphere (as march_ray).
@@ -442,8 +473,10 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, bool has_cloud,
   real nu = length(cross(d, up));
   real a0;
   real a1;
-  if (!ray_sphere_rel_nu(u_r0, h, mu, nu, top, a0, a1) || a1 < real(0.0)) return real4(cloud_l, cloud_t);
+  if (!ray_sphere_rel_nu(u_r0, h, mu, nu, top, a0, a1) || a1 < real(0.0)) return over_opaque(cloud_l, cloud_t, t_opaque < real(3.0e38), opaque_l);
+  real t_air0 = real(0.0);  // the distance from the camera to o
   if (h > top && a0 > real(0.0)) {
+    t_air0 = a0;
     o = normalize(o + a0 * d) * (u_r0 + top);
     h = top;
     up = normalize(o);
@@ -455,6 +488,9 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, bool has_cloud,
   real g1;
   bool hits_ground = ray_sphere_rel_nu(u_r0, h, mu, nu, real(0.0), g0, g1) && g1 > real(0.0);
   real t_end = hits_ground ? max(g0, real(0.0)) : a1;
+  // Opaque geometry nearer than the ground or the top of the air ends the ray there.
+  bool opaque = t_opaque - t_air0 < t_end;
+  if (opaque) t_end = max(t_opaque - t_air0, real(0.0));
   real t_cloud = has_cloud ? clamp(dot(p_cloud - o, d), real(0.0), t_end) : t_end;
   real3 sky_front = real3(0.0);
   real3 sky_back = real3(0.0);
@@ -469,7 +505,7 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, bool has_cloud,
     }
   }
   real3 ground = real3(0.0);
-  bool globe = hits_ground && kGlobe;
+  bool globe = hits_ground && kGlobe && !opaque;
   if (globe) {
     real3 pg = normalize(o + t_end * d) * u_r0;
     real3 n = normalize(pg);
@@ -487,15 +523,18 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, bool has_cloud,
     real3 ll = ecef_to_sphere(pg, u_r0);
     ground = u_irradiance * ground_radiance(ground_albedo_at(ll.x, ll.y), mu_sg, sun_air * shadow, e_sky);
   }
+  bool shown = opaque && u_has_opaque_color;  // the geometry's own radiance stands behind
+  if (shown) ground = opaque_l;
   real3 l = sky_front + tr_front * (cloud_l + cloud_t * (sky_back + tr_back * ground));
-  return real4(l, globe ? real(0.0) : cloud_t * tr_front.y * tr_back.y);
+  return real4(l, globe || shown ? real(0.0) : cloud_t * tr_front.y * tr_back.y);
 }
 
 // The pixel's radiance (rgb) and alpha once its march has ended: the march's own where the scene
 // has neither air nor globe, else the air and the ground composited around it, the cloud standing
-// for the air at the mean depth of the light it takes out.
-CV_FN real4 march_finish(MarchRay r, MarchState s) {
-  if (!(kAtmosphere || kGlobe)) return real4(s.radiance, s.t_view);
+// for the air at the mean depth of the light it takes out; opaque geometry behind as over_opaque.
+CV_FN real4 march_finish(MarchRay r, ivec2 px, MarchState s) {
+  real3 opaque_l = u_has_opaque_color ? real3(texelFetch(u_opaque, px, 0)) : real3(0.0);
+  if (!(kAtmosphere || kGlobe)) return over_opaque(s.radiance, s.t_view, r.t_opaque < real(3.0e38), opaque_l);
   real3 p_cloud = r.origin + (s.depth_w > real(0.0) ? s.depth_t / s.depth_w : real(0.0)) * r.d;
-  return sky_and_ground(r.d, s.radiance, s.t_view, s.depth_w > real(1e-6), p_cloud);
+  return sky_and_ground(r.d, s.radiance, s.t_view, s.depth_w > real(1e-6), p_cloud, r.t_opaque, opaque_l);
 }

@@ -49,6 +49,8 @@ CV_PARAM(bool, u_sun_down)           // the whole cloud layer is in the Earth's 
 CV_PARAM(bool, u_octave_gate)        // weight octave i >= 1 by w^i from the column's optical depth
 CV_PARAM(bool, u_liquid_phase_hg)    // Henyey-Greenstein with the Mie fit's mean cosine instead of the fit
 CV_PARAM(bool, u_blue_noise)         // the jitter from the blue-noise mask, else the hash
+CV_PARAM(bool, u_has_depth)          // u_depth holds the distance to opaque geometry per pixel
+CV_PARAM(bool, u_has_opaque_color)   // u_opaque holds that geometry's radiance, composited behind
 CV_PARAM(ivec4, u_level_nodes)       // grid nodes per brick side, finest level first
 CV_PARAM(ivec4, u_level_offset)      // first brick of each level in u_min_max
 CV_PARAM_ARRAY(ivec4, u_bricks, 4)   // bricks per axis (xyz), finest level first

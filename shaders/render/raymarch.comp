@@ -1,8 +1,9 @@
 // The GPU driver of the march kernel (shaders/kernel/march.glsl): the kernel's parameters as one
 // uniform block, its textures and counters, and the dispatch passes. A frame takes several
 // dispatches: pass 0 advances the march of every ray over the view steps [u_step_begin,
-// u_step_begin + u_step_count) and keeps its state in u_state_l and u_state_depth; pass 1 composites
-// the air and the ground and writes u_out (rgb radiance, a = view transmittance, 0 on the globe).
+// u_step_begin + u_step_count) and keeps its state in u_state_*; pass 1 composites the air and the
+// ground and writes u_out (rgb radiance, a = view transmittance, 0 on the globe) and u_cloud_depth
+// (the distance from the camera at which the view transmittance fell to 0.5; 3e38: never).
 // The reason is Mesa's llvmpipe: all loops of one invocation share a budget of 65 535 iterations,
 // after which every loop runs its body once and stops, silently; the host
 // (app/render/raymarcher.cpp) sizes u_step_count so that one dispatch stays inside it.
@@ -25,6 +26,8 @@ layout(std140, binding = CV_UBO_MARCH) uniform MarchParams {
 layout(rgba32f, binding = CV_IMAGE_OUT) writeonly uniform image2D u_out;
 layout(rgba32f, binding = CV_IMAGE_STATE_L) uniform image2D u_state_l;          // radiance so far, view transmittance
 layout(rgba32f, binding = CV_IMAGE_STATE_DEPTH) uniform image2D u_state_depth;  // depth_w, depth_t, 1 once ended, next step
+layout(r32f, binding = CV_IMAGE_STATE_HALF) uniform image2D u_state_half;        // where transmittance fell to 0.5
+layout(r32f, binding = CV_IMAGE_CLOUD_DEPTH) writeonly uniform image2D u_cloud_depth;  // pass 1 writes it there
 uniform int u_pass;        // 0: march a range of steps; 1: air and ground, then u_out
 uniform int u_step_begin;  // pass 0: the first view step (counted over both shell segments)
 uniform int u_step_count;  // pass 0: how many
@@ -38,6 +41,8 @@ layout(binding = CV_TEX_JITTER_MASK) uniform sampler2D u_jitter_mask;  // blue-n
 layout(binding = CV_TEX_GROUND) uniform sampler2D u_ground;  // linear albedo, equirectangular
 layout(binding = CV_TEX_NOISE_LOW) uniform sampler3D u_noise_low;    // Perlin-Worley, periodic, [0, 1]
 layout(binding = CV_TEX_NOISE_HIGH) uniform sampler3D u_noise_high;  // Worley fBm, periodic, [0, 1]
+layout(binding = CV_TEX_DEPTH) uniform sampler2D u_depth;    // distance (m) from the camera to opaque geometry
+layout(binding = CV_TEX_OPAQUE) uniform sampler2D u_opaque;  // that geometry's radiance
 // The extinction pyramid: (min, max) per brick, levels one after the other, x fastest.
 layout(std430, binding = CV_SSBO_PYRAMID) readonly buffer Pyramid { vec2 u_min_max[]; };
 // Per-frame counters (MarchStats), each as (low, high) 32-bit words.
@@ -93,12 +98,15 @@ void main() {
   s.depth_t = state_depth.y;
   s.ended = state_depth.z > 0.0;
   s.next_step = int(state_depth.w);
+  s.t_half = first ? 3.0e38 : imageLoad(u_state_half, px).r;
   if (u_pass == 0) {
     march_advance(r, px, u_step_begin, u_step_count, s);
     flush_stats();
     imageStore(u_state_l, px, vec4(s.radiance, s.t_view));
     imageStore(u_state_depth, px, vec4(s.depth_w, s.depth_t, s.ended ? 1.0 : 0.0, float(s.next_step)));
+    imageStore(u_state_half, px, vec4(s.t_half));
     return;
   }
-  imageStore(u_out, px, march_finish(r, s));
+  imageStore(u_out, px, march_finish(r, px, s));
+  imageStore(u_cloud_depth, px, vec4(s.t_half));
 }
