@@ -23,6 +23,7 @@
 #include "render/context.hpp"
 #include "render/image_output.hpp"
 #include "render/machine_id.hpp"
+#include "render/frame_renderer.hpp"
 #include "render/raymarcher.hpp"
 #include "scene/quality.hpp"
 #include "scene/standard_scenes.hpp"
@@ -251,7 +252,7 @@ int cmd_bench(const std::vector<std::string>& args) {
   std::printf("bench: %zu scene(s) at %dx%d, references %d spp, %d repeat(s), into %s; %s\n", a.scenes.size(), a.width,
               a.height, a.spp, a.repeats, a.out.c_str(), machine.c_str());
   const render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
-  render::GpuRaymarcher gpu(loader);
+  render::FrameRenderer renderer(loader);
   std::vector<BenchRow> rows;
   std::vector<SceneReference> refs;
   std::map<std::string, double> dz_by_scene;  // for the front file: view steps as multiples of dz
@@ -322,26 +323,25 @@ int cmd_bench(const std::vector<std::string>& args) {
     }
     refs.push_back(ref);
     fs::create_directories(fs::path(a.out) / name);
-    gpu.upload(sc.grid, medium);
-    const auto configs = make_configs(sc, base, core::cloud_layer(sc.grid, medium));
+    const auto prepared = std::make_shared<const core::PreparedVolume>(core::prepare_volume(sc.grid, medium));
+    renderer.use_volume(prepared);
+    const auto configs = make_configs(sc, base, prepared->layer);
     for (std::size_t ci = 0; ci < configs.size(); ++ci) {
       const Config& c = configs[ci];
-      core::Camera cam = sc.camera;
-      cam.width = std::max(1, static_cast<int>(std::lround(a.width * c.scale)));
-      cam.height = std::max(1, static_cast<int>(std::lround(a.height * c.scale)));
+      // The frame as `render` marches it: at the configuration's scale, accumulated, upscaled.
+      core::FrameSpec frame;
+      frame.camera = sc.camera;
+      frame.camera.width = a.width, frame.camera.height = a.height;
+      frame.march_camera = frame.camera;
+      core::march_size(a.width, a.height, c.scale, frame.march_camera.width, frame.march_camera.height);
+      frame.sun = sc.sun;
+      frame.march = c.march;
+      frame.accumulate = c.accumulate;
       std::vector<glm::vec4> pixels;
       auto render_image = [&](double& gpu_s) {
         render::DispatchOptions dispatch;
         dispatch.gpu_seconds = &gpu_s;
-        core::MarchSettings m = c.march;
-        if (c.accumulate == 1) return gpu.render(cam, sc.sun, m, dispatch);
-        std::vector<glm::vec4> acc(static_cast<std::size_t>(cam.width) * cam.height, glm::vec4(0.0f));
-        for (int f = 0; f < c.accumulate; ++f) {
-          m.frame = f;
-          const auto frame = gpu.render(cam, sc.sun, m, dispatch);
-          for (std::size_t i = 0; i < acc.size(); ++i) acc[i] += (frame[i] - acc[i]) / static_cast<float>(f + 1);
-        }
-        return acc;
+        return renderer.render(frame, dispatch);
       };
       const std::string variant = std::string(c.march.adaptive_steps ? "a" : "-") + (c.march.skip_empty ? "s" : "-");
       if (variants_warm.insert(variant).second) {
@@ -358,7 +358,6 @@ int cmd_bench(const std::vector<std::string>& args) {
       }
       std::vector<glm::dvec3> rgb(pixels.size());
       for (std::size_t i = 0; i < pixels.size(); ++i) rgb[i] = glm::dvec3(pixels[i].x, pixels[i].y, pixels[i].z);
-      if (cam.width != a.width || cam.height != a.height) rgb = core::bench::upscale_bilinear(rgb, cam.width, cam.height, a.width, a.height);
       BenchRow row;
       row.scene = name, row.config = c.name, row.description = c.description, row.kind = c.kind;
       row.view_step_m = c.march.view_step_m, row.sun_steps = c.march.sun_steps, row.octaves = c.march.octaves;

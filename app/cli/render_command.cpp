@@ -27,7 +27,9 @@
 #include "scene/framing.hpp"
 #include "scene/quality.hpp"
 #include "scene/scene_json.hpp"
-#include "viewer/scene_io.hpp"
+#include "kernel/volume_cache.hpp"
+#include "render/frame_renderer.hpp"
+#include "scene_source.hpp"
 #include "volume/volume_io.hpp"
 
 namespace cv::cli {
@@ -214,26 +216,6 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
   return r;
 }
 
-// Bilinear resampling of linear pixels (radiance and transmittance) from a reduced march size to
-// the output size, pixel centres aligned.
-std::vector<glm::vec4> upscale(const std::vector<glm::vec4>& in, int iw, int ih, int ow, int oh) {
-  std::vector<glm::vec4> out(static_cast<std::size_t>(ow) * oh);
-  for (int y = 0; y < oh; ++y) {
-    const double fy = std::clamp((y + 0.5) * ih / oh - 0.5, 0.0, ih - 1.0);
-    const int y0 = static_cast<int>(fy), y1 = std::min(y0 + 1, ih - 1);
-    const float ty = static_cast<float>(fy - y0);
-    for (int x = 0; x < ow; ++x) {
-      const double fx = std::clamp((x + 0.5) * iw / ow - 0.5, 0.0, iw - 1.0);
-      const int x0 = static_cast<int>(fx), x1 = std::min(x0 + 1, iw - 1);
-      const float tx = static_cast<float>(fx - x0);
-      auto at = [&](int xx, int yy) { return in[static_cast<std::size_t>(yy) * iw + xx]; };
-      const glm::vec4 top = glm::mix(at(x0, y0), at(x1, y0), tx), bottom = glm::mix(at(x0, y1), at(x1, y1), tx);
-      out[static_cast<std::size_t>(y) * ow + x] = glm::mix(top, bottom, ty);
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 const char* render_usage() {
@@ -252,40 +234,40 @@ int cmd_render(const std::vector<std::string>& args) {
   core::Scene scene;
   const RenderArgs ra = parse_render_args(args, scene);
   auto t0 = clock::now();
-  core::CloudVolume vol = viewer::load_scene_volume(scene, 1);  // one time step is rendered
+  core::CloudVolume vol = importers::load_scene_volume(scene, 1);  // one time step is rendered
   if (static_cast<std::size_t>(scene.time_step) >= vol.times.size()) {
     throw UsageError{"cloudviewer render: --time (time_step): found " + std::to_string(scene.time_step) + ", the input has " +
                      std::to_string(vol.times.size()) + " time step(s)"};
   }
-  const core::TimeStepData& data = vol.step(static_cast<std::size_t>(scene.time_step));
-  const core::GridMeanExtinction medium = core::grid_mean_extinction(vol.grid, data);
-  const double t_load = seconds_since(t0);
   const auto& g = vol.grid;
   if (g.lon_deg.count < 2 || g.lat_deg.count < 2 || g.alt_m.count < 2) {
     throw UsageError{"cloudviewer render: " + scene.data.path + ": the volume is " + std::to_string(g.lon_deg.count) + " x " +
                      std::to_string(g.lat_deg.count) + " x " + std::to_string(g.alt_m.count) +
                      " points; rendering needs at least 2 along each axis"};
   }
+  core::PreparedVolumeCache volumes;
+  const auto prepared = volumes.get(scene.data.path, vol, static_cast<std::size_t>(scene.time_step));
+  const double t_load = seconds_since(t0);
 
   // Resolve everything the scene left automatic, so the saved scene reproduces this image exactly.
-  core::Camera cam = scene.camera ? *scene.camera : core::auto_camera(g, scene.width, scene.height);
-  cam.width = scene.width, cam.height = scene.height;
+  core::FrameSpec frame = render::resolve_frame(scene, vol);
+  const core::Camera& cam = frame.camera;
+  const core::Sun& sun = frame.sun;
   const core::ValidTime& vt = vol.times[static_cast<std::size_t>(scene.time_step)];
-  const bool known_time = vt.iso_utc.find('T') != std::string::npos;
-  const core::Sun sun = core::resolve_sun(scene.sun, known_time ? std::optional<std::int64_t>(vt.unix_s) : std::nullopt, cam.lon_deg);
-  if (scene.sun.mode == core::SunMode::ValidTime && !known_time) {
+  if (scene.sun.mode == core::SunMode::ValidTime && !frame.valid_time_known) {
     std::printf("the input has no valid times: the sun is put at noon over the camera (set it with --sun)\n");
   }
   std::printf("sun overhead at %.2f, %.2f (%s)\n", sun.subsolar_lat_deg, sun.subsolar_lon_deg,
               scene.sun.mode == core::SunMode::Manual     ? "set by hand"
               : scene.sun.mode == core::SunMode::DateTime ? scene.sun.datetime_utc.c_str()
-              : known_time                                ? "from the valid time"
+              : frame.valid_time_known                    ? "from the valid time"
                                                           : "default");
   auto ctx = render::make_headless_context();
   const render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
-  render::GpuRaymarcher gpu(loader);
+  render::FrameRenderer renderer(loader);
+  render::GpuRaymarcher& gpu = renderer.raymarcher();
   t0 = clock::now();
-  gpu.upload(g, medium);
+  renderer.use_volume(prepared);
   if (scene.render.march.noise_amount > 0.0) {  // generated, compiled and bound only when used
     const auto t_noise = clock::now();
     gpu.upload_noise(core::make_erosion_noise());
@@ -294,18 +276,16 @@ int cmd_render(const std::vector<std::string>& args) {
   }
   glFinish();
   const double t_upload = seconds_since(t0);
-  scene.render.march.view_step_m = core::resolve_view_step_m(scene.render, g);
+  scene.render.march.view_step_m = frame.march.view_step_m;
   if (ra.march_overridden) scene.render.quality = "custom";
   scene.camera = cam;
   scene.sun.mode = core::SunMode::Manual;
   scene.sun.subsolar_lat_deg = sun.subsolar_lat_deg, scene.sun.subsolar_lon_deg = sun.subsolar_lon_deg;
   if (scene.render.budget_ms > 0.0) {  // the quality knobs chosen here, on this scene at this size
-    core::MarchSettings base = scene.render.march;
-    if (!(base.droplet_diameter_um > 0.0)) base.droplet_diameter_um = 2.0 * vol.liquid_r_eff_um;
-    base.ground_texture = render::resolve_ground_texture(base.ground_texture);
-    choose_by_budget(gpu, cam, sun, base, g.alt_m.step, scene.render.budget_ms, ra.front, render::machine_id(ctx->info()),
+    choose_by_budget(gpu, cam, sun, frame.march, g.alt_m.step, scene.render.budget_ms, ra.front, render::machine_id(ctx->info()),
                      scene.render);
     scene.render.budget_ms = 0.0;  // a saved scene holds the chosen settings, so it renders this image again
+    frame = render::resolve_frame(scene, vol);
   }
   if (!ra.save_scene.empty()) {
     core::Scene saved = scene;
@@ -320,51 +300,37 @@ int cmd_render(const std::vector<std::string>& args) {
   }
 
   const core::RenderSettings& rs = scene.render;
-  core::MarchSettings march = rs.march;
-  if (!(march.droplet_diameter_um > 0.0)) march.droplet_diameter_um = 2.0 * vol.liquid_r_eff_um;  // from the data
-  march.ground_texture = render::resolve_ground_texture(march.ground_texture);
-  const int mw = std::max(1, static_cast<int>(std::lround(cam.width * rs.resolution_scale)));
-  const int mh = std::max(1, static_cast<int>(std::lround(cam.height * rs.resolution_scale)));
-  core::Camera march_cam = cam;
-  march_cam.width = mw, march_cam.height = mh;
+  const core::MarchSettings& march = frame.march;
+  const int mw = frame.march_camera.width, mh = frame.march_camera.height;
   std::printf("rendering %s, time step %d (%s), %dx%d%s, quality %s: view step %.0f m, %d sun steps, %d octaves, %d frame(s)\n",
               scene.data.path.c_str(), scene.time_step, vt.iso_utc.c_str(), cam.width, cam.height,
               mw != cam.width || mh != cam.height ? (" marched at " + std::to_string(mw) + "x" + std::to_string(mh)).c_str() : "",
-              rs.quality.c_str(), march.view_step_m, march.sun_steps, march.octaves, rs.accumulate);
+              rs.quality.c_str(), march.view_step_m, march.sun_steps, march.octaves, frame.accumulate);
 
   t0 = clock::now();
   double gpu_s = 0.0;
   render::DispatchOptions dispatch;
   dispatch.gpu_seconds = &gpu_s;
   const double pixels_per_frame = static_cast<double>(mw) * mh;
-  if (rs.accumulate == 1 && pixels_per_frame > kTilePixels) {
+  if (frame.accumulate == 1 && pixels_per_frame > kTilePixels) {
     dispatch.rows_per_tile = std::max(8, static_cast<int>(kTilePixels / mw));
     dispatch.on_tile = [&](int done, int total) {
       std::printf("\rmarched %d/%d rows (%.0f%%), %.1f s", done, total, 100.0 * done / total, seconds_since(t0));
       std::fflush(stdout);
     };
   }
-  // One frame at step middles (or the scene's frame), or the mean of jittered frames.
-  std::vector<glm::vec4> pixels;
-  if (rs.accumulate == 1) {
-    pixels = gpu.render(march_cam, sun, march, dispatch);
-    if (dispatch.on_tile) std::printf("\n");
-  } else {
-    pixels.assign(static_cast<std::size_t>(mw) * mh, glm::vec4(0.0f));
-    for (int f = 0; f < rs.accumulate; ++f) {
-      march.frame = f;
-      const std::vector<glm::vec4> frame = gpu.render(march_cam, sun, march, dispatch);
-      for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] += (frame[i] - pixels[i]) / static_cast<float>(f + 1);
-      std::printf("\raccumulated %d/%d frames, %.1f s", f + 1, rs.accumulate, seconds_since(t0));
-      std::fflush(stdout);
-    }
-    std::printf("\n");
-  }
+  // One frame at step middles (or the scene's frame), or the mean of jittered frames, at the output
+  // size in linear radiance.
+  std::vector<glm::vec4> pixels = renderer.render(frame, dispatch, [&](int done, int total) {
+    if (total > 1) std::printf("\raccumulated %d/%d frames, %.1f s", done, total, seconds_since(t0));
+    std::fflush(stdout);
+  });
+  if (frame.accumulate > 1 || dispatch.on_tile) std::printf("\n");
   const double t_march = seconds_since(t0);
   const core::MarchStats& ms = gpu.last_stats();
   std::printf("march%s: %llu view samples, %llu skipped in %llu empty-brick jumps (view and sun), %llu sun samples, "
               "%llu skipped or cut off, %llu of %d rays missed the cloud shell%s\n",
-              rs.accumulate > 1 ? " (last frame)" : "", static_cast<unsigned long long>(ms.view_samples),
+              frame.accumulate > 1 ? " (last frame)" : "", static_cast<unsigned long long>(ms.view_samples),
               static_cast<unsigned long long>(ms.view_skipped), static_cast<unsigned long long>(ms.bricks_jumped),
               static_cast<unsigned long long>(ms.sun_samples), static_cast<unsigned long long>(ms.sun_skipped),
               static_cast<unsigned long long>(ms.rays_missed), mw * mh, march.skip_empty ? "" : " (skipping off)");
@@ -376,11 +342,10 @@ int cmd_render(const std::vector<std::string>& args) {
   }
 
   t0 = clock::now();
-  if (mw != cam.width || mh != cam.height) pixels = upscale(pixels, mw, mh, cam.width, cam.height);
   std::size_t bad = 0;
   for (const auto& p : pixels) bad += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w));
   render::ToneSettings tone;
-  tone.exposure = rs.exposure;
+  tone.exposure = frame.exposure;
   if (march.atmosphere || march.globe) tone.background = glm::dvec3(0.0);  // the sky and space are in the image
   const std::vector<unsigned char> rgb8 = render::tonemap_srgb8(pixels, tone);
   const double t_tone = seconds_since(t0);

@@ -3,6 +3,8 @@
 
 #include <stb_image_write.h>
 
+#include <glm/glm.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +20,40 @@ double srgb(double linear) {
   return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
 }
 }  // namespace
+
+namespace {
+// The texel below output pixel o of m when n texels stretch over m pixels (present.frag texel_below).
+int texel_below(int o, int n, int m, int& i1, float& t) {
+  const float f = std::clamp((static_cast<float>(o) + 0.5f) * static_cast<float>(n) / static_cast<float>(m) - 0.5f, 0.0f,
+                             static_cast<float>(n - 1));
+  const int i0 = static_cast<int>(f);
+  i1 = std::min(i0 + 1, n - 1);
+  t = f - static_cast<float>(i0);
+  return i0;
+}
+glm::vec4 lerp_texels(const glm::vec4& a, const glm::vec4& b, float t) { return t > 0.0f ? glm::mix(a, b, t) : a; }
+}  // namespace
+
+std::vector<glm::vec4> upscale_linear(const std::vector<glm::vec4>& in, int iw, int ih, int ow, int oh) {
+  if (in.size() != static_cast<std::size_t>(iw) * ih || iw < 1 || ih < 1 || ow < 1 || oh < 1) {
+    throw std::invalid_argument("upscale_linear: the image is not of the size given");
+  }
+  std::vector<glm::vec4> out(static_cast<std::size_t>(ow) * oh);
+  auto at = [&](int x, int y) { return in[static_cast<std::size_t>(y) * iw + x]; };
+  for (int y = 0; y < oh; ++y) {
+    int y1;
+    float ty;
+    const int y0 = texel_below(y, ih, oh, y1, ty);
+    for (int x = 0; x < ow; ++x) {
+      int x1;
+      float tx;
+      const int x0 = texel_below(x, iw, ow, x1, tx);
+      const glm::vec4 top = lerp_texels(at(x0, y0), at(x1, y0), tx), bottom = lerp_texels(at(x0, y1), at(x1, y1), tx);
+      out[static_cast<std::size_t>(y) * ow + x] = lerp_texels(top, bottom, ty);
+    }
+  }
+  return out;
+}
 
 std::vector<unsigned char> tonemap_srgb8(const std::vector<glm::vec4>& pixels, const ToneSettings& tone) {
   std::vector<unsigned char> out;

@@ -105,6 +105,7 @@ void Presenter::draw(const ToneSettings& tone, int x, int y, int w, int h) const
   glProgramUniform1f(p, loc(p, "u_exposure"), static_cast<float>(tone.exposure));
   glProgramUniform3f(p, loc(p, "u_background"), static_cast<float>(tone.background.x),
                      static_cast<float>(tone.background.y), static_cast<float>(tone.background.z));
+  glProgramUniform4i(p, loc(p, "u_viewport"), x, y, w, h);
   glViewport(x, y, w, h);
   glDisable(GL_BLEND);
   glDisable(GL_DEPTH_TEST);

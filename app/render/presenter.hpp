@@ -36,7 +36,8 @@ class Presenter {
   void accumulate(int count);
 
   // Draws the mean, tonemapped, over the currently bound framebuffer's viewport (x, y, w, h),
-  // scaling bilinearly (between tonemapped texels) when the march size differs.
+  // upscaled bilinearly in linear radiance when the march size differs, exactly as upscale_linear
+  // (the `render` command's image).
   void draw(const ToneSettings& tone, int x, int y, int w, int h) const;
 
  private:

@@ -11,7 +11,7 @@
 
 #include "viewer/camera_controller.hpp"
 #include "scene/quality.hpp"
-#include "viewer/scene_io.hpp"
+#include "scene/scene_json.hpp"
 
 namespace cv::viewer {
 namespace {
@@ -141,7 +141,7 @@ void scene_panel(ViewerState& s, PanelContext& ctx) {
   ImGui::InputText("path", &ctx.scene_path);
   if (ImGui::Button("save")) {
     try {
-      save_viewer_scene(s.scene, ctx.scene_path);
+      core::save_scene(s.scene, ctx.scene_path);
       ctx.scene_message = "saved " + ctx.scene_path;
     } catch (const std::exception& e) {
       ctx.scene_message = e.what();
@@ -152,7 +152,7 @@ void scene_panel(ViewerState& s, PanelContext& ctx) {
     // Camera, sun, time and settings come from the file; its data must be the data on screen
     // (another file means another volume: start the viewer on that scene instead).
     try {
-      core::Scene loaded = load_viewer_scene(ctx.scene_path);
+      core::Scene loaded = core::load_scene(ctx.scene_path);
       if (loaded.data.path != s.scene.data.path) {
         ctx.scene_message = ctx.scene_path + ": data.path is " + loaded.data.path + ", not the data on screen (" +
                             s.scene.data.path + "): run cloudviewer view " + ctx.scene_path;

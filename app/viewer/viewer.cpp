@@ -24,7 +24,10 @@
 #include "viewer/camera_controller.hpp"
 #include "viewer/frame_budget.hpp"
 #include "viewer/panels.hpp"
-#include "viewer/scene_io.hpp"
+#include "scene/scene_json.hpp"
+#include "scene_source.hpp"
+#include "kernel/volume_cache.hpp"
+#include "render/frame_renderer.hpp"
 #include "scene/framing.hpp"
 #include "scene/quality.hpp"
 #include "scene/scene_json.hpp"
@@ -186,7 +189,7 @@ int cmd_view(const std::vector<std::string>& args) {
     if (!o.screenshot.empty() && o.frames == 0) {
       throw ViewerInputError("cloudviewer view: --screenshot: expected --frames N as well (the frame to save is the Nth)");
     }
-    if (ends_with(o.input, ".json")) o.scene = load_viewer_scene(o.input);
+    if (ends_with(o.input, ".json")) o.scene = core::load_scene(o.input);
   } catch (const std::runtime_error& e) {  // ViewerInputError and core::SceneError
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
@@ -202,7 +205,7 @@ int run_viewer(const ViewerOptions& o) {
     s.scene.data.path = o.input;
   }
   try {
-    s.volume = load_scene_volume(s.scene, 2);
+    s.volume = importers::load_scene_volume(s.scene, 2);
   } catch (const core::SceneError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
@@ -236,8 +239,9 @@ int run_viewer(const ViewerOptions& o) {
   auto win = render::make_window_context(o.width, o.height, "cloudviewer - " + o.input);
   glfwSwapInterval(o.frames > 0 ? 0 : 1);
   const render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
-  render::GpuRaymarcher gpu(loader);
+  render::FrameRenderer renderer(loader);
   render::Presenter presenter(loader);
+  core::PreparedVolumeCache volumes;  // the time steps shown last, prepared once each
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -260,8 +264,7 @@ int run_viewer(const ViewerOptions& o) {
   FrameStats stats;
   stats.renderer = win->info().renderer;
   PassTimer march_timer, present_timer;
-  int uploaded_step = -1, accumulated = 0;
-  bool noise_uploaded = false;
+  int accumulated = 0;
   bool show_ui = !o.hide_ui, f1_was_down = false;
   core::Scene previous;
   using clock = std::chrono::steady_clock;
@@ -311,17 +314,20 @@ int run_viewer(const ViewerOptions& o) {
     s.scene.camera->width = mw;
     s.scene.camera->height = mh;
     s.scene.time_step = std::clamp(s.scene.time_step, 0, static_cast<int>(s.volume.times.size()) - 1);
-    if (s.scene.time_step != uploaded_step) {
-      const core::TimeStepData& data = s.volume.step(static_cast<std::size_t>(s.scene.time_step));
-      gpu.upload(g, core::grid_mean_extinction(g, data));
-      uploaded_step = s.scene.time_step;
-    }
+    renderer.use_volume(volumes.get(s.scene.data.path, s.volume, static_cast<std::size_t>(s.scene.time_step)));
     if (presenter.width() != mw || presenter.height() != mh) presenter.resize(mw, mh);
+    // The frame as `render` resolves it (camera at the march size, sun, settings).
+    core::FrameSpec spec;
     try {
-      ctx.sun = resolve_sun(s.scene, s.volume);
+      spec = render::resolve_frame(s.scene, s.volume);
+      ctx.sun = spec.sun;
       ctx.sun_error.clear();
     } catch (const std::invalid_argument& e) {
       ctx.sun_error = e.what();  // keep the last good sun while the date/time is being typed
+      core::Scene held = s.scene;
+      held.sun.mode = core::SunMode::Manual;
+      held.sun.subsolar_lat_deg = ctx.sun.subsolar_lat_deg, held.sun.subsolar_lon_deg = ctx.sun.subsolar_lon_deg;
+      spec = render::resolve_frame(held, s.volume);
     }
     if (frame == 0 || !same_march(s.scene, previous)) accumulated = 0;
     previous = s.scene;
@@ -330,15 +336,8 @@ int run_viewer(const ViewerOptions& o) {
     // exactly as `render` does without --accumulate.
     marched_last = accumulated < s.scene.render.accumulate;
     if (marched_last) {
-      core::MarchSettings m = s.scene.render.march;
-      m.ground_texture = render::resolve_ground_texture(m.ground_texture);
-      m.frame = s.scene.render.accumulate == 1 ? -1 : accumulated;
       march_timer.begin();
-      if (m.noise_amount > 0.0 && !noise_uploaded) {  // generated and compiled the first time it is asked for
-        gpu.upload_noise(core::make_erosion_noise());
-        noise_uploaded = true;
-      }
-      gpu.render_into(presenter.frame_texture(), *s.scene.camera, ctx.sun, m);
+      renderer.march_into(presenter.frame_texture(), spec, accumulated);
       march_timer.end();
       present_timer.begin();
       presenter.accumulate(accumulated);
@@ -348,13 +347,13 @@ int run_viewer(const ViewerOptions& o) {
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     render::ToneSettings tone;
-    tone.exposure = s.scene.render.exposure;
+    tone.exposure = spec.exposure;
     if (s.scene.render.march.atmosphere || s.scene.render.march.globe) tone.background = glm::dvec3(0.0);
     presenter.draw(tone, 0, 0, fbw, fbh);
     present_timer.end();
     stats.march_ms = march_timer.ms();
     stats.present_ms = present_timer.ms();
-    if (show_ui) stats.march = gpu.last_stats();  // read back only when shown (it waits for the march)
+    if (show_ui) stats.march = renderer.last_stats();  // read back only when shown (it waits for the march)
     stats.accumulated = accumulated;
     stats.march_w = mw;
     stats.march_h = mh;

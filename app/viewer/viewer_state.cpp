@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <ctime>
 
+#include "scene/frame_spec.hpp"
 #include "scene/framing.hpp"
 
 namespace cv::viewer {
@@ -19,9 +20,7 @@ core::Sun resolve_sun(const core::Scene& scene, const core::CloudVolume& volume)
 }
 
 void march_size(const core::Scene& scene, int window_w, int window_h, int& w, int& h) {
-  const double s = std::clamp(scene.render.resolution_scale, 0.05, 1.0);
-  w = std::max(1, static_cast<int>(std::lround(window_w * s)));
-  h = std::max(1, static_cast<int>(std::lround(window_h * s)));
+  core::march_size(window_w, window_h, scene.render.resolution_scale, w, h);  // as resolve_frame sizes `render`'s march
 }
 
 namespace {

@@ -84,28 +84,6 @@ std::vector<double> pixel_error(const std::vector<glm::dvec3>& test, const std::
   return out;
 }
 
-std::vector<glm::dvec3> upscale_bilinear(const std::vector<glm::dvec3>& src, int sw, int sh, int dw, int dh) {
-  if (sw < 1 || sh < 1 || dw < 1 || dh < 1 || src.size() != static_cast<std::size_t>(sw) * static_cast<std::size_t>(sh)) {
-    throw std::invalid_argument("upscale_bilinear: source size does not match its dimensions");
-  }
-  std::vector<glm::dvec3> out(static_cast<std::size_t>(dw) * static_cast<std::size_t>(dh));
-  auto at = [&](int x, int y) { return src[static_cast<std::size_t>(y) * sw + x]; };
-  for (int y = 0; y < dh; ++y) {
-    // Pixel centres map onto pixel centres: (y + 0.5) / dh = (sy + 0.5) / sh.
-    const double sy = std::clamp((y + 0.5) * sh / dh - 0.5, 0.0, sh - 1.0);
-    const int y0 = static_cast<int>(sy), y1 = std::min(y0 + 1, sh - 1);
-    const double fy = sy - y0;
-    for (int x = 0; x < dw; ++x) {
-      const double sx = std::clamp((x + 0.5) * sw / dw - 0.5, 0.0, sw - 1.0);
-      const int x0 = static_cast<int>(sx), x1 = std::min(x0 + 1, sw - 1);
-      const double fx = sx - x0;
-      out[static_cast<std::size_t>(y) * dw + x] =
-          (at(x0, y0) * (1 - fx) + at(x1, y0) * fx) * (1 - fy) + (at(x0, y1) * (1 - fx) + at(x1, y1) * fx) * fy;
-    }
-  }
-  return out;
-}
-
 std::vector<std::size_t> pareto_front(const std::vector<TimeError>& pts) {
   std::vector<std::size_t> idx;
   for (std::size_t i = 0; i < pts.size(); ++i) {

@@ -45,9 +45,6 @@ ImageError image_error(const std::vector<glm::dvec3>& test, const std::vector<gl
 // Per-pixel |L - L_ref| / max L_ref (0 where the reference is black everywhere), for error images.
 std::vector<double> pixel_error(const std::vector<glm::dvec3>& test, const std::vector<glm::dvec3>& ref);
 
-// Bilinear resampling over pixel centres (edges clamped): how a frame marched at a lower
-// resolution is shown at the output size.
-std::vector<glm::dvec3> upscale_bilinear(const std::vector<glm::dvec3>& src, int sw, int sh, int dw, int dh);
 
 struct TimeError {
   double time = 0.0, error = 0.0;

@@ -115,16 +115,6 @@ TEST(BenchMetrics, InterpolationAlongTheFrontIsLogLogAndNeverExtrapolates) {
   EXPECT_EQ(front_error_at_time(front, 1000.0), 0.01);
 }
 
-TEST(BenchMetrics, BilinearUpscaleKeepsConstantsAndInterpolatesBetweenCentres) {
-  const std::vector<glm::dvec3> src = {glm::dvec3(0.0), glm::dvec3(4.0)};  // 2 x 1
-  const auto out = upscale_bilinear(src, 2, 1, 4, 1);
-  // Output centres 0.5, 1.5, 2.5, 3.5 of 4 map to source x -0.25 (clamped 0), 0.25, 0.75, 1.25 (clamped 1).
-  EXPECT_NEAR(out[0].x, 0.0, 1e-12);
-  EXPECT_NEAR(out[1].x, 1.0, 1e-12);
-  EXPECT_NEAR(out[2].x, 3.0, 1e-12);
-  EXPECT_NEAR(out[3].x, 4.0, 1e-12);
-}
-
 TEST(BenchPlot, DrawsAxesPointsAndTheFront) {
   const std::vector<PlotPoint> pts = {{{1.0, 0.5}, 0}, {{10.0, 0.05}, 2}, {{5.0, 1.0}, 1}};
   const Rgb8Image img = plot_error_vs_time(pts, {0, 1}, 200, 150);

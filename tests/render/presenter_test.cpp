@@ -129,6 +129,59 @@ TEST_F(PresenterTest, ReducedResolutionUpscalesWithoutSpreadingANonFiniteTexel) 
   EXPECT_GT(near_white, 0);  // the non-finite texel itself shows (white), as in image_output
 }
 
+TEST(UpscaleLinear, KeepsConstantsAndInterpolatesBetweenCentres) {
+  const std::vector<glm::vec4> src = {glm::vec4(0.0f), glm::vec4(4.0f)};  // 2 x 1
+  const auto out = upscale_linear(src, 2, 1, 4, 1);
+  // Output centres 0.5, 1.5, 2.5, 3.5 of 4 map to source x -0.25 (clamped 0), 0.25, 0.75, 1.25 (clamped 1).
+  EXPECT_FLOAT_EQ(out[0].x, 0.0f);
+  EXPECT_FLOAT_EQ(out[1].x, 1.0f);
+  EXPECT_FLOAT_EQ(out[2].x, 3.0f);
+  EXPECT_FLOAT_EQ(out[3].x, 4.0f);
+  // 1:1 is the image itself, a non-finite texel included, without touching its neighbours.
+  const std::vector<glm::vec4> nan = {glm::vec4(1.0f), glm::vec4(std::numeric_limits<float>::quiet_NaN()), glm::vec4(2.0f)};
+  const auto same = upscale_linear(nan, 3, 1, 3, 1);
+  EXPECT_EQ(same[0].x, 1.0f);
+  EXPECT_TRUE(std::isnan(same[1].x));
+  EXPECT_EQ(same[2].x, 2.0f);
+}
+
+TEST_F(PresenterTest, UpscaledDrawIsTheCpuUpscaleTonemapped) {
+  // The viewer's draw of a reduced march equals `render`'s upscale_linear then tonemap_srgb8, within
+  // the tonemap's one step: both upscale in linear radiance with the same weights.
+  const int w = 13, h = 8, W = 40, H = 23;
+  std::vector<glm::vec4> px(static_cast<std::size_t>(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) px[static_cast<std::size_t>(y) * w + x] = glm::vec4(0.02f * x, 0.3f * (y % 3), 0.01f * x * y, 0.1f * (y % 2));
+  Presenter p(loader_);
+  p.resize(w, h);
+  upload(p.frame_texture(), w, h, px);
+  p.accumulate(0);
+  GLuint fbo = 0, color = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &color);
+  glTextureStorage2D(color, 1, GL_RGBA8, W, H);
+  glCreateFramebuffers(1, &fbo);
+  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  ToneSettings tone;
+  tone.exposure = 3.0;
+  p.draw(tone, 0, 0, W, H);
+  std::vector<unsigned char> out(static_cast<std::size_t>(W) * H * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(color, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(out.size()), out.data());
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteTextures(1, &color);
+  const std::vector<unsigned char> cpu = tonemap_srgb8(upscale_linear(px, w, h, W, H), tone);
+  int worst = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      for (int c = 0; c < 3; ++c)
+        worst = std::max(worst, std::abs(int(out[(static_cast<std::size_t>(H - 1 - y) * W + x) * 4 + c]) -
+                                         int(cpu[(static_cast<std::size_t>(y) * W + x) * 3 + c])));
+  EXPECT_LE(worst, 1);
+  EXPECT_NE(cpu[0], cpu[3 * (W - 1)]);  // the image is not one colour
+}
+
 TEST_F(PresenterTest, AccumulationIsTheRunningMeanOfTheFrames) {
   const int w = 19, h = 11, frames = 6;  // not multiples of the 8 x 8 work groups
   Presenter p(loader_);

@@ -1,15 +1,11 @@
-// Scene files and the data they name (see scene_io.hpp).
-#include "viewer/scene_io.hpp"
+// The data a scene names (see scene_source.hpp).
+#include "scene_source.hpp"
 
 #include "importer.hpp"
 #include "scene/scene_json.hpp"
 #include "volume/volume_io.hpp"
 
-namespace cv::viewer {
-
-core::Scene load_viewer_scene(const std::string& path) { return core::load_scene(path); }
-
-void save_viewer_scene(const core::Scene& scene, const std::string& path) { core::save_scene(scene, path); }
+namespace cv::importers {
 
 core::CloudVolume load_scene_volume(const core::Scene& scene, std::size_t cache_steps) {
   const core::DataSource& d = scene.data;
@@ -22,13 +18,13 @@ core::CloudVolume load_scene_volume(const core::Scene& scene, std::size_t cache_
     }
     return core::read_cvvol(d.path, cache_steps);
   }
-  importers::ImportOptions o;
-  if (d.region_deg) o.region = importers::Region{(*d.region_deg)[0], (*d.region_deg)[1], (*d.region_deg)[2], (*d.region_deg)[3]};
+  ImportOptions o;
+  if (d.region_deg) o.region = Region{(*d.region_deg)[0], (*d.region_deg)[1], (*d.region_deg)[2], (*d.region_deg)[3]};
   if (d.levels_hpa) o.level_min_hpa = (*d.levels_hpa)[0], o.level_max_hpa = (*d.levels_hpa)[1];
   o.horizontal_stride = d.horizontal_stride;
   o.dz_m = d.dz_m;
   o.cache_steps = cache_steps;
-  return importers::import_file(d.path, o);
+  return import_file(d.path, o);
 }
 
-}  // namespace cv::viewer
+}  // namespace cv::importers

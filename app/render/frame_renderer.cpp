@@ -1,0 +1,63 @@
+// The frame renderer: march, accumulate, upscale.
+#include "render/frame_renderer.hpp"
+
+#include "noise/noise.hpp"
+#include "render/albedo_map.hpp"
+#include "render/image_output.hpp"
+
+namespace cv::render {
+
+FrameRenderer::FrameRenderer(const ShaderLoader& loader) : gpu_(loader) {}
+
+void FrameRenderer::use_volume(std::shared_ptr<const core::PreparedVolume> volume) {
+  if (volume == volume_) return;
+  gpu_.upload(volume);
+  volume_ = std::move(volume);
+}
+
+core::MarchSettings FrameRenderer::frame_settings(const core::MarchSettings& march, int count, int index) {
+  core::MarchSettings m = march;
+  m.frame = count <= 1 ? march.frame : index;
+  return m;
+}
+
+core::FrameSpec resolve_frame(const core::Scene& scene, const core::CloudVolume& volume) {
+  core::FrameSpec f = core::resolve_frame(scene, volume);
+  f.march.ground_texture = resolve_ground_texture(f.march.ground_texture);
+  return f;
+}
+
+void FrameRenderer::ensure_noise(const core::MarchSettings& m) {
+  if (m.noise_amount > 0.0 && !noise_uploaded_) {  // generated, compiled and bound only when used
+    gpu_.upload_noise(core::make_erosion_noise());
+    noise_uploaded_ = true;
+  }
+}
+
+void FrameRenderer::march_into(GLuint out, const core::FrameSpec& f, int index, const DispatchOptions& dispatch,
+                               const OpaqueInput& opaque) {
+  const core::MarchSettings m = frame_settings(f.march, f.accumulate, index);
+  ensure_noise(m);
+  gpu_.render_into(out, f.march_camera, f.sun, m, dispatch, opaque);
+}
+
+std::vector<glm::vec4> FrameRenderer::render(const core::FrameSpec& f, const DispatchOptions& dispatch,
+                                             const std::function<void(int, int)>& on_frame) {
+  const int mw = f.march_camera.width, mh = f.march_camera.height;
+  std::vector<glm::vec4> mean;
+  for (int i = 0; i < f.accumulate; ++i) {
+    const core::MarchSettings m = frame_settings(f.march, f.accumulate, i);
+    ensure_noise(m);
+    const std::vector<glm::vec4> frame = gpu_.render(f.march_camera, f.sun, m, dispatch);
+    if (i == 0) {
+      mean = frame;
+    } else {
+      for (std::size_t p = 0; p < mean.size(); ++p) mean[p] += (frame[p] - mean[p]) / static_cast<float>(i + 1);
+    }
+    if (on_frame) on_frame(i + 1, f.accumulate);
+  }
+  if (mw == f.camera.width && mh == f.camera.height) return mean;
+  return upscale_linear(mean, mw, mh, f.camera.width, f.camera.height);
+}
+
+}  // namespace cv::render

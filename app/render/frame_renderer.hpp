@@ -1,0 +1,55 @@
+// One frame renderer for every command: a resolved frame (core::FrameSpec) marched on the GPU at
+// its march size, its jittered frames accumulated, upscaled in linear radiance to the output size.
+// `render`, `bench` and the viewer march through it, so one scene gives one image whichever draws it.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "kernel/prepared_volume.hpp"
+#include "render/raymarcher.hpp"
+#include "scene/frame_spec.hpp"
+
+namespace cv::render {
+
+// core::resolve_frame, the scene's ground texture found as well (resolve_ground_texture: an empty
+// setting is the Natural Earth relief where it is installed).
+core::FrameSpec resolve_frame(const core::Scene& scene, const core::CloudVolume& volume);
+
+class FrameRenderer {
+ public:
+  // Needs a current OpenGL 4.5 context; the loader must outlive the renderer.
+  explicit FrameRenderer(const ShaderLoader& loader);
+
+  // Makes `volume` the time step marched, uploading it when it is not the one on the GPU already.
+  void use_volume(std::shared_ptr<const core::PreparedVolume> volume);
+
+  // The settings of frame `index` of an accumulation of `count`: a single frame keeps the settings'
+  // own (step middles unless it names one), else the index's jitter.
+  static core::MarchSettings frame_settings(const core::MarchSettings& march, int count, int index);
+
+  // Marches frame `index` of the spec's accumulation at its march size into `out` (an RGBA32F
+  // texture of at least that size), generating the erosion noise the first time it is needed.
+  void march_into(GLuint out, const core::FrameSpec& frame, int index, const DispatchOptions& dispatch = {},
+                  const OpaqueInput& opaque = {});
+
+  // The image at the output size in linear radiance (rgb) and transmittance (a): the spec's
+  // accumulate frames at the march size, their running mean (as the viewer's accumulate.comp), then
+  // upscale_linear. on_frame(done, total) after each accumulated frame.
+  std::vector<glm::vec4> render(const core::FrameSpec& frame, const DispatchOptions& dispatch = {},
+                                const std::function<void(int, int)>& on_frame = {});
+
+  GpuRaymarcher& raymarcher() { return gpu_; }
+  const core::MarchStats& last_stats() { return gpu_.last_stats(); }
+
+ private:
+  void ensure_noise(const core::MarchSettings& m);
+  GpuRaymarcher gpu_;
+  std::shared_ptr<const core::PreparedVolume> volume_;
+  bool noise_uploaded_ = false;
+};
+
+}  // namespace cv::render

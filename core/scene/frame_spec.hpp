@@ -1,0 +1,34 @@
+// A scene resolved against its data into what one frame needs: the camera at the output size and at
+// the march size, the sun, the march settings with everything the scene left automatic filled in
+// (view step from the grid, droplet diameter from the data), the accumulation and the exposure.
+// `render`, the viewer and the bench all start a frame here.
+#pragma once
+
+#include <string>
+
+#include "reference/raymarcher.hpp"
+#include "scene/scene.hpp"
+#include "volume/cloud_volume.hpp"
+
+namespace cv::core {
+
+struct FrameSpec {
+  Camera camera;        // at the output size (scene width x height)
+  Camera march_camera;  // the same at the march size (render.resolution_scale)
+  Sun sun;
+  MarchSettings march;
+  int accumulate = 1;  // jittered frames averaged (1: one frame at step middles)
+  double exposure = 4.0;
+  bool valid_time_known = false;  // the data's time step has a UTC valid time (else the sun is at noon over the camera)
+};
+
+// The march size of an output of width x height at a resolution scale (clamped to 0.01..1):
+// each side rounded, at least 1 pixel.
+void march_size(int width, int height, double resolution_scale, int& march_w, int& march_h);
+
+// Resolves scene.time_step of `volume` (which must hold it: std::out_of_range otherwise). The camera
+// frames the volume from the south when the scene has none; the sun follows scene.sun (from the
+// valid time unless set). The ground texture stays as the scene names it (the render layer finds it).
+FrameSpec resolve_frame(const Scene& scene, const CloudVolume& volume);
+
+}  // namespace cv::core
