@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
+#include <string>
+#include <type_traits>
 #include <utility>
 
 #include <glm/glm.hpp>
@@ -64,15 +66,50 @@ int parse_int(const std::string& option, const std::string& text, int lo, int hi
   return static_cast<int>(v);
 }
 
+// The table row whose flag this is (settings/march_settings.def), or nullptr.
+const core::SettingRow* march_flag(const std::string& option) {
+  for (const core::SettingRow& row : core::kMarchSettingRows) {
+    if (row.flag && option == row.flag) return &row;
+  }
+  return nullptr;
+}
+
+// A table row's flag applied to `m`: its value read with the row's range and wording, as a scene
+// file's key is; a Bool row's flag takes no value and sets the opposite of the default (--no-skip).
+void apply_march_flag(const core::SettingRow& row, const std::string& text, core::MarchSettings& m) {
+  static const core::MarchSettings defaults;
+  core::for_each_march_setting_pair(m, defaults, [&](const core::SettingRow& r, auto& value, const auto& def) {
+    using T = std::decay_t<decltype(value)>;
+    if (&r != &row) return;
+    if constexpr (std::is_same_v<T, bool>) {
+      value = !def;
+    } else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, double>) {
+      double v = 0.0;
+      std::size_t used = 0;
+      try {
+        v = std::stod(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (text.empty() || used != text.size() || !core::in_range(row, v)) {
+        throw UsageError{"cloudviewer render: " + std::string(row.flag) + ": found '" + text + "', expected " +
+                         core::expected_text(row)};
+      }
+      value = static_cast<T>(v);
+    }
+  });
+}
+
 // The options, applied to `scene` in the order given (later ones win).
 RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& scene) {
   RenderArgs r;
-  // Every option but --no-sky and --no-skip takes a value; the one argument that is no option's value is the input. It is
-  // read first so that a scene file's settings are the base the options override.
+  // Every option but --no-sky and the table's Bool flags (--no-skip) takes a value; the one argument that is no
+  // option's value is the input. It is read first so that a scene file's settings are the base the options override.
   std::vector<std::pair<std::string, std::string>> options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "--no-sky" || a == "--no-skip") {  // the flags without a value
+    const core::SettingRow* row = march_flag(a);
+    if (a == "--no-sky" || (row && row->kind == core::SettingKind::Bool)) {  // the flags without a value
       options.emplace_back(a, "");
     } else if (!a.empty() && a[0] == '-') {
       if (i + 1 >= args.size()) throw UsageError{"cloudviewer render: " + a + ": expected a value after it"};
@@ -134,38 +171,19 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
       } else {
         throw UsageError{"cloudviewer render: --quality: found '" + v + "', expected one of " + core::quality_names()};
       }
-    } else if (a == "--steps") {
-      m.view_step_m = parse_number(a, v);
-      if (!(m.view_step_m > 0)) throw UsageError{"cloudviewer render: --steps: found '" + v + "', expected a view step in metres > 0"};
-      r.march_overridden = true;
-    } else if (a == "--sun-steps") {
-      m.sun_steps = parse_int(a, v, 1, 1024, "an integer 1..1024");
-      r.march_overridden = true;
-    } else if (a == "--octaves") {
-      m.octaves = parse_int(a, v, 1, 16, "an integer 1..16");
-      r.march_overridden = true;
+    } else if (const core::SettingRow* row = march_flag(a)) {
+      apply_march_flag(*row, v, m);
+      const std::string key = row->key;
+      // What the quality presets set: given by hand, the quality becomes custom (and a budget,
+      // which chooses them, contradicts them).
+      if (key == "view_step_m" || key == "sun_steps" || key == "octaves") r.march_overridden = true;
+      if (key == "max_step_optical_depth") {  // --adaptive TAU: the substep's optical depth, and adaptive steps on
+        m.adaptive_steps = true;
+        r.adaptive_given = true;
+      }
     } else if (a == "--accumulate") {
       scene.render.accumulate = parse_int(a, v, 1, 4096, "1..4096 frames");
       r.march_overridden = true;
-    } else if (a == "--noise") {
-      m.noise_amount = parse_number(a, v);
-      if (!(m.noise_amount >= 0 && m.noise_amount <= 1)) {
-        throw UsageError{"cloudviewer render: --noise: found " + v + ", expected an amount in 0..1 (0: the data only)"};
-      }
-    } else if (a == "--noise-scale") {
-      m.noise_scale_m = parse_number(a, v);
-      if (!(m.noise_scale_m >= 10 && m.noise_scale_m <= 1e7)) {
-        throw UsageError{"cloudviewer render: --noise-scale: found " + v + ", expected the noise tile's period in metres, 10..1e7"};
-      }
-    } else if (a == "--no-skip") {
-      m.skip_empty = false;
-    } else if (a == "--adaptive") {
-      m.adaptive_steps = true;
-      r.adaptive_given = true;
-      m.max_step_optical_depth = parse_number(a, v);
-      if (!(m.max_step_optical_depth > 0)) {
-        throw UsageError{"cloudviewer render: --adaptive: found '" + v + "', expected the optical depth per substep, a number > 0"};
-      }
     } else if (a == "--budget-ms") {
       scene.render.budget_ms = parse_number(a, v);
       if (!(scene.render.budget_ms > 0 && scene.render.budget_ms <= 1e7)) {
@@ -219,15 +237,38 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
 }  // namespace
 
 const char* render_usage() {
-  return "  render INPUT -o OUT.png   INPUT: NetCDF, .cvvol or a scene .json (docs/scene.md); options override it:\n"
-         "         [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov] [--sun LAT,LON | --sun-time ISO]\n"
-         "         [--quality low|default|high|custom] [--steps M] [--sun-steps N] [--octaves N] [--accumulate N]\n"
-         "         [--exposure E] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N] [--pfm OUT.pfm]\n"
-         "         [--noise AMOUNT] [--noise-scale METRES] [--no-sky] [--no-skip] [--adaptive TAU]\n"
-         "         [--save-scene OUT.json]  (the effective scene, camera and sun resolved, to reproduce the image)\n"
-         "         [--budget-ms MS [--front quality_front.json]]  the most accurate settings of the measured front\n"
-         "                           (from bench; else its cached copy, else the presets) that render within MS here\n"
-         "                           the sun stands where it stood at the valid time unless --sun or --sun-time\n";
+  // The march settings' flags come from their rows, with the range a scene file accepts.
+  static const std::string text = [] {
+    std::string t =
+        "  render INPUT -o OUT.png   INPUT: NetCDF, .cvvol or a scene .json (docs/scene.md); options override it:\n"
+        "         [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov] [--sun LAT,LON | --sun-time ISO]\n"
+        "         [--quality low|default|high|custom] [--accumulate N]\n"
+        "         [--exposure E] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N] [--pfm OUT.pfm]\n"
+        "         [--no-sky]  clouds on black: no air, globe or ambient sky light\n";
+    for (const core::SettingRow& row : core::kMarchSettingRows) {
+      if (!row.flag) continue;
+      std::string opt = std::string("[") + row.flag + (row.metavar ? std::string(" ") + row.metavar : "") + "]";
+      opt.resize(std::max<std::size_t>(opt.size() + 1, 26), ' ');
+      if (row.kind == core::SettingKind::Bool) {  // the flag sets the opposite of the default
+        bool on = false;
+        const core::MarchSettings defaults;
+        core::for_each_march_setting(defaults, [&](const core::SettingRow& r, const auto& value) {
+          if constexpr (std::is_same_v<std::decay_t<decltype(value)>, bool>) on = &r == &row ? value : on;
+        });
+        t += "         " + opt + row.key + " " + (on ? "false" : "true") + " (" + (on ? "true" : "false") + ": " + row.doc + ")";
+      } else {
+        t += "         " + opt + row.key + ": " + row.doc + " (" + core::range_text(row) + ")";
+      }
+      if (std::string(row.key) == "max_step_optical_depth") t += ", and adaptive_steps on";
+      t += "\n";
+    }
+    return t +
+           "         [--save-scene OUT.json]  (the effective scene, camera and sun resolved, to reproduce the image)\n"
+           "         [--budget-ms MS [--front quality_front.json]]  the most accurate settings of the measured front\n"
+           "                           (from bench; else its cached copy, else the presets) that render within MS here\n"
+           "                           the sun stands where it stood at the valid time unless --sun or --sun-time\n";
+  }();
+  return text.c_str();
 }
 
 int cmd_render(const std::vector<std::string>& args) {

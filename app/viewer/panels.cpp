@@ -1,5 +1,6 @@
 // The viewer's ImGui panels. Every widget edits a field of the shared Scene directly, so the scene
-// file stores exactly what is on screen; the main loop resets the accumulation on any change.
+// file stores exactly what is on screen; the main loop resets the accumulation on any change. The
+// march settings' widgets come from their rows (core/settings/march_settings.def).
 #include "viewer/panels.hpp"
 
 #include <imgui.h>
@@ -8,6 +9,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <type_traits>
+
+#include <glm/glm.hpp>
 
 #include "viewer/camera_controller.hpp"
 #include "scene/quality.hpp"
@@ -94,46 +99,68 @@ void sun_panel(ViewerState& s, PanelContext& ctx) {
   if (!ctx.sun_error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.4f, 1.0f), "%s", ctx.sun_error.c_str());
 }
 
+// Whether a row's setting is on (a true bool, a non-zero number): rows that need it show only then.
+bool setting_on(const core::MarchSettings& m, const char* key) {
+  bool on = false;
+  core::for_each_march_setting(m, [&](const core::SettingRow& row, const auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, int> || std::is_same_v<T, double>) {
+      if (std::string(row.key) == key) on = value != T{};
+    }
+  });
+  return on;
+}
+
+// One widget per row of this group that has a label, with the row's widget range (the row's full
+// range where usable; logarithmic where the row says so). The row's line of documentation is
+// the tooltip.
+void march_widgets(core::MarchSettings& m, core::SettingGroup group) {
+  core::for_each_march_setting(m, [&](const core::SettingRow& row, auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    if (row.group != group || !row.label || (row.needs && !setting_on(m, row.needs))) return;
+    const ImGuiSliderFlags log = row.wlog ? ImGuiSliderFlags_Logarithmic : 0;
+    if constexpr (std::is_same_v<T, bool>) {
+      if (row.kind == core::SettingKind::Choice) {
+        int choice = value ? 1 : 0;
+        if (ImGui::Combo(row.label, &choice, row.choice_labels.data(), 2)) value = choice == 1;
+      } else {
+        ImGui::Checkbox(row.label, &value);
+      }
+    } else if constexpr (std::is_same_v<T, int>) {
+      ImGui::SliderInt(row.label, &value, static_cast<int>(row.wlo), static_cast<int>(row.whi), "%d",
+                       ImGuiSliderFlags_AlwaysClamp | log);
+    } else if constexpr (std::is_same_v<T, double>) {
+      slider_double(row.label, &value, row.wlo, row.whi, "%.5g", log);
+    } else if constexpr (std::is_same_v<T, glm::dvec3>) {
+      float rgb[3] = {static_cast<float>(value.x), static_cast<float>(value.y), static_cast<float>(value.z)};
+      if (ImGui::ColorEdit3(row.label, rgb, ImGuiColorEditFlags_Float)) {
+        value = glm::clamp(glm::dvec3(rgb[0], rgb[1], rgb[2]), row.lo, row.hi);
+      }
+    }
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s: %s", row.key, row.doc);
+  });
+}
+
 void lighting_panel(ViewerState& s) {
   if (!ImGui::CollapsingHeader("Lighting")) return;
-  core::MarchSettings& m = s.scene.render.march;
-  slider_double("droplet diameter (um)", &m.droplet_diameter_um, 1.0, 50.0, "%.1f");
-  slider_double("ice g", &m.ice_g, 0.0, 0.99, "%.2f");
-  ImGui::SliderInt("octaves N", &m.octaves, 1, 16, "%d", ImGuiSliderFlags_AlwaysClamp);
-  slider_double("octave a (extinction)", &m.octave_a, 0.0, 1.0, "%.2f");
-  slider_double("octave b (scattering)", &m.octave_b, 0.0, 1.0, "%.2f");
-  slider_double("octave c (phase)", &m.octave_c, 0.0, 1.0, "%.2f");
-  ImGui::Checkbox("octave gate (thin cloud: fewer octaves)", &m.octave_gate);
-  int phase = m.liquid_phase_hg ? 1 : 0;
-  if (ImGui::Combo("liquid phase", &phase, "approximate Mie\0Henyey-Greenstein (same mean cosine)\0")) m.liquid_phase_hg = phase == 1;
-  ImGui::Checkbox("air (sun colour, sky, ambient)", &m.atmosphere);
-  ImGui::Checkbox("globe and cloud shadows", &m.globe);
-  slider_double("ambient sky light", &m.ambient, 0.0, 4.0, "%.2f");
-  slider_double("erosion noise (0: data only)", &m.noise_amount, 0.0, 1.0, "%.2f");
-  if (m.noise_amount > 0.0) {
-    drag_double("noise tile (m)", &m.noise_scale_m, 100.0, 100.0, 1e6, "%.0f", ImGuiSliderFlags_Logarithmic);
-  }
+  march_widgets(s.scene.render.march, core::SettingGroup::Medium);
+}
+
+void features_panel(ViewerState& s) {
+  if (!ImGui::CollapsingHeader("Features")) return;
+  march_widgets(s.scene.render.march, core::SettingGroup::Features);
 }
 
 void quality_panel(ViewerState& s, const PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Quality")) return;
-  {
-    core::RenderSettings& r = s.scene.render;
-    drag_double("view step (m)", &r.march.view_step_m, 5.0, 10.0, 10000.0, "%.0f", ImGuiSliderFlags_Logarithmic);
-    ImGui::SliderInt("sun steps", &r.march.sun_steps, 1, 256, "%d", ImGuiSliderFlags_AlwaysClamp);
-    ImGui::Checkbox("skip empty space", &r.march.skip_empty);
-    ImGui::Checkbox("adaptive steps", &r.march.adaptive_steps);
-    if (r.march.adaptive_steps) {
-      slider_double("optical depth per substep", &r.march.max_step_optical_depth, 0.05, 10.0, "%.2f", ImGuiSliderFlags_Logarithmic);
-    }
-    ImGui::Checkbox("blue-noise jitter", &r.march.blue_noise);
-    slider_double("resolution scale", &r.resolution_scale, 0.1, 1.0, "%.2f");
-    ImGui::SliderInt("accumulate (frames)", &r.accumulate, 1, 1024, "%d", ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
-    slider_double("exposure", &r.exposure, 0.1, 64.0, "%.2f", ImGuiSliderFlags_Logarithmic);
-    // 0 is off; on, the budget sets the step, sun steps, octaves, adaptive and scale above.
-    drag_double("frame budget (ms)", &r.budget_ms, 1.0, 0.0, 1e7, r.budget_ms > 0.0 ? "%.0f" : "off");
-    if (r.budget_ms > 0.0 && !ctx.budget_text.empty()) ImGui::TextWrapped("budget: %s", ctx.budget_text.c_str());
-  }
+  march_widgets(s.scene.render.march, core::SettingGroup::Quality);
+  core::RenderSettings& r = s.scene.render;
+  slider_double("resolution scale", &r.resolution_scale, 0.1, 1.0, "%.2f");
+  ImGui::SliderInt("accumulate (frames)", &r.accumulate, 1, 1024, "%d", ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
+  slider_double("exposure", &r.exposure, 0.1, 64.0, "%.2f", ImGuiSliderFlags_Logarithmic);
+  // 0 is off; on, the budget sets the step, sun steps, octaves, adaptive and scale above.
+  drag_double("frame budget (ms)", &r.budget_ms, 1.0, 0.0, 1e7, r.budget_ms > 0.0 ? "%.0f" : "off");
+  if (r.budget_ms > 0.0 && !ctx.budget_text.empty()) ImGui::TextWrapped("budget: %s", ctx.budget_text.c_str());
 }
 
 void scene_panel(ViewerState& s, PanelContext& ctx) {
@@ -181,6 +208,7 @@ void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats)
     camera_panel(state, ctx);
     sun_panel(state, ctx);
     lighting_panel(state);
+    features_panel(state);
     quality_panel(state, ctx);
     scene_panel(state, ctx);
     ImGui::TextDisabled("F1 hides the panels; %s", stats.renderer.c_str());

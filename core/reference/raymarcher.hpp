@@ -12,6 +12,7 @@
 #include <glm/vec3.hpp>
 
 #include "noise/noise.hpp"
+#include "settings/march_settings.hpp"
 #include "volume/cloud_volume.hpp"
 
 namespace cv::core {
@@ -31,61 +32,7 @@ struct Sun {
   glm::dvec3 irradiance{1.0, 1.0, 1.0};
 };
 
-struct MarchSettings {
-  double view_step_m = 100.0;  // march step along view rays
-  int sun_steps = 32;          // steps of the secondary march toward the sun
-  // Fewer sun steps where the volume is thin: a sun segment takes only as many steps as keep each
-  // below this optical depth at the volume's largest extinction (sun_march_steps); 0: no such lowering.
-  double max_sun_step_optical_depth = 0.05;
-  // The longest a sun step may be (m): a segment takes more than sun_steps where its steps would be
-  // longer (a low sun's 200 km segments jumped over whole cumuli). 0: the grid's horizontal cell
-  // size (sun_step_limit_m in shaders/common/march_control.glsl), so no step skips a cell.
-  double max_sun_step_m = 0.0;
-  int octaves = 1;             // 1 = single scattering
-  double octave_a = 0.5, octave_b = 0.5, octave_c = 0.5;
-  // Octave gate (shaders/common/octaves.glsl): octave i >= 1 weighted by w^i, w = 1 - exp(-tau_col)
-  // from the column's vertical optical depth, so thin cloud is not brightened as if it were thick.
-  // On by default: against Monte Carlo it takes thin cirrus from +56 % to -10 % (docs/physics.md).
-  bool octave_gate = true;
-  double droplet_diameter_um = 20.0;  // approximate Mie phase for liquid
-  // The liquid phase function: the approximate Mie fit (Jendersie & d'Eon 2023), or Henyey-Greenstein
-  // with the same mean cosine (the choice of the documents this product grew from, for comparison).
-  bool liquid_phase_hg = false;
-  double ice_g = 0.75;                // Henyey-Greenstein for ice
-  // -1: sample each step at its middle; otherwise the accumulation frame whose jittered offsets
-  // place the samples, so banding averages away over frames.
-  int frame = -1;
-  // The offsets: true, the blue-noise mask rotated by the golden ratio per frame (rng.glsl
-  // blue_noise_jitter, core/noise/blue_noise): low-discrepancy per pixel, so a mean over frames
-  // converges faster; false, the white-noise hash step_jitter (kept for comparison).
-  bool blue_noise = true;
-  // Sub-grid erosion noise (core/noise, shaders/common/erosion.glsl). 0 = off: the image is the
-  // data's field exactly, and no noise is generated, bound or sampled. Up to 1 = strongest.
-  double noise_amount = 0.0;
-  double noise_scale_m = 20000.0;  // period of the low-frequency noise tile, metres
-  // Air and ground (shaders/common/atmosphere.glsl, ground.glsl). Off by default: the clouds alone,
-  // lit by the sun as it arrives at the top of the atmosphere, on black.
-  bool atmosphere = false;  // sunlight reddened through the air, sky in-scatter, ambient sky light
-  bool globe = false;       // the ground where a view ray meets it (else the ray just ends there)
-  double ambient = 0.0;     // strength of the isotropic sky light on clouds (1 = the modelled sky)
-  int sky_steps = 16;       // steps of each sky in-scatter integral along a view ray
-  int atmo_sun_steps = 8;   // steps of each atmospheric transmittance toward the sun
-  glm::dvec3 ground_albedo{0.12, 0.12, 0.12};  // linear, where no ground texture is given
-  std::string ground_texture;  // equirectangular albedo image (PNG); empty: ground_albedo
-  // Acceleration (shaders/common/march_control.glsl). Skipping jumps over bricks of the extinction
-  // pyramid that hold no cloud and resumes on the same sample grid: the image does not change.
-  bool skip_empty = true;
-  // Splits a view step into substeps where the brick's largest extinction would give a step an
-  // optical depth above max_step_optical_depth (thick cores are then not under-sampled).
-  bool adaptive_steps = false;
-  double max_step_optical_depth = 1.0;
-  // View rays stop below this transmittance, sun marches once every octave's attenuation is below it.
-  double min_transmittance = 1e-6;
-  // When the whole cloud layer over the data is in the Earth's shadow (layer_in_earth_shadow,
-  // decided once per frame), leave out every sun march and octave sum: the image is the one the
-  // per-sample test gives (false: test each sample, as before).
-  bool leave_out_night = true;
-};
+// MarchSettings: one table of rows, settings/march_settings.def.
 
 // An equirectangular ground albedo image: linear rgb per texel, rows from latitude 90 down to -90,
 // columns from longitude -180 east to 180.

@@ -10,6 +10,8 @@
 #include <initializer_list>
 #include <optional>
 #include <sstream>
+#include <type_traits>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -40,7 +42,8 @@ class Reader {
   }
 
   // Every key must be one of `known`: a misspelt key would otherwise be ignored without a word.
-  void only(std::initializer_list<const char*> known) const {
+  void only(std::initializer_list<const char*> known) const { only(std::vector<const char*>(known)); }
+  void only(const std::vector<const char*>& known) const {
     for (const auto& [key, value] : obj_.items()) {
       bool ok = false;
       for (const char* k : known) ok = ok || key == k;
@@ -165,58 +168,44 @@ void read_sun(const Reader& r, SunSpec& s) {
   r.number("irradiance", s.irradiance, 1e-300, kHuge, "a relative irradiance > 0");
 }
 
+// render.march, row by row from the table (settings/march_settings.def): its keys, its ranges
+// and its wording, so a new row is read without a line here.
 void read_march(const Reader& r, MarchSettings& m) {
-  r.only({"view_step_m", "sun_steps", "octaves", "octave_a", "octave_b", "octave_c", "octave_gate", "droplet_diameter_um", "liquid_phase", "ice_g", "frame",
-          "blue_noise", "noise_amount", "noise_scale_m", "atmosphere", "globe", "ambient", "sky_steps", "atmo_sun_steps",
-          "ground_albedo", "ground_texture", "skip_empty", "adaptive_steps", "max_step_optical_depth",
-          "min_transmittance", "leave_out_night",
-          "max_sun_step_optical_depth", "max_sun_step_m"});
-  r.number("view_step_m", m.view_step_m, 0.0, 1e7, "a view step in metres 0..1e7 (0: from the grid)");
-  r.integer("sun_steps", m.sun_steps, 1, 1024);
-  r.integer("octaves", m.octaves, 1, 16);
-  r.number("octave_a", m.octave_a, 0.0, 1.0, "a number 0..1");
-  r.number("octave_b", m.octave_b, 0.0, 1.0, "a number 0..1");
-  r.number("octave_c", m.octave_c, 0.0, 1.0, "a number 0..1");
-  r.boolean("octave_gate", m.octave_gate);
-  r.boolean("leave_out_night", m.leave_out_night);
-  r.number("max_sun_step_optical_depth", m.max_sun_step_optical_depth, 0.0, 1000.0,
-           "an optical depth per sun step 0..1000 (0: always sun_steps)");
-  r.number("max_sun_step_m", m.max_sun_step_m, 0.0, 1e7, "a sun step length in metres 0..1e7 (0: the grid's horizontal cell)");
-  r.number("droplet_diameter_um", m.droplet_diameter_um, 0.0, 50.0, "a droplet diameter in um 0.01..50, or 0: from the data");
-  if (m.droplet_diameter_um > 0.0 && m.droplet_diameter_um < 0.01) {
-    r.fail("droplet_diameter_um", std::to_string(m.droplet_diameter_um), "a droplet diameter in um 0.01..50, or 0: from the data");
-  }
-  {
-    std::string phase = m.liquid_phase_hg ? "hg" : "mie";
-    r.string("liquid_phase", phase);
-    if (phase != "mie" && phase != "hg") r.fail("liquid_phase", "\"" + phase + "\"", "\"mie\" or \"hg\"");
-    m.liquid_phase_hg = phase == "hg";
-  }
-  r.number("ice_g", m.ice_g, -0.999, 0.999, "an asymmetry parameter -0.999..0.999");
-  r.integer("frame", m.frame, -1, 1 << 30);
-  r.boolean("blue_noise", m.blue_noise);
-  r.number("noise_amount", m.noise_amount, 0.0, 1.0, "an erosion amount 0..1 (0: the data only)");
-  r.number("noise_scale_m", m.noise_scale_m, 10.0, 1e7, "a noise tile period in metres 10..1e7");
-  r.boolean("atmosphere", m.atmosphere);
-  r.boolean("globe", m.globe);
-  r.number("ambient", m.ambient, 0.0, 10.0, "an ambient sky light strength 0..10 (1: the modelled sky)");
-  r.integer("sky_steps", m.sky_steps, 1, 1024);
-  r.integer("atmo_sun_steps", m.atmo_sun_steps, 1, 1024);
-  if (const auto a = r.numbers<3>("ground_albedo", "three linear albedos 0..1 [r, g, b]")) {
-    for (double v : *a) {
-      if (!(v >= 0.0 && v <= 1.0)) {
-        char found[64];
-        std::snprintf(found, sizeof found, "a value of %g", v);
-        r.fail("ground_albedo", found, "three linear albedos 0..1 [r, g, b]");
+  std::vector<const char*> keys;
+  for (const SettingRow& row : kMarchSettingRows) keys.push_back(row.key);
+  r.only(keys);
+  for_each_march_setting(m, [&](const SettingRow& row, auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    const json* v = r.find(row.key);
+    if (!v) return;
+    const std::string expected = expected_text(row);
+    if constexpr (std::is_same_v<T, bool>) {
+      if (row.kind == SettingKind::Choice) {
+        if (!v->is_string() || (*v != row.choices[0] && *v != row.choices[1])) r.fail(row.key, shown(*v), expected);
+        value = *v == row.choices[1];
+      } else {
+        if (!v->is_boolean()) r.fail(row.key, shown(*v), expected);
+        value = v->get<bool>();
       }
+    } else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, double>) {
+      if (!v->is_number() || !in_range(row, v->get<double>())) r.fail(row.key, shown(*v), expected);
+      value = static_cast<T>(v->get<double>());
+    } else if constexpr (std::is_same_v<T, glm::dvec3>) {
+      const auto a = r.numbers<3>(row.key, expected);
+      if (!a) return;  // null: as if absent
+      for (double x : *a) {
+        if (!in_range(row, x)) {
+          char found[64];
+          std::snprintf(found, sizeof found, "a value of %g", x);
+          r.fail(row.key, found, expected);
+        }
+      }
+      value = glm::dvec3((*a)[0], (*a)[1], (*a)[2]);
+    } else {
+      if (!v->is_string()) r.fail(row.key, shown(*v), expected);
+      value = v->get<std::string>();
     }
-    m.ground_albedo = glm::dvec3((*a)[0], (*a)[1], (*a)[2]);
-  }
-  r.string("ground_texture", m.ground_texture);
-  r.boolean("skip_empty", m.skip_empty);
-  r.boolean("adaptive_steps", m.adaptive_steps);
-  r.number("max_step_optical_depth", m.max_step_optical_depth, 1e-3, 1e3, "an optical depth per substep 0.001..1000");
-  r.number("min_transmittance", m.min_transmittance, 0.0, 0.1, "a transmittance 0..0.1 below which a view ray stops");
+  });
 }
 
 void read_render(const Reader& r, RenderSettings& s) {
@@ -236,6 +225,22 @@ void read_render(const Reader& r, RenderSettings& s) {
   r.number("resolution_scale", s.resolution_scale, 0.01, 1.0, "a fraction of the output size 0.01..1");
   r.number("exposure", s.exposure, 1e-300, kHuge, "an exposure > 0");
   r.number("budget_ms", s.budget_ms, 0.0, 1e7, "a frame-time budget in ms 0..1e7 (0: off)");
+}
+
+// Every row of the table, in its order, so a saved scene holds every setting.
+ojson march_to_json(const MarchSettings& m) {
+  ojson out = ojson::object();
+  for_each_march_setting(m, [&](const SettingRow& row, const auto& value) {
+    using T = std::decay_t<decltype(value)>;
+    if constexpr (std::is_same_v<T, bool>) {
+      out[row.key] = row.kind == SettingKind::Choice ? ojson(row.choices[value ? 1 : 0]) : ojson(value);
+    } else if constexpr (std::is_same_v<T, glm::dvec3>) {
+      out[row.key] = {value.x, value.y, value.z};
+    } else {
+      out[row.key] = value;
+    }
+  });
+  return out;
 }
 
 }  // namespace
@@ -307,41 +312,12 @@ std::string scene_to_json(const Scene& s) {
                  {"subsolar_lat_deg", s.sun.subsolar_lat_deg},
                  {"subsolar_lon_deg", s.sun.subsolar_lon_deg},
                  {"irradiance", s.sun.irradiance}};
-  const MarchSettings& m = s.render.march;
   root["render"] = {{"quality", s.render.quality},
                     {"accumulate", s.render.accumulate},
                     {"resolution_scale", s.render.resolution_scale},
                     {"exposure", s.render.exposure},
                     {"budget_ms", s.render.budget_ms},
-                    {"march",
-                     {{"view_step_m", m.view_step_m},
-                      {"sun_steps", m.sun_steps},
-                      {"octaves", m.octaves},
-                      {"octave_a", m.octave_a},
-                      {"octave_b", m.octave_b},
-                      {"octave_c", m.octave_c},
-                      {"octave_gate", m.octave_gate},
-                      {"leave_out_night", m.leave_out_night},
-                      {"max_sun_step_optical_depth", m.max_sun_step_optical_depth},
-                      {"max_sun_step_m", m.max_sun_step_m},
-                      {"droplet_diameter_um", m.droplet_diameter_um},
-                      {"liquid_phase", m.liquid_phase_hg ? "hg" : "mie"},
-                      {"ice_g", m.ice_g},
-                      {"frame", m.frame},
-                      {"blue_noise", m.blue_noise},
-                      {"noise_amount", m.noise_amount},
-                      {"noise_scale_m", m.noise_scale_m},
-                      {"atmosphere", m.atmosphere},
-                      {"globe", m.globe},
-                      {"ambient", m.ambient},
-                      {"sky_steps", m.sky_steps},
-                      {"atmo_sun_steps", m.atmo_sun_steps},
-                      {"ground_albedo", {m.ground_albedo.x, m.ground_albedo.y, m.ground_albedo.z}},
-                      {"ground_texture", m.ground_texture},
-                      {"skip_empty", m.skip_empty},
-                      {"adaptive_steps", m.adaptive_steps},
-                      {"max_step_optical_depth", m.max_step_optical_depth},
-                      {"min_transmittance", m.min_transmittance}}}};
+                    {"march", march_to_json(s.render.march)}};
   root["overlays"] = s.overlays;
   return root.dump(2) + "\n";
 }

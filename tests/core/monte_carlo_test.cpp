@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <string>
 #include <utility>
 
 #include <glm/glm.hpp>
@@ -244,12 +246,21 @@ TEST(MonteCarlo, TheSameSeedGivesTheSameImageOnAnyThreadCountAndInSteps) {
 }
 
 TEST(MonteCarlo, MeasuresTheOctaveApproximation) {
-  // Issue 5's figure: full multiple scattering against the raymarcher's octaves, clouds only.
-  // Printed, not asserted: it is a property of the approximation, not a check of either code. The
-  // thin cirrus converges fast; the stratocumulus's droplet forward peak (g_HG ~ 0.995) makes
-  // next-event estimation heavy-tailed, and its figure carries the standard error printed with it.
-  // The octave gate (octave_gate) is printed off and on for each: it should take the thin cirrus's
-  // excess out and leave the thick scenes' sums nearly as they were.
+  // Issue 5's figure: full multiple scattering against the raymarcher's octaves, clouds only,
+  // printed for docs/physics.md, and the relations that table states asserted. Each bound on a
+  // bias is 4 standard errors of the Monte Carlo mean wide (sd_rel below: the per-pixel standard
+  // errors summed in quadrature, over the mean), so the Monte Carlo's own noise (a new seed, a
+  // changed sampling order) cannot fail it, while a change of the model or of either code that
+  // moves a figure by more than the noise does. The seed is fixed, so the figures themselves are
+  // reproducible. The thin cirrus converges (sd_rel ~0.5 %); the stratocumulus's droplet forward
+  // peak (g_HG ~ 0.995) makes next-event estimation heavy-tailed (its sd_rel ~10 % understates the
+  // spread, docs/physics.md), so on the droplet scenes only relations far outside that are asserted.
+  struct Result {
+    double mc = 0.0, sd_rel = 0.0;
+    double ref[5] = {};  // mean luminance at the configurations below
+  };
+  const std::pair<int, bool> configs[5] = {{1, false}, {4, false}, {4, true}, {8, false}, {8, true}};
+  std::map<std::string, Result> results;
   for (const auto& [name, spp] :
        {std::pair<const char*, int>{"thin_cirrus", 4096}, {"cumulus_field", 256}, {"stratocumulus", 256}}) {
     const SceneCase c(name, 16, 9);
@@ -274,7 +285,11 @@ TEST(MonteCarlo, MeasuresTheOctaveApproximation) {
         static_cast<unsigned long long>(img.stats.truncated),
         static_cast<unsigned long long>(img.stats.paths), mc.max_bounces);
     ASSERT_GT(mc_lum, 0.0);
-    for (const auto& [octaves, gate] : {std::pair{1, false}, {4, false}, {4, true}, {8, false}, {8, true}}) {
+    Result& res = results[name];
+    res.mc = mc_lum / npx;
+    res.sd_rel = std::sqrt(noise_var) / mc_lum;
+    for (int k = 0; k < 5; ++k) {
+      const auto [octaves, gate] = configs[k];
       m.octaves = octaves;
       m.octave_gate = gate;
       const ReferenceImage ref = render_reference(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m);
@@ -284,6 +299,7 @@ TEST(MonteCarlo, MeasuresTheOctaveApproximation) {
         ref_lum += l;
         sq += (l - img.luminance(i)) * (l - img.luminance(i));
       }
+      res.ref[k] = ref_lum / npx;
       // The Monte Carlo image's own noise adds its variance to the squared differences: take it out,
       // so what remains is the octaves' error.
       const double rmse = std::sqrt(std::max(sq - noise_var, 0.0) / npx) / (mc_lum / npx);
@@ -294,6 +310,27 @@ TEST(MonteCarlo, MeasuresTheOctaveApproximation) {
           100.0 * std::sqrt(sq / npx) / (mc_lum / npx));
     }
   }
+  const auto bias = [&](const char* scene, int k) { return results[scene].ref[k] / results[scene].mc - 1.0; };
+  const auto band = [&](const char* scene) { return 4.0 * results[scene].sd_rel; };
+  // Single scattering is part of the full transport, so one octave is darker than the Monte Carlo
+  // on every scene (thin cirrus -15.7 %, the droplet scenes about -90 %).
+  for (const char* scene : {"thin_cirrus", "cumulus_field", "stratocumulus"}) {
+    EXPECT_LT(bias(scene, 0), -band(scene)) << scene << ": single scattering is not below full multiple scattering";
+  }
+  // Thin cirrus, converged: the classic sum overestimates (+55.7 % at 4 octaves, +62.0 % at 8),
+  // and the gate takes that excess out (-9.7 % at both). Each figure within its 4-sigma band.
+  EXPECT_NEAR(bias("thin_cirrus", 1), 0.557, band("thin_cirrus") + 0.0005);
+  EXPECT_NEAR(bias("thin_cirrus", 3), 0.620, band("thin_cirrus") + 0.0005);
+  EXPECT_NEAR(bias("thin_cirrus", 2), -0.097, band("thin_cirrus") + 0.0005);
+  EXPECT_NEAR(bias("thin_cirrus", 4), -0.097, band("thin_cirrus") + 0.0005);
+  // On the thick droplet scenes the gate leaves the sums nearly as they were (within 10 % of their
+  // value; measured -4 % and -6 %): a relation between two raymarcher images, free of the Monte
+  // Carlo's noise. On the cirrus it removes more than a third of the sum.
+  for (const char* scene : {"cumulus_field", "stratocumulus"}) {
+    EXPECT_NEAR(results[scene].ref[2] / results[scene].ref[1], 1.0, 0.10) << scene;
+    EXPECT_NEAR(results[scene].ref[4] / results[scene].ref[3], 1.0, 0.10) << scene;
+  }
+  EXPECT_LT(results["thin_cirrus"].ref[2] / results["thin_cirrus"].ref[1], 0.67);
 }
 
 }  // namespace

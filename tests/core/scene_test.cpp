@@ -15,6 +15,7 @@
 #include "scene/framing.hpp"
 #include "scene/quality.hpp"
 #include "scene/scene_json.hpp"
+#include "support/march_values.hpp"
 
 namespace {
 using namespace cv::core;
@@ -40,17 +41,11 @@ Scene full_scene() {
   s.sun.datetime_utc = "2024-01-15T03:00:00Z";
   s.sun.subsolar_lat_deg = -21.1, s.sun.subsolar_lon_deg = 134.7, s.sun.irradiance = 1.7;
   s.render.quality = "custom";
-  s.render.march.view_step_m = 333.3;
-  s.render.march.sun_steps = 24, s.render.march.octaves = 6;
-  s.render.march.octave_a = 0.4, s.render.march.octave_b = 0.3, s.render.march.octave_c = 0.6;
-  s.render.march.droplet_diameter_um = 12.5, s.render.march.ice_g = 0.8, s.render.march.frame = 9;
-  s.render.march.blue_noise = false;  // not the default, so the round trip shows it is stored
-  s.render.march.noise_amount = 0.35, s.render.march.noise_scale_m = 12345.0;
-  s.render.march.liquid_phase_hg = true;
-  // The leave-out switches, off their defaults.
-  s.render.march.octave_gate = false, s.render.march.leave_out_night = false;
-  s.render.march.max_sun_step_optical_depth = 0.0125;
-  s.render.march.max_sun_step_m = 850.0;  // the sun step's length limit, off its default (0: the grid's cell)
+  // Every march row off the value a file without it reads (a preset's or the scene's default), so
+  // a writer that drops a row, or a reader that skips one, fails the round trip.
+  Scene defaults;
+  apply_quality("default", defaults.render);
+  cv::test::set_every_row_off(s.render.march, defaults.render.march);
   s.render.accumulate = 8, s.render.resolution_scale = 0.5, s.render.exposure = 6.25, s.render.budget_ms = 40.0;
   s.overlays = {"coastlines"};
   return s;
@@ -81,25 +76,11 @@ void expect_equal(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.sun.subsolar_lat_deg, b.sun.subsolar_lat_deg);
   EXPECT_EQ(a.sun.subsolar_lon_deg, b.sun.subsolar_lon_deg);
   EXPECT_EQ(a.sun.irradiance, b.sun.irradiance);
-  const MarchSettings &m = a.render.march, &n = b.render.march;
   EXPECT_EQ(a.render.quality, b.render.quality);
-  EXPECT_EQ(m.view_step_m, n.view_step_m);
-  EXPECT_EQ(m.sun_steps, n.sun_steps);
-  EXPECT_EQ(m.octaves, n.octaves);
-  EXPECT_EQ(m.octave_a, n.octave_a);
-  EXPECT_EQ(m.octave_b, n.octave_b);
-  EXPECT_EQ(m.octave_c, n.octave_c);
-  EXPECT_EQ(m.droplet_diameter_um, n.droplet_diameter_um);
-  EXPECT_EQ(m.ice_g, n.ice_g);
-  EXPECT_EQ(m.frame, n.frame);
-  EXPECT_EQ(m.blue_noise, n.blue_noise);
-  EXPECT_EQ(m.noise_amount, n.noise_amount);
-  EXPECT_EQ(m.liquid_phase_hg, n.liquid_phase_hg);
-  EXPECT_EQ(m.noise_scale_m, n.noise_scale_m);
-  EXPECT_EQ(m.octave_gate, n.octave_gate);
-  EXPECT_EQ(m.leave_out_night, n.leave_out_night);
-  EXPECT_EQ(m.max_sun_step_optical_depth, n.max_sun_step_optical_depth);
-  EXPECT_EQ(m.max_sun_step_m, n.max_sun_step_m);
+  // The march member by member through the table: every row, named in the message.
+  for_each_march_setting_pair(a.render.march, b.render.march, [](const SettingRow& row, const auto& x, const auto& y) {
+    EXPECT_TRUE(x == y) << "render.march." << row.key << " differs after the round trip";
+  });
   EXPECT_EQ(a.render.accumulate, b.render.accumulate);
   EXPECT_EQ(a.render.resolution_scale, b.render.resolution_scale);
   EXPECT_EQ(a.render.exposure, b.render.exposure);
@@ -109,6 +90,12 @@ void expect_equal(const Scene& a, const Scene& b) {
 
 TEST(SceneJson, FullyPopulatedSceneRoundTripsExactly) {
   const Scene s = full_scene();
+  // Every march row is off what a file without it reads: otherwise a dropped row would pass.
+  Scene defaults;
+  apply_quality("default", defaults.render);
+  for_each_march_setting_pair(s.render.march, defaults.render.march, [](const SettingRow& row, const auto& x, const auto& y) {
+    EXPECT_FALSE(x == y) << "render.march." << row.key << " is at its default in full_scene()";
+  });
   const std::string text = scene_to_json(s);
   expect_equal(scene_from_json(text), s);
   // And through a file: save, load (an absolute data path stays as it is).
