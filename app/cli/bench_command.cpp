@@ -26,7 +26,7 @@
 #include "render/frame_renderer.hpp"
 #include "render/raymarcher.hpp"
 #include "scene/quality.hpp"
-#include "scene/standard_scenes.hpp"
+#include "bench/standard_scenes.hpp"
 #include "volume/volume_io.hpp"
 
 #include <glm/geometric.hpp>
@@ -58,7 +58,7 @@ int parse_int(const std::string& opt, const std::string& text, int lo, int hi, c
 
 BenchArgs parse_args(const std::vector<std::string>& args) {
   BenchArgs a;
-  const auto known = core::standard_scene_names();
+  const auto known = bench::standard_scene_names();
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& s = args[i];
     auto next = [&]() -> const std::string& {
@@ -98,7 +98,7 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
 }
 
 // Everything that decides the reference image, as text (the data enter through a checksum).
-std::string reference_key(const core::StandardScene& sc, const core::GridMeanExtinction& medium,
+std::string reference_key(const bench::StandardScene& sc, const core::GridMeanExtinction& medium,
                           const core::MarchSettings& m, const core::MonteCarloSettings& mc) {
   double sum = 0.0;
   for (std::size_t i = 0; i < medium.liquid_per_m.size(); ++i) sum += medium.liquid_per_m[i] * (1.0 + 1e-3 * static_cast<double>(i % 977));
@@ -129,7 +129,7 @@ struct Config {
 // The length of the camera's central ray inside the cloud layer's shell (m), for Costa's fixed
 // count of steps per ray: our march takes one step length for the whole image, so the central
 // ray's chord stands for all. 0 when the central ray misses the shell.
-double central_chord_m(const core::StandardScene& sc, const core::CloudLayer& layer) {
+double central_chord_m(const bench::StandardScene& sc, const core::CloudLayer& layer) {
   const double r0 = sc.grid.earth_radius_m;
   const glm::dvec3 o = geo::sphere_to_ecef({sc.camera.lat_deg, sc.camera.lon_deg, sc.camera.alt_m}, r0);
   const glm::dvec3 d = core::camera_ray(sc.camera, sc.camera.width / 2, sc.camera.height / 2);
@@ -150,7 +150,7 @@ double central_chord_m(const core::StandardScene& sc, const core::CloudLayer& la
   return std::max(len, 0.0);
 }
 
-std::vector<Config> make_configs(const core::StandardScene& sc, const core::MarchSettings& base, const core::CloudLayer& layer) {
+std::vector<Config> make_configs(const bench::StandardScene& sc, const core::MarchSettings& base, const core::CloudLayer& layer) {
   std::vector<Config> out;
   auto from_preset = [&](const std::string& preset) {
     core::RenderSettings rs;
@@ -258,7 +258,7 @@ int cmd_bench(const std::vector<std::string>& args) {
   std::map<std::string, double> dz_by_scene;  // for the front file: view steps as multiples of dz
   std::set<std::string> variants_warm;  // program variants compiled already (compile time is not frame time)
   for (const auto& name : a.scenes) {
-    const core::StandardScene sc = core::standard_scene(name, a.width, a.height);
+    const bench::StandardScene sc = bench::standard_scene(name, a.width, a.height);
     const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
     dz_by_scene[name] = std::abs(sc.grid.alt_m.step);
     // Clouds only, as the Monte Carlo reference models them.
@@ -269,7 +269,7 @@ int cmd_bench(const std::vector<std::string>& args) {
     // The reference: cached by scene, size and a hash of what decides it, with its running sums, so
     // a later run with more samples (or one resumed after an interruption) extends it.
     const core::MonteCarloSettings mc;
-    const std::uint64_t key = core::bench::reference_key_hash(reference_key(sc, medium, base, mc));
+    const std::uint64_t key = bench::reference_key_hash(reference_key(sc, medium, base, mc));
     char hash[20];
     std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(key));
     SceneReference ref{name, "ref_" + name + "_" + std::to_string(a.width) + "x" + std::to_string(a.height) + "_" + hash + ".cvref",
@@ -278,7 +278,7 @@ int cmd_bench(const std::vector<std::string>& args) {
     const core::MonteCarloRenderer mcr(sc.grid, medium, sc.camera, sc.sun, base, mc);
     core::MonteCarloImage img = mcr.start();
     std::string why;
-    if (core::bench::read_reference_cache(ref_path.string(), key, a.width, a.height, img, &why)) {
+    if (bench::read_reference_cache(ref_path.string(), key, a.width, a.height, img, &why)) {
       std::printf("%s: reference %s holds %llu spp (mean relative standard error %.3g)\n", name.c_str(), ref_path.c_str(),
                   static_cast<unsigned long long>(img.spp), img.mean_relative_standard_error());
     } else if (why != "no file") {
@@ -296,7 +296,7 @@ int cmd_bench(const std::vector<std::string>& args) {
       const auto tc = clock::now();
       mcr.add_samples(img, n);
       const double dt = seconds_since(tc);
-      core::bench::write_reference_cache(ref_path.string(), key, img);
+      bench::write_reference_cache(ref_path.string(), key, img);
       const double per_spp = dt / n;
       chunk = static_cast<int>(std::clamp(10.0 / std::max(per_spp, 1e-6), 1.0, 4.0 * n));
       std::printf("\r%s: Monte Carlo reference %llu/%d spp, mean rel. s.e. %.3g, %.0f s, about %.0f s to go   ",
@@ -364,10 +364,10 @@ int cmd_bench(const std::vector<std::string>& args) {
       row.accumulate = c.accumulate, row.resolution_scale = c.scale;
       row.phase_hg = c.march.liquid_phase_hg, row.adaptive = c.march.adaptive_steps;
       row.wall_ms = median(wall), row.gpu_ms = median(gpu_t);
-      row.err = core::bench::image_error(rgb, ref_rgb, ref_var);
+      row.err = bench::image_error(rgb, ref_rgb, ref_var);
       row.error_image = name + "/err_" + c.name + ".png";
       render::write_png((fs::path(a.out) / row.error_image).string(), a.width, a.height,
-                        error_png(core::bench::pixel_error(rgb, ref_rgb)));
+                        error_png(bench::pixel_error(rgb, ref_rgb)));
       std::printf("%s [%zu/%zu] %-22s %8.2f ms  rel. RMSE %-9.3g (raw %-9.3g) bias %+-9.3g worst %-8.3g PSNR %.1f dB\n",
                   name.c_str(), ci + 1, configs.size(), c.name.c_str(), row.wall_ms, row.err.rel_rmse, row.err.rel_rmse_raw,
                   row.err.rel_bias, row.err.worst, row.err.psnr_db);

@@ -47,13 +47,13 @@ std::string num(double v, const char* fmt = "%.3g") {
 void mark_pareto(std::vector<BenchRow>& rows) {
   for (const auto& scene : scene_order(rows)) {
     std::vector<std::size_t> idx;
-    std::vector<core::bench::TimeError> pts;
+    std::vector<bench::TimeError> pts;
     for (std::size_t i = 0; i < rows.size(); ++i) {
       if (rows[i].scene != scene) continue;
       idx.push_back(i);
       pts.push_back({rows[i].wall_ms, rows[i].err.rel_rmse});
     }
-    for (std::size_t k : core::bench::pareto_front(pts)) rows[idx[k]].pareto = true;
+    for (std::size_t k : bench::pareto_front(pts)) rows[idx[k]].pareto = true;
   }
 }
 
@@ -128,14 +128,14 @@ void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows
                      num(r->err.rel_rmse_raw).c_str(), num(r->err.rel_noise_floor).c_str(), num(r->err.rel_bias, "%+.3g").c_str(), num(r->err.worst).c_str(), num(r->err.psnr_db, "%.1f").c_str());
       }
       // Ratios: our configurations' own front (sweep and presets, no seed) interpolated in log-log.
-      std::vector<core::bench::TimeError> ours_pts;
+      std::vector<bench::TimeError> ours_pts;
       const BenchRow* def = nullptr;
       for (const BenchRow* r : list) {
         if (r->kind != ConfigKind::Seed) ours_pts.push_back({r->wall_ms, r->err.rel_rmse});
         if (r->config == "default") def = r;
       }
-      std::vector<core::bench::TimeError> front;
-      for (std::size_t k : core::bench::pareto_front(ours_pts)) front.push_back(ours_pts[k]);
+      std::vector<bench::TimeError> front;
+      for (std::size_t k : bench::pareto_front(ours_pts)) front.push_back(ours_pts[k]);
       std::fprintf(f,
                    "\nAgainst the seed presets. \"Our front\" = the Pareto front of our sweep and presets only; between "
                    "its measured points time and error are interpolated linearly in log-log, never extrapolated (n/a: "
@@ -151,8 +151,8 @@ void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows
                        r->config.c_str(), r->wall_ms, num(r->err.rel_rmse_resolution).c_str());
           continue;
         }
-        const double t = core::bench::front_time_for_error(front, r->err.rel_rmse);
-        const double e = core::bench::front_error_at_time(front, r->wall_ms);
+        const double t = bench::front_time_for_error(front, r->err.rel_rmse);
+        const double e = bench::front_error_at_time(front, r->wall_ms);
         std::fprintf(f, "| %s | %.4g | %s | %s ms (%s) | %s (%s) | %s | %s |\n", r->config.c_str(), r->wall_ms,
                      num(r->err.rel_rmse).c_str(), num(t, "%.4g").c_str(), num(t / r->wall_ms).c_str(), num(e).c_str(),
                      num(e / r->err.rel_rmse).c_str(), def ? num(def->wall_ms / r->wall_ms).c_str() : "n/a",
@@ -166,13 +166,13 @@ void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows
 std::vector<std::string> write_plots(const std::string& dir, const std::vector<BenchRow>& rows) {
   std::vector<std::string> out;
   for (const auto& scene : scene_order(rows)) {
-    std::vector<core::bench::PlotPoint> pts;
-    std::vector<core::bench::TimeError> te;
+    std::vector<bench::PlotPoint> pts;
+    std::vector<bench::TimeError> te;
     for (const BenchRow* r : rows_of(rows, scene)) {
       pts.push_back({{r->wall_ms, r->err.rel_rmse}, static_cast<int>(r->kind)});
       te.push_back(pts.back().p);
     }
-    const auto img = core::bench::plot_error_vs_time(pts, core::bench::pareto_front(te), 320, 240);
+    const auto img = bench::plot_error_vs_time(pts, bench::pareto_front(te), 320, 240);
     const std::string name = scene + "_pareto.png";
     render::write_png(dir + "/" + name, img.width, img.height, img.rgb);
     out.push_back(name);

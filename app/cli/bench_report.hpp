@@ -22,7 +22,7 @@ struct BenchRow {
   bool phase_hg = false, adaptive = false;
   double wall_ms = 0.0;  // median over repeats, per output image (all its accumulated frames)
   double gpu_ms = 0.0;   // median GL_TIME_ELAPSED; 0 when the driver reports none
-  core::bench::ImageError err;
+  bench::ImageError err;
   bool pareto = false;
   std::string error_image;  // relative to the output folder
 };

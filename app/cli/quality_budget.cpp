@@ -17,7 +17,7 @@ namespace cv::cli {
 namespace {
 
 namespace fs = std::filesystem;
-using core::bench::FrontConfig;
+using bench::FrontConfig;
 
 // Calibration frames larger than this many pixels are marched at a reduced size of about this many
 // pixels, and their time scaled by the pixel count (march time grows with the pixels marched; a
@@ -33,7 +33,7 @@ const char* kind_name(ConfigKind k) {
 void write_quality_front(const std::string& out_dir, const std::vector<BenchRow>& rows,
                          const std::map<std::string, double>& dz_by_scene, const std::string& machine,
                          int width, int height, const std::string& command, bool cache) {
-  core::bench::QualityFront front;
+  bench::QualityFront front;
   front.machine = machine, front.width = width, front.height = height, front.command = command;
   std::map<std::string, std::size_t> index;  // config name -> position in front.configs (first-seen order)
   std::map<std::string, std::pair<double, int>>
@@ -64,19 +64,19 @@ void write_quality_front(const std::string& out_dir, const std::vector<BenchRow>
       c.view_step_dz = std::exp(lr->second.first / lr->second.second);
     }
   }
-  core::bench::rank_front(front);
+  bench::rank_front(front);
   const std::string path = (fs::path(out_dir) / "quality_front.json").string();
-  core::bench::save_front(front, path);
+  bench::save_front(front, path);
   std::printf("wrote %s (%zu configurations, %zu candidates for --budget-ms)\n", path.c_str(),
-              front.configs.size(), core::bench::front_candidates(front).size());
+              front.configs.size(), bench::front_candidates(front).size());
   if (!cache) return;
-  const std::string cached = core::bench::front_cache_path();
+  const std::string cached = bench::front_cache_path();
   if (cached.empty()) {
     std::printf("not cached: neither XDG_CACHE_HOME nor HOME is set\n");
     return;
   }
   try {
-    core::bench::save_front(front, cached);
+    bench::save_front(front, cached);
     std::printf(
         "cached it as %s (render --budget-ms and the viewer's frame budget use it; --no-cache to skip)\n",
         cached.c_str());
@@ -99,10 +99,10 @@ void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const
                       const core::MarchSettings& base, double dz_m, double budget_ms,
                       const std::string& front_file, const std::string& machine,
                       core::RenderSettings& render) {
-  core::bench::CandidateSource src;
+  bench::CandidateSource src;
   try {
-    src = core::bench::budget_candidates(front_file, machine);
-  } catch (const core::bench::FrontError& e) {
+    src = bench::budget_candidates(front_file, machine);
+  } catch (const bench::FrontError& e) {
     throw UsageError{std::string("cloudviewer render: --front: ") + e.what()};
   }
   if (!src.warning.empty()) std::printf("budget: %s\n", src.warning.c_str());
@@ -143,20 +143,20 @@ void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const
     return ms;
   };
   const auto t_choice = clock::now();
-  const core::bench::BudgetChoice choice =
-      core::bench::choose_under_budget(src.candidates, budget_ms, measure);
+  const bench::BudgetChoice choice =
+      bench::choose_under_budget(src.candidates, budget_ms, measure);
   std::printf("budget: %zu of %zu candidate(s) timed in %.2f s\n", choice.trials.size(),
               src.candidates.size(), std::chrono::duration<double>(clock::now() - t_choice).count());
   const FrontConfig& c = src.candidates[choice.index];
   apply_front_config(c, dz_m, render);
   if (choice.met) {
     std::printf("budget %.4g ms: chose %s (%s), measured %.1f ms\n", budget_ms, c.name.c_str(),
-                core::bench::describe_config(c).c_str(), choice.ms);
+                bench::describe_config(c).c_str(), choice.ms);
   } else {
     std::printf(
         "budget %.4g ms: chose %s (%s), measured %.1f ms: budget not met, %.1f ms (%.0f%%) over; the fastest "
         "candidate\n",
-        budget_ms, c.name.c_str(), core::bench::describe_config(c).c_str(), choice.ms, choice.ms - budget_ms,
+        budget_ms, c.name.c_str(), bench::describe_config(c).c_str(), choice.ms, choice.ms - budget_ms,
         100.0 * (choice.ms - budget_ms) / budget_ms);
   }
 }

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "reference/raymarcher.hpp"
+#include "frame/albedo_map.hpp"
 
 namespace cv::render {
 

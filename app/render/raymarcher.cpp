@@ -31,6 +31,11 @@ int view_steps_per_dispatch(const core::MarchSettings& s, int sun_march_steps) {
   return std::max(1, (kLlvmpipeLoopBudget - kLoopReserve) / loop_iterations_per_view_step(s, sun_march_steps));
 }
 
+bool driver_has_loop_budget(const std::string& renderer) {
+  // Mesa's gallivm drivers: llvmpipe (and the older softpipe shares the limit through its TGSI path).
+  return renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos;
+}
+
 int max_view_steps(double r0_m, double top_m, double view_step_m) {
   const double top = std::max(top_m, 0.0);
   const double chord = 2.0 * std::sqrt((r0_m + top) * (r0_m + top) - r0_m * r0_m);
@@ -38,6 +43,8 @@ int max_view_steps(double r0_m, double top_m, double view_step_m) {
 }
 
 GpuRaymarcher::GpuRaymarcher(const ShaderLoader& loader) : loader_(loader) {
+  const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  loop_budget_ = driver_has_loop_budget(renderer ? renderer : "");
   program_for(kernel::MarchVariant::of(core::MarchSettings{}));  // the default program now: shader errors show at construction
   // The jitter's blue-noise mask, the very array the CPU reference reads (made once per process),
   // fetched texel by texel: a sampler's filtering would blend ranks.
@@ -59,7 +66,7 @@ const GlProgram& GpuRaymarcher::program_for(const kernel::MarchVariant& v) {
 
 GpuRaymarcher::~GpuRaymarcher() {
   if (textures_[0]) glDeleteTextures(2, textures_);
-  if (state_[0]) glDeleteTextures(4, state_);
+  if (state_[0]) glDeleteTextures(3, state_);
   if (ground_) glDeleteTextures(1, &ground_);
   if (jitter_mask_) glDeleteTextures(1, &jitter_mask_);
   if (column_tau_) glDeleteTextures(1, &column_tau_);
@@ -180,20 +187,18 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PYRAMID, pyramid_buffer_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_STATS, stats_buffer_);
   if (!state_[0] || state_w_ != cam.width || state_h_ != cam.height) {
-    if (state_[0]) glDeleteTextures(4, state_);
-    glCreateTextures(GL_TEXTURE_2D, 4, state_);
+    if (state_[0]) glDeleteTextures(3, state_);
+    glCreateTextures(GL_TEXTURE_2D, 3, state_);
     glTextureStorage2D(state_[0], 1, GL_RGBA32F, cam.width, cam.height);
     glTextureStorage2D(state_[1], 1, GL_RGBA32F, cam.width, cam.height);
-    glTextureStorage2D(state_[2], 1, GL_R32F, cam.width, cam.height);
-    glTextureStorage2D(state_[3], 1, GL_R32F, cam.width, cam.height);  // the cloud depth, kept after the frame
+    glTextureStorage2D(state_[2], 1, GL_R32F, cam.width, cam.height);  // the cloud depth, kept after the frame
     state_w_ = cam.width;
     state_h_ = cam.height;
   }
   glBindImageTexture(CV_IMAGE_OUT, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glBindImageTexture(CV_IMAGE_STATE_L, state_[0], 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(CV_IMAGE_STATE_DEPTH, state_[1], 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-  glBindImageTexture(CV_IMAGE_STATE_HALF, state_[2], 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
-  glBindImageTexture(CV_IMAGE_CLOUD_DEPTH, state_[3], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glBindImageTexture(CV_IMAGE_CLOUD_DEPTH, state_[2], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
   glBindTextureUnit(CV_TEX_DEPTH, opaque.depth);
   glBindTextureUnit(CV_TEX_OPAQUE, opaque.color);
   glBindTextureUnit(CV_TEX_LIQUID, textures_[0]);
@@ -205,13 +210,15 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   const int tile = dispatch.rows_per_tile > 0 ? (dispatch.rows_per_tile + 7) / 8 * 8 : cam.height;
   GLuint query = 0;
   if (dispatch.gpu_seconds) glCreateQueries(GL_TIME_ELAPSED, 1, &query);
-  // The march goes in ranges of view steps, one dispatch each, then the air and the ground: no
-  // dispatch exceeds llvmpipe's loop budget (see loop_iterations_per_view_step).
+  // On llvmpipe the march goes in ranges of view steps, one dispatch each, then the air and the
+  // ground: no dispatch exceeds its loop budget (see loop_iterations_per_view_step). Other drivers
+  // have no such budget and march every step in one dispatch.
   const double top_m = v.layer.empty ? grid.alt_m.last() : v.layer.top_m;
   const int total_steps = max_view_steps(r0, top_m, s.view_step_m);
-  const int chunk = view_steps_per_dispatch(
-      s, core::max_sun_march_steps(s.sun_steps, params.u_sun_step_max, r0, v.layer.bottom_m, top_m,
-                                   core::smallest_sun_cosine(grid, to_sun)));
+  const int chunk = loop_budget_ ? view_steps_per_dispatch(s, core::max_sun_march_steps(s.sun_steps, params.u_sun_step_max, r0,
+                                                                                        v.layer.bottom_m, top_m,
+                                                                                        core::smallest_sun_cosine(grid, to_sun)))
+                                 : total_steps;
   glProgramUniform1i(p, loc(p, "u_step_count"), chunk);
   for (int row = 0; row < cam.height; row += tile) {
     const int rows = std::min(tile, cam.height - row);
@@ -268,8 +275,8 @@ const core::MarchStats& GpuRaymarcher::last_stats() {
 
 std::vector<float> GpuRaymarcher::read_cloud_depth() const {
   std::vector<float> depth(static_cast<std::size_t>(state_w_) * state_h_);
-  if (state_[3]) {
-    glGetTextureImage(state_[3], 0, GL_RED, GL_FLOAT, static_cast<GLsizei>(depth.size() * sizeof(float)), depth.data());
+  if (state_[2]) {
+    glGetTextureImage(state_[2], 0, GL_RED, GL_FLOAT, static_cast<GLsizei>(depth.size() * sizeof(float)), depth.data());
   }
   return depth;
 }

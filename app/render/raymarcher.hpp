@@ -11,8 +11,13 @@
 #include <glm/vec4.hpp>
 
 #include "kernel/march_params.hpp"
+#include "kernel/march_limits.hpp"
 #include "kernel/prepared_volume.hpp"
-#include "reference/raymarcher.hpp"
+#include "noise/noise.hpp"
+#include "frame/camera.hpp"
+#include "frame/march_stats.hpp"
+#include "frame/sun.hpp"
+#include "settings/march_settings.hpp"
 #include "render/shader_loader.hpp"
 
 namespace cv::render {
@@ -48,6 +53,10 @@ inline constexpr int kLlvmpipeLoopBudget = 65535;
 // step may take with adaptive steps. Every loop counts one iteration more than its trip count (the
 // test that ends it), and a loop that no lane needs still runs once (llvmpipe executes masked code).
 int loop_iterations_per_view_step(const core::MarchSettings& settings, int sun_march_steps);
+
+// Whether a driver (its GL_RENDERER string) has that loop budget: only then is the march split
+// into dispatches of view_steps_per_dispatch steps.
+bool driver_has_loop_budget(const std::string& renderer);
 
 // How many view steps one dispatch of the march takes: the budget, less kLoopReserve for the loops
 // outside the steps (the two shell segments, the counters), over the bound above.
@@ -92,7 +101,7 @@ class GpuRaymarcher {
 
   // The last frame's cloud depth, for later passes: an R32F texture of its size holding the distance
   // (m) from the camera at which the view transmittance fell to 0.5 (3e38 where it never did).
-  GLuint cloud_depth_texture() const { return state_[3]; }
+  GLuint cloud_depth_texture() const { return state_[2]; }
   // The same, read back (rows top to bottom).
   std::vector<float> read_cloud_depth() const;
 
@@ -112,9 +121,8 @@ class GpuRaymarcher {
   GLuint column_tau_ = 0;           // vertical optical depth per column (R32F), for the octave gate
   GLuint jitter_mask_ = 0;          // the blue-noise mask (R32F), uploaded at construction
   GLuint ground_ = 0;               // linear albedo (RGB32F), loaded from ground_path_
-  // The march's state between dispatches (image-sized: two RGBA32F, one R32F) and the cloud depth it
-  // writes (R32F).
-  GLuint state_[4] = {0, 0, 0, 0};
+  // The march's state between dispatches (image-sized, two RGBA32F) and the cloud depth it writes (R32F).
+  GLuint state_[3] = {0, 0, 0};
   int state_w_ = 0, state_h_ = 0;
   int ground_w_ = 0, ground_h_ = 0;
   std::string ground_path_;
@@ -122,6 +130,7 @@ class GpuRaymarcher {
   GLuint params_buffer_ = 0;  // the kernel's uniform block (kernel::MarchParamsStd140)
   std::shared_ptr<const core::PreparedVolume> volume_;  // the time step uploaded
   bool stats_read_ = true;
+  bool loop_budget_ = true;  // the driver ends loops past kLlvmpipeLoopBudget (driver_has_loop_budget)
   bool sun_down_ = false;  // the last render left out the sun (core::layer_in_earth_shadow)
   core::MarchStats stats_;
 };

@@ -4,7 +4,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "reference/raymarcher.hpp"
+#include "frame/camera.hpp"
 
 namespace cv::viewer {
 

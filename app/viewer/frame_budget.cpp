@@ -9,7 +9,7 @@
 namespace cv::viewer {
 
 FrameBudget::FrameBudget(const std::string& machine)
-    : source_(core::bench::budget_candidates("", machine)),
+    : source_(bench::budget_candidates("", machine)),
       stepper_(source_.candidates.size(), source_.candidates.size() - 1) {}
 
 bool FrameBudget::update(core::RenderSettings& render, double dz_m, double last_frame_ms, bool marched) {
@@ -21,7 +21,7 @@ bool FrameBudget::update(core::RenderSettings& render, double dz_m, double last_
   bool apply = false;
   if (!on_) {  // just switched on: from the fastest, with nothing known
     on_ = true;
-    stepper_ = core::bench::BudgetStepper(source_.candidates.size(), source_.candidates.size() - 1);
+    stepper_ = bench::BudgetStepper(source_.candidates.size(), source_.candidates.size() - 1);
     // The bench's times per marched frame predict the ratios between candidates (the viewer
     // accumulates frames progressively, so a candidate's accumulate does not slow a frame).
     std::vector<double> costs;
@@ -32,7 +32,7 @@ bool FrameBudget::update(core::RenderSettings& render, double dz_m, double last_
     apply = stepper_.observe(last_frame_ms, render.budget_ms);
   }
   if (!apply) return false;
-  const core::bench::FrontConfig& c = candidate();
+  const bench::FrontConfig& c = candidate();
   render.march.view_step_m = c.view_step_m(dz_m);
   render.march.sun_steps = c.sun_steps;
   render.march.octaves = c.octaves;

@@ -28,15 +28,15 @@ class FrameBudget {
 
   bool on() const { return on_; }
   std::size_t current() const { return stepper_.current(); }
-  const core::bench::FrontConfig& candidate() const { return source_.candidates[stepper_.current()]; }
+  const bench::FrontConfig& candidate() const { return source_.candidates[stepper_.current()]; }
   // "default (2 of 3), last 41.3 ms" and where the candidates came from, for the panel.
   std::string status() const;
   const std::string& source() const { return source_.source; }
   const std::string& warning() const { return source_.warning; }
 
  private:
-  core::bench::CandidateSource source_;
-  core::bench::BudgetStepper stepper_;
+  bench::CandidateSource source_;
+  bench::BudgetStepper stepper_;
   bool on_ = false;
 };
 

@@ -4,7 +4,10 @@
 
 #include <string>
 
-#include "reference/raymarcher.hpp"
+#include "frame/camera.hpp"
+#include "frame/march_stats.hpp"
+#include "frame/sun.hpp"
+#include "settings/march_settings.hpp"
 #include "viewer/viewer_state.hpp"
 
 namespace cv::viewer {

@@ -6,7 +6,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "reference/raymarcher.hpp"
+#include "frame/camera.hpp"
+#include "frame/march_stats.hpp"
+#include "frame/sun.hpp"
+#include "settings/march_settings.hpp"
 #include "scene/scene.hpp"
 #include "volume/cloud_volume.hpp"
 

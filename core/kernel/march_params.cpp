@@ -1,7 +1,7 @@
 // Packing the march parameters for the GPU, and the program variant of a march's settings.
 #include "kernel/march_params.hpp"
 
-#include "reference/raymarcher.hpp"
+#include "settings/march_settings.hpp"
 
 namespace cv::kernel {
 

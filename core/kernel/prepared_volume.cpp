@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "geo/geodesy.hpp"
+#include "kernel/march_limits.hpp"
 #include "noise/noise.hpp"
 #include "physics/physics.hpp"
 #include "reference/earth_shadow.hpp"

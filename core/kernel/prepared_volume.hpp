@@ -10,7 +10,10 @@
 #include <glm/vec2.hpp>
 
 #include "kernel/march_params.hpp"
-#include "reference/raymarcher.hpp"
+#include "frame/camera.hpp"
+#include "frame/sun.hpp"
+#include "settings/march_settings.hpp"
+#include "volume/grid_mean.hpp"
 #include "volume/column_depth.hpp"
 #include "volume/extinction_pyramid.hpp"
 

@@ -5,7 +5,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "reference/raymarcher.hpp"
+#include "volume/grid_mean.hpp"
 
 namespace cv::core {
 

@@ -10,7 +10,9 @@
 #include <glm/glm.hpp>
 
 #include "geo/geodesy.hpp"
+#include "kernel/prepared_volume.hpp"
 #include "physics/physics.hpp"
+#include "reference/track_kernel.hpp"
 
 namespace cv::core {
 namespace {
@@ -19,20 +21,7 @@ constexpr double kDeg = 3.14159265358979323846 / 180.0;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 const glm::dvec3 kLumWeights(0.2126, 0.7152, 0.0722);
 
-// splitmix64's finaliser: a bijective 64-bit mix with full avalanche.
-std::uint64_t mix64(std::uint64_t z) {
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-constexpr std::uint64_t kGolden = 0x9E3779B97F4A7C15ull;
 
-// Below this many metres the pyramid's extent is not trusted to make progress (a query on a brick
-// face); the grid-wide majorant covers that metre instead, which keeps the estimate unbiased.
-constexpr double kMinBrickExtentM = 1.0;
-// Ratio tracking plays roulette below this transmittance: deep in thick cloud a sun ray would
-// otherwise look up the medium for hundreds of optical depths to multiply tiny factors.
-constexpr double kShadowRouletteBelow = 1e-2;
 }  // namespace
 
 void MonteCarloStats::add(const MonteCarloStats& o) {
@@ -93,17 +82,6 @@ std::vector<glm::dvec3> MonteCarloImage::radiance() const {
 
 // ---- random numbers ----
 
-PathRng::PathRng(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample)
-    : key_(mix64(mix64(seed + kGolden) ^ mix64(pixel * 0xD1B54A32D192ED03ull + 1) ^
-                 mix64(sample * kGolden + 7))) {}
-
-double PathRng::uniform() {
-  return static_cast<double>(mix64(key_ + (++counter_) * kGolden) >> 11) * 0x1.0p-53;
-}
-
-std::uint32_t PathRng::bits32() {
-  return static_cast<std::uint32_t>(mix64(key_ + (++counter_) * kGolden) >> 32);
-}
 
 // ---- the tracer ----
 
@@ -116,47 +94,39 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
       sun_(sun),
       march_(march),
       mc_(mc),
-      noise_(noise),
-      liquid_(grid, ext.liquid_per_m),
-      ice_(grid, ext.ice_per_m) {
+      noise_(noise) {
   if (march.atmosphere) {
     throw std::invalid_argument(
         "monte carlo: atmosphere on is not modelled (clouds only, optionally the globe)");
   }
   if (mc.max_bounces < 1) throw std::invalid_argument("monte carlo: max_bounces must be >= 1");
-  if (march.noise_amount > 0.0) {
-    if (!noise) throw std::invalid_argument("monte carlo: noise_amount > 0 needs the erosion noise textures");
-    anchor_ = noise_anchor(grid_centre_ecef(grid), march.noise_scale_m);
+  if (march.noise_amount > 0.0 && !noise) throw std::invalid_argument("monte carlo: noise_amount > 0 needs the erosion noise textures");
+  // The medium as the march kernel reads it (shaders/kernel/march.glsl medium_at_point), erosion
+  // included, and the kernel's tracking (tracking.glsl) over it.
+  volume_ = std::make_shared<const PreparedVolume>(prepare_volume(grid, ext));
+  kernel_ = std::make_shared<kernel::f64::TrackKernel>();
+  kernel::f64::TrackKernel& k = *kernel_;
+  static_cast<kernel::MarchParams&>(k) = march_params(*volume_, cam, sun, march);
+  const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
+  k.u_liquid = {volume_->extinction.liquid_per_m.data(), n};
+  k.u_ice = {volume_->extinction.ice_per_m.data(), n};
+  k.u_min_max = volume_->pyramid_packed.data();
+  k.kNoise = march.noise_amount > 0.0;
+  if (k.kNoise) {
+    k.u_noise_low = {noise->low.texels.data(), glm::ivec3(noise->low.n)};
+    k.u_noise_high = {noise->high.texels.data(), glm::ivec3(noise->high.n)};
   }
-  wraps_ = grid.wraps_lon();
-  global_lat_ = liquid_.global_lat();
   // Trilinear weights are convex, so liquid + ice anywhere is at most the largest node sum; erosion
   // only lowers extinction (erode_extinction keeps at most the data's value).
-  for (std::size_t i = 0; i < grid.points(); ++i) {
-    const double l = ext.liquid_per_m.empty() ? 0.0 : ext.liquid_per_m[i];
-    const double c = ext.ice_per_m.empty() ? 0.0 : ext.ice_per_m[i];
-    majorant_ = std::max(majorant_, l + c);
-  }
-  if (mc.brick_majorants) pyramid_ = ExtinctionPyramid(grid, ext.liquid_per_m, ext.ice_per_m);
+  k.u_track_majorant = volume_->sigma_max_per_m;
+  k.u_track_bricks = mc.brick_majorants;
   to_sun_ = glm::normalize(
       geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, grid.earth_radius_m));
 }
 
-void MonteCarloRenderer::extinction(const glm::dvec3& p, double& sl, double& si) const {
-  const glm::dvec3 g = p64::ecef_to_sphere(p, grid_.earth_radius_m);
-  const double lat = g.x / kDeg, lon = g.y / kDeg, alt = g.z;
-  sl = liquid_.sample(lat, lon, alt, 0.0);
-  si = ice_.sample(lat, lon, alt, 0.0);
-  if (noise_ && march_.noise_amount > 0.0 && sl + si > 0.0) {
-    // The same erosion as the raymarcher's (shaders/common/erosion.glsl), anchored at the grid centre.
-    const glm::dvec3 t = p64::noise_tile_coords(p - anchor_.ecef_m, anchor_.frac, march_.noise_scale_m);
-    const double e = p64::erosion_threshold(
-        noise_->low.sample(t), noise_->high.sample(p64::noise_high_coords(t)), march_.noise_amount);
-    const double feature_m = p64::noise_feature_m(march_.noise_scale_m);
-    sl = p64::erode_extinction(sl, e, feature_m);
-    si = p64::erode_extinction(si, e, feature_m);
-  }
-}
+double MonteCarloRenderer::majorant_per_m() const { return kernel_->u_track_majorant; }
+
+void MonteCarloRenderer::extinction(const glm::dvec3& p, double& sl, double& si) const { kernel_->medium_at_point(p, sl, si); }
 
 int MonteCarloRenderer::shell_parts(const glm::dvec3& p, const glm::dvec3& d, double seg[4],
                                     double& t_ground) const {
@@ -186,66 +156,17 @@ int MonteCarloRenderer::shell_parts(const glm::dvec3& p, const glm::dvec3& d, do
   return kept;
 }
 
-void MonteCarloRenderer::majorant_at(const glm::dvec3& p, const glm::dvec3& d, double t, double t_end,
-                                     double& sigma_max, double& t_valid) const {
-  sigma_max = majorant_;
-  t_valid = t_end;
-  if (!mc_.brick_majorants) return;
-  const ExtinctionPyramid::Space sp = pyramid_.at(p + t * d, d);
-  if (!(sp.extent_m >= kMinBrickExtentM) || !std::isfinite(sp.extent_m)) {
-    t_valid = std::min(t + kMinBrickExtentM, t_end);
-    return;
-  }
-  sigma_max = sp.empty ? 0.0 : sp.sigma_max_per_m;
-  t_valid = std::min(t + sp.extent_m, t_end);
-}
-
-template <class Visit>
-bool MonteCarloRenderer::tentative_collisions(const glm::dvec3& p, const glm::dvec3& d, const double seg[4], int n,
-                                              PathRng& rng, MonteCarloStats& st, Visit&& visit) const {
-  for (int k = 0; k < n; ++k) {
-    double t = seg[2 * k];
-    const double b = seg[2 * k + 1];
-    while (t < b) {
-      double maj, lim;
-      majorant_at(p, d, t, b, maj, lim);
-      if (!(maj > 0.0)) {
-        t = lim;
-        continue;
-      }
-      // The exponential distribution is memoryless: a draw past the majorant's range restarts there.
-      const double s = -std::log1p(-rng.uniform()) / maj;
-      if (t + s >= lim) {
-        t = lim;
-        continue;
-      }
-      t += s;
-      double sl, si;
-      extinction(p + t * d, sl, si);
-      const double sigma = sl + si;
-      st.majorant_exceeded += sigma > maj * (1.0 + 1e-9);
-      if (visit(t, sigma, maj)) return true;
-    }
-  }
-  return false;
-}
-
 double MonteCarloRenderer::free_path(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng,
                                      MonteCarloStats& st, double* ground_m) const {
   double seg[4], t_ground;
   const int n = shell_parts(p, d, seg, t_ground);
   if (ground_m) *ground_m = t_ground;
   // Delta tracking: a tentative collision is real with probability sigma / majorant.
-  double hit = kInf;
-  tentative_collisions(p, d, seg, n, rng, st, [&](double t, double sigma, double maj) {
-    if (rng.uniform() * maj < sigma) {
-      hit = t;
-      return true;
-    }
-    ++st.null_collisions;
-    return false;
-  });
-  return hit;
+  kernel::f64::TrackKernel::TrackCounts c = kernel_->track_counts();
+  const double t = kernel_->delta_track(p, d, glm::dvec4(seg[0], seg[1], seg[2], seg[3]), n, rng, c);
+  st.null_collisions += c.null_collisions;
+  st.majorant_exceeded += c.exceeded;
+  return t < 3.0e38 ? t : kInf;
 }
 
 double MonteCarloRenderer::transmittance(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng,
@@ -253,19 +174,12 @@ double MonteCarloRenderer::transmittance(const glm::dvec3& p, const glm::dvec3& 
   double seg[4], t_ground;
   const int n = shell_parts(p, d, seg, t_ground);
   if (std::isfinite(t_ground)) return 0.0;  // the Earth's shadow
-  // Ratio tracking: each tentative collision keeps the fraction 1 - sigma / majorant.
-  double tr = 1.0;
-  const bool stopped = tentative_collisions(p, d, seg, n, rng, st, [&](double, double sigma, double maj) {
-    ++st.shadow_lookups;
-    tr *= std::max(0.0, 1.0 - sigma / maj);
-    if (tr < kShadowRouletteBelow) {
-      // Survive with probability tr / threshold carrying the threshold: expectation unchanged.
-      if (rng.uniform() * kShadowRouletteBelow >= tr) return true;
-      tr = kShadowRouletteBelow;
-    }
-    return false;
-  });
-  return stopped ? 0.0 : tr;
+  // Ratio tracking, with roulette deep in thick cloud.
+  kernel::f64::TrackKernel::TrackCounts c = kernel_->track_counts();
+  const double tr = kernel_->ratio_track(p, d, glm::dvec4(seg[0], seg[1], seg[2], seg[3]), n, rng, c);
+  st.shadow_lookups += c.lookups;
+  st.majorant_exceeded += c.exceeded;
+  return tr;
 }
 
 MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec3 d, PathRng& rng,

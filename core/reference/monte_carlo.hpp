@@ -5,15 +5,19 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
 #include "noise/noise.hpp"
+#include "reference/path_rng.hpp"
 #include "reference/raymarcher.hpp"
 #include "volume/cloud_volume.hpp"
-#include "volume/extinction_pyramid.hpp"
-#include "volume/sampler.hpp"
+
+namespace cv::kernel::f64 {
+struct TrackKernel;
+}
 
 namespace cv::core {
 
@@ -65,17 +69,6 @@ struct MonteCarloImage {
   std::vector<glm::dvec3> radiance() const;  // the means
 };
 
-// A random stream per (seed, pixel, sample): counter-based, so any thread computes any sample.
-class PathRng {
- public:
-  PathRng(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample);
-  double uniform();  // [0, 1)
-  std::uint32_t bits32();
-
- private:
-  std::uint64_t key_, counter_ = 0;
-};
-
 class MonteCarloRenderer {
  public:
   // `noise` is needed when march.noise_amount > 0. Throws std::invalid_argument for settings the
@@ -111,21 +104,12 @@ class MonteCarloRenderer {
   // at every vertex, new directions by the phase functions, roulette, until it ends.
   PathResult trace(glm::dvec3 p, glm::dvec3 d, PathRng& rng, MonteCarloStats& st) const;
 
-  double majorant_per_m() const { return majorant_; }
+  double majorant_per_m() const;
 
  private:
   void extinction(const glm::dvec3& p, double& sigma_liquid, double& sigma_ice) const;
   // The ray's parts inside the cloud shell, cut at the ground; returns their count (<= 2).
   int shell_parts(const glm::dvec3& p, const glm::dvec3& d, double seg[4], double& t_ground) const;
-  // Majorant valid from t on along the ray and the distance up to which it holds.
-  void majorant_at(const glm::dvec3& p, const glm::dvec3& d, double t, double t_end, double& sigma_max,
-                   double& t_valid) const;
-  // Walks the tentative collisions of a majorant-driven (delta or ratio) tracking along the shell
-  // parts seg[0..2n): visit(t, sigma, majorant) sees each one and returns true to stop the walk.
-  // Returns whether a visit stopped it.
-  template <class Visit>
-  bool tentative_collisions(const glm::dvec3& p, const glm::dvec3& d, const double seg[4], int n, PathRng& rng,
-                            MonteCarloStats& st, Visit&& visit) const;
   glm::dvec3 sun_light(const glm::dvec3& x, PathRng& rng, MonteCarloStats& st, double& mu_sun_local) const;
   glm::dvec3 pixel_sample(int px, int py, std::uint64_t sample, MonteCarloStats& st) const;
 
@@ -136,11 +120,10 @@ class MonteCarloRenderer {
   MarchSettings march_;
   MonteCarloSettings mc_;
   const ErosionNoise* noise_ = nullptr;
-  NoiseAnchor anchor_;
-  VolumeSampler liquid_, ice_;
-  ExtinctionPyramid pyramid_;
-  bool wraps_ = false, global_lat_ = false;
-  double majorant_ = 0.0;  // largest liquid + ice extinction of any node, 1/m
+  std::shared_ptr<const PreparedVolume> volume_;
+  // The march kernel's medium and tracking over volume_ (reference/track_kernel.hpp); its functions
+  // called here write nothing, so the threads share it.
+  std::shared_ptr<kernel::f64::TrackKernel> kernel_;
   glm::dvec3 to_sun_{0.0};
 };
 

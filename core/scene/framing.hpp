@@ -6,7 +6,9 @@
 #include <optional>
 #include <string>
 
+#include "frame/sun.hpp"
 #include "scene/scene.hpp"
+#include "volume/cloud_volume.hpp"
 
 namespace cv::core {
 

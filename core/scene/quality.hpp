@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "scene/scene.hpp"
+#include "volume/cloud_volume.hpp"
 
 namespace cv::core {
 

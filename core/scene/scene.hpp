@@ -8,7 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "reference/raymarcher.hpp"
+#include "frame/camera.hpp"
+#include "settings/march_settings.hpp"
 
 namespace cv::core {
 

@@ -112,17 +112,25 @@ CV_FN real cell_max(real3 p, real alt_m) {
   return m;
 }
 
-// The medium at Earth-centred point p whose altitude alt_m the caller knows better than |p| - r0
-// (ray_altitude): latitude and longitude come from p. Eroded by the noise where it is on.
-CV_FN void medium_at(real3 p, real alt_m, CV_OUT(real) sl, CV_OUT(real) si) {
+// The medium (liquid and ice extinction, 1/m) at Earth-centred point p, whose latitude and longitude
+// g (radians, ecef_to_sphere) and altitude alt_m are given. Eroded by the noise where it is on.
+CV_FN void medium_in(real3 p, real3 g, real alt_m, CV_OUT(real) sl, CV_OUT(real) si) {
   sl = real(0.0);
   si = real(0.0);
-  real3 g = ecef_to_sphere(p, u_r0);
   real3 f;
   if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
   sl = fetch(u_liquid, f);
   si = fetch(u_ice, f);
   if (kNoise && sl + si > real(0.0)) erode_at(p, sl, si);
+}
+
+// The medium at p whose altitude alt_m a marcher knows better than |p| - r0 (ray_altitude).
+CV_FN void medium_at(real3 p, real alt_m, CV_OUT(real) sl, CV_OUT(real) si) { medium_in(p, ecef_to_sphere(p, u_r0), alt_m, sl, si); }
+
+// The medium at p, its altitude from p (the Monte Carlo's free-flying points).
+CV_FN void medium_at_point(real3 p, CV_OUT(real) sl, CV_OUT(real) si) {
+  real3 g = ecef_to_sphere(p, u_r0);
+  medium_in(p, g, g.z, sl, si);
 }
 
 // One level of the pyramid at grid index g (see space_at): true when its brick there is empty, with

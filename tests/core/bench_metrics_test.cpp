@@ -9,7 +9,7 @@
 #include "bench/plot.hpp"
 
 namespace {
-using namespace cv::core::bench;
+using namespace cv::bench;
 
 TEST(BenchMetrics, ErrorOfAKnownImagePair) {
   // Grey pixels (luminance = the value): reference 1, 1, 2, 4 (mean 2, max 4); test off by +1, -1, 0, +2.

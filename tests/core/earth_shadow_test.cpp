@@ -11,12 +11,14 @@
 #include "geo/geodesy.hpp"
 #include "physics/physics.hpp"
 #include "reference/earth_shadow.hpp"
-#include "scene/standard_scenes.hpp"
+#include "bench/standard_scenes.hpp"
+#include "reference/raymarcher.hpp"
 
 #include "night_sun.hpp"
 
 namespace {
 using namespace cv::core;
+using namespace cv::bench;
 namespace geo = cv::geo;
 namespace p64 = cv::physics::f64;
 using cv::test::sun_at;

@@ -9,12 +9,12 @@
 #include <vector>
 
 #include "reference/raymarcher.hpp"
-#include "scene/standard_scenes.hpp"
+#include "bench/standard_scenes.hpp"
 
 namespace {
 using namespace cv;
 
-std::vector<double> mean_of_frames(const core::StandardScene& sc, const core::GridMeanExtinction& medium,
+std::vector<double> mean_of_frames(const bench::StandardScene& sc, const core::GridMeanExtinction& medium,
                                    bool blue, int first, int count) {
   core::MarchSettings s = sc.march;
   s.blue_noise = blue;
@@ -37,7 +37,7 @@ double rms(const std::vector<double>& a, const std::vector<double>& b) {
 }
 
 TEST(JitterConvergence, BlueNoiseAccumulatesFasterThanTheHash) {
-  const core::StandardScene sc = core::standard_scene("stratocumulus", 48, 27);
+  const bench::StandardScene sc = bench::standard_scene("stratocumulus", 48, 27);
   const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
   // The converged image: 256 blue-noise frames that the N-frame means below do not use (frames 16
   // on), so neither method's error is shrunk by sharing frames with it. The hash's own 256-frame

@@ -14,10 +14,11 @@
 #include "geo/geodesy.hpp"
 #include "reference/monte_carlo.hpp"
 #include "reference/raymarcher.hpp"
-#include "scene/standard_scenes.hpp"
+#include "bench/standard_scenes.hpp"
 
 namespace {
 using namespace cv::core;
+using namespace cv::bench;
 
 // Bounds below are stated in standard errors; at 4.5 sigma a correct estimator fails one check in
 // about 150 000, and the seeds are fixed, so a pass is reproducible.

@@ -8,7 +8,8 @@
 
 #include "geo/geodesy.hpp"
 #include "reference/earth_shadow.hpp"
-#include "scene/standard_scenes.hpp"
+#include "bench/standard_scenes.hpp"
+#include "reference/raymarcher.hpp"
 
 namespace cv::test {
 
@@ -23,7 +24,7 @@ inline glm::dvec3 sun_at(double lat_deg, double lon_deg, double theta_deg, doubl
 
 // The sun just far enough past the terminator that the layer of a standard scene is dark; the air
 // above it (to 60 km) is still sunlit there, so the sky in the image is not black.
-inline core::Sun sun_just_down(const core::StandardScene& sc) {
+inline core::Sun sun_just_down(const bench::StandardScene& sc) {
   const core::CloudLayer layer = core::cloud_layer(sc.grid, core::grid_mean_extinction(sc.grid, sc.data));
   const double lat = sc.grid.lat_deg.start + 0.5 * (sc.grid.lat_deg.last() - sc.grid.lat_deg.start);
   const double lon = sc.grid.lon_deg.start + 0.5 * (sc.grid.lon_deg.last() - sc.grid.lon_deg.start);

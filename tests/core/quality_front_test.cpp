@@ -14,7 +14,7 @@
 #include "bench/budget_stepper.hpp"
 #include "bench/quality_front.hpp"
 
-namespace cv::core::bench {
+namespace cv::bench {
 namespace {
 
 FrontConfig config(const std::string& name, const std::string& kind, std::vector<FrontScene> scenes) {
@@ -398,4 +398,4 @@ TEST(BudgetStepper, OffDoesNothing) {
 }
 
 }  // namespace
-}  // namespace cv::core::bench
+}  // namespace cv::bench

@@ -9,11 +9,12 @@
 #include <unistd.h>
 
 #include "bench/reference_cache.hpp"
-#include "scene/standard_scenes.hpp"
+#include "bench/standard_scenes.hpp"
+#include "reference/raymarcher.hpp"
 
 namespace {
 using namespace cv::core;
-using namespace cv::core::bench;
+using namespace cv::bench;
 namespace fs = std::filesystem;
 
 struct ReferenceCache : ::testing::Test {

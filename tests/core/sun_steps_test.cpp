@@ -11,10 +11,11 @@
 
 #include "physics/physics.hpp"
 #include "reference/raymarcher.hpp"
-#include "scene/standard_scenes.hpp"
+#include "bench/standard_scenes.hpp"
 
 namespace {
 using namespace cv::core;
+using namespace cv::bench;
 namespace p64 = cv::physics::f64;
 
 TEST(SunSteps, EachStepHoldsAtMostTheGivenOpticalDepth) {

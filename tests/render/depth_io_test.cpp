@@ -13,7 +13,7 @@
 #include "render/context.hpp"
 #include "render/gl.hpp"
 #include "render/raymarcher.hpp"
-#include "scene/standard_scenes.hpp"
+#include "bench/standard_scenes.hpp"
 
 namespace {
 using namespace cv;
@@ -153,7 +153,7 @@ TEST(DepthOut, CloudDepthIsWhereTransmittanceFallsToHalf) {
 }
 
 TEST(DepthOut, CloudDepthMatchesTheCpuOnTheStratocumulusDeck) {
-  const core::StandardScene sc = core::standard_scene("stratocumulus", 48, 27);
+  const bench::StandardScene sc = bench::standard_scene("stratocumulus", 48, 27);
   auto ctx = render::make_headless_context();
   render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
   render::GpuRaymarcher gpu(loader);

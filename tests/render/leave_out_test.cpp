@@ -11,7 +11,7 @@
 #include "reference/raymarcher.hpp"
 #include "render/context.hpp"
 #include "render/raymarcher.hpp"
-#include "scene/standard_scenes.hpp"
+#include "bench/standard_scenes.hpp"
 
 #include "../core/night_sun.hpp"
 
@@ -19,7 +19,7 @@ namespace {
 using namespace cv;
 
 TEST(LeaveOut, NightOnTheGpuIsThePerSampleImage) {
-  core::StandardScene sc = core::standard_scene("cumulus_field", 32, 18);
+  bench::StandardScene sc = bench::standard_scene("cumulus_field", 32, 18);
   sc.sun = test::sun_just_down(sc);
   sc.march.atmosphere = sc.march.globe = true;
   sc.march.ambient = 1.0;
@@ -64,7 +64,7 @@ TEST(LeaveOut, ThinCloudTakesFewerSunStepsOnTheGpu) {
   render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
   render::GpuRaymarcher gpu(loader);
   for (const char* name : {"thin_cirrus", "towering_cell"}) {
-    const core::StandardScene sc = core::standard_scene(name, 96, 54);
+    const bench::StandardScene sc = bench::standard_scene(name, 96, 54);
     gpu.upload(sc.grid, core::grid_mean_extinction(sc.grid, sc.data));
     core::MarchSettings all = sc.march;
     all.max_sun_step_optical_depth = 0.0;
@@ -101,7 +101,7 @@ namespace {
 // the classic sum would (the count is the CPU reference's, to the few samples float rounding tips),
 // and with the gate off it evaluates them all.
 TEST(LeaveOut, TheGateCountsTheOctaveTermsItLeavesOut) {
-  core::StandardScene sc = core::standard_scene("thin_cirrus", 32, 18);
+  bench::StandardScene sc = bench::standard_scene("thin_cirrus", 32, 18);
   sc.march.octaves = 4;
   auto ctx = render::make_headless_context();
   render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});

@@ -115,3 +115,16 @@ TEST(LoopBudget, TheDispatchesCoverEveryRaysSteps) {
 }
 
 }  // namespace
+
+namespace {
+TEST(LoopBudget, OnlyLlvmpipeSplitsTheMarch) {
+  EXPECT_TRUE(cv::render::driver_has_loop_budget("llvmpipe (LLVM 15.0.6, 256 bits)"));
+  EXPECT_FALSE(cv::render::driver_has_loop_budget("NVIDIA H100 80GB HBM3/PCIe/SSE2"));
+  EXPECT_FALSE(cv::render::driver_has_loop_budget("AMD Radeon RX 7900 XTX (radeonsi, navi31, LLVM 15.0.7, DRM 3.54)"));
+  // This machine's driver decides what the raymarcher does: on llvmpipe the tests above hold it to
+  // the budget; elsewhere a frame is one dispatch per tile.
+  auto ctx = cv::render::make_headless_context();
+  std::printf("driver %s: march %s\n", ctx->info().renderer.c_str(),
+              cv::render::driver_has_loop_budget(ctx->info().renderer) ? "split by the loop budget" : "in one dispatch");
+}
+}  // namespace

@@ -11,7 +11,7 @@
 #include "reference/raymarcher.hpp"
 #include "render/context.hpp"
 #include "render/raymarcher.hpp"
-#include "scene/standard_scenes.hpp"
+#include "bench/standard_scenes.hpp"
 
 namespace {
 using namespace cv;
@@ -27,7 +27,7 @@ struct Comparison {
   std::size_t pixels = 0;
 };
 
-Comparison compare_on_gpu(const core::StandardScene& sc) {
+Comparison compare_on_gpu(const bench::StandardScene& sc) {
   Comparison c;
   auto ctx = render::make_headless_context();
   render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
@@ -55,7 +55,7 @@ Comparison compare_on_gpu(const core::StandardScene& sc) {
 }
 
 TEST_P(StandardScenes, GpuMatchesTheCpuReferenceWithEveryPixelFinite) {
-  const core::StandardScene sc = core::standard_scene(GetParam(), 48, 27);
+  const bench::StandardScene sc = bench::standard_scene(GetParam(), 48, 27);
   const Comparison c = compare_on_gpu(sc);
   std::printf("%-14s %4d cloudy pixels of %zu; radiance error (of the brightest pixel) mean %.3g, worst %.3g; "
               "transmittance worst %.3g\n",
@@ -73,7 +73,7 @@ TEST_P(StandardScenes, GpuMatchesTheCpuReferenceWithEveryPixelFinite) {
 // The same scenes as the product shows them: sunlight through the air, the sky, ambient light and
 // the globe (constant albedo) with the clouds' shadows, GPU against CPU within the sky tests' bounds.
 TEST_P(StandardScenes, WithSkyAndGlobeTheGpuMatchesTheCpuReference) {
-  core::StandardScene sc = core::standard_scene(GetParam(), 32, 18);
+  bench::StandardScene sc = bench::standard_scene(GetParam(), 32, 18);
   sc.march.atmosphere = sc.march.globe = true;
   sc.march.ambient = 1.0;
   const Comparison c = compare_on_gpu(sc);
@@ -88,7 +88,7 @@ TEST_P(StandardScenes, WithSkyAndGlobeTheGpuMatchesTheCpuReference) {
 // Skipping empty bricks must not change the image: every skipped sample would have read exactly
 // 0, including beside a regional grid's edge, where the data fades out over a border cell.
 TEST_P(StandardScenes, SkippingEmptySpaceLeavesTheImageExactlyAsItWas) {
-  core::StandardScene sc = core::standard_scene(GetParam(), 32, 18);
+  bench::StandardScene sc = bench::standard_scene(GetParam(), 32, 18);
   const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
   sc.march.skip_empty = false;
   const auto plain = core::render_reference(sc.grid, medium, sc.camera, sc.sun, sc.march);
@@ -108,7 +108,7 @@ TEST_P(StandardScenes, SkippingEmptySpaceLeavesTheImageExactlyAsItWas) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(All, StandardScenes, ::testing::ValuesIn(core::standard_scene_names()),
+INSTANTIATE_TEST_SUITE_P(All, StandardScenes, ::testing::ValuesIn(bench::standard_scene_names()),
                          [](const auto& info) { return info.param; });
 
 }  // namespace

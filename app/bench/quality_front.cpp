@@ -16,7 +16,7 @@
 #include "scene/quality.hpp"
 #include "volume/volume_io.hpp"
 
-namespace cv::core::bench {
+namespace cv::bench {
 namespace {
 
 using json = nlohmann::json;
@@ -374,4 +374,4 @@ std::string describe_config(const FrontConfig& c) {
   return b;
 }
 
-}  // namespace cv::core::bench
+}  // namespace cv::bench

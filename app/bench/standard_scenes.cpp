@@ -1,6 +1,6 @@
 // The standard scenes (see standard_scenes.hpp): analytic cloud fields, deterministic, built in
 // milliseconds, small enough for the CPU reference at test sizes.
-#include "scene/standard_scenes.hpp"
+#include "bench/standard_scenes.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,7 @@
 
 #include "geo/geodesy.hpp"
 
-namespace cv::core {
+namespace cv::bench {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
@@ -321,4 +321,4 @@ StandardScene standard_scene(const std::string& name, int w, int h) {
   throw std::invalid_argument("unknown scene '" + name + "', expected one of: " + known);
 }
 
-}  // namespace cv::core
+}  // namespace cv::bench

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <string>
 
-namespace cv::core::bench {
+namespace cv::bench {
 
 namespace {
 
@@ -125,4 +125,4 @@ Rgb8Image plot_error_vs_time(const std::vector<PlotPoint>& pts, const std::vecto
   return cv.take();
 }
 
-}  // namespace cv::core::bench
+}  // namespace cv::bench

@@ -8,7 +8,11 @@
 
 #include <glm/vec3.hpp>
 
-namespace cv::core::bench {
+namespace cv::core {}
+
+namespace cv::bench {
+// The bench works on core's types throughout (it was core::bench before it moved up to app/).
+using namespace cv::core;
 
 // Rec. 709 luminance of linear rgb radiance.
 double luminance(const glm::dvec3& rgb);
@@ -64,4 +68,4 @@ double front_time_for_error(const std::vector<TimeError>& front, double error);
 // when time is beyond its slowest: waiting longer does not make that front worse).
 double front_error_at_time(const std::vector<TimeError>& front, double time);
 
-}  // namespace cv::core::bench
+}  // namespace cv::bench

@@ -8,7 +8,11 @@
 
 #include "reference/monte_carlo.hpp"
 
-namespace cv::core::bench {
+namespace cv::core {}
+
+namespace cv::bench {
+// The bench works on core's types throughout (it was core::bench before it moved up to app/).
+using namespace cv::core;
 
 // File layout (native byte order, doubles): "CVREF2\n", uint64 key, int32 width, int32 height,
 // uint64 spp, 7 uint64 MonteCarloStats counters, then per pixel sum (rgb), sum_sq (rgb), lum_sum,
@@ -26,4 +30,4 @@ void write_reference_cache(const std::string& path, std::uint64_t key, const Mon
 // FNV-1a, 64 bit, of a text: the key of everything that decides a reference.
 std::uint64_t reference_key_hash(const std::string& text);
 
-}  // namespace cv::core::bench
+}  // namespace cv::bench

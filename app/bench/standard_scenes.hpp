@@ -8,10 +8,16 @@
 #include <string>
 #include <vector>
 
-#include "reference/raymarcher.hpp"
+#include "frame/camera.hpp"
+#include "frame/sun.hpp"
+#include "settings/march_settings.hpp"
 #include "volume/cloud_volume.hpp"
 
-namespace cv::core {
+namespace cv::core {}
+
+namespace cv::bench {
+// The bench works on core's types throughout (it was core::bench before it moved up to app/).
+using namespace cv::core;
 
 struct StandardScene {
   std::string name;
@@ -30,4 +36,4 @@ std::vector<std::string> standard_scene_names();
 // std::invalid_argument naming the known ones.
 StandardScene standard_scene(const std::string& name, int width, int height);
 
-}  // namespace cv::core
+}  // namespace cv::bench

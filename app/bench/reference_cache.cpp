@@ -8,7 +8,7 @@
 
 #include "volume/volume_io.hpp"
 
-namespace cv::core::bench {
+namespace cv::bench {
 
 namespace {
 constexpr char kMagic[] = "CVREF2\n";
@@ -87,4 +87,4 @@ void write_reference_cache(const std::string& path, std::uint64_t key, const Mon
   });
 }
 
-}  // namespace cv::core::bench
+}  // namespace cv::bench

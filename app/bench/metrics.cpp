@@ -7,7 +7,7 @@
 #include <numeric>
 #include <stdexcept>
 
-namespace cv::core::bench {
+namespace cv::bench {
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -124,4 +124,4 @@ double front_error_at_time(const std::vector<TimeError>& front, double time) {
   return front.back().error;
 }
 
-}  // namespace cv::core::bench
+}  // namespace cv::bench

@@ -7,7 +7,7 @@
 #include <limits>
 #include <utility>
 
-namespace cv::core::bench {
+namespace cv::bench {
 
 BudgetStepper::BudgetStepper(std::size_t n, std::size_t start)
     : current_(n == 0 ? 0 : std::min(start, n - 1)),
@@ -67,4 +67,4 @@ bool BudgetStepper::observe(double frame_ms, double budget_ms) {
   return true;
 }
 
-}  // namespace cv::core::bench
+}  // namespace cv::bench

@@ -9,7 +9,11 @@
 #include <string>
 #include <vector>
 
-namespace cv::core::bench {
+namespace cv::core {}
+
+namespace cv::bench {
+// The bench works on core's types throughout (it was core::bench before it moved up to app/).
+using namespace cv::core;
 
 // A quality front that cannot be used. One line: the file, the key, what was found and expected,
 // e.g. "quality_front.json: configs[2].sun_steps: found "x", expected an integer 1..1024".
@@ -125,4 +129,4 @@ BudgetChoice choose_under_budget(const std::vector<FrontConfig>& by_accuracy, do
 // "view step 1.00 dz (>= 50 m), 16 sun steps, 4 octaves, 1 frame(s), scale 1, adaptive off"
 std::string describe_config(const FrontConfig& c);
 
-}  // namespace cv::core::bench
+}  // namespace cv::bench

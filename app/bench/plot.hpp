@@ -9,7 +9,11 @@
 
 #include "bench/metrics.hpp"
 
-namespace cv::core::bench {
+namespace cv::core {}
+
+namespace cv::bench {
+// The bench works on core's types throughout (it was core::bench before it moved up to app/).
+using namespace cv::core;
 
 struct PlotPoint {
   TimeError p;
@@ -26,4 +30,4 @@ struct Rgb8Image {
 Rgb8Image plot_error_vs_time(const std::vector<PlotPoint>& pts, const std::vector<std::size_t>& front, int width,
                              int height);
 
-}  // namespace cv::core::bench
+}  // namespace cv::bench

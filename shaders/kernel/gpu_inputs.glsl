@@ -1,0 +1,51 @@
+// The march kernel's inputs as a GPU program declares them: the parameters as one uniform block
+// (core/kernel/march_params.hpp packs it, std140), the prepared volume and the other textures, the
+// pyramid and the counters, and the program's compile-time switches. shaders/render/raymarch.comp
+// and the kernel's other GPU programs include it before the kernel.
+#define CV_PARAM(T, name) T name;
+#define CV_PARAM_ARRAY(T, name, N) T name[N];
+layout(std140, binding = CV_UBO_MARCH) uniform MarchParams {
+#include "../kernel/march_params.glsl"
+};
+#undef CV_PARAM
+#undef CV_PARAM_ARRAY
+
+// The prepared volume and the other textures, fetched texel by texel (interpolated in the kernel).
+layout(binding = CV_TEX_LIQUID) uniform sampler3D u_liquid;  // grid-mean extinction, 1/m (cf x in-cloud)
+layout(binding = CV_TEX_ICE) uniform sampler3D u_ice;
+layout(binding = CV_TEX_COLUMN_TAU) uniform sampler2D u_column_tau;  // vertical optical depth per column
+layout(binding = CV_TEX_JITTER_MASK) uniform sampler2D u_jitter_mask;  // blue-noise rank / n^2, tiled
+layout(binding = CV_TEX_GROUND) uniform sampler2D u_ground;  // linear albedo, equirectangular
+layout(binding = CV_TEX_NOISE_LOW) uniform sampler3D u_noise_low;    // Perlin-Worley, periodic, [0, 1]
+layout(binding = CV_TEX_NOISE_HIGH) uniform sampler3D u_noise_high;  // Worley fBm, periodic, [0, 1]
+layout(binding = CV_TEX_DEPTH) uniform sampler2D u_depth;    // distance (m) from the camera to opaque geometry
+layout(binding = CV_TEX_OPAQUE) uniform sampler2D u_opaque;  // that geometry's radiance
+// The extinction pyramid: (min, max) per brick, levels one after the other, x fastest.
+layout(std430, binding = CV_SSBO_PYRAMID) readonly buffer Pyramid { vec2 u_min_max[]; };
+// Per-frame counters (MarchStats), each as (low, high) 32-bit words.
+layout(std430, binding = CV_SSBO_STATS) buffer Stats { uint u_stats[]; };
+uint g_stats[CV_STAT_COUNT] = uint[CV_STAT_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u);
+
+// Program variants (kernel::MarchVariant::defines): llvmpipe runs both sides of a branch under masks,
+// so code switched off by a uniform would still cost every iteration. Without defines (a bare
+// compile): the defaults of MarchSettings.
+#ifndef CV_SKIP_EMPTY
+#define CV_SKIP_EMPTY 1
+#endif
+#ifndef CV_ADAPTIVE
+#define CV_ADAPTIVE 0
+#endif
+#ifndef CV_ATMOSPHERE
+#define CV_ATMOSPHERE 1
+#endif
+#ifndef CV_GLOBE
+#define CV_GLOBE 1
+#endif
+#ifndef CV_NOISE
+#define CV_NOISE 0
+#endif
+const bool kSkipEmpty = CV_SKIP_EMPTY != 0;
+const bool kAdaptive = CV_ADAPTIVE != 0;
+const bool kAtmosphere = CV_ATMOSPHERE != 0;
+const bool kGlobe = CV_GLOBE != 0;
+const bool kNoise = CV_NOISE != 0;
