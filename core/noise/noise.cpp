@@ -179,7 +179,7 @@ double NoiseTexture::sample(const glm::dvec3& t) const {
   int i0[3], i1[3];
   double w[3];
   for (int d = 0; d < 3; ++d) p64::noise_texel_pair(t[d], n, i0[d], i1[d], w[d]);
-  // The same order of interpolation as fetch_noise in raymarch.comp: x, then y, then z.
+  // The same order of interpolation as fetch_noise in shaders/kernel/march.glsl: x, then y, then z.
   auto mx = [](double a, double b, double s) { return a * (1.0 - s) + b * s; };
   const double c00 = mx(at(i0[0], i0[1], i0[2]), at(i1[0], i0[1], i0[2]), w[0]);
   const double c10 = mx(at(i0[0], i1[1], i0[2]), at(i1[0], i1[1], i0[2]), w[0]);

@@ -54,7 +54,7 @@ struct RenderSettings {
   double resolution_scale = 1.0;    // march at this fraction of the output size
   double exposure = 4.0;            // tonemapping
   // Frame-time budget in ms (`render --budget-ms`, the viewer's frame budget): the quality knobs
-  // are chosen from the measured front to fit it (core/bench/quality_front.hpp). 0: off.
+  // are chosen from the measured front to fit it (app/bench/quality_front.hpp). 0: off.
   double budget_ms = 0.0;
 };
 

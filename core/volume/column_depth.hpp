@@ -15,7 +15,7 @@ struct ColumnDepth {
   // The optical depth of the column at a point, bilinear between the four columns around it with
   // the 3-D sampler's horizontal rules (volume_coords, volume_fetch_index): longitude wraps on
   // global grids, latitude clamps at the pole rows, a regional grid fades to 0 over one cell
-  // beyond its sides; 0 outside. raymarch.comp's column_tau reads the uploaded map the same way.
+  // beyond its sides; 0 outside. the march kernel's column_tau reads the uploaded map the same way.
   double at(const VolumeGrid& grid, double lat_deg, double lon_deg) const;
 };
 

@@ -38,7 +38,7 @@ class ExtinctionPyramid {
   const std::vector<Level>& levels() const { return levels_; }
 
   // What a ray through a point (direction dir, unit) learns about the space ahead (double-precision
-  // twin of space_at in shaders/render/raymarch.comp): empty with the distance it may jump (m), or
+  // twin of space_at in shaders/kernel/march.glsl, which tests hold it against): empty with the distance it may jump (m), or
   // not empty with the finest brick's largest extinction and the distance (m) over which that
   // brick still holds it.
   struct Space {

@@ -1,6 +1,6 @@
 // Sub-grid erosion noise: where a point falls in the tileable noise textures, the texel pair and
 // weight of wrapped trilinear interpolation, and the erosion of the grid-mean extinction. The CPU
-// reference (core/reference) and the GPU raymarcher (raymarch.comp) both use these, so they erode
+// reference and the GPU raymarcher both use these (through shaders/kernel/march.glsl), so they erode
 // the same field.
 
 // The high-frequency tile's coordinates from the low-frequency tile's: it repeats 4 times per

@@ -34,6 +34,25 @@ void upload(GLuint tex, int w, int h, const std::vector<glm::vec4>& px) {
   glTextureSubImage2D(tex, 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, px.data());
 }
 
+// The presenter's draw into a W x H RGBA8 target, read back (rows bottom to top, as GL stores them).
+std::vector<unsigned char> draw_rgba8(const Presenter& p, const ToneSettings& tone, int W, int H) {
+  GLuint fbo = 0, color = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &color);
+  glTextureStorage2D(color, 1, GL_RGBA8, W, H);
+  glCreateFramebuffers(1, &fbo);
+  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  p.draw(tone, 0, 0, W, H);
+  std::vector<unsigned char> out(static_cast<std::size_t>(W) * H * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(color, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(out.size()), out.data());
+  check_gl("reading the presenter's draw");
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteTextures(1, &color);
+  return out;
+}
+
 TEST_F(PresenterTest, TonemapShaderMatchesTheCpuTonemapWithinOneStep) {
   // Radiance over five decades, transmittance 0..1, and the non-finite cases.
   const int w = 48, h = 27;
@@ -97,21 +116,8 @@ TEST_F(PresenterTest, ReducedResolutionUpscalesWithoutSpreadingANonFiniteTexel) 
   p.resize(w, h);
   upload(p.frame_texture(), w, h, px);
   p.accumulate(0);
-  GLuint fbo = 0, color = 0;
-  glCreateTextures(GL_TEXTURE_2D, 1, &color);
-  glTextureStorage2D(color, 1, GL_RGBA8, W, H);
-  glCreateFramebuffers(1, &fbo);
-  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   ToneSettings tone;
-  p.draw(tone, 0, 0, W, H);
-  std::vector<unsigned char> out(static_cast<std::size_t>(W) * H * 4);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(color, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(out.size()), out.data());
-  check_gl("reading the upscaled test image");
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  glDeleteFramebuffers(1, &fbo);
-  glDeleteTextures(1, &color);
+  const std::vector<unsigned char> out = draw_rgba8(p, tone, W, H);
   const std::vector<unsigned char> want = tonemap_srgb8({px[1]}, tone);
   int far_off = 0, near_white = 0;
   for (int y = 0; y < H; ++y) {
@@ -156,21 +162,9 @@ TEST_F(PresenterTest, UpscaledDrawIsTheCpuUpscaleTonemapped) {
   p.resize(w, h);
   upload(p.frame_texture(), w, h, px);
   p.accumulate(0);
-  GLuint fbo = 0, color = 0;
-  glCreateTextures(GL_TEXTURE_2D, 1, &color);
-  glTextureStorage2D(color, 1, GL_RGBA8, W, H);
-  glCreateFramebuffers(1, &fbo);
-  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   ToneSettings tone;
   tone.exposure = 3.0;
-  p.draw(tone, 0, 0, W, H);
-  std::vector<unsigned char> out(static_cast<std::size_t>(W) * H * 4);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(color, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(out.size()), out.data());
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  glDeleteFramebuffers(1, &fbo);
-  glDeleteTextures(1, &color);
+  const std::vector<unsigned char> out = draw_rgba8(p, tone, W, H);
   const std::vector<unsigned char> cpu = tonemap_srgb8(upscale_linear(px, w, h, W, H), tone);
   int worst = 0;
   for (int y = 0; y < H; ++y)
