@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <regex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "importer.hpp"
@@ -28,26 +29,43 @@ using cv::cli::parse_list;
 using cv::cli::parse_number;
 using cv::cli::UsageError;
 
+// Each command's lines of the usage text, in the order `cloudviewer --help` lists them.
+std::vector<std::pair<std::string, std::string>> command_usages() {
+  return {
+      {"info", "  info FILE                what the importer understands of a NetCDF file (or a .cvvol volume)\n"},
+      {"import",
+       "  import FILE -o OUT [--region W,E,S,N] [--times FIRST:LAST[:STRIDE] | --times START..END]\n"
+       "         [--levels MIN_HPA:MAX_HPA]\n"
+       "         [--stride N] [--dz M] [--reff-liquid UM] [--reff-ice UM] [--vti]\n"
+       "                           import into OUT.cvvol (+ OUT.report.json, and OUT_tNNN.vti with --vti)\n"},
+      {"gpu-info", "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"},
+      {"phase", "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"},
+      {"render", cv::cli::render_usage()},
+      {"bench", cv::cli::bench_usage()},
+      {"view",
+       "  view INPUT [--size WxH] [--time N] [--scale S] [--hide-ui] [--frame-budget MS]\n"
+       "             [--frames N --screenshot OUT.png]\n"
+       "                           the interactive viewer (GLFW window); with --frames it renders N frames,\n"
+       "                           saves the window to OUT.png and exits; --frame-budget: the quality panel's\n"
+       "                           frame budget (0 off)\n"},
+  };
+}
+
 void print_usage() {
-  std::printf(
-      "usage: cloudviewer <command> [options]\n"
-      "commands:\n"
-      "  info FILE                what the importer understands of a NetCDF file (or a .cvvol volume)\n"
-      "  import FILE -o OUT [--region W,E,S,N] [--times FIRST:LAST[:STRIDE] | --times START..END]\n"
-      "         [--levels MIN_HPA:MAX_HPA]\n"
-      "         [--stride N] [--dz M] [--reff-liquid UM] [--reff-ice UM] [--vti]\n"
-      "                           import into OUT.cvvol (+ OUT.report.json, and OUT_tNNN.vti with --vti)\n"
-      "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"
-      "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"
-      "%s"
-      "%s"
-      "  view INPUT [--size WxH] [--time N] [--scale S] [--hide-ui] [--frame-budget MS]\n"
-      "             [--frames N --screenshot OUT.png]\n"
-      "                           the interactive viewer (GLFW window); with --frames it renders N frames,\n"
-      "                           saves the window to OUT.png and exits; --frame-budget: the quality panel's\n"
-      "                           frame budget (0 off)\n"
-      "  --version                print the version\n",
-      cv::cli::render_usage(), cv::cli::bench_usage());
+  std::printf("usage: cloudviewer <command> [options]\ncommands:\n");
+  for (const auto& [name, text] : command_usages()) std::printf("%s", text.c_str());
+  std::printf("  --version                print the version\n");
+}
+
+// `cloudviewer COMMAND --help`: that command's usage, exit 0. False for an unknown command.
+bool print_command_usage(const std::string& cmd) {
+  for (const auto& [name, text] : command_usages()) {
+    if (name == cmd) {
+      std::printf("usage: cloudviewer %s [options]\n%s", name.c_str(), text.c_str());
+      return true;
+    }
+  }
+  return false;
 }
 
 std::vector<fs::path> all_shaders(const fs::path& dir) {
@@ -212,6 +230,11 @@ int main(int argc, char** argv) {
   }
   const std::string cmd = args[0];
   args.erase(args.begin());
+  // Every command answers --help (or -h) anywhere among its arguments, before it reads any of them.
+  if (std::find_if(args.begin(), args.end(), [](const std::string& x) { return x == "--help" || x == "-h"; }) != args.end() &&
+      print_command_usage(cmd)) {
+    return 0;
+  }
   try {
     if (cmd == "--version") {
       std::printf("cloudviewer %s\n", CV_VERSION);
