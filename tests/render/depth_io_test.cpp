@@ -45,19 +45,12 @@ struct UniformCloud {
   }
 };
 
-GLuint r32f_texture(int w, int h, const std::vector<float>& v) {
+// A w x h float texture of 1 (R32F) or 4 (RGBA32F) channels holding v.
+GLuint float_texture(int w, int h, int channels, const std::vector<float>& v) {
   GLuint t = 0;
   glCreateTextures(GL_TEXTURE_2D, 1, &t);
-  glTextureStorage2D(t, 1, GL_R32F, w, h);
-  glTextureSubImage2D(t, 0, 0, 0, w, h, GL_RED, GL_FLOAT, v.data());
-  return t;
-}
-
-GLuint rgba32f_texture(int w, int h, const std::vector<float>& v) {
-  GLuint t = 0;
-  glCreateTextures(GL_TEXTURE_2D, 1, &t);
-  glTextureStorage2D(t, 1, GL_RGBA32F, w, h);
-  glTextureSubImage2D(t, 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, v.data());
+  glTextureStorage2D(t, 1, channels == 1 ? GL_R32F : GL_RGBA32F, w, h);
+  glTextureSubImage2D(t, 0, 0, 0, w, h, channels == 1 ? GL_RED : GL_RGBA, GL_FLOAT, v.data());
   return t;
 }
 
@@ -79,8 +72,8 @@ Both render_both(const UniformCloud& u, double distance_m, const std::vector<flo
   layer.distance_m.assign(kSize * kSize, static_cast<float>(distance_m));
   layer.radiance_rgba = rgba;
   render::OpaqueInput in;
-  if (distance_m > 0.0) in.depth = r32f_texture(kSize, kSize, layer.distance_m);
-  if (distance_m > 0.0 && !rgba.empty()) in.color = rgba32f_texture(kSize, kSize, rgba);
+  if (distance_m > 0.0) in.depth = float_texture(kSize, kSize, 1, layer.distance_m);
+  if (distance_m > 0.0 && !rgba.empty()) in.color = float_texture(kSize, kSize, 4, rgba);
   Both b;
   b.gpu = gpu.render(u.cam, u.sun, u.march, {}, in);
   b.gpu_depth = gpu.read_cloud_depth();

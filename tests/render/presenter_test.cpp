@@ -41,6 +41,7 @@ std::vector<unsigned char> draw_rgba8(const Presenter& p, const ToneSettings& to
   glTextureStorage2D(color, 1, GL_RGBA8, W, H);
   glCreateFramebuffers(1, &fbo);
   glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
+  if (glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) ADD_FAILURE() << "incomplete framebuffer";
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   p.draw(tone, 0, 0, W, H);
   std::vector<unsigned char> out(static_cast<std::size_t>(W) * H * 4);
@@ -69,23 +70,9 @@ TEST_F(PresenterTest, TonemapShaderMatchesTheCpuTonemapWithinOneStep) {
   p.resize(w, h);
   upload(p.frame_texture(), w, h, px);
   p.accumulate(0);  // one frame: the mean is the frame
-  GLuint fbo = 0, color = 0;
-  glCreateTextures(GL_TEXTURE_2D, 1, &color);
-  glTextureStorage2D(color, 1, GL_RGBA8, w, h);
-  glCreateFramebuffers(1, &fbo);
-  glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
-  ASSERT_EQ(glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER), static_cast<GLenum>(GL_FRAMEBUFFER_COMPLETE));
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   ToneSettings tone;
   tone.exposure = 4.0;
-  p.draw(tone, 0, 0, w, h);
-  std::vector<unsigned char> gpu(static_cast<std::size_t>(w) * h * 4);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(color, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(gpu.size()), gpu.data());
-  check_gl("reading the tonemapped test image");
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  glDeleteFramebuffers(1, &fbo);
-  glDeleteTextures(1, &color);
+  const std::vector<unsigned char> gpu = draw_rgba8(p, tone, w, h);
   const std::vector<unsigned char> cpu = tonemap_srgb8(px, tone);
   int worst = 0, differ = 0;
   for (int y = 0; y < h; ++y) {
