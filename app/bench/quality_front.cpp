@@ -66,6 +66,14 @@ class Reader {
     if (!v.is_string()) fail(key, shown(v), expected);
     return v.get<std::string>();
   }
+  // A quality knob by its row (quality_knobs.def): range and message from the table.
+  void knob(const SettingRow& row, double& out) const {
+    out = number(row.key, row.lo, row.hi, expected_text(row));
+  }
+  void knob(const SettingRow& row, int& out) const {
+    out = integer(row.key, static_cast<int>(row.lo), static_cast<int>(row.hi));
+  }
+  void knob(const SettingRow& row, bool& out) const { out = boolean(row.key); }
   const std::string& source() const { return source_; }
   const std::string& path() const { return path_; }
 
@@ -82,10 +90,6 @@ bool usable(const FrontScene& s) {
 }
 
 }  // namespace
-
-double FrontConfig::view_step_m(double dz_m) const {
-  return std::max(view_step_min_m, view_step_dz * std::abs(dz_m));
-}
 
 void rank_front(QualityFront& front) {
   for (FrontConfig& c : front.configs) {
@@ -139,8 +143,7 @@ std::vector<FrontConfig> preset_ladder() {
   for (auto it = presets.rbegin(); it != presets.rend(); ++it) {
     FrontConfig c;
     c.name = it->name, c.kind = "preset";
-    c.view_step_dz = it->view_step_dz_fraction, c.view_step_min_m = it->view_step_min_m;
-    c.sun_steps = it->sun_steps, c.octaves = it->octaves, c.accumulate = it->accumulate;
+    c.knobs = it->knobs;
     c.error = c.ms = kNaN;
     c.candidate = true;
     out.push_back(c);
@@ -168,20 +171,14 @@ std::string front_to_json(const QualityFront& front) {
                         {"rel_rmse", num(s.rel_rmse)},
                         {"pareto", s.pareto}});
     }
-    configs.push_back({{"name", c.name},
-                       {"kind", c.kind},
-                       {"view_step_dz", c.view_step_dz},
-                       {"view_step_min_m", c.view_step_min_m},
-                       {"sun_steps", c.sun_steps},
-                       {"octaves", c.octaves},
-                       {"accumulate", c.accumulate},
-                       {"resolution_scale", c.resolution_scale},
-                       {"adaptive", c.adaptive},
-                       {"phase_hg", c.phase_hg},
-                       {"error_geomean", num(c.error)},
-                       {"ms_geomean", num(c.ms)},
-                       {"candidate", c.candidate},
-                       {"scenes", scenes}});
+    ojson config = {{"name", c.name}, {"kind", c.kind}};
+    for_each_quality_knob(c.knobs, [&](const KnobRow& k, const auto& v) { config[k.row.key] = v; });
+    config["phase_hg"] = c.phase_hg;
+    config["error_geomean"] = num(c.error);
+    config["ms_geomean"] = num(c.ms);
+    config["candidate"] = c.candidate;
+    config["scenes"] = scenes;
+    configs.push_back(config);
   }
   root["configs"] = configs;
   return root.dump(2) + "\n";
@@ -227,13 +224,7 @@ QualityFront front_from_json(const std::string& text, const std::string& source)
     if (fc.kind != "sweep" && fc.kind != "preset" && fc.kind != "seed") {
       c.fail("kind", shown(configs[i]["kind"]), "\"sweep\", \"preset\" or \"seed\"");
     }
-    fc.view_step_dz = c.number("view_step_dz", 1e-4, 1e4, "a view step in multiples of dz, 1e-4..1e4");
-    fc.view_step_min_m = c.number("view_step_min_m", 0.0, 1e7, "a minimum view step in metres, 0..1e7");
-    fc.sun_steps = c.integer("sun_steps", 1, 1024);
-    fc.octaves = c.integer("octaves", 1, 16);
-    fc.accumulate = c.integer("accumulate", 1, 4096);
-    fc.resolution_scale = c.number("resolution_scale", 0.01, 1.0, "a fraction of the image size 0.01..1");
-    fc.adaptive = c.boolean("adaptive");
+    for_each_quality_knob(fc.knobs, [&](const KnobRow& k, auto& v) { c.knob(k.row, v); });
     fc.phase_hg = c.boolean("phase_hg");
     fc.candidate = c.boolean("candidate");
     fc.error = maybe_number(c, configs[i], "error_geomean", "a relative error >= 0 or null");
@@ -362,16 +353,6 @@ BudgetChoice choose_under_budget(const std::vector<FrontConfig>& cands, double b
   return out;
 }
 
-std::string describe_config(const FrontConfig& c) {
-  char b[256];
-  char floor_text[48] = "";
-  if (c.view_step_min_m > 0.0) std::snprintf(floor_text, sizeof floor_text, " (>= %g m)", c.view_step_min_m);
-  std::snprintf(
-      b, sizeof b,
-      "view step %.3g dz%s, %d sun steps, %d octave(s), %d frame(s), resolution scale %g, adaptive %s",
-      c.view_step_dz, floor_text, c.sun_steps, c.octaves, c.accumulate, c.resolution_scale,
-      c.adaptive ? "on" : "off");
-  return b;
-}
+std::string describe_config(const FrontConfig& c) { return describe_knobs(c.knobs); }
 
 }  // namespace cv::bench

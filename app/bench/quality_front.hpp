@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "settings/quality_knobs.hpp"
+
 namespace cv::core {}
 
 namespace cv::bench {
@@ -35,23 +37,16 @@ struct FrontScene {
 struct FrontConfig {
   std::string name;
   std::string kind = "sweep";  // "sweep", "preset" or "seed" (a seed document's method)
-  // View step as a multiple of the grid's vertical spacing dz (the geometric mean over the scenes
-  // it was measured on), never below view_step_min_m: steps in metres do not carry from one grid
-  // to another, multiples of dz do.
-  double view_step_dz = 1.0;
-  double view_step_min_m = 0.0;
-  int sun_steps = 16, octaves = 4, accumulate = 1;
-  double resolution_scale = 1.0;
-  bool adaptive = false;
+  // The quality knobs it sets (core/settings/quality_knobs.def): the view step as a multiple of
+  // the grid's vertical spacing dz (the geometric mean over the scenes it was measured on), sun
+  // steps, octaves, frames, resolution scale, adaptive steps.
+  QualityKnobs knobs;
   bool phase_hg = false;  // Henyey-Greenstein for liquid: a change of physics, not of quality
   std::vector<FrontScene> scenes;
   // From rank_front:
   double error = 0.0;  // geometric mean of rel_rmse over the scenes with a finite error (NaN: none)
   double ms = 0.0;     // geometric mean of wall_ms over the same scenes (NaN: none)
   bool candidate = false;  // may be chosen under a budget (see rank_front)
-
-  // The view step in metres on a grid of vertical spacing dz_m.
-  double view_step_m(double dz_m) const;
 };
 
 struct QualityFront {

@@ -360,9 +360,11 @@ int cmd_bench(const std::vector<std::string>& args) {
       for (std::size_t i = 0; i < pixels.size(); ++i) rgb[i] = glm::dvec3(pixels[i].x, pixels[i].y, pixels[i].z);
       BenchRow row;
       row.scene = name, row.config = c.name, row.description = c.description, row.kind = c.kind;
-      row.view_step_m = c.march.view_step_m, row.sun_steps = c.march.sun_steps, row.octaves = c.march.octaves;
-      row.accumulate = c.accumulate, row.resolution_scale = c.scale;
-      row.phase_hg = c.march.liquid_phase_hg, row.adaptive = c.march.adaptive_steps;
+      row.view_step_m = c.march.view_step_m;
+      core::RenderSettings marched;
+      marched.march = c.march, marched.accumulate = c.accumulate, marched.resolution_scale = c.scale;
+      row.knobs = core::knobs_of(marched, c.march.view_step_m, sc.grid.alt_m.step);
+      row.phase_hg = c.march.liquid_phase_hg;
       row.wall_ms = median(wall), row.gpu_ms = median(gpu_t);
       row.err = bench::image_error(rgb, ref_rgb, ref_var);
       row.error_image = name + "/err_" + c.name + ".png";

@@ -72,8 +72,8 @@ void write_results_csv(const std::string& path, const std::vector<BenchRow>& row
         if (s.scene == r.scene) ref = &s;
       }
       std::fprintf(f, "%s,%s,%s,%.6g,%d,%d,%d,%.3g,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.6g,%s\n",
-                   r.scene.c_str(), r.config.c_str(), kind_name(r.kind), r.view_step_m, r.sun_steps, r.octaves,
-                   r.accumulate, r.resolution_scale, r.phase_hg ? "hg" : "mie", r.adaptive ? 1 : 0, r.wall_ms, r.gpu_ms,
+                   r.scene.c_str(), r.config.c_str(), kind_name(r.kind), r.view_step_m, r.knobs.sun_steps, r.knobs.octaves,
+                   r.knobs.accumulate, r.knobs.resolution_scale, r.phase_hg ? "hg" : "mie", r.knobs.adaptive ? 1 : 0, r.wall_ms, r.gpu_ms,
                    r.err.rel_rmse, r.err.rel_rmse_raw, r.err.rel_noise_floor, r.err.rel_rmse_resolution, r.err.rel_bias, r.err.worst, r.err.psnr_db, r.pareto ? 1 : 0, ref ? ref->spp : 0,
                    ref ? ref->mean_rel_stderr : 0.0, r.error_image.c_str());
     }
@@ -120,8 +120,8 @@ void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows
       std::fprintf(f, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
       for (const BenchRow* r : list) {
         std::fprintf(f, "| %s | %s | %s | %.4g%s | %d | %d | %d | %.2g | %s | %.4g | %s | %s | %s | %s | %s | %s | %s |\n",
-                     r->pareto ? "*" : "", r->config.c_str(), kind_name(r->kind), r->view_step_m, r->adaptive ? " adapt." : "",
-                     r->sun_steps, r->octaves, r->accumulate, r->resolution_scale, r->phase_hg ? "HG" : "Mie", r->wall_ms,
+                     r->pareto ? "*" : "", r->config.c_str(), kind_name(r->kind), r->view_step_m, r->knobs.adaptive ? " adapt." : "",
+                     r->knobs.sun_steps, r->knobs.octaves, r->knobs.accumulate, r->knobs.resolution_scale, r->phase_hg ? "HG" : "Mie", r->wall_ms,
                      r->gpu_ms > 0 ? num(r->gpu_ms, "%.4g").c_str() : "-",
                      r->err.rel_rmse < r->err.rel_rmse_resolution ? ("< " + num(r->err.rel_rmse_resolution)).c_str()
                                                                    : num(r->err.rel_rmse).c_str(),

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bench/metrics.hpp"
+#include "settings/quality_knobs.hpp"
 
 namespace cv::cli {
 
@@ -16,10 +17,10 @@ enum class ConfigKind { Sweep = 0, Preset = 1, Seed = 2 };
 struct BenchRow {
   std::string scene, config, description;
   ConfigKind kind = ConfigKind::Sweep;
-  double view_step_m = 0.0;
-  int sun_steps = 0, octaves = 0, accumulate = 1;
-  double resolution_scale = 1.0;
-  bool phase_hg = false, adaptive = false;
+  double view_step_m = 0.0;  // marched with, on this scene's grid
+  // The quality knobs (core/settings/quality_knobs.def), view_step_dz this scene's step / dz.
+  core::QualityKnobs knobs;
+  bool phase_hg = false;
   double wall_ms = 0.0;  // median over repeats, per output image (all its accumulated frames)
   double gpu_ms = 0.0;   // median GL_TIME_ELAPSED; 0 when the driver reports none
   bench::ImageError err;

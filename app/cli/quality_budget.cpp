@@ -43,8 +43,8 @@ void write_quality_front(const std::string& out_dir, const std::vector<BenchRow>
     if (fresh) {
       FrontConfig c;
       c.name = r.config, c.kind = kind_name(r.kind);
-      c.sun_steps = r.sun_steps, c.octaves = r.octaves, c.accumulate = r.accumulate;
-      c.resolution_scale = r.resolution_scale, c.adaptive = r.adaptive, c.phase_hg = r.phase_hg;
+      c.knobs = r.knobs, c.phase_hg = r.phase_hg;
+      c.knobs.view_step_dz = 1.0, c.knobs.view_step_min_m = 0.0;  // below: over all its scenes
       front.configs.push_back(c);
     }
     FrontConfig& c = front.configs[it->second];
@@ -59,9 +59,9 @@ void write_quality_front(const std::string& out_dir, const std::vector<BenchRow>
   for (FrontConfig& c : front.configs) {
     const core::QualityPreset* p = c.kind == "preset" ? core::find_quality(c.name) : nullptr;
     if (p) {  // a preset's own definition, floor included
-      c.view_step_dz = p->view_step_dz_fraction, c.view_step_min_m = p->view_step_min_m;
+      c.knobs.view_step_dz = p->knobs.view_step_dz, c.knobs.view_step_min_m = p->knobs.view_step_min_m;
     } else if (const auto lr = log_ratio.find(c.name); lr != log_ratio.end() && lr->second.second > 0) {
-      c.view_step_dz = std::exp(lr->second.first / lr->second.second);
+      c.knobs.view_step_dz = std::exp(lr->second.first / lr->second.second);
     }
   }
   bench::rank_front(front);
@@ -87,12 +87,7 @@ void write_quality_front(const std::string& out_dir, const std::vector<BenchRow>
 
 void apply_front_config(const FrontConfig& c, double dz_m, core::RenderSettings& render) {
   render.quality = c.kind == "preset" && core::find_quality(c.name) ? c.name : "custom";
-  render.march.view_step_m = c.view_step_m(dz_m);
-  render.march.sun_steps = c.sun_steps;
-  render.march.octaves = c.octaves;
-  render.march.adaptive_steps = c.adaptive;
-  render.accumulate = c.accumulate;
-  render.resolution_scale = c.resolution_scale;
+  core::apply_knobs(c.knobs, dz_m, render);
 }
 
 void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const core::Sun& sun,
@@ -111,14 +106,13 @@ void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const
   using clock = std::chrono::steady_clock;
   auto measure = [&](std::size_t i) {
     const FrontConfig& c = src.candidates[i];
-    core::RenderSettings rs = render;
-    apply_front_config(c, dz_m, rs);
-    core::MarchSettings m = base;
-    m.view_step_m = rs.march.view_step_m, m.sun_steps = rs.march.sun_steps, m.octaves = rs.march.octaves;
-    m.adaptive_steps = rs.march.adaptive_steps;
-    m.frame = c.accumulate > 1 ? 0 : -1;
-    const double mw = std::max(1.0, std::round(cam.width * c.resolution_scale));
-    const double mh = std::max(1.0, std::round(cam.height * c.resolution_scale));
+    core::RenderSettings knobbed;  // base with the candidate's knobs
+    knobbed.march = base;
+    core::apply_knobs(c.knobs, dz_m, knobbed);
+    core::MarchSettings m = knobbed.march;
+    m.frame = c.knobs.accumulate > 1 ? 0 : -1;
+    const double mw = std::max(1.0, std::round(cam.width * c.knobs.resolution_scale));
+    const double mh = std::max(1.0, std::round(cam.height * c.knobs.resolution_scale));
     const double shrink = std::min(1.0, std::sqrt(kCalibrationPixels / (mw * mh)));
     core::Camera cal = cam;
     cal.width = std::max(1, static_cast<int>(std::lround(mw * shrink)));
@@ -128,15 +122,15 @@ void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const
     const auto t0 = clock::now();
     gpu.render(cal, sun, m);
     const double frame_ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
-    const double ms = frame_ms * (mw * mh) / (static_cast<double>(cal.width) * cal.height) * c.accumulate;
+    const double ms = frame_ms * (mw * mh) / (static_cast<double>(cal.width) * cal.height) * c.knobs.accumulate;
     std::printf("budget: %-24s %9.1f ms", c.name.c_str(), ms);
     if (cal.width != static_cast<int>(mw) || cal.height != static_cast<int>(mh)) {
       std::printf("  (one frame at %dx%d, scaled by pixel count to %.0fx%.0f", cal.width, cal.height, mw, mh);
     } else {
       std::printf("  (one frame at %.0fx%.0f", mw, mh);
     }
-    if (c.accumulate > 1)
-      std::printf(", times %d frames)\n", c.accumulate);
+    if (c.knobs.accumulate > 1)
+      std::printf(", times %d frames)\n", c.knobs.accumulate);
     else
       std::printf(")\n");
     std::fflush(stdout);

@@ -182,7 +182,9 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
         r.adaptive_given = true;
       }
     } else if (a == "--accumulate") {
-      scene.render.accumulate = parse_int(a, v, 1, 4096, "1..4096 frames");
+      const core::SettingRow& acc = core::find_quality_knob("accumulate")->row;
+      scene.render.accumulate = parse_int(a, v, static_cast<int>(acc.lo), static_cast<int>(acc.hi),
+                                          core::range_text(acc) + " frames");
       r.march_overridden = true;
     } else if (a == "--budget-ms") {
       scene.render.budget_ms = parse_number(a, v);

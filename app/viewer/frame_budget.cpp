@@ -25,7 +25,7 @@ bool FrameBudget::update(core::RenderSettings& render, double dz_m, double last_
     // The bench's times per marched frame predict the ratios between candidates (the viewer
     // accumulates frames progressively, so a candidate's accumulate does not slow a frame).
     std::vector<double> costs;
-    for (const auto& c : source_.candidates) costs.push_back(c.ms / c.accumulate);
+    for (const auto& c : source_.candidates) costs.push_back(c.ms / c.knobs.accumulate);
     stepper_.set_predicted_costs(costs);
     apply = true;
   } else if (marched) {
@@ -33,11 +33,9 @@ bool FrameBudget::update(core::RenderSettings& render, double dz_m, double last_
   }
   if (!apply) return false;
   const bench::FrontConfig& c = candidate();
-  render.march.view_step_m = c.view_step_m(dz_m);
-  render.march.sun_steps = c.sun_steps;
-  render.march.octaves = c.octaves;
-  render.march.adaptive_steps = c.adaptive;
-  render.resolution_scale = c.resolution_scale;
+  const int accumulate = render.accumulate;  // the viewer accumulates progressively, not by the knob
+  core::apply_knobs(c.knobs, dz_m, render);
+  render.accumulate = accumulate;
   render.quality = "custom";
   return true;
 }

@@ -12,9 +12,9 @@ const std::vector<QualityPreset>& quality_presets() {
   // max(50 m, dz)). low and high halve and double it as in docs/BENCHMARKS.md's renderer table
   // (there 1000/500/250 m on the sample, whose dz is 500 m); high also averages 4 jittered frames.
   static const std::vector<QualityPreset> table = {
-      {"low", 2.0, 100.0, 8, 1, 1},
-      {"default", 1.0, 50.0, 16, 4, 1},
-      {"high", 0.5, 25.0, 32, 8, 4},
+      {"low", {.view_step_dz = 2.0, .view_step_min_m = 100.0, .sun_steps = 8, .octaves = 1, .accumulate = 1}},
+      {"default", {.view_step_dz = 1.0, .view_step_min_m = 50.0, .sun_steps = 16, .octaves = 4, .accumulate = 1}},
+      {"high", {.view_step_dz = 0.5, .view_step_min_m = 25.0, .sun_steps = 32, .octaves = 8, .accumulate = 4}},
   };
   return table;
 }
@@ -36,17 +36,14 @@ void apply_quality(const std::string& name, RenderSettings& render) {
   const QualityPreset* p = find_quality(name);
   if (!p) throw std::invalid_argument("unknown quality preset '" + name + "', expected one of " + quality_names());
   render.quality = p->name;
-  render.march.view_step_m = 0.0;
-  render.march.sun_steps = p->sun_steps;
-  render.march.octaves = p->octaves;
-  render.accumulate = p->accumulate;
+  apply_knobs(p->knobs, 0.0, render, /*presets_only=*/true);  // view step 0: from the grid
 }
 
 double resolve_view_step_m(const RenderSettings& render, const VolumeGrid& grid) {
   if (render.march.view_step_m > 0.0) return render.march.view_step_m;
   const QualityPreset* p = find_quality(render.quality);
   if (!p) p = find_quality("default");
-  return std::max(p->view_step_min_m, p->view_step_dz_fraction * std::abs(grid.alt_m.step));
+  return p->knobs.view_step_m(grid.alt_m.step);
 }
 
 }  // namespace cv::core

@@ -6,19 +6,18 @@
 #include <vector>
 
 #include "scene/scene.hpp"
+#include "settings/quality_knobs.hpp"
 #include "volume/cloud_volume.hpp"
 
 namespace cv::core {
 
 struct QualityPreset {
   const char* name;
-  // View step as a fraction of the grid's vertical spacing, never below view_step_min_m: the
-  // data hold no structure finer than dz, so a fixed step in metres would over- or under-sample.
-  double view_step_dz_fraction;
-  double view_step_min_m;
-  int sun_steps;
-  int octaves;     // 1 = single scattering
-  int accumulate;  // jittered frames averaged per image (banding averages away)
+  // The knobs a preset sets (quality_knobs.def, rows with .preset): the view step as a fraction
+  // of the grid's vertical spacing, never below view_step_min_m (the data hold no structure finer
+  // than dz, so a fixed step in metres would over- or under-sample), sun steps, octaves and the
+  // jittered frames averaged per image (banding averages away).
+  QualityKnobs knobs;
 };
 
 // The presets, from fastest to best. "custom" is not among them: it names settings set by hand.

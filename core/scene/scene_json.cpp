@@ -17,6 +17,7 @@
 
 #include "scene/framing.hpp"
 #include "scene/quality.hpp"
+#include "settings/quality_knobs.hpp"
 #include "volume/volume_io.hpp"
 
 namespace cv::core {
@@ -221,8 +222,12 @@ void read_render(const Reader& r, RenderSettings& s) {
     r.fail("quality", shown(json(quality)), "one of " + quality_names());
   }
   if (const auto m = r.child("march")) read_march(*m, s.march);
-  r.integer("accumulate", s.accumulate, 1, 4096);
-  r.number("resolution_scale", s.resolution_scale, 0.01, 1.0, "a fraction of the output size 0.01..1");
+  {  // ranges from the quality knobs' rows (quality_knobs.def)
+    const SettingRow& acc = find_quality_knob("accumulate")->row;
+    const SettingRow& scale = find_quality_knob("resolution_scale")->row;
+    r.integer(acc.key, s.accumulate, static_cast<int>(acc.lo), static_cast<int>(acc.hi));
+    r.number(scale.key, s.resolution_scale, scale.lo, scale.hi, expected_text(scale));
+  }
   r.number("exposure", s.exposure, 1e-300, kHuge, "an exposure > 0");
   r.number("budget_ms", s.budget_ms, 0.0, 1e7, "a frame-time budget in ms 0..1e7 (0: off)");
 }

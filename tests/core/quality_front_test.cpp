@@ -1,5 +1,7 @@
 // The quality front file (round trip, strict reading), its ranking across scenes, the choice under a
 // budget from given times, and the viewer's frame-budget state machine: all without GL or timing.
+#include <type_traits>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +15,7 @@
 
 #include "bench/budget_stepper.hpp"
 #include "bench/quality_front.hpp"
+#include "scene/quality.hpp"
 
 namespace cv::bench {
 namespace {
@@ -35,9 +38,9 @@ QualityFront sample_front() {
   f.configs.push_back(
       config("slow_bad", "sweep", {{"a", 500, 60, 0.09, false}, {"b", 200, 70, 0.03, false}}));
   f.configs.push_back(config("seed", "seed", {{"a", 100, 30, 0.005, true}, {"b", 50, 30, 0.004, true}}));
-  f.configs[1].view_step_dz = 0.5, f.configs[1].view_step_min_m = 25.0, f.configs[1].sun_steps = 32;
-  f.configs[1].octaves = 8, f.configs[1].accumulate = 4;
-  f.configs[0].resolution_scale = 0.5, f.configs[0].adaptive = true;
+  f.configs[1].knobs.view_step_dz = 0.5, f.configs[1].knobs.view_step_min_m = 25.0, f.configs[1].knobs.sun_steps = 32;
+  f.configs[1].knobs.octaves = 8, f.configs[1].knobs.accumulate = 4;
+  f.configs[0].knobs.resolution_scale = 0.5, f.configs[0].knobs.adaptive = true;
   f.configs[4].phase_hg = true;
   return f;
 }
@@ -96,13 +99,7 @@ TEST(QualityFront, JsonRoundTrip) {
     const FrontConfig &a = f.configs[i], &b = g.configs[i];
     EXPECT_EQ(a.name, b.name);
     EXPECT_EQ(a.kind, b.kind);
-    EXPECT_EQ(a.view_step_dz, b.view_step_dz);
-    EXPECT_EQ(a.view_step_min_m, b.view_step_min_m);
-    EXPECT_EQ(a.sun_steps, b.sun_steps);
-    EXPECT_EQ(a.octaves, b.octaves);
-    EXPECT_EQ(a.accumulate, b.accumulate);
-    EXPECT_EQ(a.resolution_scale, b.resolution_scale);
-    EXPECT_EQ(a.adaptive, b.adaptive);
+    EXPECT_EQ(a.knobs, b.knobs) << describe_knobs(a.knobs) << " against " << describe_knobs(b.knobs);
     EXPECT_EQ(a.phase_hg, b.phase_hg);
     EXPECT_EQ(a.candidate, b.candidate);
     EXPECT_EQ(a.error, b.error);
@@ -208,11 +205,70 @@ TEST(QualityFront, CandidatesFromFileCacheOrLadder) {
 }
 
 TEST(QualityFront, ViewStepFromTheGrid) {
+  QualityKnobs k;
+  k.view_step_dz = 0.5, k.view_step_min_m = 25.0;
+  EXPECT_DOUBLE_EQ(k.view_step_m(500.0), 250.0);
+  EXPECT_DOUBLE_EQ(k.view_step_m(-500.0), 250.0);  // descending altitude axes have a negative step
+  EXPECT_DOUBLE_EQ(k.view_step_m(20.0), 25.0);
+}
+
+// Every knob of the table is written and read back: a configuration whose every knob differs from
+// the default round-trips exactly (a knob the writer dropped would come back as its default).
+TEST(QualityFront, EveryKnobRoundTrips) {
+  QualityKnobs k;
+  for_each_quality_knob(k, [](const KnobRow& row, auto& v) {
+    using T = std::decay_t<decltype(v)>;
+    if constexpr (std::is_same_v<T, bool>) v = !v;
+    else if constexpr (std::is_same_v<T, int>) v = v + 1 <= row.row.hi ? v + 1 : v - 1;
+    else v = v * 0.75 + 0.25 * (row.row.lo + row.row.hi) / 2.0;  // inside lo..hi, not the default
+  });
+  for_each_quality_knob(k, [&](const KnobRow& row, const auto& v) {
+    QualityKnobs d;
+    bool differs = true;
+    for_each_quality_knob(d, [&](const KnobRow& r2, const auto& w) {
+      if (std::string(r2.row.key) == row.row.key) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(w)>, std::decay_t<decltype(v)>>) differs = !(w == v);
+      }
+    });
+    EXPECT_TRUE(differs) << row.row.key << " was left at its default";
+    EXPECT_TRUE(row.row.kind == SettingKind::Bool || in_range(row.row, static_cast<double>(v))) << row.row.key;
+  });
+  QualityFront f;
+  f.machine = "m", f.width = 8, f.height = 8, f.command = "c";
   FrontConfig c;
-  c.view_step_dz = 0.5, c.view_step_min_m = 25.0;
-  EXPECT_DOUBLE_EQ(c.view_step_m(500.0), 250.0);
-  EXPECT_DOUBLE_EQ(c.view_step_m(-500.0), 250.0);  // descending altitude axes have a negative step
-  EXPECT_DOUBLE_EQ(c.view_step_m(20.0), 25.0);
+  c.name = "all", c.knobs = k;
+  c.scenes.push_back({"s", 100.0, 1.0, 0.1, true});
+  f.configs.push_back(c);
+  const QualityFront g = front_from_json(front_to_json(f), "front.json");
+  ASSERT_EQ(g.configs.size(), 1u);
+  EXPECT_EQ(g.configs[0].knobs, k) << describe_knobs(g.configs[0].knobs) << " against " << describe_knobs(k);
+}
+
+// apply_knobs writes each knob where the table says; a preset sets only its rows and leaves the
+// resolution scale and adaptive steps as the scene gave them.
+TEST(QualityFront, KnobsApplyWhereTheTableSays) {
+  QualityKnobs k;
+  k.view_step_dz = 2.0, k.view_step_min_m = 10.0, k.sun_steps = 7, k.octaves = 3, k.accumulate = 5;
+  k.resolution_scale = 0.25, k.adaptive = true;
+  RenderSettings r;
+  apply_knobs(k, 400.0, r);
+  EXPECT_DOUBLE_EQ(r.march.view_step_m, 800.0);
+  EXPECT_EQ(r.march.sun_steps, 7);
+  EXPECT_EQ(r.march.octaves, 3);
+  EXPECT_EQ(r.accumulate, 5);
+  EXPECT_DOUBLE_EQ(r.resolution_scale, 0.25);
+  EXPECT_TRUE(r.march.adaptive_steps);
+  EXPECT_EQ(knobs_of(r, 800.0, 400.0).sun_steps, 7);
+  EXPECT_DOUBLE_EQ(knobs_of(r, 800.0, 400.0).view_step_dz, 2.0);
+
+  RenderSettings p;
+  p.resolution_scale = 0.5, p.march.adaptive_steps = true;
+  apply_quality("low", p);
+  EXPECT_EQ(p.quality, "low");
+  EXPECT_EQ(p.march.view_step_m, 0.0);  // from the grid
+  EXPECT_EQ(p.march.sun_steps, find_quality("low")->knobs.sun_steps);
+  EXPECT_DOUBLE_EQ(p.resolution_scale, 0.5);
+  EXPECT_TRUE(p.march.adaptive_steps);
 }
 
 // Candidates with given front times, most accurate first.
