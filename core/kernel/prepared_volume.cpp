@@ -44,6 +44,13 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
   const double r0 = grid.earth_radius_m;
   const CameraFrame c = camera_frame(cam);
   kernel::MarchParams p;
+  // The settings that go in as they are (CV_MARCH_UNIFORM rows of march_settings.def); the rest
+  // below are derived from the settings, the camera, the sun and the prepared volume.
+#define CV_MARCH_SETTING(TYPE, NAME, DEF, GROUP, FIELDS)
+#define CV_MARCH_UNIFORM(MEMBER, UNIFORM) p.UNIFORM = s.MEMBER;
+#include "settings/march_settings.def"
+#undef CV_MARCH_UNIFORM
+#undef CV_MARCH_SETTING
   p.u_size = {cam.width, cam.height};
   p.u_cam_ecef = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);
   p.u_cam_alt = cam.alt_m;
@@ -62,21 +69,11 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
   p.u_grid_count = {double(grid.lon_deg.count), double(grid.lat_deg.count), double(grid.alt_m.count)};
   p.u_wraps = v.wraps;
   p.u_global_lat = v.global_lat;
-  p.u_view_step = s.view_step_m;
   p.u_layer = {v.layer.bottom_m, v.layer.top_m};
   p.u_cloudless = v.layer.empty;
-  p.u_sun_steps = s.sun_steps;
   p.u_sigma_max = v.sigma_max_per_m;
-  p.u_sun_step_tau = s.max_sun_step_optical_depth;
   p.u_sun_step_max = sun_step_limit_m(grid, v.layer, s);
-  p.u_octaves = s.octaves;
   p.u_octave_abc = {s.octave_a, s.octave_b, s.octave_c};
-  p.u_octave_gate = s.octave_gate;
-  p.u_droplet_um = s.droplet_diameter_um;
-  p.u_liquid_phase_hg = s.liquid_phase_hg;
-  p.u_ice_g = s.ice_g;
-  p.u_frame = s.frame;
-  p.u_blue_noise = s.blue_noise;
   if (s.noise_amount > 0.0) {
     const NoiseAnchor a = noise_anchor(grid_centre_ecef(grid), s.noise_scale_m);
     p.u_noise_anchor = a.ecef_m;  // float-exact by construction
@@ -84,13 +81,7 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
     p.u_noise_period = s.noise_scale_m;
     p.u_noise_amount = s.noise_amount;
   }
-  p.u_ambient = s.ambient;
-  p.u_sky_steps = s.sky_steps;
-  p.u_atmo_sun_steps = s.atmo_sun_steps;
-  p.u_ground_albedo = s.ground_albedo;
   p.u_ground_size = ground_size;
-  p.u_max_step_tau = s.max_step_optical_depth;
-  p.u_min_t = s.min_transmittance;
   // Float's largest finite value bounds it, so the GPU's copy is never Inf.
   p.u_sun_tau_limit = std::min(3.0e38, physics::f64::sun_march_tau_limit(s.octaves, s.octave_a, s.min_transmittance));
   const auto& levels = v.pyramid.levels();
