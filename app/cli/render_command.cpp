@@ -265,6 +265,8 @@ const char* render_usage() {
       t += "\n";
     }
     return t +
+           "         [--pfm OUT.pfm]           linear radiance alone (no background, no exposure), and the\n"
+           "                           transmittance beside it as OUT.transmittance.pfm (one channel)\n"
            "         [--save-scene OUT.json]  (the effective scene, camera and sun resolved, to reproduce the image)\n"
            "         [--budget-ms MS [--front quality_front.json]]  the most accurate settings of the measured front\n"
            "                           (from bench; else its cached copy, else the presets) that render within MS here\n"
@@ -394,7 +396,11 @@ int cmd_render(const std::vector<std::string>& args) {
   const double t_tone = seconds_since(t0);
   t0 = clock::now();
   render::write_png(ra.out, cam.width, cam.height, rgb8);
-  if (!ra.pfm.empty()) render::write_pfm(ra.pfm, cam.width, cam.height, pixels, tone);
+  const std::string transmittance_pfm = ra.pfm.empty() ? "" : render::transmittance_pfm_path(ra.pfm);
+  if (!ra.pfm.empty()) {  // radiance alone, and the transmittance as its own file
+    render::write_pfm(ra.pfm, cam.width, cam.height, pixels);
+    render::write_pfm_transmittance(transmittance_pfm, cam.width, cam.height, pixels);
+  }
   const double t_write = seconds_since(t0);
   char gpu_text[48];
   // GL_TIME_ELAPSED as the driver reports it (Mesa's llvmpipe runs compute on the CPU and reports
@@ -405,7 +411,8 @@ int cmd_render(const std::vector<std::string>& args) {
               "  composite/tonemap %.3f s\n  write       %.3f s\n",
               ctx->info().renderer.c_str(), t_load, t_upload, t_march, gpu_text, t_tone, t_write);
   if (bad) std::fprintf(stderr, "cloudviewer render: %zu pixels were not finite (drawn white)\n", bad);
-  std::printf("wrote %s%s\n", ra.out.c_str(), ra.pfm.empty() ? "" : (" and " + ra.pfm).c_str());
+  std::printf("wrote %s%s\n", ra.out.c_str(),
+              ra.pfm.empty() ? "" : (", " + ra.pfm + " (radiance) and " + transmittance_pfm + " (transmittance)").c_str());
   return bad ? 1 : 0;
 }
 

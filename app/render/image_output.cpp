@@ -77,20 +77,37 @@ void write_png(const std::string& path, int width, int height, const std::vector
   });
 }
 
-void write_pfm(const std::string& path, int width, int height, const std::vector<glm::vec4>& pixels,
-               const ToneSettings& tone) {
+namespace {
+// PFM stores rows bottom to top; a negative scale means little-endian (floats as the host has them).
+void write_pfm_channels(const std::string& path, int width, int height, const std::vector<glm::vec4>& pixels,
+                        int first, int channels) {
   core::write_file_atomically(path, [&](std::FILE* f) {
-    // PFM stores rows bottom to top; a negative scale means little-endian.
-    std::fprintf(f, "PF\n%d %d\n-1.0\n", width, height);
-    std::vector<float> row(static_cast<std::size_t>(width) * 3);
+    std::fprintf(f, "%s\n%d %d\n-1.0\n", channels == 3 ? "PF" : "Pf", width, height);
+    std::vector<float> row(static_cast<std::size_t>(width) * channels);
     for (int y = height - 1; y >= 0; --y) {
       for (int x = 0; x < width; ++x) {
         const auto& p = pixels[static_cast<std::size_t>(y) * width + x];
-        for (int c = 0; c < 3; ++c) row[static_cast<std::size_t>(x) * 3 + c] = static_cast<float>(p[c] + p.w * tone.background[c]);
+        for (int c = 0; c < channels; ++c) row[static_cast<std::size_t>(x) * channels + c] = p[first + c];
       }
       if (std::fwrite(row.data(), sizeof(float), row.size(), f) != row.size()) throw std::runtime_error("write failed");
     }
   });
+}
+}  // namespace
+
+void write_pfm(const std::string& path, int width, int height, const std::vector<glm::vec4>& pixels) {
+  write_pfm_channels(path, width, height, pixels, 0, 3);
+}
+
+void write_pfm_transmittance(const std::string& path, int width, int height, const std::vector<glm::vec4>& pixels) {
+  write_pfm_channels(path, width, height, pixels, 3, 1);
+}
+
+std::string transmittance_pfm_path(const std::string& radiance_pfm) {
+  const std::string ext = ".pfm";
+  const bool has_ext = radiance_pfm.size() > ext.size() &&
+                       radiance_pfm.compare(radiance_pfm.size() - ext.size(), ext.size(), ext) == 0;
+  return (has_ext ? radiance_pfm.substr(0, radiance_pfm.size() - ext.size()) : radiance_pfm) + ".transmittance.pfm";
 }
 
 }  // namespace cv::render

@@ -12,7 +12,9 @@ namespace cv::render {
 
 struct ToneSettings {
   double exposure = 1.0;                                     // radiance multiplier before the curve
-  glm::dvec3 background{0.015, 0.02, 0.035};                 // seen through the clouds' transmittance
+  // Seen through the clouds' transmittance in the tonemapped image only: linear output (PFM) is
+  // the radiance alone.
+  glm::dvec3 background{0.015, 0.02, 0.035};
 };
 
 // Bilinear upscaling of an iw x ih image (rgb radiance, a transmittance; rows top to bottom) to
@@ -24,8 +26,14 @@ std::vector<glm::vec4> upscale_linear(const std::vector<glm::vec4>& in, int iw, 
 // rgb = radiance, a = transmittance, rows top to bottom; composited over the background.
 std::vector<unsigned char> tonemap_srgb8(const std::vector<glm::vec4>& pixels, const ToneSettings& tone);
 void write_png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb8);
-// Portable float map (3 channels, linear radiance composited over the background).
-void write_pfm(const std::string& path, int width, int height, const std::vector<glm::vec4>& pixels,
-               const ToneSettings& tone);
+// Portable float map ("PF", 3 channels): the linear radiance alone, nothing composited behind it
+// (rgb of `pixels`; no background, no exposure).
+void write_pfm(const std::string& path, int width, int height, const std::vector<glm::vec4>& pixels);
+// One-channel portable float map ("Pf"): the transmittance, what shows through to whatever stands
+// behind the image (a of `pixels`: the clouds' and the air's; 0 where the globe or opaque geometry
+// shows).
+void write_pfm_transmittance(const std::string& path, int width, int height, const std::vector<glm::vec4>& pixels);
+// Where write_pfm_transmittance goes beside a radiance PFM: "out.pfm" -> "out.transmittance.pfm".
+std::string transmittance_pfm_path(const std::string& radiance_pfm);
 
 }  // namespace cv::render

@@ -3,12 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <filesystem>
 #include <limits>
 #include <random>
 #include <vector>
 
 #include <glm/vec4.hpp>
+
+#include <unistd.h>
 
 #include "render/context.hpp"
 #include "render/image_output.hpp"
@@ -213,3 +217,60 @@ TEST_F(PresenterTest, EveryVertexAndFragmentShaderPairCompilesAndLinks) {
 }
 
 }  // namespace
+
+namespace {
+// A PFM read back: its header's type and size, and the floats in file order (rows bottom to top).
+struct Pfm {
+  std::string type;
+  int w = 0, h = 0;
+  double scale = 0.0;
+  std::vector<float> data;
+};
+Pfm read_pfm(const std::string& path) {
+  Pfm p;
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return p;
+  char type[3] = {};
+  if (std::fscanf(f, "%2s %d %d %lf", type, &p.w, &p.h, &p.scale) == 4 && std::fgetc(f) == '\n') {
+    p.type = type;
+    const std::size_t n = static_cast<std::size_t>(p.w) * p.h * (p.type == "PF" ? 3 : 1);
+    p.data.resize(n);
+    if (std::fread(p.data.data(), sizeof(float), n, f) != n) p.data.clear();
+  }
+  std::fclose(f);
+  return p;
+}
+}  // namespace
+
+// Linear output is radiance only: clouds on black stay black (no background colour added through
+// the transmittance, whatever the tone settings), and the transmittance is its own one-channel file.
+TEST(ImageOutput, PfmHoldsRadianceAloneAndTheTransmittanceBeside) {
+  const fs::path dir = fs::temp_directory_path() / ("cv_pfm_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const int w = 3, h = 2;
+  std::vector<glm::vec4> px = {{0, 0, 0, 1},       {0.5f, 0.25f, 0.125f, 0.5f}, {2, 3, 4, 0},
+                               {1e-3f, 0, 0, 0.9f}, {0, 0, 0, 0},              {7, 8, 9, 0.25f}};
+  const std::string path = (dir / "x.pfm").string();
+  EXPECT_EQ(transmittance_pfm_path(path), (dir / "x.transmittance.pfm").string());
+  EXPECT_EQ(transmittance_pfm_path("noext"), "noext.transmittance.pfm");
+  write_pfm(path, w, h, px);
+  write_pfm_transmittance(transmittance_pfm_path(path), w, h, px);
+  const Pfm rgb = read_pfm(path), t = read_pfm(transmittance_pfm_path(path));
+  ASSERT_EQ(rgb.type, "PF");
+  ASSERT_EQ(t.type, "Pf");
+  ASSERT_EQ(rgb.w, w);
+  ASSERT_EQ(rgb.h, h);
+  ASSERT_EQ(t.w, w);
+  ASSERT_EQ(t.h, h);
+  ASSERT_EQ(rgb.data.size(), 18u);
+  ASSERT_EQ(t.data.size(), 6u);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const glm::vec4& p = px[static_cast<std::size_t>(y) * w + x];
+      const std::size_t row = static_cast<std::size_t>(h - 1 - y) * w + x;  // PFM rows bottom to top
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(rgb.data[row * 3 + c], p[c]) << x << "," << y << " channel " << c;
+      EXPECT_EQ(t.data[row], p.w) << x << "," << y;
+    }
+  }
+  fs::remove_all(dir);
+}
