@@ -245,7 +245,7 @@ const char* render_usage() {
         "  render INPUT -o OUT.png   INPUT: NetCDF, .cvvol or a scene .json (docs/scene.md); options override it:\n"
         "         [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov] [--sun LAT,LON | --sun-time ISO]\n"
         "         [--quality low|default|high|custom] [--accumulate N]\n"
-        "         [--exposure E] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N] [--pfm OUT.pfm]\n"
+        "         [--exposure E] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N]\n"
         "         [--no-sky]  clouds on black: no air, globe or ambient sky light\n";
     for (const core::SettingRow& row : core::kMarchSettingRows) {
       if (!row.flag) continue;
