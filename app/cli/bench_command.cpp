@@ -108,13 +108,13 @@ std::string reference_key(const bench::StandardScene& sc, const core::GridMeanEx
   char b[1024];
   std::snprintf(b, sizeof b,
                 "v2 grid %d %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g data %.17g cam %.17g %.17g %.17g %.17g %.17g "
-                "%.17g %d %d sun %.17g %.17g %.17g %.17g %.17g march d%.17g hg%d ice%.17g noise%.17g mc %d %d %llu",
+                "%.17g %d %d sun %.17g %.17g %.17g %.17g %.17g march d%.17g hg%d ice%.17g noise%.17g mc %d %d %llu peak%d",
                 g.lon_deg.count, g.lat_deg.count, g.alt_m.count, g.lon_deg.start, g.lon_deg.step, g.lat_deg.start,
                 g.lat_deg.step, g.alt_m.start, g.alt_m.step, g.earth_radius_m, sum, c.lat_deg, c.lon_deg, c.alt_m,
                 c.heading_deg, c.pitch_deg, c.fov_deg, c.width, c.height, sc.sun.subsolar_lat_deg, sc.sun.subsolar_lon_deg,
                 sc.sun.irradiance.x, sc.sun.irradiance.y, sc.sun.irradiance.z, m.droplet_diameter_um,
                 m.liquid_phase_hg ? 1 : 0, m.ice_g, m.noise_amount, mc.max_bounces, mc.roulette_after,
-                static_cast<unsigned long long>(mc.seed));
+                static_cast<unsigned long long>(mc.seed), mc.peak_mis ? 1 : 0);
   return b;
 }
 

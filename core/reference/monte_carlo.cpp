@@ -32,6 +32,7 @@ void MonteCarloStats::add(const MonteCarloStats& o) {
   truncated += o.truncated;
   roulette_killed += o.roulette_killed;
   majorant_exceeded += o.majorant_exceeded;
+  peak_samples += o.peak_samples;
 }
 
 // ---- accumulator ----
@@ -187,9 +188,25 @@ MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec
   const double r0 = grid_.earth_radius_m;
   const p64::MieParams mie = p64::mie_params(march_.droplet_diameter_um);
   const double liquid_g = p64::mie_mean_cosine(mie);  // for liquid_phase_hg
+  // The phase function of a point holding liquid sl and ice si, at scattering cosine mu: the mix by
+  // extinction share, which is also the density of the direction the path draws there.
+  auto phase_at = [&](double sl, double si, double mu) {
+    const double sigma = sl + si;
+    if (!(sigma > 0.0)) return p64::phase_isotropic();
+    return (sl * (march_.liquid_phase_hg ? p64::phase_hg(mu, liquid_g) : p64::phase_mie(mu, mie)) +
+            si * p64::phase_hg(mu, march_.ice_g)) / sigma;
+  };
+  // The second technique for the direction into a vertex (peak_mis): the droplets' HG peak lobe
+  // around the sun, drawn at every cloud vertex holding liquid. q(w) is its density.
+  const bool peak = mc_.peak_mis && !march_.liquid_phase_hg;
+  auto peak_density = [&](const glm::dvec3& w) { return p64::phase_hg_c(glm::dot(w, to_sun_), mie.g_hg, mie.c_hg); };
   PathResult r;
   glm::dvec3 beta(1.0);
   ++st.paths;
+  // The vertex the current direction was drawn at, when the peak technique could have drawn it too.
+  bool prev_peak = false;
+  double prev_sl = 0.0, prev_si = 0.0;
+  glm::dvec3 prev_d(0.0);
   for (;;) {
     double t_ground;
     const double t = free_path(p, d, rng, st, &t_ground);
@@ -202,16 +219,37 @@ MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec
       ++st.scatterings;
       // Next-event estimation: the sun is a delta light, reachable only this way. The scattering
       // cosine is between the sunlight's propagation (-to_sun) and the light's toward the camera (-d).
-      const double mu = glm::dot(d, to_sun_);
-      const double phase = sigma > 0.0
-                               ? (sl * (march_.liquid_phase_hg ? p64::phase_hg(mu, liquid_g) : p64::phase_mie(mu, mie)) +
-                                  si * p64::phase_hg(mu, march_.ice_g)) / sigma
-                               : p64::phase_isotropic();
-      r.radiance += beta * sun_.irradiance * (phase * transmittance(p, to_sun_, rng, st));
+      // Balance heuristic against the peak technique, which could have drawn d at the vertex before.
+      double w = 1.0;
+      if (prev_peak) {
+        const double p_prev = phase_at(prev_sl, prev_si, glm::dot(prev_d, d));
+        w = p_prev / (p_prev + peak_density(d));
+      }
+      r.radiance += beta * sun_.irradiance * (w * phase_at(sl, si, glm::dot(d, to_sun_)) * transmittance(p, to_sun_, rng, st));
       if (r.scatterings >= mc_.max_bounces) {
         r.end = End::Truncated;
         ++st.truncated;
         break;
+      }
+      if (!roulette(r, beta, rng, st)) break;
+      // The peak technique: a direction w ~ q around the sun, the free path along it, the sun's light
+      // at the vertex it reaches, weighted q / (p + q) (the path's own technique is weighted above).
+      prev_peak = peak && sl > 0.0;
+      if (prev_peak) {
+        ++st.peak_samples;
+        double q;
+        const glm::dvec3 wq = p64::sample_hg(to_sun_, mie.g_hg, glm::dvec2(rng.uniform(), rng.uniform()), q);
+        q = peak_density(wq);  // with c_hg kept apart (the sampler's pdf loses digits near g = 1)
+        const double p_here = phase_at(sl, si, glm::dot(d, wq));
+        const double tq = free_path(p, wq, rng, st);
+        if (std::isfinite(tq) && p_here > 0.0) {
+          const glm::dvec3 x = p + tq * wq;
+          double sl2, si2;
+          extinction(x, sl2, si2);
+          r.radiance += beta * sun_.irradiance *
+                        (p_here / (p_here + q) * phase_at(sl2, si2, glm::dot(wq, to_sun_)) * transmittance(x, to_sun_, rng, st));
+        }
+        prev_sl = sl, prev_si = si, prev_d = d;
       }
       // Clouds do not absorb (albedo 1): the new direction is drawn from the phase function of the
       // component that scattered, chosen by its share of the extinction, and beta is unchanged.
@@ -246,25 +284,29 @@ MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec
         ++st.truncated;
         break;
       }
+      if (!roulette(r, beta, rng, st)) break;
+      prev_peak = false;  // a cosine draw from the ground: no other technique makes it
       d = p64::direction_around(n, std::sqrt(rng.uniform()), p64::CV_TWO_PI * rng.uniform());
     } else {
       r.end = std::isfinite(t_ground) ? End::Ground : End::Space;
       break;
     }
-    if (r.scatterings >= mc_.roulette_after) {
-      const double q = std::min(1.0, std::max({beta.x, beta.y, beta.z}));
-      if (q < 1.0) {
-        if (rng.uniform() >= q) {
-          r.end = End::Roulette;
-          ++st.roulette_killed;
-          break;
-        }
-        beta /= q;
-      }
-    }
   }
   r.weight = beta;
   return r;
+}
+
+bool MonteCarloRenderer::roulette(PathResult& r, glm::dvec3& beta, PathRng& rng, MonteCarloStats& st) const {
+  if (r.scatterings < mc_.roulette_after) return true;
+  const double q = std::min(1.0, std::max({beta.x, beta.y, beta.z}));
+  if (q >= 1.0) return true;
+  if (rng.uniform() >= q) {
+    r.end = End::Roulette;
+    ++st.roulette_killed;
+    return false;
+  }
+  beta /= q;
+  return true;
 }
 
 MonteCarloImage MonteCarloRenderer::start() const {
