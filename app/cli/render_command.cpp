@@ -198,8 +198,12 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
       m.atmosphere = m.globe = false;
       m.ambient = 0.0;
     } else if (a == "--exposure") {
-      scene.render.exposure = parse_number(a, v);
-      if (!(scene.render.exposure > 0)) throw UsageError{"cloudviewer render: --exposure: found '" + v + "', expected a number > 0"};
+      scene.render.auto_exposure = v == "auto";
+      if (!scene.render.auto_exposure) {
+        scene.render.exposure = parse_number(a, v);
+        if (!(scene.render.exposure > 0))
+          throw UsageError{"cloudviewer render: --exposure: found '" + v + "', expected a number > 0 or auto"};
+      }
     } else if (a == "--region") {
       const auto g = parse_list(a, v, ',', 4, 4, "W,E,S,N in degrees");
       if (g[2] > g[3] || g[2] < -90 || g[3] > 90) {
@@ -245,7 +249,7 @@ const char* render_usage() {
         "  render INPUT -o OUT.png   INPUT: NetCDF, .cvvol or a scene .json (docs/scene.md); options override it:\n"
         "         [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov] [--sun LAT,LON | --sun-time ISO]\n"
         "         [--quality low|default|high|custom] [--accumulate N]\n"
-        "         [--exposure E] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N]\n"
+        "         [--exposure E|auto] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N]\n"
         "         [--no-sky]  clouds on black: no air, globe or ambient sky light\n";
     for (const core::SettingRow& row : core::kMarchSettingRows) {
       if (!row.flag) continue;
@@ -366,10 +370,14 @@ int cmd_render(const std::vector<std::string>& args) {
   }
   // One frame at step middles (or the scene's frame), or the mean of jittered frames, at the output
   // size in linear radiance.
-  std::vector<glm::vec4> pixels = renderer.render(frame, dispatch, [&](int done, int total) {
-    if (total > 1) std::printf("\raccumulated %d/%d frames, %.1f s", done, total, seconds_since(t0));
-    std::fflush(stdout);
-  });
+  std::vector<glm::vec4> marched;  // at the march size, for the automatic exposure
+  std::vector<glm::vec4> pixels = renderer.render(
+      frame, dispatch,
+      [&](int done, int total) {
+        if (total > 1) std::printf("\raccumulated %d/%d frames, %.1f s", done, total, seconds_since(t0));
+        std::fflush(stdout);
+      },
+      &marched);
   if (frame.accumulate > 1 || dispatch.on_tile) std::printf("\n");
   const double t_march = seconds_since(t0);
   const core::MarchStats& ms = gpu.last_stats();
@@ -390,7 +398,8 @@ int cmd_render(const std::vector<std::string>& args) {
   std::size_t bad = 0;
   for (const auto& p : pixels) bad += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w));
   render::ToneSettings tone;
-  tone.exposure = frame.exposure;
+  tone.exposure = frame.auto_exposure ? render::auto_exposure(marched) : frame.exposure;
+  if (frame.auto_exposure) std::printf("exposure %.4g (auto: the 99th percentile of lit pixels' luminance at 0.8; --exposure E sets it)\n", tone.exposure);
   if (march.atmosphere || march.globe) tone.background = glm::dvec3(0.0);  // the sky and space are in the image
   const std::vector<unsigned char> rgb8 = render::tonemap_srgb8(pixels, tone);
   const double t_tone = seconds_since(t0);

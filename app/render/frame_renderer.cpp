@@ -42,7 +42,8 @@ void FrameRenderer::march_into(GLuint out, const core::FrameSpec& f, int index, 
 }
 
 std::vector<glm::vec4> FrameRenderer::render(const core::FrameSpec& f, const DispatchOptions& dispatch,
-                                             const std::function<void(int, int)>& on_frame) {
+                                             const std::function<void(int, int)>& on_frame,
+                                             std::vector<glm::vec4>* marched) {
   const int mw = f.march_camera.width, mh = f.march_camera.height;
   std::vector<glm::vec4> mean;
   for (int i = 0; i < f.accumulate; ++i) {
@@ -56,6 +57,7 @@ std::vector<glm::vec4> FrameRenderer::render(const core::FrameSpec& f, const Dis
     }
     if (on_frame) on_frame(i + 1, f.accumulate);
   }
+  if (marched) *marched = mean;
   if (mw == f.camera.width && mh == f.camera.height) return mean;
   return upscale_linear(mean, mw, mh, f.camera.width, f.camera.height);
 }

@@ -38,9 +38,11 @@ class FrameRenderer {
 
   // The image at the output size in linear radiance (rgb) and transmittance (a): the spec's
   // accumulate frames at the march size, their running mean (as the viewer's accumulate.comp), then
-  // upscale_linear. on_frame(done, total) after each accumulated frame.
+  // upscale_linear. on_frame(done, total) after each accumulated frame. `marched`, when given,
+  // receives the mean at the march size (what auto_exposure reads, as the viewer does).
   std::vector<glm::vec4> render(const core::FrameSpec& frame, const DispatchOptions& dispatch = {},
-                                const std::function<void(int, int)>& on_frame = {});
+                                const std::function<void(int, int)>& on_frame = {},
+                                std::vector<glm::vec4>* marched = nullptr);
 
   GpuRaymarcher& raymarcher() { return gpu_; }
   const core::MarchStats& last_stats() { return gpu_.last_stats(); }

@@ -55,6 +55,23 @@ std::vector<glm::vec4> upscale_linear(const std::vector<glm::vec4>& in, int iw, 
   return out;
 }
 
+double auto_exposure(const std::vector<glm::vec4>& linear) {
+  std::vector<double> y;
+  y.reserve(linear.size());
+  for (const auto& p : linear) {
+    const double l = 0.2126 * p.x + 0.7152 * p.y + 0.0722 * p.z;
+    if (std::isfinite(l) && l > 0.0) y.push_back(l);
+  }
+  if (y.empty()) return kDefaultExposure;
+  const std::size_t k = std::min(y.size() - 1, static_cast<std::size_t>(0.99 * static_cast<double>(y.size())));
+  std::nth_element(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(k), y.end());
+  // filmic(x) = 0.8: (2.51 - 2.43 t) x^2 + (0.03 - 0.59 t) x - 0.14 t = 0, its positive root.
+  constexpr double t = 0.8;
+  const double a = 2.51 - 2.43 * t, b = 0.03 - 0.59 * t, c = -0.14 * t;
+  const double x = (-b + std::sqrt(b * b - 4.0 * a * c)) / (2.0 * a);
+  return std::clamp(x / y[k], 1e-6, 1e6);
+}
+
 std::vector<unsigned char> tonemap_srgb8(const std::vector<glm::vec4>& pixels, const ToneSettings& tone) {
   std::vector<unsigned char> out;
   out.reserve(pixels.size() * 3);

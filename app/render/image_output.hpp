@@ -23,6 +23,13 @@ struct ToneSettings {
 // so the viewer shows what `render` writes.
 std::vector<glm::vec4> upscale_linear(const std::vector<glm::vec4>& in, int iw, int ih, int ow, int oh);
 
+// The automatic exposure of a linear image (rgb radiance; a is not used): the exposure that puts
+// the 99th percentile of the luminance of its lit pixels (Rec. 709 luminance > 0, finite) at 0.8 on
+// the filmic curve, so the brightest cloud tops are bright without clipping and a stray hot pixel
+// (the top 1 %) does not darken the rest. An image with no lit pixel gets kDefaultExposure.
+inline constexpr double kDefaultExposure = 4.0;
+double auto_exposure(const std::vector<glm::vec4>& linear);
+
 // rgb = radiance, a = transmittance, rows top to bottom; composited over the background.
 std::vector<unsigned char> tonemap_srgb8(const std::vector<glm::vec4>& pixels, const ToneSettings& tone);
 void write_png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb8);

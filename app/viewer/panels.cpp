@@ -157,7 +157,12 @@ void quality_panel(ViewerState& s, const PanelContext& ctx) {
   core::RenderSettings& r = s.scene.render;
   slider_double("resolution scale", &r.resolution_scale, 0.1, 1.0, "%.2f");
   ImGui::SliderInt("accumulate (frames)", &r.accumulate, 1, 1024, "%d", ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
-  slider_double("exposure", &r.exposure, 0.1, 64.0, "%.2f", ImGuiSliderFlags_Logarithmic);
+  if (ImGui::Checkbox("automatic exposure", &r.auto_exposure) && !r.auto_exposure) r.exposure = ctx.auto_exposure;
+  if (r.auto_exposure) {
+    ImGui::Text("exposure %.3g (the 99th percentile of lit pixels at 0.8)", ctx.auto_exposure);
+  } else {
+    slider_double("exposure", &r.exposure, 1e-3, 1e4, "%.3g", ImGuiSliderFlags_Logarithmic);
+  }
   // 0 is off; on, the budget sets the step, sun steps, octaves, adaptive and scale above.
   drag_double("frame budget (ms)", &r.budget_ms, 1.0, 0.0, 1e7, r.budget_ms > 0.0 ? "%.0f" : "off");
   if (r.budget_ms > 0.0 && !ctx.budget_text.empty()) ImGui::TextWrapped("budget: %s", ctx.budget_text.c_str());

@@ -30,6 +30,7 @@ struct PanelContext {
   double goto_lat_deg = 0.0, goto_lon_deg = 0.0, goto_alt_m = 10000.0;
   std::string scene_path = "scene.json";
   std::string scene_message;    // result of the last load/save
+  double auto_exposure = 4.0;   // what the automatic exposure chose, shown while it is on
   std::string budget_text;      // the frame budget's candidate and its source, when the budget is on
 };
 

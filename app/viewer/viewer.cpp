@@ -19,6 +19,7 @@
 #include "render/albedo_map.hpp"
 #include "render/context.hpp"
 #include "render/machine_id.hpp"
+#include "render/image_output.hpp"
 #include "render/presenter.hpp"
 #include "render/raymarcher.hpp"
 #include "viewer/camera_controller.hpp"
@@ -265,6 +266,7 @@ int run_viewer(const ViewerOptions& o) {
   stats.renderer = win->info().renderer;
   PassTimer march_timer, present_timer;
   int accumulated = 0;
+  double auto_exposure = render::kDefaultExposure;  // the last automatic exposure (render::auto_exposure)
   bool show_ui = !o.hide_ui, f1_was_down = false;
   core::Scene previous;
   using clock = std::chrono::steady_clock;
@@ -342,12 +344,21 @@ int run_viewer(const ViewerOptions& o) {
       present_timer.begin();
       presenter.accumulate(accumulated);
       ++accumulated;
+      // The automatic exposure from the mean at the march size (as `render` takes it), when the mean
+      // starts and when it is complete: not frame by frame, so the picture does not pulse.
+      if (spec.auto_exposure && (accumulated == 1 || accumulated == s.scene.render.accumulate)) {
+        std::vector<glm::vec4> mean(static_cast<std::size_t>(mw) * mh);
+        glGetTextureImage(presenter.mean_texture(), 0, GL_RGBA, GL_FLOAT,
+                          static_cast<GLsizei>(mean.size() * sizeof(glm::vec4)), mean.data());
+        auto_exposure = render::auto_exposure(mean);
+      }
     } else {
       present_timer.begin();
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     render::ToneSettings tone;
-    tone.exposure = spec.exposure;
+    tone.exposure = spec.auto_exposure ? auto_exposure : spec.exposure;
+    ctx.auto_exposure = auto_exposure;
     if (s.scene.render.march.atmosphere || s.scene.render.march.globe) tone.background = glm::dvec3(0.0);
     presenter.draw(tone, 0, 0, fbw, fbh);
     present_timer.end();

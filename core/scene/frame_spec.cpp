@@ -36,6 +36,7 @@ FrameSpec resolve_frame(const Scene& scene, const CloudVolume& volume) {
   if (!(f.march.droplet_diameter_um > 0.0)) f.march.droplet_diameter_um = 2.0 * volume.liquid_r_eff_um;  // from the data
   f.accumulate = std::max(1, scene.render.accumulate);
   f.exposure = scene.render.exposure;
+  f.auto_exposure = scene.render.auto_exposure;
   return f;
 }
 

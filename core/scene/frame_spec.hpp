@@ -21,6 +21,7 @@ struct FrameSpec {
   MarchSettings march;
   int accumulate = 1;  // jittered frames averaged (1: one frame at step middles)
   double exposure = 4.0;
+  bool auto_exposure = false;  // exposure from the marched image (render::auto_exposure), not the number
   bool valid_time_known = false;  // the data's time step has a UTC valid time (else the sun is at noon over the camera)
 };
 

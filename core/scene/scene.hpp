@@ -52,7 +52,10 @@ struct RenderSettings {
   std::string quality = "default";  // the preset the march settings came from, or "custom"
   int accumulate = 1;               // jittered frames averaged per image
   double resolution_scale = 1.0;    // march at this fraction of the output size
-  double exposure = 4.0;            // tonemapping
+  // Tonemapping: automatic (render::auto_exposure, from the marched image's luminance) unless a
+  // number is given; `exposure` is then that number ("exposure": "auto" or a number in files).
+  bool auto_exposure = true;
+  double exposure = 4.0;
   // Frame-time budget in ms (`render --budget-ms`, the viewer's frame budget): the quality knobs
   // are chosen from the measured front to fit it (app/bench/quality_front.hpp). 0: off.
   double budget_ms = 0.0;

@@ -228,7 +228,13 @@ void read_render(const Reader& r, RenderSettings& s) {
     r.integer(acc.key, s.accumulate, static_cast<int>(acc.lo), static_cast<int>(acc.hi));
     r.number(scale.key, s.resolution_scale, scale.lo, scale.hi, expected_text(scale));
   }
-  r.number("exposure", s.exposure, 1e-300, kHuge, "an exposure > 0");
+  if (const json* e = r.find("exposure"); e && e->is_string()) {
+    if (e->get<std::string>() != "auto") r.fail("exposure", shown(*e), "an exposure > 0 or \"auto\"");
+    s.auto_exposure = true;
+  } else if (e) {
+    r.number("exposure", s.exposure, 1e-300, kHuge, "an exposure > 0 or \"auto\"");
+    s.auto_exposure = false;
+  }
   r.number("budget_ms", s.budget_ms, 0.0, 1e7, "a frame-time budget in ms 0..1e7 (0: off)");
 }
 
@@ -320,7 +326,7 @@ std::string scene_to_json(const Scene& s) {
   root["render"] = {{"quality", s.render.quality},
                     {"accumulate", s.render.accumulate},
                     {"resolution_scale", s.render.resolution_scale},
-                    {"exposure", s.render.exposure},
+                    {"exposure", s.render.auto_exposure ? ojson("auto") : ojson(s.render.exposure)},
                     {"budget_ms", s.render.budget_ms},
                     {"march", march_to_json(s.render.march)}};
   root["overlays"] = s.overlays;

@@ -46,7 +46,8 @@ Scene full_scene() {
   Scene defaults;
   apply_quality("default", defaults.render);
   cv::test::set_every_row_off(s.render.march, defaults.render.march);
-  s.render.accumulate = 8, s.render.resolution_scale = 0.5, s.render.exposure = 6.25, s.render.budget_ms = 40.0;
+  s.render.accumulate = 8, s.render.resolution_scale = 0.5, s.render.exposure = 6.25, s.render.auto_exposure = false;
+  s.render.budget_ms = 40.0;
   s.overlays = {"coastlines"};
   return s;
 }
@@ -84,6 +85,7 @@ void expect_equal(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.render.accumulate, b.render.accumulate);
   EXPECT_EQ(a.render.resolution_scale, b.render.resolution_scale);
   EXPECT_EQ(a.render.exposure, b.render.exposure);
+  EXPECT_EQ(a.render.auto_exposure, b.render.auto_exposure);
   EXPECT_EQ(a.render.budget_ms, b.render.budget_ms);
   EXPECT_EQ(a.overlays, b.overlays);
 }

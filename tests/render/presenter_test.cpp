@@ -274,3 +274,29 @@ TEST(ImageOutput, PfmHoldsRadianceAloneAndTheTransmittanceBeside) {
   }
   fs::remove_all(dir);
 }
+
+// The automatic exposure puts the 99th percentile of the lit pixels' luminance at 0.8 on the filmic
+// curve (sRGB byte 231 for grey), ignores unlit and non-finite pixels and the top 1 % (a stray hot
+// pixel), scales inversely with the radiance, and falls back to the default on a black image.
+TEST(ImageOutput, AutoExposurePutsTheBrightCloudsAtPointEight) {
+  std::vector<glm::vec4> grey(1000, glm::vec4(0.1f, 0.1f, 0.1f, 0.0f));
+  const double e = auto_exposure(grey);
+  ToneSettings tone;
+  tone.exposure = e;
+  tone.background = glm::dvec3(0.0);
+  const std::vector<unsigned char> out = tonemap_srgb8(grey, tone);
+  const double srgb08 = 1.055 * std::pow(0.8, 1.0 / 2.4) - 0.055;
+  EXPECT_EQ(static_cast<int>(out[0]), static_cast<int>(std::lround(srgb08 * 255.0)));
+
+  std::vector<glm::vec4> spoilt = grey;
+  for (int i = 0; i < 5; ++i) spoilt.push_back(glm::vec4(1e6f, 1e6f, 1e6f, 0.0f));  // hot pixels, 0.5 %
+  spoilt.push_back(glm::vec4(std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f, 0.0f));
+  spoilt.insert(spoilt.end(), 3000, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));  // clear sky on black
+  EXPECT_DOUBLE_EQ(auto_exposure(spoilt), e);
+
+  std::vector<glm::vec4> brighter(1000, glm::vec4(0.2f, 0.2f, 0.2f, 0.0f));
+  EXPECT_NEAR(auto_exposure(brighter), e / 2.0, 1e-9 * e);
+
+  EXPECT_EQ(auto_exposure(std::vector<glm::vec4>(64, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f))), kDefaultExposure);
+  EXPECT_EQ(auto_exposure({}), kDefaultExposure);
+}
