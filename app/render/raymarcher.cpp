@@ -70,6 +70,7 @@ GpuRaymarcher::~GpuRaymarcher() {
   if (ground_) glDeleteTextures(1, &ground_);
   if (jitter_mask_) glDeleteTextures(1, &jitter_mask_);
   if (column_tau_) glDeleteTextures(1, &column_tau_);
+  if (ms_[0]) glDeleteTextures(2, ms_);
   if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
   if (pyramid_buffer_) glDeleteBuffers(1, &pyramid_buffer_);
   if (stats_buffer_) glDeleteBuffers(1, &stats_buffer_);
@@ -126,6 +127,10 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
   glTextureStorage2D(column_tau_, 1, GL_R32F, columns.nx, columns.ny);
   glTextureSubImage2D(column_tau_, 0, 0, 0, columns.nx, columns.ny, GL_RED, GL_FLOAT, columns.tau.data());
   check_gl("uploading the column optical depths");
+  // The two-stream source belongs to a time step: built again, at this size, when a march needs it.
+  if (ms_[0]) glDeleteTextures(2, ms_);
+  ms_[0] = ms_[1] = 0;
+  ms_volume_ = nullptr;
   // The pyramid for empty-space skipping and adapted steps, all levels in one buffer.
   std::vector<glm::vec2> packed = volume->pyramid_packed;
   if (packed.empty()) packed.emplace_back(0.0f, 1.0f);  // a buffer must not be empty; u_levels = 0 ignores it
@@ -164,6 +169,24 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
       core::march_params(v, cam, sun, s, textured ? glm::ivec2(ground_w_, ground_h_) : glm::ivec2(0));
   params.u_has_depth = opaque.depth != 0;
   params.u_has_opaque_color = opaque.depth != 0 && opaque.color != 0;
+  if (s.ms_two_stream) {  // the two-stream source, for this time step and sun
+    const core::MsSourceKey key = core::ms_source_key(s, params.u_to_sun);
+    if (!ms_[0] || ms_volume_ != &v || !(key == ms_key_)) {
+      const core::MsSource src = core::build_ms_source(v, key);
+      if (!ms_[0]) {
+        glCreateTextures(GL_TEXTURE_3D, 2, ms_);
+        const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
+        for (GLuint t : ms_) glTextureStorage3D(t, 1, GL_R32F, n.x, n.y, n.z);
+      }
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+      glTextureSubImage3D(ms_[0], 0, 0, 0, 0, grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count, GL_RED, GL_FLOAT,
+                          src.i0.data());
+      glTextureSubImage3D(ms_[1], 0, 0, 0, 0, grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count, GL_RED, GL_FLOAT,
+                          src.i1.data());
+      check_gl("uploading the two-stream source");
+      ms_volume_ = &v, ms_key_ = key, ms_build_ms_ = src.build_ms;
+    }
+  }
   const kernel::MarchParamsStd140 block = kernel::pack_std140(params);
   if (!params_buffer_) {
     glCreateBuffers(1, &params_buffer_);
@@ -206,6 +229,8 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glBindTextureUnit(CV_TEX_GROUND, ground_);
   glBindTextureUnit(CV_TEX_JITTER_MASK, jitter_mask_);
   glBindTextureUnit(CV_TEX_COLUMN_TAU, column_tau_);
+  glBindTextureUnit(CV_TEX_MS_I0, ms_[0]);
+  glBindTextureUnit(CV_TEX_MS_I1, ms_[1]);
   glUseProgram(p);
   const int tile = dispatch.rows_per_tile > 0 ? (dispatch.rows_per_tile + 7) / 8 * 8 : cam.height;
   GLuint query = 0;

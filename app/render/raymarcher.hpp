@@ -12,6 +12,7 @@
 
 #include "kernel/march_params.hpp"
 #include "kernel/march_limits.hpp"
+#include "kernel/ms_source.hpp"
 #include "kernel/prepared_volume.hpp"
 #include "noise/noise.hpp"
 #include "frame/camera.hpp"
@@ -108,6 +109,9 @@ class GpuRaymarcher {
   // What the last march did (view and sun samples, what was skipped, octave terms); waits for it to
   // finish.
   const core::MarchStats& last_stats();
+  // Wall time of the last build of the two-stream source (ms; 0 before any), rebuilt only when the
+  // time step, the sun or the medium's phases change.
+  double ms_source_build_ms() const { return ms_build_ms_; }
 
  private:
   static constexpr int kStatCounters = 8;  // 64-bit counters in the Stats buffer (CV_STAT_COUNT, kernel/march_stats.glsl)
@@ -118,6 +122,10 @@ class GpuRaymarcher {
   std::unique_ptr<GlProgram> programs_[kernel::MarchVariant::kCount];  // by MarchVariant::key
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
+  GLuint ms_[2] = {0, 0};           // the two-stream source (R32F x2), built for ms_key_ on ms_volume_
+  core::MsSourceKey ms_key_;
+  const core::PreparedVolume* ms_volume_ = nullptr;
+  double ms_build_ms_ = 0.0;
   GLuint column_tau_ = 0;           // vertical optical depth per column (R32F), for the octave gate
   GLuint jitter_mask_ = 0;          // the blue-noise mask (R32F), uploaded at construction
   GLuint ground_ = 0;               // linear albedo (RGB32F), loaded from ground_path_

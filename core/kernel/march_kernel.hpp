@@ -48,7 +48,7 @@ using namespace cv::physics::f64;
 #define CV_INOUT(T) T&
 
 struct MarchKernel : MarchParams {
-  sampler3D u_liquid, u_ice, u_noise_low, u_noise_high;
+  sampler3D u_liquid, u_ice, u_noise_low, u_noise_high, u_ms_i0, u_ms_i1;
   sampler2D u_column_tau, u_jitter_mask, u_ground, u_depth, u_opaque;
   const glm::vec2* u_min_max = nullptr;
   // The program switches (compile-time constants on the GPU).

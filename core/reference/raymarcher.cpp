@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "kernel/march_kernel.hpp"
+#include "kernel/ms_source.hpp"
 #include "kernel/prepared_volume.hpp"
 #include "noise/blue_noise.hpp"
 #include "physics/physics.hpp"
@@ -34,6 +35,12 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   k.u_liquid = {v.extinction.liquid_per_m.data(), n};
   k.u_ice = {v.extinction.ice_per_m.data(), n};
   k.u_column_tau = {v.columns.tau.data(), {v.columns.nx, v.columns.ny}, 1};
+  MsSource ms;  // the two-stream source, built as the GPU's (core/kernel/ms_source)
+  if (s.ms_two_stream) {
+    ms = build_ms_source(v, ms_source_key(s, k.u_to_sun));
+    k.u_ms_i0 = {ms.i0.data(), n};
+    k.u_ms_i1 = {ms.i1.data(), n};
+  }
   const BlueNoiseMask& mask = step_jitter_mask();
   k.u_jitter_mask = {mask.values.data(), {mask.n, mask.n}, 1};
   if (ground_map) k.u_ground = {ground_map->rgb.data(), {ground_map->width, ground_map->height}, 3};

@@ -20,6 +20,8 @@ layout(binding = CV_TEX_NOISE_LOW) uniform sampler3D u_noise_low;    // Perlin-W
 layout(binding = CV_TEX_NOISE_HIGH) uniform sampler3D u_noise_high;  // Worley fBm, periodic, [0, 1]
 layout(binding = CV_TEX_DEPTH) uniform sampler2D u_depth;    // distance (m) from the camera to opaque geometry
 layout(binding = CV_TEX_OPAQUE) uniform sampler2D u_opaque;  // that geometry's radiance
+layout(binding = CV_TEX_MS_I0) uniform sampler3D u_ms_i0;  // two-stream diffuse radiance per unit irradiance
+layout(binding = CV_TEX_MS_I1) uniform sampler3D u_ms_i1;  // its first moment (upward)
 // The extinction pyramid: (min, max) per brick, levels one after the other, x fastest.
 layout(std430, binding = CV_SSBO_PYRAMID) readonly buffer Pyramid { vec2 u_min_max[]; };
 // Per-frame counters (MarchStats), each as (low, high) 32-bit words.

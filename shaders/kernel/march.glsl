@@ -5,7 +5,7 @@
 // a state, then composites sky and ground. The parameters are shaders/kernel/march_params.glsl.
 //
 // What the including side declares before this file: the parameters (u_*), the textures u_liquid,
-// u_ice (sampler3D, grid-mean extinction 1/m), u_column_tau, u_jitter_mask, u_ground, u_depth (the
+// u_ice (sampler3D, grid-mean extinction 1/m), u_ms_i0, u_ms_i1 (sampler3D, the two-stream source), u_column_tau, u_jitter_mask, u_ground, u_depth (the
 // distance to opaque geometry per pixel, m), u_opaque (that geometry's radiance) (sampler2D),
 // u_noise_low, u_noise_high (sampler3D), the pyramid u_min_max (vec2 per brick, levels one after
 // the other), the counters g_stats[CV_STAT_COUNT] (uint, indices in march_stats.glsl) and the switches kSkipEmpty, kAdaptive,
@@ -124,6 +124,17 @@ CV_FN void medium_in(real3 p, real3 g, real alt_m, CV_OUT(real) sl, CV_OUT(real)
   if (kNoise && sl + si > real(0.0)) erode_at(p, sl, si);
 }
 
+// The two-stream source's moments (per unit irradiance) at p, altitude alt_m (core/kernel/ms_source).
+CV_FN void ms_source_at(real3 p, real alt_m, CV_OUT(real) i0, CV_OUT(real) i1) {
+  i0 = real(0.0);
+  i1 = real(0.0);
+  real3 g = ecef_to_sphere(p, u_r0);
+  real3 f;
+  if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
+  i0 = fetch(u_ms_i0, f);
+  i1 = fetch(u_ms_i1, f);
+}
+
 // The medium at p whose altitude alt_m a marcher knows better than |p| - r0 (ray_altitude).
 CV_FN void medium_at(real3 p, real alt_m, CV_OUT(real) sl, CV_OUT(real) si) { medium_in(p, ecef_to_sphere(p, u_r0), alt_m, sl, si); }
 
@@ -237,7 +248,7 @@ struct MarchState {
 // begins t_entry from the camera: in-scattered light (sun through the air, ambient sky light),
 // attenuation, and where the view transmittance falls to 0.5 (exactly, for the step's constant
 // extinction).
-CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real mu, MieParams mie, CV_INOUT(MarchState) s) {
+CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real3 d, real mu, MieParams mie, CV_INOUT(MarchState) s) {
   real sl;
   real si;
   medium_at(p, alt_p, sl, si);
@@ -258,7 +269,23 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
   // The octave sums of both phases (clouds do not absorb), only where the sun shines (llvmpipe runs
   // masked code: a ternary would not save them).
   real scatter = real(0.0);
-  if (lit) {
+  real3 diffuse = real3(0.0);
+  if (u_ms_two_stream) {
+    // The two-stream model (docs/physics.md): the sun's light scattered once, exactly, with the full
+    // phase, through exp(-(1 - f) tau_sun) (f = g^2 of delta-Eddington: the light the forward peak
+    // keeps in the beam), plus the column's diffuse light scattered toward the camera,
+    // sigma (I0 + g I1 mu_out), mu_out the cosine of the outgoing direction -d to the vertical.
+    real g_liquid = mie_mean_cosine(mie);
+    real g_mix = (sl * g_liquid + si * u_ice_g) / sigma;
+    if (lit) {
+      real p_liquid = u_liquid_phase_hg ? phase_hg(mu, g_liquid) : phase_mie(mu, mie);
+      scatter = (sl * p_liquid + si * phase_hg(mu, u_ice_g)) * transmittance((real(1.0) - g_mix * g_mix) * tau_sun);
+    }
+    real i0;
+    real i1;
+    ms_source_at(p, alt_p, i0, i1);
+    diffuse = sun_air * (sigma * max(i0 - g_mix * i1 * dot(d, up_p), real(0.0)));
+  } else if (lit) {
     // The octave gate (octaves.glsl): w from the column's optical depth; off, the classic sum.
     bool gate = u_octave_gate && u_octaves > 1;
     real w = gate ? octave_gate_weight(column_tau(p)) : real(1.0);
@@ -270,7 +297,7 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
                                     : ms_octaves_mie_gated(sl, mu, mie, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
     scatter = liquid + ms_octaves_hg_gated(si, mu, u_ice_g, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
   }
-  s.radiance += s.t_view * segment_integral(u_irradiance * (sun_air * scatter + ambient), sigma, ds);
+  s.radiance += s.t_view * segment_integral(u_irradiance * (sun_air * scatter + diffuse + ambient), sigma, ds);
   // The light the step takes out of the view, t_view (1 - exp(-sigma ds)), without the cancellation
   // of t_view - t_next: in float that is a multiple of 6e-8, which left faint cloud with a mean
   // depth tens of kilometres off.
@@ -431,7 +458,7 @@ CV_FN void march_advance(MarchRay r, ivec2 px, int step_begin, int step_count, C
       }
       real ds = dt / real(substeps);
       real t = t_start + (real(i) + (real(j) + offset) / real(substeps)) * dt;
-      march_sample(r.origin + t * r.d, ray_altitude(u_r0, r.h, r.mu_up, t), t, ds, r.t_offset + t - offset * ds, mu, mie, s);
+      march_sample(r.origin + t * r.d, ray_altitude(u_r0, r.h, r.mu_up, t), t, ds, r.t_offset + t - offset * ds, r.d, mu, mie, s);
       if (++j == substeps) {
         j = 0;
         ++i;

@@ -85,6 +85,21 @@ TEST_P(StandardScenes, WithSkyAndGlobeTheGpuMatchesTheCpuReference) {
   EXPECT_LT(c.worst_t, 1e-3);
 }
 
+// The two-stream model: the same kernel with its source textures, GPU against CPU within the
+// clouds-only bound, every pixel finite.
+TEST_P(StandardScenes, TwoStreamGpuMatchesTheCpuReference) {
+  bench::StandardScene sc = bench::standard_scene(GetParam(), 32, 18);
+  sc.march.ms_two_stream = true;
+  const Comparison c = compare_on_gpu(sc);
+  std::printf("%-14s two-stream: radiance error (of the brightest pixel) mean %.3g, worst %.3g\n", sc.name.c_str(), c.mean,
+              c.worst);
+  if (sc.name != "clear_sky") {
+    EXPECT_GT(c.max_l, 0.0);
+  }
+  EXPECT_LT(c.worst, 1e-3);
+  EXPECT_LT(c.worst_t, 1e-3);
+}
+
 // Skipping empty bricks must not change the image: every skipped sample would have read exactly
 // 0, including beside a regional grid's edge, where the data fades out over a border cell.
 TEST_P(StandardScenes, SkippingEmptySpaceLeavesTheImageExactlyAsItWas) {

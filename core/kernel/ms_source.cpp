@@ -1,0 +1,106 @@
+// The two-stream source: a closed-form delta-Eddington column per grid column.
+#include "kernel/ms_source.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "geo/geodesy.hpp"
+#include "physics/physics.hpp"
+
+namespace cv::core {
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}
+
+// Eddington's I(tau, mu) = I0 + I1 mu (mu upward, tau downward from the top) in a conservative
+// medium (omega = 1), delta-scaled: f = g^2, dtau' = (1 - f) dtau, g' = g / (1 + g), the direct beam
+// exp(-tau' / mu0) (it keeps the light the forward peak scatters). The moment equations
+//   dI1/dtau' = -(3 F0 / 4 pi) exp(-tau'/mu0),  dI0/dtau' = (1 - g') I1 + (3 F0 g' mu0 / 4 pi) exp(-tau'/mu0)
+// integrate in closed form: I1 = C1 + K E, I0 = C0 + C1 G - mu0 K (E - 1), K = 3 F0 mu0 / (4 pi),
+// E = exp(-tau'/mu0), G = int (1 - g') dtau' = int (1 - g) dtau. Marshak's conditions fix C0, C1:
+// no diffuse light down at the top (I0 = 2/3 I1), and at the bottom the upward diffuse flux
+// pi (I0 + 2/3 I1) equals the ground's albedo times what reaches it, pi (I0 - 2/3 I1) + mu0 F0 E.
+TwoStreamColumn two_stream_column(const double* sigma, const double* g, int n, double dz, double mu0, double a) {
+  TwoStreamColumn c;
+  c.i0.assign(static_cast<std::size_t>(std::max(n, 0)), 0.0);
+  c.i1.assign(c.i0.size(), 0.0);
+  if (n < 1 || !(mu0 > 0.0)) return c;
+  a = std::clamp(std::isfinite(a) ? a : 0.0, 0.0, 1.0);
+  dz = std::abs(dz);
+  // Scaled optical depth and G at each node, from the top (node n - 1) down; layers by the trapezoid.
+  std::vector<double> tau(c.i0.size(), 0.0), big_g(c.i0.size(), 0.0);
+  for (int k = n - 2; k >= 0; --k) {
+    const double s0 = std::max(sigma[k + 1], 0.0), s1 = std::max(sigma[k], 0.0);
+    const double st = s0 + s1;
+    const double dtau = std::isfinite(st) ? 0.5 * st * dz : 0.0;
+    const double gl = st > 0.0 ? std::clamp((s0 * g[k + 1] + s1 * g[k]) / st, -0.999, 0.999) : 0.0;
+    tau[static_cast<std::size_t>(k)] = tau[static_cast<std::size_t>(k) + 1] + (1.0 - gl * gl) * dtau;
+    big_g[static_cast<std::size_t>(k)] = big_g[static_cast<std::size_t>(k) + 1] + (1.0 - gl) * dtau;
+  }
+  const double k_ = 3.0 * mu0 / (4.0 * kPi);  // F0 = 1
+  const double e_b = std::exp(-tau[0] / mu0), g_b = big_g[0];
+  // (1 - A) I0* + 2/3 (1 + A) I1* - A mu0 E* / pi = 0 with I0*, I1* linear in C1 (C0 = 2/3 (C1 + K)):
+  const double num = (1.0 - a) * k_ * (2.0 / 3.0 + mu0 * (1.0 - e_b)) + (2.0 / 3.0) * (1.0 + a) * k_ * e_b -
+                     a * mu0 * e_b / kPi;
+  const double den = 4.0 / 3.0 + (1.0 - a) * g_b;
+  const double c1 = -num / den, c0 = (2.0 / 3.0) * (c1 + k_);
+  for (std::size_t k = 0; k < c.i0.size(); ++k) {
+    const double e = std::exp(-tau[k] / mu0);
+    c.i0[k] = c0 + c1 * big_g[k] - mu0 * k_ * (e - 1.0);
+    c.i1[k] = c1 + k_ * e;
+  }
+  const std::size_t top = c.i0.size() - 1;
+  c.reflected = kPi * (c.i0[top] + (2.0 / 3.0) * c.i1[top]) / mu0;
+  const double down = kPi * (c.i0[0] - (2.0 / 3.0) * c.i1[0]) + mu0 * e_b;
+  c.transmitted = down / mu0;
+  c.absorbed_ground = (1.0 - a) * down / mu0;
+  return c;
+}
+
+MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun) {
+  MsSourceKey k;
+  k.to_sun = to_sun;
+  const physics::f64::MieParams mie = physics::f64::mie_params(s.droplet_diameter_um);
+  k.liquid_g = physics::f64::mie_mean_cosine(mie);  // HG for liquid has the same mean cosine
+  k.ice_g = s.ice_g;
+  k.ground_albedo = s.globe ? (s.ground_albedo.x + s.ground_albedo.y + s.ground_albedo.z) / 3.0 : 0.0;
+  return k;
+}
+
+MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const VolumeGrid& grid = v.grid;
+  const int nx = grid.lon_deg.count, ny = grid.lat_deg.count, nz = grid.alt_m.count;
+  MsSource out;
+  out.i0.assign(grid.points(), 0.0f);
+  out.i1.assign(grid.points(), 0.0f);
+  std::vector<double> sigma(static_cast<std::size_t>(nz)), g(static_cast<std::size_t>(nz));
+  const glm::dvec3 to_sun = glm::length(key.to_sun) > 0.0 ? glm::normalize(key.to_sun) : glm::dvec3(0.0);
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const double lat = grid.lat_deg.at(j), lon = grid.lon_deg.at(i);
+      const double mu0 = glm::dot(geo::sphere_enu(lat, lon).up, to_sun);
+      if (!(mu0 > 0.0)) continue;  // night: no source
+      bool any = false;
+      for (int k = 0; k < nz; ++k) {
+        const std::size_t idx = grid.index(i, j, k);
+        const double sl = std::max(0.0, double(v.extinction.liquid_per_m[idx]));
+        const double si = std::max(0.0, double(v.extinction.ice_per_m[idx]));
+        sigma[static_cast<std::size_t>(k)] = sl + si;
+        g[static_cast<std::size_t>(k)] = sl + si > 0.0 ? (sl * key.liquid_g + si * key.ice_g) / (sl + si) : 0.0;
+        any = any || sl + si > 0.0;
+      }
+      if (!any) continue;  // a clear column holds no diffuse light from cloud (the sky is the air's)
+      const TwoStreamColumn c = two_stream_column(sigma.data(), g.data(), nz, grid.alt_m.step, mu0, key.ground_albedo);
+      for (int k = 0; k < nz; ++k) {
+        out.i0[grid.index(i, j, k)] = static_cast<float>(c.i0[static_cast<std::size_t>(k)]);
+        out.i1[grid.index(i, j, k)] = static_cast<float>(c.i1[static_cast<std::size_t>(k)]);
+      }
+    }
+  }
+  out.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace cv::core

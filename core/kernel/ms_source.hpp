@@ -1,0 +1,53 @@
+// The multiple-scattering source of the two-stream model (docs/physics.md, "Multiple scattering:
+// the two-stream source"): per grid column, the delta-Eddington solution of a conservative
+// plane-parallel column lit by the sun, as the mean diffuse radiance I0 and its first moment I1
+// (I(mu) = I0 + I1 mu, mu the cosine to the local upward vertical) at every grid node, per unit
+// solar irradiance. Built once per time step and sun direction on the CPU, read by the march kernel
+// (u_ms_i0, u_ms_i1) on the GPU and in the CPU reference alike.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "kernel/prepared_volume.hpp"
+
+namespace cv::core {
+
+// One column's solution at its nodes (bottom to top, as the grid's altitudes), per unit irradiance.
+struct TwoStreamColumn {
+  std::vector<double> i0, i1;  // diffuse radiance moments at the nodes
+  double reflected = 0.0;      // upward diffuse flux at the top / (mu0 F0): the plane albedo
+  double transmitted = 0.0;    // downward diffuse plus direct flux at the bottom / (mu0 F0)
+  double absorbed_ground = 0.0;  // by the ground below, / (mu0 F0)
+};
+
+// The delta-Eddington solution of one conservative column: extinction sigma_per_m and asymmetry g at
+// n nodes spaced dz_m apart (bottom first), the sun at cosine mu0 > 0 to the vertical, a Lambertian
+// ground of albedo ground_albedo (0..1) below the lowest node. Closed form for single-scattering
+// albedo 1 (no eigenvalues, no exponential growth): stable for any optical depth.
+TwoStreamColumn two_stream_column(const double* sigma_per_m, const double* g, int n, double dz_m, double mu0,
+                                  double ground_albedo);
+
+// The source over a prepared volume: i0 and i1 per grid node (the grid's layout), as R32F textures.
+struct MsSource {
+  std::vector<float> i0, i1;
+  double build_ms = 0.0;  // wall time to build it
+};
+
+// The asymmetry parameters of the medium's two phases: liquid (the approximate Mie fit's mean cosine
+// at the droplet diameter, or HG's g) and ice; and the ground's albedo (0: no ground, the ray ends).
+struct MsSourceKey {
+  glm::dvec3 to_sun{0.0};
+  double liquid_g = 0.0, ice_g = 0.0, ground_albedo = 0.0;
+  bool operator==(const MsSourceKey&) const = default;
+};
+
+// The key of the source a march with these settings and this sun needs (ground albedo: the mean of
+// the constant ground_albedo where the globe is drawn, else 0).
+MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun);
+
+MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key);
+
+}  // namespace cv::core

@@ -1,0 +1,97 @@
+// The two-stream source's column solution (core/kernel/ms_source): the closed-form delta-Eddington
+// plane albedo of a homogeneous conservative layer, energy conserved, a white ground reflecting
+// everything, and no NaN or Inf at extreme optical depths and grazing suns.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "kernel/ms_source.hpp"
+
+namespace cv::core {
+namespace {
+
+// Joseph, Wiscombe & Weinman (1976), the conservative delta-Eddington plane albedo of a layer over
+// a black ground: R = ((1 - g') tau' + (2/3 - mu0)(1 - exp(-tau'/mu0))) / (4/3 + (1 - g') tau'),
+// tau' = (1 - g^2) tau, g' = g / (1 + g).
+double delta_eddington_albedo(double tau, double g, double mu0) {
+  const double tp = (1.0 - g * g) * tau, gp = g / (1.0 + g);
+  return ((1.0 - gp) * tp + (2.0 / 3.0 - mu0) * (1.0 - std::exp(-tp / mu0))) / (4.0 / 3.0 + (1.0 - gp) * tp);
+}
+
+TwoStreamColumn homogeneous(double tau, double g, double mu0, double albedo, int n = 51) {
+  const double dz = 10.0;
+  const double sigma = tau / ((n - 1) * dz);
+  std::vector<double> s(static_cast<std::size_t>(n), sigma), gg(static_cast<std::size_t>(n), g);
+  return two_stream_column(s.data(), gg.data(), n, dz, mu0, albedo);
+}
+
+TEST(TwoStream, MatchesTheClosedFormDeltaEddingtonAlbedo) {
+  for (double tau : {0.1, 1.0, 5.0, 20.0, 100.0}) {
+    for (double mu0 : {1.0, 0.5, 0.1}) {
+      for (double g : {0.0, 0.75, 0.85}) {
+        const TwoStreamColumn c = homogeneous(tau, g, mu0, 0.0);
+        EXPECT_NEAR(c.reflected, delta_eddington_albedo(tau, g, mu0), 1e-12) << tau << " " << mu0 << " " << g;
+      }
+    }
+  }
+}
+
+TEST(TwoStream, ConservesEnergyAndAWhiteGroundReflectsEverything) {
+  for (double tau : {0.0, 0.5, 10.0, 300.0}) {
+    for (double mu0 : {1.0, 0.3, 0.02}) {
+      const TwoStreamColumn black = homogeneous(tau, 0.85, mu0, 0.0);
+      EXPECT_NEAR(black.reflected + black.transmitted, 1.0, 1e-12) << tau << " " << mu0;
+      EXPECT_GE(black.reflected, 0.0);
+      EXPECT_LE(black.reflected, 1.0 + 1e-12);
+      const TwoStreamColumn grey = homogeneous(tau, 0.85, mu0, 0.3);
+      EXPECT_NEAR(grey.reflected + grey.absorbed_ground, 1.0, 1e-12) << tau << " " << mu0;
+      EXPECT_GE(grey.reflected, black.reflected - 1e-12);  // a brighter ground never darkens the top
+      const TwoStreamColumn white = homogeneous(tau, 0.85, mu0, 1.0);
+      EXPECT_NEAR(white.reflected, 1.0, 1e-12) << tau << " " << mu0;
+    }
+  }
+}
+
+// Thicker is brighter from above (for a black ground), and a layered column is solved across its
+// layers: two halves of different asymmetry against the same total optical depth.
+TEST(TwoStream, ThickerIsBrighterAndLayersCompose) {
+  double last = -1.0;
+  for (double tau : {0.1, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0}) {
+    const double r = homogeneous(tau, 0.85, 0.8, 0.0).reflected;
+    EXPECT_GT(r, last) << tau;
+    last = r;
+  }
+  const int n = 41;
+  std::vector<double> s(n, 0.01), g(n, 0.85), g2(n, 0.85);
+  for (int k = 0; k < n / 2; ++k) g2[static_cast<std::size_t>(k)] = 0.75;  // ice-like below
+  const TwoStreamColumn a = two_stream_column(s.data(), g.data(), n, 50.0, 0.6, 0.0);
+  const TwoStreamColumn b = two_stream_column(s.data(), g2.data(), n, 50.0, 0.6, 0.0);
+  EXPECT_NEAR(a.reflected + a.transmitted, 1.0, 1e-12);
+  EXPECT_NEAR(b.reflected + b.transmitted, 1.0, 1e-12);
+  EXPECT_GT(b.reflected, a.reflected);  // lower asymmetry scatters more back
+}
+
+TEST(TwoStream, NoNanOrInfAtExtremes) {
+  for (double tau : {0.0, 1e-9, 1e4, 1e7}) {
+    for (double mu0 : {1.0, 1e-3, 1e-9}) {
+      for (double a : {0.0, 0.5, 1.0}) {
+        const TwoStreamColumn c = homogeneous(tau, 0.999, mu0, a);
+        for (std::size_t k = 0; k < c.i0.size(); ++k) {
+          ASSERT_TRUE(std::isfinite(c.i0[k]) && std::isfinite(c.i1[k])) << tau << " " << mu0 << " " << a;
+        }
+        EXPECT_TRUE(std::isfinite(c.reflected) && c.reflected >= -1e-12 && c.reflected <= 1.0 + 1e-9)
+            << tau << " " << mu0 << " " << a << ": " << c.reflected;
+      }
+    }
+  }
+  // The sun below the horizon, and NaN extinction: no light, no NaN.
+  const TwoStreamColumn night = homogeneous(10.0, 0.85, -0.2, 0.0);
+  for (double v : night.i0) EXPECT_EQ(v, 0.0);
+  std::vector<double> s(5, std::nan("")), g(5, 0.85);
+  const TwoStreamColumn bad = two_stream_column(s.data(), g.data(), 5, 10.0, 0.5, 0.0);
+  for (std::size_t k = 0; k < bad.i0.size(); ++k) EXPECT_TRUE(std::isfinite(bad.i0[k]) && std::isfinite(bad.i1[k]));
+}
+
+}  // namespace
+}  // namespace cv::core
