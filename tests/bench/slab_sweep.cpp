@@ -1,0 +1,96 @@
+// The plane-parallel slab sweep of issue 11 (a benchmark, not a test): for each optical depth, sun
+// zenith angle and phase, the slab written as a NetCDF file, imported and traced by the Monte Carlo
+// reference, against the independent adding-doubling solver (tests/physics/slab_solver.hpp).
+// docs/BENCHMARKS.md ("Plane-parallel slab check (issue 11)") holds a measured table and the command.
+//
+//   bench_slab_sweep [--spp N] [--paths N] [--phase hg|mie|both] [--tau 1,2,...] [--zenith 0,30,...]
+//                    [--seed S]
+//
+// --spp: camera samples for the nadir radiance (2 pixels, one per thread); --paths: beams for the
+// analog plane albedo. Both are scaled down by 10 / tau above tau 10, so each row costs about the same.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "physics/slab_solver.hpp"
+#include "support/slab_case.hpp"
+
+namespace {
+using namespace cv::test::slab;
+constexpr double kPi = 3.14159265358979323846;
+
+std::vector<double> list(const std::string& s) {
+  std::vector<double> v;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ',')) v.push_back(std::atof(item.c_str()));
+  return v;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  int spp = 100000, paths = 100000;
+  std::uint64_t seed = 11;
+  std::string phases = "both";
+  std::vector<double> taus{1, 2, 5, 10, 20, 50, 100}, zeniths{0, 30, 60, 75};
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string a = argv[i], v = argv[i + 1];
+    if (a == "--spp") spp = std::atoi(v.c_str());
+    else if (a == "--paths") paths = std::atoi(v.c_str());
+    else if (a == "--phase") phases = v;
+    else if (a == "--tau") taus = list(v);
+    else if (a == "--zenith") zeniths = list(v);
+    else if (a == "--seed") seed = std::strtoull(v.c_str(), nullptr, 10);
+    else {
+      std::fprintf(stderr, "unknown option %s\n", a.c_str());
+      return 2;
+    }
+  }
+  const auto dir = std::filesystem::temp_directory_path() / "cv_slab_sweep";
+  std::filesystem::create_directories(dir);
+  std::vector<SlabPhase> which;
+  if (phases == "hg" || phases == "both") which.push_back(SlabPhase::HG085);
+  if (phases == "mie" || phases == "both") which.push_back(SlabPhase::Mie);
+  std::printf("| phase | tau | sun zenith | solver I/E at nadir | Monte Carlo I/E | z | solver plane albedo | Monte Carlo plane albedo | z | MC R + T | MC s |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (SlabPhase ph : which) {
+    const slabcheck::PhaseFunction phase =
+        ph == SlabPhase::HG085 ? slabcheck::henyey_greenstein_phase(0.85) : slabcheck::approximate_mie_phase(20.0);
+    // The solver at N and 2N streams per hemisphere: the difference is its stated uncertainty.
+    const int n1 = ph == SlabPhase::HG085 ? 32 : 128;
+    for (double tau : taus) {
+      const std::string path = (dir / "slab.nc").string();
+      write_slab_file(path, tau, ph);
+      const ImportedSlab s = import_slab(path, ph);
+      const cv::core::MarchSettings m = march_for(ph, s);
+      slabcheck::SlabProblem p;
+      p.tau = tau;
+      p.phase = phase;
+      p.mu_extra = {1.0};
+      for (double z : zeniths) p.mu_extra.push_back(std::cos(z * kPi / 180.0));
+      slabcheck::SlabOptions o1, o2;
+      o1.streams = n1;
+      o2.streams = 2 * n1;
+      const slabcheck::SlabSolution a = solve_slab(p, o1), b = solve_slab(p, o2);
+      const double scale = tau > 10.0 ? 10.0 / tau : 1.0;
+      for (double z : zeniths) {
+        const double mu0 = std::cos(z * kPi / 180.0);
+        const double i_sol = a.nadir_radiance(mu0), i_err = std::abs(a.nadir_radiance(mu0) - b.nadir_radiance(mu0));
+        const double a_sol = a.plane_albedo(mu0), a_err = std::abs(a.plane_albedo(mu0) - b.plane_albedo(mu0));
+        const Estimate e = mc_nadir_radiance(s, m, z, std::max(1000, static_cast<int>(spp * scale)), seed);
+        const AnalogFluxes f = mc_analog_fluxes(s, m, z, std::max(1000, static_cast<int>(paths * scale)), seed + 1);
+        std::printf("| %s | %g | %g | %.5f +- %.1e | %.5f +- %.5f | %+.2f | %.5f +- %.1e | %.5f +- %.5f | %+.2f | %.6f (%llu lost) | %.1f |\n",
+                    phase_name(ph), tau, z, i_sol, i_err, e.mean, e.se, (e.mean - i_sol) / std::hypot(e.se, i_err), a_sol, a_err,
+                    f.albedo(), f.albedo_se(), (f.albedo() - a_sol) / std::hypot(f.albedo_se(), a_err),
+                    f.albedo() + f.transmission(), static_cast<unsigned long long>(f.lost), e.seconds + f.seconds);
+        std::fflush(stdout);
+      }
+    }
+  }
+  std::filesystem::remove_all(dir);
+  return 0;
+}

@@ -1,0 +1,96 @@
+// An adding-doubling solver for a homogeneous plane-parallel slab, written for the tests as an
+// independent check of the Monte Carlo reference (issue 11). It shares no code with the project: no
+// header from core/ or shaders/ is included, and its phase functions (Henyey-Greenstein, Draine, the
+// approximate Mie blend of Jendersie & d'Eon 2023) are written here again from the published
+// formulas. docs/physics.md ("Plane-parallel slab check") states the method and its validation.
+//
+// Conventions (van de Hulst 1980, "Multiple Light Scattering"): a parallel beam of flux pi F per
+// unit area normal to it falls on the top at mu0 = cos(zenith angle). The reflected radiance is
+// I(mu) = mu0 F R(mu, mu0) and the diffusely transmitted one mu0 F T(mu, mu0); the plane albedo is
+// A(mu0) = 2 int_0^1 R(mu, mu0) mu dmu. With the irradiance E = pi F normal to the beam, the
+// radiance per unit irradiance is I / E = mu0 R / pi. Only the azimuthal mean (Fourier term m = 0)
+// is computed: it is all a plane albedo needs, and at nadir (mu = 1) the radiance does not depend on
+// azimuth, so it is the whole radiance there.
+#pragma once
+
+#include <functional>
+#include <vector>
+
+namespace slabcheck {
+
+// A phase function: its value per steradian at the scattering cosine, and its Legendre moments
+// chi_l = 2 pi int p(mu) P_l(mu) dmu (chi_0 = 1, chi_1 = the mean cosine), 0..l_max.
+struct PhaseFunction {
+  std::function<double(double)> value;
+  std::function<std::vector<double>(int l_max)> moments;
+};
+
+PhaseFunction isotropic_phase();
+PhaseFunction henyey_greenstein_phase(double g);
+// Draine (2003): HG(g) (1 + alpha mu^2) / (1 + alpha (1 + 2 g^2) / 3).
+PhaseFunction draine_phase(double g, double alpha);
+
+// Jendersie & d'Eon (2023), "An Approximate Mie Scattering Function for Fog and Cloud Rendering"
+// (SIGGRAPH 2023 talk): (1 - w_D) HG(g_HG) + w_D Draine(g_D, alpha), with the parameters fitted over
+// the droplet diameter. Only the branch for 5 <= d <= 50 um is written (clouds; d = 2 r_eff);
+// outside it the function throws.
+struct MieFit {
+  double g_hg, one_minus_g_hg, g_d, alpha, w_d;
+};
+MieFit approximate_mie_fit(double diameter_um);
+PhaseFunction approximate_mie_phase(double diameter_um);
+
+// Legendre moments by quadrature of `value` over the sphere (panels packed geometrically toward the
+// forward direction, so peaks down to 1 - mu ~ 1e-9 are resolved): a check of `moments`.
+std::vector<double> moments_by_quadrature(const std::function<double(double)>& value, int l_max);
+
+struct SlabProblem {
+  double tau = 1.0;    // optical thickness
+  double omega = 1.0;  // single-scattering albedo
+  PhaseFunction phase;
+  // Directions (cosines in (0, 1]) at which R and T are wanted, as outgoing or incident ones: added
+  // to the quadrature as nodes of zero weight, so they take no part in the integrals.
+  std::vector<double> mu_extra;
+};
+
+struct SlabOptions {
+  int streams = 32;            // Gauss-Legendre nodes per hemisphere (double Gauss)
+  bool delta_m = true;         // Wiscombe (1977): truncate the forward peak at 2 * streams moments
+  bool tms = true;             // Nakajima & Tanaka (1988): exact single scattering in R at mu_extra
+  double thin_layer = 1.0e-13;  // the doubling starts from single scattering in a layer at most this thick
+};
+
+class SlabSolution {
+ public:
+  // Reflection and diffuse transmission functions (m = 0) at two of the problem's mu_extra.
+  double reflection(double mu, double mu0) const;
+  double diffuse_transmission(double mu, double mu0) const;
+  // Reflected and transmitted (direct + diffuse) flux over the incident, mu0 one of mu_extra.
+  double plane_albedo(double mu0) const;
+  double total_transmission(double mu0) const;
+  // I / E at nadir, mu0 one of mu_extra and 1 among them too.
+  double nadir_radiance(double mu0) const { return mu0 * reflection(1.0, mu0) / 3.14159265358979323846; }
+
+  // What was solved, for the reports.
+  double truncated_fraction = 0.0;  // delta-M's f
+  double scaled_tau = 0.0;
+  int doublings = 0;
+
+ private:
+  friend SlabSolution solve_slab(const SlabProblem& p, const SlabOptions& o);
+  int index(double mu) const;
+  std::vector<double> mu_, weight_;  // nodes, and 2 w mu (0 for the extra nodes)
+  std::vector<double> r_, t_;        // n x n, row = outgoing, column = incident
+  std::vector<double> r_ss_fix_;     // TMS correction added to R (extra rows and columns only)
+  std::vector<double> direct_;       // exp(-tau* / mu) per node
+};
+
+SlabSolution solve_slab(const SlabProblem& p, const SlabOptions& o = {});
+
+// Gauss-Legendre nodes and weights on (a, b).
+void gauss_legendre(int n, double a, double b, std::vector<double>& x, std::vector<double>& w);
+
+// Delta-Eddington plane albedo of a conservative slab (Joseph, Wiscombe & Weinman 1976), for context.
+double delta_eddington_albedo(double tau, double g, double mu0);
+
+}  // namespace slabcheck
