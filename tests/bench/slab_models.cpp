@@ -1,0 +1,105 @@
+// Benchmark (not a test): the raymarcher's multiple-scattering models on the plane-parallel slabs of
+// issue 11, against the independent adding-doubling solver (tests/physics/slab_solver.hpp): nadir
+// reflected radiance per unit irradiance from the CPU kernel (the GPU runs the same kernel), the
+// octave sum at the scene defaults (4 octaves, gate on) and the two-stream source, as the relative
+// error against the solver. The slab is written as NetCDF and imported as in the slab check.
+//   bench_slab_models [--phase hg|mie|both] [--tau 1,2,...] [--zenith 0,30,...] [--octaves N]
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "physics/slab_solver.hpp"
+#include "reference/raymarcher.hpp"
+#include "support/slab_case.hpp"
+
+namespace {
+using namespace cv::test::slab;
+constexpr double kPi = 3.14159265358979323846;
+
+std::vector<double> list(const std::string& s) {
+  std::vector<double> v;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ',')) v.push_back(std::atof(item.c_str()));
+  return v;
+}
+
+// The kernel's nadir radiance over (0, 0): a camera 10 km up looking straight down, one pixel.
+double nadir(const ImportedSlab& s, cv::core::MarchSettings m, double theta0) {
+  cv::core::Camera cam;
+  cam.alt_m = 10000.0;
+  cam.pitch_deg = -90.0;
+  cam.fov_deg = 1e-3;
+  cam.width = cam.height = 1;
+  m.view_step_m = 5.0;
+  m.sun_steps = 256;
+  const cv::core::ReferenceImage r = cv::core::render_reference(s.grid, s.medium, cam, sun_at_zenith_angle(theta0), m);
+  return r.radiance[0].y;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string phases = "both";
+  int octaves = 4;
+  std::vector<double> taus{1, 2, 5, 10, 20, 50, 100}, zeniths{0, 30, 60};
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      std::printf("usage: bench_slab_models [--phase hg|mie|both] [--tau 1,2,...] [--zenith 0,30,...] [--octaves N]\n");
+      return 0;
+    }
+    if (i + 1 >= argc) {
+      std::fprintf(stderr, "bench_slab_models: %s needs a value (see --help)\n", a.c_str());
+      return 2;
+    }
+    const std::string v = argv[++i];
+    if (a == "--phase") phases = v;
+    else if (a == "--tau") taus = list(v);
+    else if (a == "--zenith") zeniths = list(v);
+    else if (a == "--octaves") octaves = std::atoi(v.c_str());
+    else {
+      std::fprintf(stderr, "bench_slab_models: unknown option %s (see --help)\n", a.c_str());
+      return 2;
+    }
+  }
+  const auto dir = std::filesystem::temp_directory_path() / "cv_slab_models";
+  std::filesystem::create_directories(dir);
+  std::vector<SlabPhase> which;
+  if (phases == "hg" || phases == "both") which.push_back(SlabPhase::HG085);
+  if (phases == "mie" || phases == "both") which.push_back(SlabPhase::Mie);
+  std::printf("| phase | tau | sun zenith | solver I/E at nadir | octaves (%d, gate) | two-stream |\n|---|---|---|---|---|---|\n", octaves);
+  for (SlabPhase ph : which) {
+    const slabcheck::PhaseFunction phase =
+        ph == SlabPhase::HG085 ? slabcheck::henyey_greenstein_phase(0.85) : slabcheck::approximate_mie_phase(20.0);
+    for (double tau : taus) {
+      const std::string path = (dir / "slab.nc").string();
+      write_slab_file(path, tau, ph);
+      const ImportedSlab s = import_slab(path, ph);
+      cv::core::MarchSettings m = march_for(ph, s);
+      m.octaves = octaves;
+      slabcheck::SlabProblem p;
+      p.tau = tau;
+      p.phase = phase;
+      p.mu_extra = {1.0};
+      for (double z : zeniths) p.mu_extra.push_back(std::cos(z * kPi / 180.0));
+      slabcheck::SlabOptions o;
+      o.streams = ph == SlabPhase::HG085 ? 32 : 128;
+      const slabcheck::SlabSolution sol = solve_slab(p, o);
+      for (double z : zeniths) {
+        const double ref = sol.nadir_radiance(std::cos(z * kPi / 180.0));
+        cv::core::MarchSettings two = m;
+        two.ms_two_stream = true;
+        const double a = nadir(s, m, z), b = nadir(s, two, z);
+        std::printf("| %s | %g | %g | %.5f | %+.1f %% | %+.1f %% |\n", phase_name(ph), tau, z, ref, 100.0 * (a / ref - 1.0),
+                    100.0 * (b / ref - 1.0));
+        std::fflush(stdout);
+      }
+    }
+  }
+  std::filesystem::remove_all(dir);
+  return 0;
+}
