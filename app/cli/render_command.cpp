@@ -351,10 +351,12 @@ int cmd_render(const std::vector<std::string>& args) {
   const core::RenderSettings& rs = scene.render;
   const core::MarchSettings& march = frame.march;
   const int mw = frame.march_camera.width, mh = frame.march_camera.height;
-  std::printf("rendering %s, time step %d (%s), %dx%d%s, quality %s: view step %.0f m, %d sun steps, %d octaves, %d frame(s)\n",
+  const std::string model =
+      march.ms_two_stream ? std::string("two-stream multiple scattering") : std::to_string(march.octaves) + " octaves";
+  std::printf("rendering %s, time step %d (%s), %dx%d%s, quality %s: view step %.0f m, %d sun steps, %s, %d frame(s)\n",
               scene.data.path.c_str(), scene.time_step, vt.iso_utc.c_str(), cam.width, cam.height,
               mw != cam.width || mh != cam.height ? (" marched at " + std::to_string(mw) + "x" + std::to_string(mh)).c_str() : "",
-              rs.quality.c_str(), march.view_step_m, march.sun_steps, march.octaves, frame.accumulate);
+              rs.quality.c_str(), march.view_step_m, march.sun_steps, model.c_str(), frame.accumulate);
 
   t0 = clock::now();
   double gpu_s = 0.0;
@@ -380,6 +382,8 @@ int cmd_render(const std::vector<std::string>& args) {
       &marched);
   if (frame.accumulate > 1 || dispatch.on_tile) std::printf("\n");
   const double t_march = seconds_since(t0);
+  if (march.ms_two_stream)
+    std::printf("two-stream source built in %.1f ms (once per time step and sun direction)\n", gpu.ms_source_build_ms());
   const core::MarchStats& ms = gpu.last_stats();
   std::printf("march%s: %llu view samples, %llu skipped in %llu empty-brick jumps (view and sun), %llu sun samples, "
               "%llu skipped or cut off, %llu of %d rays missed the cloud shell%s\n",
