@@ -20,13 +20,6 @@ namespace {
 using namespace cv::test::slab;
 constexpr double kPi = 3.14159265358979323846;
 
-std::vector<double> list(const std::string& s) {
-  std::vector<double> v;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ',')) v.push_back(std::atof(item.c_str()));
-  return v;
-}
 
 // The kernel's nadir radiance over (0, 0): a camera 10 km up looking straight down, one pixel.
 double nadir(const ImportedSlab& s, cv::core::MarchSettings m, double theta0) {
@@ -58,8 +51,8 @@ int main(int argc, char** argv) {
     }
     const std::string v = argv[++i];
     if (a == "--phase") phases = v;
-    else if (a == "--tau") taus = list(v);
-    else if (a == "--zenith") zeniths = list(v);
+    else if (a == "--tau") taus = number_list(v);
+    else if (a == "--zenith") zeniths = number_list(v);
     else if (a == "--octaves") octaves = std::atoi(v.c_str());
     else {
       std::fprintf(stderr, "bench_slab_models: unknown option %s (see --help)\n", a.c_str());

@@ -23,13 +23,6 @@ namespace {
 using namespace cv::test::slab;
 constexpr double kPi = 3.14159265358979323846;
 
-std::vector<double> list(const std::string& s) {
-  std::vector<double> v;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ',')) v.push_back(std::atof(item.c_str()));
-  return v;
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -42,8 +35,8 @@ int main(int argc, char** argv) {
     if (a == "--spp") spp = std::atoi(v.c_str());
     else if (a == "--paths") paths = std::atoi(v.c_str());
     else if (a == "--phase") phases = v;
-    else if (a == "--tau") taus = list(v);
-    else if (a == "--zenith") zeniths = list(v);
+    else if (a == "--tau") taus = number_list(v);
+    else if (a == "--zenith") zeniths = number_list(v);
     else if (a == "--seed") seed = std::strtoull(v.c_str(), nullptr, 10);
     else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());

@@ -2,6 +2,8 @@
 // scattering, and itself (determinism); and the octave approximation measured against it.
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -354,13 +356,21 @@ std::pair<double, double> image_mean_luminance(const MonteCarloImage& img) {
 // The forward-peak technique changes the estimator, not its expectation: with 2 um droplets (a
 // peak of ~23 /sr, which the path's own phase sampling finds well) the deck's image-mean luminance
 // with and without it agree within their joint standard error, and the technique did draw.
+// The deck at 24x14, clouds only, with droplets of the given diameter.
+struct DeckCase {
+  bench::StandardScene sc = bench::standard_scene("stratocumulus", 24, 14);
+  GridMeanExtinction ext = grid_mean_extinction(sc.grid, sc.data);
+  MarchSettings m;
+  explicit DeckCase(double droplet_um) : m(sc.march) {
+    m.atmosphere = m.globe = false;
+    m.ambient = 0.0, m.noise_amount = 0.0;
+    m.droplet_diameter_um = droplet_um;
+  }
+};
+
 TEST(MonteCarlo, PeakImportanceSamplingKeepsTheExpectation) {
-  const bench::StandardScene sc = bench::standard_scene("stratocumulus", 24, 14);
-  const GridMeanExtinction ext = grid_mean_extinction(sc.grid, sc.data);
-  MarchSettings m = sc.march;
-  m.atmosphere = m.globe = false;
-  m.ambient = 0.0, m.noise_amount = 0.0;
-  m.droplet_diameter_um = 2.0;
+  const DeckCase d(2.0);
+  const auto& [sc, ext, m] = std::tie(d.sc, d.ext, d.m);
   MonteCarloSettings on, off;
   on.seed = 11, off.seed = 12;
   off.peak_mis = false;
@@ -380,12 +390,8 @@ TEST(MonteCarlo, PeakImportanceSamplingKeepsTheExpectation) {
 // converge: at the same seed and 64 spp its mean relative standard error is lower than without it
 // (measured 1/sqrt(N) ratios are in docs/BENCHMARKS.md, bench_mc_convergence).
 TEST(MonteCarlo, PeakImportanceSamplingLowersTheDeckNoise) {
-  const bench::StandardScene sc = bench::standard_scene("stratocumulus", 24, 14);
-  const GridMeanExtinction ext = grid_mean_extinction(sc.grid, sc.data);
-  MarchSettings m = sc.march;
-  m.atmosphere = m.globe = false;
-  m.ambient = 0.0, m.noise_amount = 0.0;
-  m.droplet_diameter_um = 20.0;
+  const DeckCase d(20.0);
+  const auto& [sc, ext, m] = std::tie(d.sc, d.ext, d.m);
   MonteCarloSettings on, off;
   off.peak_mis = false;
   const MonteCarloImage a = render_monte_carlo(sc.grid, ext, sc.camera, sc.sun, m, on, 64);
