@@ -25,11 +25,11 @@ CV_FN real3 ground_radiance(real3 albedo, real mu_s, real3 t_sun, real3 e_sky) {
 // (docs/physics.md, "Ground albedo"). Cosines are with the local vertical; nu_sv is the cosine
 // between the directions to the sun and to the viewer (both away from the surface).
 
-// Refractive index of sea water in the visible (Hale & Querry 1973: 1.333-1.34 from 650 to 450 nm).
+// Refractive index of water in the visible (Hale & Querry 1973: 1.331 at 650 nm to 1.337 at 450 nm).
 const real CV_WATER_N = real(1.333);
 // Albedo of a flat water surface under isotropic light, the integral of fresnel_water(mu) 2 mu dmu
-// over the hemisphere (0.066 for n = 1.333; Jin et al. 2011 use the same figure; a test checks it).
-const real CV_WATER_DIFFUSE_FRESNEL = real(0.0663);
+// over the hemisphere: 0.066 for n = 1.333 (a test integrates it).
+const real CV_WATER_DIFFUSE_FRESNEL = real(0.0664);
 // Reflectance of the water body (red, green, blue: 0.67, 0.55, 0.47 um), above the surface at nadir
 // under an overhead sun: pi x the remote-sensing reflectance of clear open ocean (Case 1 water,
 // chlorophyll ~0.1-0.3 mg/m3: Rrs ~0.0003, 0.002, 0.006 /sr; Morel & Maritorena 2001).

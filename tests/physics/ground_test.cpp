@@ -49,7 +49,7 @@ TEST(Water, FresnelIsTheAirWaterReflectance) {
   }
   std::printf("water: F(0) %.5f, albedo under isotropic light %.5f (constant %.4f)\n", f64::fresnel_water(1.0), diffuse,
               f64::CV_WATER_DIFFUSE_FRESNEL);
-  EXPECT_NEAR(diffuse, f64::CV_WATER_DIFFUSE_FRESNEL, 2e-4);
+  EXPECT_NEAR(diffuse, f64::CV_WATER_DIFFUSE_FRESNEL, 1e-4);
 }
 
 TEST(Water, CoxMunkSlopesGrowWithTheWind) {
