@@ -13,6 +13,7 @@
 #include "importer.hpp"
 #include "physics/physics.hpp"
 #include "volume/volume_io.hpp"
+#include "render/albedo_map.hpp"
 #include "render/context.hpp"
 #include "render/shader_loader.hpp"
 #include "cli_common.hpp"
@@ -255,6 +256,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
   } catch (const cv::core::VolumeFileError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  } catch (const cv::render::GroundImageError& e) {
+    // A ground texture that is no usable image: bad input, one line naming the file.
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
   } catch (const cv::importers::ImportError& e) {

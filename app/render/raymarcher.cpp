@@ -152,17 +152,18 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   const core::VolumeGrid& grid = v.grid;
   const GLuint p = program_for(kernel::MarchVariant::of(s)).id();
   const bool textured = s.globe && !s.ground_texture.empty();
-  if (textured && s.ground_texture != ground_path_) {
-    const core::AlbedoMap map = load_albedo_map(s.ground_texture);
+  if (textured && (s.ground_texture != ground_path_ || s.ground_map_colours != ground_map_colours_)) {
+    const core::AlbedoMap map = load_albedo_map(s.ground_texture, s.ground_map_colours);
     if (ground_) glDeleteTextures(1, &ground_);
     glCreateTextures(GL_TEXTURE_2D, 1, &ground_);
-    glTextureStorage2D(ground_, 1, GL_RGB32F, map.width, map.height);
+    glTextureStorage2D(ground_, 1, GL_RGBA32F, map.width, map.height);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTextureSubImage2D(ground_, 0, 0, 0, map.width, map.height, GL_RGB, GL_FLOAT, map.rgb.data());
-    check_gl("uploading the ground albedo texture");
+    glTextureSubImage2D(ground_, 0, 0, 0, map.width, map.height, GL_RGBA, GL_FLOAT, map.rgba.data());
+    check_gl("uploading the ground texture");
     ground_w_ = map.width;
     ground_h_ = map.height;
     ground_path_ = s.ground_texture;
+    ground_map_colours_ = s.ground_map_colours;
   }
   // The kernel's parameters, built as the CPU kernel builds them, packed into the uniform block.
   kernel::MarchParams params =

@@ -90,8 +90,8 @@ class GpuRaymarcher {
 
   // Renders: rgb = radiance, a = view transmittance (0 where the globe shows), rows top to bottom.
   // With noise_amount 0 the program without the noise code runs and the noise textures are not
-  // bound. With settings.globe and a ground_texture, the image is loaded (once per path) with
-  // load_albedo_map; a file that cannot be read throws std::runtime_error.
+  // bound. With settings.globe and a ground_texture, the image is loaded (once per path and ground
+  // model) with load_albedo_map; a file that cannot be read throws GroundImageError.
   std::vector<glm::vec4> render(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings,
                                 const DispatchOptions& dispatch = {}, const OpaqueInput& opaque = {});
 
@@ -128,12 +128,13 @@ class GpuRaymarcher {
   double ms_build_ms_ = 0.0;
   GLuint column_tau_ = 0;           // vertical optical depth per column (R32F), for the octave gate
   GLuint jitter_mask_ = 0;          // the blue-noise mask (R32F), uploaded at construction
-  GLuint ground_ = 0;               // linear albedo (RGB32F), loaded from ground_path_
+  GLuint ground_ = 0;               // land albedo and water fraction (RGBA32F), loaded from ground_path_
   // The march's state between dispatches (image-sized, two RGBA32F) and the cloud depth it writes (R32F).
   GLuint state_[3] = {0, 0, 0};
   int state_w_ = 0, state_h_ = 0;
   int ground_w_ = 0, ground_h_ = 0;
   std::string ground_path_;
+  bool ground_map_colours_ = false;  // the ground model ground_ was loaded with
   GLuint pyramid_buffer_ = 0, stats_buffer_ = 0;
   GLuint params_buffer_ = 0;  // the kernel's uniform block (kernel::MarchParamsStd140)
   std::shared_ptr<const core::PreparedVolume> volume_;  // the time step uploaded

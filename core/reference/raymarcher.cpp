@@ -43,7 +43,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   }
   const BlueNoiseMask& mask = step_jitter_mask();
   k.u_jitter_mask = {mask.values.data(), {mask.n, mask.n}, 1};
-  if (ground_map) k.u_ground = {ground_map->rgb.data(), {ground_map->width, ground_map->height}, 3};
+  if (ground_map) k.u_ground = {ground_map->rgba.data(), {ground_map->width, ground_map->height}, 4};
   if (eroded) {
     k.u_noise_low = {noise->low.texels.data(), glm::ivec3(noise->low.n)};
     k.u_noise_high = {noise->high.texels.data(), glm::ivec3(noise->high.n)};

@@ -41,8 +41,9 @@ struct PreparedVolume;  // kernel/prepared_volume.hpp
 
 // Renders one time step of a volume through the march kernel (shaders/kernel/march.glsl) in
 // double. `noise` is needed when settings.noise_amount > 0 (std::invalid_argument otherwise) and is
-// not read when it is 0. The globe takes its albedo from `ground` when given (the caller loads
-// settings.ground_texture: core reads no images), else from settings.ground_albedo.
+// not read when it is 0. The globe takes its land albedo and water from `ground` when given (the
+// caller loads settings.ground_texture with render::load_albedo_map: core reads no images), else
+// the constant settings.ground_albedo, all land.
 ReferenceImage render_reference(const PreparedVolume& volume, const Camera& cam, const Sun& sun, const MarchSettings& settings,
                                 const ErosionNoise* noise = nullptr, const AlbedoMap* ground = nullptr,
                                 const OpaqueLayer* opaque = nullptr);

@@ -471,16 +471,17 @@ CV_FN void march_advance(MarchRay r, ivec2 px, int step_begin, int step_count, C
   s.next_step = next_step;
 }
 
-// Linear albedo at a ground point, bilinear over texel centres.
-CV_FN real3 ground_albedo_at(real lat_rad, real lon_rad) {
-  if (u_ground_size.x <= 0) return u_ground_albedo;
+// The ground at a point, bilinear over texel centres: linear land albedo (rgb) and water fraction (a)
+// from the texture (render::load_albedo_map), else the constant albedo and no water.
+CV_FN real4 ground_at(real lat_rad, real lon_rad) {
+  if (u_ground_size.x <= 0) return real4(u_ground_albedo, real(0.0));
   real4 c = equirect_texel(lat_rad, lon_rad, u_ground_size.x, u_ground_size.y);
   int x0 = int(c.x);
   int y0 = int(c.y);
   int x1 = (x0 + 1) % u_ground_size.x;
   int y1 = min(y0 + 1, u_ground_size.y - 1);
-  real3 a = mix(real3(texelFetch(u_ground, ivec2(x0, y0), 0)), real3(texelFetch(u_ground, ivec2(x1, y0), 0)), c.z);
-  real3 b = mix(real3(texelFetch(u_ground, ivec2(x0, y1), 0)), real3(texelFetch(u_ground, ivec2(x1, y1), 0)), c.z);
+  real4 a = mix(real4(texelFetch(u_ground, ivec2(x0, y0), 0)), real4(texelFetch(u_ground, ivec2(x1, y0), 0)), c.z);
+  real4 b = mix(real4(texelFetch(u_ground, ivec2(x0, y1), 0)), real4(texelFetch(u_ground, ivec2(x1, y1), 0)), c.z);
   return mix(a, b, c.w);
 }
 
@@ -556,7 +557,12 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, bool has_cloud,
     // Earth's shadow no sunlit ray crosses cloud: left out (u_sun_down).
     real shadow = mu_sg > real(0.0) ? (u_sun_down ? real(1.0) : transmittance(cloud_sun_depth(pg, real(0.0), mu_sg, nu_sg))) : real(0.0);
     real3 ll = ecef_to_sphere(pg, u_r0);
-    ground = u_irradiance * ground_radiance(ground_albedo_at(ll.x, ll.y), mu_sg, sun_air * shadow, e_sky);
+    real4 g = ground_at(ll.x, ll.y);
+    // Water (g.w > 0) needs the view: the cosine toward the camera and between camera and sun.
+    real mu_vg = -dot(d, n);
+    real nu_svg = -dot(d, u_to_sun);
+    ground = u_irradiance * ground_radiance_water(real3(g), g.w, CV_WATER_BODY, mu_sg, mu_vg, nu_svg,
+                                                  cox_munk_mss(u_ocean_wind), sun_air * shadow, e_sky);
   }
   bool shown = opaque && u_has_opaque_color;  // the geometry's own radiance stands behind
   if (shown) ground = opaque_l;

@@ -36,6 +36,7 @@ CV_PARAM(real2, u_layer)             // altitudes (m) between which the data hol
 CV_PARAM(ivec2, u_size)              // image size, pixels
 CV_PARAM(ivec2, u_ground_size)       // of the albedo texture; (0, 0): constant albedo
 CV_PARAM(real, u_ambient)            // strength of the isotropic sky light on clouds
+CV_PARAM(real, u_ocean_wind)         // m/s, the sea's roughness for the sun glint (cox_munk_mss)
 CV_PARAM(int, u_sun_steps)
 CV_PARAM(int, u_octaves)
 CV_PARAM(int, u_frame)               // -1: step middles; else the accumulation frame whose jitter places the samples

@@ -130,6 +130,12 @@ void main() {
       r.a.x = erosion_threshold(c.in0.y, c.in0.z, c.in0.w);
       r.a.y = erode_extinction(c.in0.x, r.a.x, c.in1.x) / c.in0.x;
       break;
+    case PARITY_FRESNEL_WATER: r.a.x = fresnel_water(c.in0.x); break;
+    case PARITY_SEA_GLINT: r.a.x = sea_glint_brdf(c.in0.x, c.in0.y, c.in0.z, c.in0.w); break;
+    case PARITY_WATER_RADIANCE:
+      // in0 = (mu_s, mu_v, nu_sv, mss); the sun's transmittance and the sky light fixed.
+      r.a.xyz = water_radiance(CV_WATER_BODY, c.in0.x, c.in0.y, c.in0.z, c.in0.w, vec3(0.8, 0.7, 0.6), vec3(0.02, 0.03, 0.05));
+      break;
     default: r.u.w = 1u; break;
   }
   results[i] = r;

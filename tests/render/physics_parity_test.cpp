@@ -143,6 +143,13 @@ Result eval(const Case& c) {
       r.a.x = f32::erosion_threshold(c.in0.y, c.in0.z, c.in0.w);
       r.a.y = f32::erode_extinction(c.in0.x, r.a.x, c.in1.x) / c.in0.x;
       break;
+    case PARITY_FRESNEL_WATER: r.a.x = f32::fresnel_water(c.in0.x); break;
+    case PARITY_SEA_GLINT: r.a.x = f32::sea_glint_brdf(c.in0.x, c.in0.y, c.in0.z, c.in0.w); break;
+    case PARITY_WATER_RADIANCE:
+      r.a = vec4(f32::water_radiance(f32::CV_WATER_BODY, c.in0.x, c.in0.y, c.in0.z, c.in0.w, vec3(0.8f, 0.7f, 0.6f),
+                                     vec3(0.02f, 0.03f, 0.05f)),
+                 0.0f);
+      break;
     default: r.u.w = 1u; break;
   }
   return r;
@@ -268,6 +275,20 @@ std::vector<Case> build_cases() {
       }
     }
   }
+  // Water: Fresnel from grazing to normal incidence; the glint and the water's radiance over sun
+  // and view angles (grazing included), azimuths and the sea's roughness from calm to 30 m/s.
+  for (int i = -2; i <= 50; ++i) cs.push_back(mk(PARITY_FRESNEL_WATER, vec4(i / 50.0f, 0, 0, 0)));
+  for (float ts : {0.0f, 0.3f, 0.8f, 1.3f, 1.5707f}) {
+    for (float tv : {0.0f, 0.2f, 0.6f, 1.2f, 1.5706f}) {
+      for (float phi : {0.0f, 1.0f, 3.14159f}) {
+        for (float mss : {0.003f, 0.0388f, 0.157f}) {
+          const float nu = std::sin(ts) * std::sin(tv) * std::cos(phi) + std::cos(ts) * std::cos(tv);
+          cs.push_back(mk(PARITY_SEA_GLINT, vec4(std::cos(ts), std::cos(tv), nu, mss)));
+          cs.push_back(mk(PARITY_WATER_RADIANCE, vec4(std::cos(ts), std::cos(tv), nu, mss)));
+        }
+      }
+    }
+  }
   for (int i = 0; i <= 10; ++i) {
     cs.push_back(mk(PARITY_DIRECTION_AROUND, vec4(glm::normalize(vec3(0.1f * i - 0.5f, 0.2f, -0.9f)), 0),
                     vec4(-1.0f + 0.2f * i, 0.6f * i, 0, 0)));
@@ -300,6 +321,8 @@ float floor_for(unsigned id, int component) {
     case PARITY_SPHERE_TO_ECEF: return 6.4e6f;
     case PARITY_MIE_PARAMS: return 1e-3f;
     case PARITY_TWO_PROD: return 1e-30f;
+    case PARITY_SEA_GLINT:        // 1/sr, up to ~100 at the peak of a calm sea
+    case PARITY_WATER_RADIANCE: return 1e-3f;  // per unit irradiance
     default: return 1e-30f;
   }
 }
@@ -312,7 +335,7 @@ const char* name_of(unsigned id) {
                                 "ray_shell_rel", "ray_sphere", "sphere_to_ecef", "ecef_to_sphere", "enu_frame",
                                 "geopotential", "pcg_hash", "two_prod", "direction_around", "volume_coords", "step_jitter",
                                 "ray_altitude", "noise_tile_coords", "noise_texel_pair", "erosion",
-                                "blue_noise_jitter"};
+                                "blue_noise_jitter", "fresnel_water", "sea_glint", "water_radiance"};
   return id < PARITY_FUNCTION_COUNT ? names[id] : "?";
 }
 

@@ -164,6 +164,16 @@ TEST(SkyGlobe, GpuMatchesTheCpuReferenceWithSkyAndGlobe) {
   });
 }
 
+// The sea's sun glint (Cox-Munk, shaders/common/ground.glsl) with the relief texture's water: seen
+// from geostationary distance with the sun high over the Gulf of Guinea beside the bubble, and as
+// the glitter path toward a sun 10 degrees up, from 2 km over the sea (grazing sun and view).
+TEST(SkyGlobe, GpuMatchesTheCpuReferenceOnTheSunGlint) {
+  expect_gpu_matches_cpu_with_sky({
+      Case{"geostationary, sun glint", camera(0.0, 0.0, 3.6e7, 0.0, -90.0, 20.0, 32, 32), 5.0, 8.0},
+      Case{"glitter path, low sun", camera(-1.0, -2.0, 2000.0, 90.0, -4.0, 60.0, 48, 27), 0.0, 78.0},
+  });
+}
+
 // Views along the horizon from inside the air, whose view rays run for hundreds of kilometres
 // through the cloud shell and the air. They used to differ by up to 0.22 of the brightest pixel
 // (alpha 1.1e-2; 1.1e-3 at the surface), for two reasons. (1) llvmpipe lets all loops of one
