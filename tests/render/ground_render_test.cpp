@@ -125,17 +125,23 @@ TEST(GroundRender, CloudOfOpticalDepth50AgainstTheSeaBesideIt) {
     return static_cast<int>(std::lround((std::tan(view_deg * kPi / 180.0) / tan_half + 1.0) * 0.5 * w - 0.5));
   };
   const int cloud = column_at(0.0);
-  double ratio_now_45 = 0.0, ratio_before_15 = 0.0;
-  for (bool map_colours : {true, false}) {
+  double ratio_now_45 = 0.0, ratio_before_15 = 0.0, ratio_two_stream_15 = 0.0, cloud_two_stream = 0.0;
+  // The map's colours and the octave sum (before), water with the octave sum, water with the
+  // two-stream source (the product's default now).
+  for (int variant = 0; variant < 3; ++variant) {
+    const bool map_colours = variant == 0;
     core::MarchSettings s = globe_settings(true);
     s.ground_map_colours = map_colours;
+    s.ms_two_stream = variant == 2;
     const core::AlbedoMap map = render::load_albedo_map(render::kNaturalEarthRelief, map_colours);
     const auto img = core::render_reference(slab.grid, slab.data, cam, sun, s, nullptr, &map);
     // Luminance (Rec. 709 weights of the linear radiance, per unit irradiance).
     auto lum = [](glm::dvec3 l) { return 0.2126 * l.x + 0.7152 * l.y + 0.0722 * l.z; };
     const glm::dvec3 c_rgb = img.radiance[static_cast<std::size_t>(cloud)];
     const double lc = lum(c_rgb);
-    std::printf("%-9s cloud (tau 50, nadir): rgb %.4f %.4f %.4f, luminance %.4f\n", map_colours ? "map" : "physical", c_rgb.x, c_rgb.y,
+    if (variant == 2) cloud_two_stream = lc;
+    std::printf("%-22s cloud (tau 50, nadir): rgb %.4f %.4f %.4f, luminance %.4f\n",
+                variant == 0 ? "map, octaves" : variant == 1 ? "physical, octaves" : "physical, two-stream", c_rgb.x, c_rgb.y,
                 c_rgb.z, lc);
     for (double view : {15.0, 30.0, 45.0}) {
       const int c = column_at(view);
@@ -145,7 +151,8 @@ TEST(GroundRender, CloudOfOpticalDepth50AgainstTheSeaBesideIt) {
       std::printf("  sea %2.0f deg from nadir: rgb %.4f %.4f %.4f, luminance %.4f; cloud/sea: luminance %.2f, rgb %.2f %.2f %.2f\n", view,
                   s_rgb.x, s_rgb.y, s_rgb.z, ls, lc / ls, c_rgb.x / s_rgb.x, c_rgb.y / s_rgb.y, c_rgb.z / s_rgb.z);
       if (map_colours && view == 15.0) ratio_before_15 = lc / ls;
-      if (!map_colours && view == 45.0) ratio_now_45 = lc / ls;
+      if (variant == 1 && view == 45.0) ratio_now_45 = lc / ls;
+      if (variant == 2 && view == 15.0) ratio_two_stream_15 = lc / ls;
     }
     EXPECT_LT(img.cloud_depth_m[static_cast<std::size_t>(cloud)], 1e6);  // the cloud
   }
@@ -153,6 +160,14 @@ TEST(GroundRender, CloudOfOpticalDepth50AgainstTheSeaBesideIt) {
   // dark background it is.
   EXPECT_LT(ratio_before_15, 1.0);
   EXPECT_GT(ratio_now_45, 1.0);
+  // With the two-stream source the cloud reflects what a thick cloud does: a nadir reflectance factor
+  // pi L / E (overhead sun, through the air) near the 0.75-0.85 a plane-parallel water cloud of
+  // optical depth 50 reflects, where the octave sum gave 0.18; so it outshines even the glint's flank.
+  std::printf("two-stream cloud: nadir reflectance factor %.3f; cloud/sea at 15 deg %.2f\n", kPi * cloud_two_stream,
+              ratio_two_stream_15);
+  EXPECT_GT(kPi * cloud_two_stream, 0.6);
+  EXPECT_LT(kPi * cloud_two_stream, 0.95);
+  EXPECT_GT(ratio_two_stream_15, 4.0);
 }
 
 }  // namespace
