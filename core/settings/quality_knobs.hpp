@@ -34,18 +34,20 @@ struct KnobFields {
   const char* doc = "";
 };
 
-constexpr const SettingRow* march_row(const char* key) {
-  for (const SettingRow& r : kMarchSettingRows) {
-    if (same_text(r.key, key)) return &r;
+// The index of the march setting row with this key, or -1 (an index, not a pointer: GCC cannot
+// constant-evaluate pointer tests under -fsanitize=address).
+constexpr int march_row_index(const char* key) {
+  for (std::size_t i = 0; i < kMarchSettingCount; ++i) {
+    if (same_text(kMarchSettingRows[i].key, key)) return static_cast<int>(i);
   }
-  return nullptr;
+  return -1;
 }
 
 constexpr KnobRow knob_row(const char* member, SettingKind kind, bool step, KnobFields f) {
   KnobRow k;
   if (f.march) {
-    const SettingRow* m = march_row(f.march);
-    if (m) k.row = *m;  // nullptr: caught by knob_rows_consistent
+    const int m = march_row_index(f.march);
+    if (m >= 0) k.row = kMarchSettingRows[static_cast<std::size_t>(m)];  // -1: caught by knob_rows_consistent
   }
   k.row.member = member;
   k.row.group = SettingGroup::Quality;
