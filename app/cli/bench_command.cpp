@@ -361,7 +361,7 @@ int cmd_bench(const std::vector<std::string>& args) {
         dispatch.gpu_seconds = &gpu_s;
         return renderer.render(frame, dispatch);
       };
-      const std::string variant = std::string(c.march.adaptive_steps ? "a" : "-") + (c.march.skip_empty ? "s" : "-");
+      const std::string variant = std::to_string(kernel::MarchVariant::of(c.march).key());
       if (variants_warm.insert(variant).second) {
         double ignored = 0.0;
         render_image(ignored);

@@ -117,7 +117,7 @@ void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const
     core::Camera cal = cam;
     cal.width = std::max(1, static_cast<int>(std::lround(mw * shrink)));
     cal.height = std::max(1, static_cast<int>(std::lround(mh * shrink)));
-    const std::string variant = std::string(m.adaptive_steps ? "a" : "-") + (m.skip_empty ? "s" : "-");
+    const std::string variant = std::to_string(kernel::MarchVariant::of(m).key());
     if (warm.insert(variant).second) gpu.render(cal, sun, m);
     const auto t0 = clock::now();
     gpu.render(cal, sun, m);

@@ -52,7 +52,7 @@ struct MarchKernel : MarchParams {
   sampler2D u_column_tau, u_jitter_mask, u_ground, u_depth, u_opaque;
   const glm::vec2* u_min_max = nullptr;
   // The program switches (compile-time constants on the GPU).
-  bool kSkipEmpty = true, kAdaptive = false, kAtmosphere = false, kGlobe = false, kNoise = false;
+  bool kSkipEmpty = true, kAdaptive = false, kAtmosphere = false, kGlobe = false, kNoise = false, kTwoStream = false;
 
 #include "kernel/march.glsl"
 

@@ -25,17 +25,19 @@ MarchVariant MarchVariant::of(const core::MarchSettings& s) {
   v.adaptive = s.adaptive_steps;
   v.atmosphere = s.atmosphere;
   v.globe = s.globe;
+  v.two_stream = s.ms_two_stream;
   return v;
 }
 
 unsigned MarchVariant::key() const {
-  return (noise ? 1u : 0u) | (skip_empty ? 2u : 0u) | (adaptive ? 4u : 0u) | (atmosphere ? 8u : 0u) | (globe ? 16u : 0u);
+  return (noise ? 1u : 0u) | (skip_empty ? 2u : 0u) | (adaptive ? 4u : 0u) | (atmosphere ? 8u : 0u) | (globe ? 16u : 0u) |
+         (two_stream ? 32u : 0u);
 }
 
 std::vector<std::pair<std::string, std::string>> MarchVariant::defines() const {
   auto b = [](bool on) { return std::string(on ? "1" : "0"); };
   return {{"CV_NOISE", b(noise)}, {"CV_SKIP_EMPTY", b(skip_empty)}, {"CV_ADAPTIVE", b(adaptive)},
-          {"CV_ATMOSPHERE", b(atmosphere)}, {"CV_GLOBE", b(globe)}};
+          {"CV_ATMOSPHERE", b(atmosphere)}, {"CV_GLOBE", b(globe)}, {"CV_TWO_STREAM", b(two_stream)}};
 }
 
 }  // namespace cv::kernel

@@ -121,10 +121,11 @@ struct MarchVariant {
   bool adaptive = false;    // divide view steps by optical depth
   bool atmosphere = false;  // the air: sun colour, sky in-scatter, ambient light
   bool globe = false;       // the ground where a ray meets it
+  bool two_stream = false;  // multiple scattering from the two-stream source, not the octave sum
   static MarchVariant of(const core::MarchSettings& s);
   // A small integer naming the variant (a bit per switch), for caches of compiled programs.
   unsigned key() const;
-  static constexpr unsigned kCount = 32;
+  static constexpr unsigned kCount = 64;
   std::vector<std::pair<std::string, std::string>> defines() const;
 };
 

@@ -60,6 +60,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   k.kAtmosphere = s.atmosphere;
   k.kGlobe = s.globe;
   k.kNoise = eroded;
+  k.kTwoStream = s.ms_two_stream;
 
   ReferenceImage img;
   img.width = cam.width;

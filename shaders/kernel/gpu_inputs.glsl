@@ -46,8 +46,12 @@ uint g_stats[CV_STAT_COUNT] = uint[CV_STAT_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u
 #ifndef CV_NOISE
 #define CV_NOISE 0
 #endif
+#ifndef CV_TWO_STREAM
+#define CV_TWO_STREAM 0
+#endif
 const bool kSkipEmpty = CV_SKIP_EMPTY != 0;
 const bool kAdaptive = CV_ADAPTIVE != 0;
 const bool kAtmosphere = CV_ATMOSPHERE != 0;
 const bool kGlobe = CV_GLOBE != 0;
 const bool kNoise = CV_NOISE != 0;
+const bool kTwoStream = CV_TWO_STREAM != 0;  // the two-stream source; else the octave sum

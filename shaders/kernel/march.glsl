@@ -9,7 +9,7 @@
 // distance to opaque geometry per pixel, m), u_opaque (that geometry's radiance) (sampler2D),
 // u_noise_low, u_noise_high (sampler3D), the pyramid u_min_max (vec2 per brick, levels one after
 // the other), the counters g_stats[CV_STAT_COUNT] (uint, indices in march_stats.glsl) and the switches kSkipEmpty, kAdaptive,
-// kAtmosphere, kGlobe and kNoise (compile-time constants on the GPU, where llvmpipe runs both sides
+// kAtmosphere, kGlobe, kNoise and kTwoStream (compile-time constants on the GPU, where llvmpipe runs both sides
 // of a branch under masks; plain members in C++).
 //
 // Loops are shaped for Mesa's llvmpipe: all loops of one invocation share a budget of 65 535
@@ -270,7 +270,7 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
   // masked code: a ternary would not save them).
   real scatter = real(0.0);
   real3 diffuse = real3(0.0);
-  if (u_ms_two_stream) {
+  if (kTwoStream) {
     // The two-stream model (docs/physics.md): the sun's light scattered once, exactly, with the full
     // phase, through exp(-(1 - f) tau_sun) (f = g^2 of delta-Eddington: the light the forward peak
     // keeps in the beam), plus the column's diffuse light scattered toward the camera,

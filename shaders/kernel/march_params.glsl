@@ -52,7 +52,6 @@ CV_PARAM(bool, u_liquid_phase_hg)    // Henyey-Greenstein with the Mie fit's mea
 CV_PARAM(bool, u_blue_noise)         // the jitter from the blue-noise mask, else the hash
 CV_PARAM(bool, u_has_depth)          // u_depth holds the distance to opaque geometry per pixel
 CV_PARAM(bool, u_has_opaque_color)   // u_opaque holds that geometry's radiance, composited behind
-CV_PARAM(bool, u_ms_two_stream)      // multiple scattering from the two-stream source u_ms_i0, u_ms_i1
 CV_PARAM(ivec4, u_level_nodes)       // grid nodes per brick side, finest level first
 CV_PARAM(ivec4, u_level_offset)      // first brick of each level in u_min_max
 CV_PARAM_ARRAY(ivec4, u_bricks, 4)   // bricks per axis (xyz), finest level first
