@@ -79,9 +79,9 @@ Sun sun_at(double lat, double lon) {
 
 MarchSettings march(double view_step_m) {
   MarchSettings m;
-  m.view_step_m = view_step_m;
-  m.sun_steps = 16;
-  m.octaves = 4;
+  m.quality.view_step_m = view_step_m;
+  m.quality.sun_steps = 16;
+  m.quality.octaves = 4;
   return m;
 }
 

@@ -113,8 +113,8 @@ std::string reference_key(const bench::StandardScene& sc, const core::GridMeanEx
                 g.lon_deg.count, g.lat_deg.count, g.alt_m.count, g.lon_deg.start, g.lon_deg.step, g.lat_deg.start,
                 g.lat_deg.step, g.alt_m.start, g.alt_m.step, g.earth_radius_m, sum, c.lat_deg, c.lon_deg, c.alt_m,
                 c.heading_deg, c.pitch_deg, c.fov_deg, c.width, c.height, sc.sun.subsolar_lat_deg, sc.sun.subsolar_lon_deg,
-                sc.sun.irradiance.x, sc.sun.irradiance.y, sc.sun.irradiance.z, m.droplet_diameter_um,
-                m.liquid_phase_hg ? 1 : 0, m.ice_g, m.noise_amount, mc.max_bounces, mc.roulette_after,
+                sc.sun.irradiance.x, sc.sun.irradiance.y, sc.sun.irradiance.z, m.medium.droplet_diameter_um,
+                m.medium.liquid_phase_hg ? 1 : 0, m.medium.ice_g, m.medium.noise_amount, mc.max_bounces, mc.roulette_after,
                 static_cast<unsigned long long>(mc.seed), mc.peak_mis ? 1 : 0);
   return b;
 }
@@ -157,7 +157,7 @@ std::vector<Config> make_configs(const bench::StandardScene& sc, const core::Mar
     core::RenderSettings rs;
     rs.march = base;
     core::apply_quality(preset, rs);
-    rs.march.view_step_m = core::resolve_view_step_m(rs, sc.grid);
+    rs.march.quality.view_step_m = core::resolve_view_step_m(rs, sc.grid);
     Config c{preset, "", ConfigKind::Preset, rs.march, rs.accumulate, 1.0};
     return c;
   };
@@ -173,14 +173,14 @@ std::vector<Config> make_configs(const bench::StandardScene& sc, const core::Mar
   for (double f : {4.0, 2.0, 0.5, 0.25}) {
     char n[32];
     std::snprintf(n, sizeof n, "step_%gdz", f);
-    add(n, [&](Config& c) { c.march.view_step_m = std::max(25.0, f * dz); });
+    add(n, [&](Config& c) { c.march.quality.view_step_m = std::max(25.0, f * dz); });
   }
-  for (int s : {4, 8, 32}) add("sun_" + std::to_string(s), [&](Config& c) { c.march.sun_steps = s; });
+  for (int s : {4, 8, 32}) add("sun_" + std::to_string(s), [&](Config& c) { c.march.quality.sun_steps = s; });
   add("accumulate_4", [](Config& c) { c.accumulate = 4; });
   add("scale_0.5", [](Config& c) { c.scale = 0.5; });
-  add("adaptive", [](Config& c) { c.march.adaptive_steps = true; });
+  add("adaptive", [](Config& c) { c.march.features.adaptive_steps = true; });
   add("fast_2dz_sun8_scale0.5", [&](Config& c) {
-    c.march.view_step_m = std::max(25.0, 2.0 * dz), c.march.sun_steps = 8, c.scale = 0.5;
+    c.march.quality.view_step_m = std::max(25.0, 2.0 * dz), c.march.quality.sun_steps = 8, c.scale = 0.5;
   });
   // The seed documents' methods (../shared/seeds), as near as our march's settings come: the classic
   // octave sum (no gate by column optical depth) and a fixed count of sun steps (no fewer in thin
@@ -188,43 +188,43 @@ std::vector<Config> make_configs(const bench::StandardScene& sc, const core::Mar
   const double chord = central_chord_m(sc, layer);
   const auto seed = [](Config& c) {
     c.kind = ConfigKind::Seed;
-    c.march.ms_two_stream = false;  // the documents' own octave sum
-    c.march.octave_gate = false;
-    c.march.max_sun_step_optical_depth = 0.0;
+    c.march.medium.ms_two_stream = false;  // the documents' own octave sum
+    c.march.features.octave_gate = false;
+    c.march.quality.max_sun_step_optical_depth = 0.0;
   };
   // The octave sum the seed documents use for multiple scattering, beside the two-stream default:
   // with our gate at the default preset, with 8 octaves, and the classic sum without the gate.
   add("octave_sum", [&](Config& c) {
     c.kind = ConfigKind::Seed;
     c.description = "the default preset with the octave sum (4 octaves, gate on) for multiple scattering";
-    c.march.ms_two_stream = false;
+    c.march.medium.ms_two_stream = false;
   });
   add("octave_sum_8", [&](Config& c) {
     c.kind = ConfigKind::Seed;
     c.description = "the default preset with the octave sum at 8 octaves, gate on";
-    c.march.ms_two_stream = false, c.march.octaves = 8;
+    c.march.medium.ms_two_stream = false, c.march.quality.octaves = 8;
   });
   add("octave_sum_classic", [&](Config& c) {
     c.kind = ConfigKind::Seed;
     c.description = "the default preset with the classic octave sum (4 octaves, no gate)";
-    c.march.ms_two_stream = false, c.march.octave_gate = false;
+    c.march.medium.ms_two_stream = false, c.march.features.octave_gate = false;
   });
   add("costa2023", [&](Config& c) {
     seed(c);
     c.description = "64 view steps over the central ray's chord of the cloud shell, 32 light steps, HG, single scattering";
-    c.march.view_step_m = chord > 0.0 ? chord / 64.0 : std::max(25.0, (layer.top_m - layer.bottom_m) / 64.0);
-    c.march.sun_steps = 32, c.march.octaves = 1, c.march.liquid_phase_hg = true;
+    c.march.quality.view_step_m = chord > 0.0 ? chord / 64.0 : std::max(25.0, (layer.top_m - layer.bottom_m) / 64.0);
+    c.march.quality.sun_steps = 32, c.march.quality.octaves = 1, c.march.medium.liquid_phase_hg = true;
   });
   add("haggstrom2018", [&](Config& c) {
     seed(c);
     c.description = "long steps of 2 dz split into short ones in dense cloud (adaptive), 4 sun steps, HG";
-    c.march.view_step_m = std::max(50.0, 2.0 * dz), c.march.adaptive_steps = true;
-    c.march.sun_steps = 4, c.march.octaves = 1, c.march.liquid_phase_hg = true;
+    c.march.quality.view_step_m = std::max(50.0, 2.0 * dz), c.march.features.adaptive_steps = true;
+    c.march.quality.sun_steps = 4, c.march.quality.octaves = 1, c.march.medium.liquid_phase_hg = true;
   });
   add("fordsung2024", [&](Config& c) {
     seed(c);
     c.description = "100 m steps, 8 octaves, approximate Mie at 20 um, 8 accumulated frames";
-    c.march.view_step_m = 100.0, c.march.octaves = 8, c.march.droplet_diameter_um = 20.0, c.accumulate = 8;
+    c.march.quality.view_step_m = 100.0, c.march.quality.octaves = 8, c.march.medium.droplet_diameter_um = 20.0, c.accumulate = 8;
   });
   return out;
 }
@@ -280,10 +280,10 @@ int cmd_bench(const std::vector<std::string>& args) {
     dz_by_scene[name] = std::abs(sc.grid.alt_m.step);
     // Clouds only, as the Monte Carlo reference models them.
     core::MarchSettings base = sc.march;
-    base.ms_two_stream = core::scene_march_defaults().ms_two_stream;  // the model the product renders with
-    base.atmosphere = base.globe = false;
-    base.ambient = 0.0, base.noise_amount = 0.0;
-    if (!(base.droplet_diameter_um > 0.0)) base.droplet_diameter_um = 20.0;
+    base.medium.ms_two_stream = core::scene_march_defaults().medium.ms_two_stream;  // the model the product renders with
+    base.features.atmosphere = base.features.globe = false;
+    base.medium.ambient = 0.0, base.medium.noise_amount = 0.0;
+    if (!(base.medium.droplet_diameter_um > 0.0)) base.medium.droplet_diameter_um = 20.0;
     // The reference: cached by scene, size and a hash of what decides it, with its running sums, so
     // a later run with more samples (or one resumed after an interruption) extends it.
     const core::MonteCarloSettings mc;
@@ -378,11 +378,11 @@ int cmd_bench(const std::vector<std::string>& args) {
       for (std::size_t i = 0; i < pixels.size(); ++i) rgb[i] = glm::dvec3(pixels[i].x, pixels[i].y, pixels[i].z);
       BenchRow row;
       row.scene = name, row.config = c.name, row.description = c.description, row.kind = c.kind;
-      row.view_step_m = c.march.view_step_m;
+      row.view_step_m = c.march.quality.view_step_m;
       core::RenderSettings marched;
       marched.march = c.march, marched.accumulate = c.accumulate, marched.resolution_scale = c.scale;
-      row.knobs = core::knobs_of(marched, c.march.view_step_m, sc.grid.alt_m.step);
-      row.phase_hg = c.march.liquid_phase_hg;
+      row.knobs = core::knobs_of(marched, c.march.quality.view_step_m, sc.grid.alt_m.step);
+      row.phase_hg = c.march.medium.liquid_phase_hg;
       row.wall_ms = median(wall), row.gpu_ms = median(gpu_t);
       row.err = bench::image_error(rgb, ref_rgb, ref_var);
       row.error_image = name + "/err_" + c.name + ".png";

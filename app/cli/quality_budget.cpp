@@ -110,7 +110,7 @@ void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const
     knobbed.march = base;
     core::apply_knobs(c.knobs, dz_m, knobbed);
     core::MarchSettings m = knobbed.march;
-    m.frame = c.knobs.accumulate > 1 ? 0 : -1;
+    m.per_frame.frame = c.knobs.accumulate > 1 ? 0 : -1;
     const double mw = std::max(1.0, std::round(cam.width * c.knobs.resolution_scale));
     const double mh = std::max(1.0, std::round(cam.height * c.knobs.resolution_scale));
     const double shrink = std::min(1.0, std::sqrt(kCalibrationPixels / (mw * mh)));

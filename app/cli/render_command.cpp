@@ -178,7 +178,7 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
       // which chooses them, contradicts them).
       if (key == "view_step_m" || key == "sun_steps" || key == "octaves") r.march_overridden = true;
       if (key == "max_step_optical_depth") {  // --adaptive TAU: the substep's optical depth, and adaptive steps on
-        m.adaptive_steps = true;
+        m.features.adaptive_steps = true;
         r.adaptive_given = true;
       }
     } else if (a == "--accumulate") {
@@ -195,8 +195,8 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
     } else if (a == "--front") {
       r.front = v;
     } else if (a == "--no-sky") {
-      m.atmosphere = m.globe = false;
-      m.ambient = 0.0;
+      m.features.atmosphere = m.features.globe = false;
+      m.medium.ambient = 0.0;
     } else if (a == "--exposure") {
       scene.render.auto_exposure = v == "auto";
       if (!scene.render.auto_exposure) {
@@ -317,15 +317,15 @@ int cmd_render(const std::vector<std::string>& args) {
   render::GpuRaymarcher& gpu = renderer.raymarcher();
   t0 = clock::now();
   renderer.use_volume(prepared);
-  if (scene.render.march.noise_amount > 0.0) {  // generated, compiled and bound only when used
+  if (scene.render.march.medium.noise_amount > 0.0) {  // generated, compiled and bound only when used
     const auto t_noise = clock::now();
     gpu.upload_noise(core::make_erosion_noise());
-    std::printf("erosion noise %.2f, tile %.0f m: generated and uploaded in %.2f s\n", scene.render.march.noise_amount,
-                scene.render.march.noise_scale_m, seconds_since(t_noise));
+    std::printf("erosion noise %.2f, tile %.0f m: generated and uploaded in %.2f s\n", scene.render.march.medium.noise_amount,
+                scene.render.march.medium.noise_scale_m, seconds_since(t_noise));
   }
   glFinish();
   const double t_upload = seconds_since(t0);
-  scene.render.march.view_step_m = frame.march.view_step_m;
+  scene.render.march.quality.view_step_m = frame.march.quality.view_step_m;
   if (ra.march_overridden) scene.render.quality = "custom";
   scene.camera = cam;
   scene.sun.mode = core::SunMode::Manual;
@@ -352,11 +352,11 @@ int cmd_render(const std::vector<std::string>& args) {
   const core::MarchSettings& march = frame.march;
   const int mw = frame.march_camera.width, mh = frame.march_camera.height;
   const std::string model =
-      march.ms_two_stream ? std::string("two-stream multiple scattering") : std::to_string(march.octaves) + " octaves";
+      march.medium.ms_two_stream ? std::string("two-stream multiple scattering") : std::to_string(march.quality.octaves) + " octaves";
   std::printf("rendering %s, time step %d (%s), %dx%d%s, quality %s: view step %.0f m, %d sun steps, %s, %d frame(s)\n",
               scene.data.path.c_str(), scene.time_step, vt.iso_utc.c_str(), cam.width, cam.height,
               mw != cam.width || mh != cam.height ? (" marched at " + std::to_string(mw) + "x" + std::to_string(mh)).c_str() : "",
-              rs.quality.c_str(), march.view_step_m, march.sun_steps, model.c_str(), frame.accumulate);
+              rs.quality.c_str(), march.quality.view_step_m, march.quality.sun_steps, model.c_str(), frame.accumulate);
 
   t0 = clock::now();
   double gpu_s = 0.0;
@@ -382,7 +382,7 @@ int cmd_render(const std::vector<std::string>& args) {
       &marched);
   if (frame.accumulate > 1 || dispatch.on_tile) std::printf("\n");
   const double t_march = seconds_since(t0);
-  if (march.ms_two_stream)
+  if (march.medium.ms_two_stream)
     std::printf("two-stream source built in %.1f ms (once per time step and sun direction)\n", gpu.ms_source_build_ms());
   const core::MarchStats& ms = gpu.last_stats();
   std::printf("march%s: %llu view samples, %llu skipped in %llu empty-brick jumps (view and sun), %llu sun samples, "
@@ -390,7 +390,7 @@ int cmd_render(const std::vector<std::string>& args) {
               frame.accumulate > 1 ? " (last frame)" : "", static_cast<unsigned long long>(ms.view_samples),
               static_cast<unsigned long long>(ms.view_skipped), static_cast<unsigned long long>(ms.bricks_jumped),
               static_cast<unsigned long long>(ms.sun_samples), static_cast<unsigned long long>(ms.sun_skipped),
-              static_cast<unsigned long long>(ms.rays_missed), mw * mh, march.skip_empty ? "" : " (skipping off)");
+              static_cast<unsigned long long>(ms.rays_missed), mw * mh, march.features.skip_empty ? "" : " (skipping off)");
   if (ms.sun_down) std::printf("the sun is below the horizon for the whole cloud layer: sun marches and octave sums left out\n");
   if (ms.octave_terms_full > ms.octave_terms) {
     std::printf("octave gate: %llu of %llu octave terms evaluated at sunlit samples (%.1f %% left out where the cloud is thin)\n",
@@ -404,7 +404,7 @@ int cmd_render(const std::vector<std::string>& args) {
   render::ToneSettings tone;
   tone.exposure = frame.auto_exposure ? render::auto_exposure(marched) : frame.exposure;
   if (frame.auto_exposure) std::printf("exposure %.4g (auto: the 99th percentile of lit pixels' luminance at 0.8; --exposure E sets it)\n", tone.exposure);
-  if (march.atmosphere || march.globe) tone.background = glm::dvec3(0.0);  // the sky and space are in the image
+  if (march.features.atmosphere || march.features.globe) tone.background = glm::dvec3(0.0);  // the sky and space are in the image
   const std::vector<unsigned char> rgb8 = render::tonemap_srgb8(pixels, tone);
   const double t_tone = seconds_since(t0);
   t0 = clock::now();

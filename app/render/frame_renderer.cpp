@@ -17,18 +17,18 @@ void FrameRenderer::use_volume(std::shared_ptr<const core::PreparedVolume> volum
 
 core::MarchSettings FrameRenderer::frame_settings(const core::MarchSettings& march, int count, int index) {
   core::MarchSettings m = march;
-  m.frame = count <= 1 ? march.frame : index;
+  m.per_frame.frame = count <= 1 ? march.per_frame.frame : index;
   return m;
 }
 
 core::FrameSpec resolve_frame(const core::Scene& scene, const core::CloudVolume& volume) {
   core::FrameSpec f = core::resolve_frame(scene, volume);
-  f.march.ground_texture = resolve_ground_texture(f.march.ground_texture);
+  f.march.medium.ground_texture = resolve_ground_texture(f.march.medium.ground_texture);
   return f;
 }
 
 void FrameRenderer::ensure_noise(const core::MarchSettings& m) {
-  if (m.noise_amount > 0.0 && !noise_uploaded_) {  // generated, compiled and bound only when used
+  if (m.medium.noise_amount > 0.0 && !noise_uploaded_) {  // generated, compiled and bound only when used
     gpu_.upload_noise(core::make_erosion_noise());
     noise_uploaded_ = true;
   }

@@ -20,10 +20,10 @@ GLint loc(GLuint program, const char* name) { return glGetUniformLocation(progra
 int loop_iterations_per_view_step(const core::MarchSettings& s, int sun_march_steps) {
   // The sun march (cloud_sun_depth): at most sun_march_steps over both segments, never fewer than
   // the 2 sun_steps budgeted before the length limit; 5 for the tests that end its loops.
-  const int sun = 3 + 2 + std::max(sun_march_steps, 2 * std::max(s.sun_steps, 0));
-  const int air = std::max(s.atmo_sun_steps, 0) + 2;
-  const int octaves = 2 * (std::max(s.octaves, 0) + 1);
-  const int substeps = s.adaptive_steps ? 64 : 1;  // march_substeps divides a step at most 64 times
+  const int sun = 3 + 2 + std::max(sun_march_steps, 2 * std::max(s.quality.sun_steps, 0));
+  const int air = std::max(s.quality.atmo_sun_steps, 0) + 2;
+  const int octaves = 2 * (std::max(s.quality.octaves, 0) + 1);
+  const int substeps = s.features.adaptive_steps ? 64 : 1;  // march_substeps divides a step at most 64 times
   return substeps * (1 + sun + air + octaves);
 }
 
@@ -81,7 +81,7 @@ void GpuRaymarcher::upload_noise(const core::ErosionNoise& noise) {
   // The noise variant (with the default march switches) is compiled here, not in the first
   // render, so render timings are the march's.
   core::MarchSettings with_noise;
-  with_noise.noise_amount = 1.0;
+  with_noise.medium.noise_amount = 1.0;
   program_for(kernel::MarchVariant::of(with_noise));
   if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
   glCreateTextures(GL_TEXTURE_3D, 2, noise_textures_);
@@ -144,16 +144,16 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
 void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
                                 const DispatchOptions& dispatch, const OpaqueInput& opaque) {
   if (!volume_) throw GlError("render needs upload() first");
-  const bool noise = s.noise_amount > 0.0;
+  const bool noise = s.medium.noise_amount > 0.0;
   if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
-  if (noise && !(s.noise_scale_m > 0.0)) throw GlError("noise_scale_m must be > 0");
-  if (!(s.view_step_m > 0.0)) throw GlError("view_step_m must be > 0");
+  if (noise && !(s.medium.noise_scale_m > 0.0)) throw GlError("noise_scale_m must be > 0");
+  if (!(s.quality.view_step_m > 0.0)) throw GlError("view_step_m must be > 0");
   const core::PreparedVolume& v = *volume_;
   const core::VolumeGrid& grid = v.grid;
   const GLuint p = program_for(kernel::MarchVariant::of(s)).id();
-  const bool textured = s.globe && !s.ground_texture.empty();
-  if (textured && (s.ground_texture != ground_path_ || s.ground_map_colours != ground_map_colours_)) {
-    const core::AlbedoMap map = load_albedo_map(s.ground_texture, s.ground_map_colours);
+  const bool textured = s.features.globe && !s.medium.ground_texture.empty();
+  if (textured && (s.medium.ground_texture != ground_path_ || s.medium.ground_map_colours != ground_map_colours_)) {
+    const core::AlbedoMap map = load_albedo_map(s.medium.ground_texture, s.medium.ground_map_colours);
     if (ground_) glDeleteTextures(1, &ground_);
     glCreateTextures(GL_TEXTURE_2D, 1, &ground_);
     glTextureStorage2D(ground_, 1, GL_RGBA32F, map.width, map.height);
@@ -162,15 +162,15 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
     check_gl("uploading the ground texture");
     ground_w_ = map.width;
     ground_h_ = map.height;
-    ground_path_ = s.ground_texture;
-    ground_map_colours_ = s.ground_map_colours;
+    ground_path_ = s.medium.ground_texture;
+    ground_map_colours_ = s.medium.ground_map_colours;
   }
   // The kernel's parameters, built as the CPU kernel builds them, packed into the uniform block.
   kernel::MarchParams params =
       core::march_params(v, cam, sun, s, textured ? glm::ivec2(ground_w_, ground_h_) : glm::ivec2(0));
   params.u_has_depth = opaque.depth != 0;
   params.u_has_opaque_color = opaque.depth != 0 && opaque.color != 0;
-  if (s.ms_two_stream) {  // the two-stream source, for this time step and sun
+  if (s.medium.ms_two_stream) {  // the two-stream source, for this time step and sun
     const core::MsSourceKey key = core::ms_source_key(s, params.u_to_sun);
     if (!ms_[0] || ms_volume_ != &v || !(key == ms_key_)) {
       const core::MsSource src = core::build_ms_source(v, key);
@@ -240,8 +240,8 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   // ground: no dispatch exceeds its loop budget (see loop_iterations_per_view_step). Other drivers
   // have no such budget and march every step in one dispatch.
   const double top_m = v.layer.empty ? grid.alt_m.last() : v.layer.top_m;
-  const int total_steps = max_view_steps(r0, top_m, s.view_step_m);
-  const int chunk = loop_budget_ ? view_steps_per_dispatch(s, core::max_sun_march_steps(s.sun_steps, params.u_sun_step_max, r0,
+  const int total_steps = max_view_steps(r0, top_m, s.quality.view_step_m);
+  const int chunk = loop_budget_ ? view_steps_per_dispatch(s, core::max_sun_march_steps(s.quality.sun_steps, params.u_sun_step_max, r0,
                                                                                         v.layer.bottom_m, top_m,
                                                                                         core::smallest_sun_cosine(grid, to_sun)))
                                  : total_steps;

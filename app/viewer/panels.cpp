@@ -192,8 +192,8 @@ void scene_panel(ViewerState& s, PanelContext& ctx) {
         const int w = s.scene.width, h = s.scene.height;
         s.scene = loaded;
         s.scene.width = w, s.scene.height = h;  // the window keeps its size
-        if (s.scene.render.march.view_step_m <= 0.0) {
-          s.scene.render.march.view_step_m = core::resolve_view_step_m(s.scene.render, s.volume.grid);
+        if (s.scene.render.march.quality.view_step_m <= 0.0) {
+          s.scene.render.march.quality.view_step_m = core::resolve_view_step_m(s.scene.render, s.volume.grid);
         }
         ctx.scene_message = "loaded " + ctx.scene_path;
       }

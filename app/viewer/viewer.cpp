@@ -231,8 +231,8 @@ int run_viewer(const ViewerOptions& o) {
     core::apply_quality("default", s.scene.render);
     s.scene.render.accumulate = 64;
   }
-  s.scene.render.march.view_step_m = core::resolve_view_step_m(s.scene.render, g);
-  if (!(s.scene.render.march.droplet_diameter_um > 0.0)) s.scene.render.march.droplet_diameter_um = 2.0 * s.volume.liquid_r_eff_um;
+  s.scene.render.march.quality.view_step_m = core::resolve_view_step_m(s.scene.render, g);
+  if (!(s.scene.render.march.medium.droplet_diameter_um > 0.0)) s.scene.render.march.medium.droplet_diameter_um = 2.0 * s.volume.liquid_r_eff_um;
   if (o.frames > 0) s.scene.render.accumulate = o.frames;
   if (!o.scene || o.scale_given) s.scene.render.resolution_scale = o.scale;
   if (o.frame_budget_ms >= 0.0) s.scene.render.budget_ms = o.frame_budget_ms;
@@ -359,7 +359,7 @@ int run_viewer(const ViewerOptions& o) {
     render::ToneSettings tone;
     tone.exposure = spec.auto_exposure ? auto_exposure : spec.exposure;
     ctx.auto_exposure = auto_exposure;
-    if (s.scene.render.march.atmosphere || s.scene.render.march.globe) tone.background = glm::dvec3(0.0);
+    if (s.scene.render.march.features.atmosphere || s.scene.render.march.features.globe) tone.background = glm::dvec3(0.0);
     presenter.draw(tone, 0, 0, fbw, fbh);
     present_timer.end();
     stats.march_ms = march_timer.ms();

@@ -18,7 +18,7 @@ double sun_step_limit_m(const VolumeGrid& grid, const CloudLayer& layer, const M
   const glm::dvec3 step(grid.lon_deg.step, grid.lat_deg.step, grid.alt_m.step);
   const glm::dvec3 count(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
   const double floor_m = layer.empty ? grid.alt_m.start : layer.bottom_m;
-  return p64::sun_step_limit_m(settings.max_sun_step_m, start, step, count, grid.earth_radius_m + std::max(floor_m, 0.0));
+  return p64::sun_step_limit_m(settings.quality.max_sun_step_m, start, step, count, grid.earth_radius_m + std::max(floor_m, 0.0));
 }
 
 int max_sun_march_steps(int sun_steps, double max_step_m, double r0_m, double bottom_m, double top_m,

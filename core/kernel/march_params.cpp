@@ -20,12 +20,12 @@ MarchParamsStd140 pack_std140(const MarchParams& p) {
 
 MarchVariant MarchVariant::of(const core::MarchSettings& s) {
   MarchVariant v;
-  v.noise = s.noise_amount > 0.0;
-  v.skip_empty = s.skip_empty;
-  v.adaptive = s.adaptive_steps;
-  v.atmosphere = s.atmosphere;
-  v.globe = s.globe;
-  v.two_stream = s.ms_two_stream;
+  v.noise = s.medium.noise_amount > 0.0;
+  v.skip_empty = s.features.skip_empty;
+  v.adaptive = s.features.adaptive_steps;
+  v.atmosphere = s.features.atmosphere;
+  v.globe = s.features.globe;
+  v.two_stream = s.medium.ms_two_stream;
   return v;
 }
 

@@ -61,10 +61,10 @@ TwoStreamColumn two_stream_column(const double* sigma, const double* g, int n, d
 MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun) {
   MsSourceKey k;
   k.to_sun = to_sun;
-  const physics::f64::MieParams mie = physics::f64::mie_params(s.droplet_diameter_um);
+  const physics::f64::MieParams mie = physics::f64::mie_params(s.medium.droplet_diameter_um);
   k.liquid_g = physics::f64::mie_mean_cosine(mie);  // HG for liquid has the same mean cosine
-  k.ice_g = s.ice_g;
-  k.ground_albedo = s.globe ? (s.ground_albedo.x + s.ground_albedo.y + s.ground_albedo.z) / 3.0 : 0.0;
+  k.ice_g = s.medium.ice_g;
+  k.ground_albedo = s.features.globe ? (s.medium.ground_albedo.x + s.medium.ground_albedo.y + s.medium.ground_albedo.z) / 3.0 : 0.0;
   return k;
 }
 

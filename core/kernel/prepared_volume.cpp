@@ -47,7 +47,7 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
   // The settings that go in as they are (CV_MARCH_UNIFORM rows of march_settings.def); the rest
   // below are derived from the settings, the camera, the sun and the prepared volume.
 #define CV_MARCH_SETTING(TYPE, NAME, DEF, GROUP, FIELDS)
-#define CV_MARCH_UNIFORM(MEMBER, UNIFORM) p.UNIFORM = s.MEMBER;
+#define CV_MARCH_UNIFORM(GROUP, MEMBER, UNIFORM) p.UNIFORM = s.CV_SETTING_GROUP(GROUP).MEMBER;
 #include "settings/march_settings.def"
 #undef CV_MARCH_UNIFORM
 #undef CV_MARCH_SETTING
@@ -61,7 +61,7 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
   p.u_tan_half = c.tan_half;
   p.u_to_sun = glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, r0));
   // Night over the whole cloud layer: decided here once, in double, with a margin (earth_shadow.hpp).
-  p.u_sun_down = s.leave_out_night && layer_in_earth_shadow(grid, v.layer, p.u_to_sun);
+  p.u_sun_down = s.features.leave_out_night && layer_in_earth_shadow(grid, v.layer, p.u_to_sun);
   p.u_irradiance = sun.irradiance;
   p.u_r0 = r0;
   p.u_grid_start = {grid.lon_deg.start, grid.lat_deg.start, grid.alt_m.start};
@@ -73,17 +73,17 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
   p.u_cloudless = v.layer.empty;
   p.u_sigma_max = v.sigma_max_per_m;
   p.u_sun_step_max = sun_step_limit_m(grid, v.layer, s);
-  p.u_octave_abc = {s.octave_a, s.octave_b, s.octave_c};
-  if (s.noise_amount > 0.0) {
-    const NoiseAnchor a = noise_anchor(grid_centre_ecef(grid), s.noise_scale_m);
+  p.u_octave_abc = {s.medium.octave_a, s.medium.octave_b, s.medium.octave_c};
+  if (s.medium.noise_amount > 0.0) {
+    const NoiseAnchor a = noise_anchor(grid_centre_ecef(grid), s.medium.noise_scale_m);
     p.u_noise_anchor = a.ecef_m;  // float-exact by construction
     p.u_noise_anchor_frac = a.frac;
-    p.u_noise_period = s.noise_scale_m;
-    p.u_noise_amount = s.noise_amount;
+    p.u_noise_period = s.medium.noise_scale_m;
+    p.u_noise_amount = s.medium.noise_amount;
   }
   p.u_ground_size = ground_size;
   // Float's largest finite value bounds it, so the GPU's copy is never Inf.
-  p.u_sun_tau_limit = std::min(3.0e38, physics::f64::sun_march_tau_limit(s.octaves, s.octave_a, s.min_transmittance));
+  p.u_sun_tau_limit = std::min(3.0e38, physics::f64::sun_march_tau_limit(s.quality.octaves, s.medium.octave_a, s.quality.min_transmittance));
   const auto& levels = v.pyramid.levels();
   p.u_levels = static_cast<int>(levels.size());
   for (std::size_t l = 0; l < levels.size(); ++l) {

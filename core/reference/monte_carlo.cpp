@@ -96,12 +96,12 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
       march_(march),
       mc_(mc),
       noise_(noise) {
-  if (march.atmosphere) {
+  if (march.features.atmosphere) {
     throw std::invalid_argument(
         "monte carlo: atmosphere on is not modelled (clouds only, optionally the globe)");
   }
   if (mc.max_bounces < 1) throw std::invalid_argument("monte carlo: max_bounces must be >= 1");
-  if (march.noise_amount > 0.0 && !noise) throw std::invalid_argument("monte carlo: noise_amount > 0 needs the erosion noise textures");
+  if (march.medium.noise_amount > 0.0 && !noise) throw std::invalid_argument("monte carlo: noise_amount > 0 needs the erosion noise textures");
   // The medium as the march kernel reads it (shaders/kernel/march.glsl medium_at_point), erosion
   // included, and the kernel's tracking (tracking.glsl) over it.
   volume_ = std::make_shared<const PreparedVolume>(prepare_volume(grid, ext));
@@ -112,7 +112,7 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
   k.u_liquid = {volume_->extinction.liquid_per_m.data(), n};
   k.u_ice = {volume_->extinction.ice_per_m.data(), n};
   k.u_min_max = volume_->pyramid_packed.data();
-  k.kNoise = march.noise_amount > 0.0;
+  k.kNoise = march.medium.noise_amount > 0.0;
   if (k.kNoise) {
     k.u_noise_low = {noise->low.texels.data(), glm::ivec3(noise->low.n)};
     k.u_noise_high = {noise->high.texels.data(), glm::ivec3(noise->high.n)};
@@ -186,19 +186,19 @@ double MonteCarloRenderer::transmittance(const glm::dvec3& p, const glm::dvec3& 
 MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec3 d, PathRng& rng,
                                                          MonteCarloStats& st) const {
   const double r0 = grid_.earth_radius_m;
-  const p64::MieParams mie = p64::mie_params(march_.droplet_diameter_um);
+  const p64::MieParams mie = p64::mie_params(march_.medium.droplet_diameter_um);
   const double liquid_g = p64::mie_mean_cosine(mie);  // for liquid_phase_hg
   // The phase function of a point holding liquid sl and ice si, at scattering cosine mu: the mix by
   // extinction share, which is also the density of the direction the path draws there.
   auto phase_at = [&](double sl, double si, double mu) {
     const double sigma = sl + si;
     if (!(sigma > 0.0)) return p64::phase_isotropic();
-    return (sl * (march_.liquid_phase_hg ? p64::phase_hg(mu, liquid_g) : p64::phase_mie(mu, mie)) +
-            si * p64::phase_hg(mu, march_.ice_g)) / sigma;
+    return (sl * (march_.medium.liquid_phase_hg ? p64::phase_hg(mu, liquid_g) : p64::phase_mie(mu, mie)) +
+            si * p64::phase_hg(mu, march_.medium.ice_g)) / sigma;
   };
   // The second technique for the direction into a vertex (peak_mis): the droplets' HG peak lobe
   // around the sun, drawn at every cloud vertex holding liquid. q(w) is its density.
-  const bool peak = mc_.peak_mis && !march_.liquid_phase_hg;
+  const bool peak = mc_.peak_mis && !march_.medium.liquid_phase_hg;
   auto peak_density = [&](const glm::dvec3& w) { return p64::phase_hg_c(glm::dot(w, to_sun_), mie.g_hg, mie.c_hg); };
   PathResult r;
   glm::dvec3 beta(1.0);
@@ -255,16 +255,16 @@ MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec
       // component that scattered, chosen by its share of the extinction, and beta is unchanged.
       double pdf;
       if (rng.uniform() * sigma < sl || !(sigma > 0.0)) {
-        if (march_.liquid_phase_hg) {
+        if (march_.medium.liquid_phase_hg) {
           d = p64::sample_hg(d, liquid_g, glm::dvec2(rng.uniform(), rng.uniform()), pdf);
         } else {
           std::uint32_t state = rng.bits32();
           d = p64::sample_mie(d, mie, state, pdf);
         }
       } else {
-        d = p64::sample_hg(d, march_.ice_g, glm::dvec2(rng.uniform(), rng.uniform()), pdf);
+        d = p64::sample_hg(d, march_.medium.ice_g, glm::dvec2(rng.uniform(), rng.uniform()), pdf);
       }
-    } else if (march_.globe && std::isfinite(t_ground)) {
+    } else if (march_.features.globe && std::isfinite(t_ground)) {
       // A Lambertian ground of constant albedo: lit by the sun through the clouds, and reflecting
       // a cosine-distributed new direction with throughput times albedo.
       p = glm::normalize(p + t_ground * d) * r0;
@@ -275,10 +275,10 @@ MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec
       if (mu_s > 0.0) {
         const double tr = transmittance(p, to_sun_, rng, st);
         r.radiance += beta * sun_.irradiance *
-                      p64::ground_radiance(march_.ground_albedo, mu_s, glm::dvec3(tr), glm::dvec3(0.0));
+                      p64::ground_radiance(march_.medium.ground_albedo, mu_s, glm::dvec3(tr), glm::dvec3(0.0));
       }
-      r.absorbed += beta * (glm::dvec3(1.0) - march_.ground_albedo);
-      beta *= march_.ground_albedo;
+      r.absorbed += beta * (glm::dvec3(1.0) - march_.medium.ground_albedo);
+      beta *= march_.medium.ground_albedo;
       if (r.scatterings >= mc_.max_bounces) {
         r.end = End::Truncated;
         ++st.truncated;

@@ -23,9 +23,9 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   if (opaque && (opaque->distance_m.size() != pixels || (!opaque->radiance_rgba.empty() && opaque->radiance_rgba.size() != 4 * pixels))) {
     throw std::invalid_argument("render_reference: the opaque layer is not of the image's size");
   }
-  const bool eroded = s.noise_amount > 0.0;
+  const bool eroded = s.medium.noise_amount > 0.0;
   if (eroded && !noise) throw std::invalid_argument("render_reference: noise_amount > 0 needs the erosion noise textures");
-  if (eroded && !(s.noise_scale_m > 0.0)) throw std::invalid_argument("render_reference: noise_scale_m must be > 0");
+  if (eroded && !(s.medium.noise_scale_m > 0.0)) throw std::invalid_argument("render_reference: noise_scale_m must be > 0");
   // The very kernel the GPU runs (shaders/kernel/march.glsl), in double, over the same texels.
   kernel::f64::MarchKernel k;
   static_cast<kernel::MarchParams&>(k) =
@@ -36,7 +36,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   k.u_ice = {v.extinction.ice_per_m.data(), n};
   k.u_column_tau = {v.columns.tau.data(), {v.columns.nx, v.columns.ny}, 1};
   MsSource ms;  // the two-stream source, built as the GPU's (core/kernel/ms_source)
-  if (s.ms_two_stream) {
+  if (s.medium.ms_two_stream) {
     ms = build_ms_source(v, ms_source_key(s, k.u_to_sun));
     k.u_ms_i0 = {ms.i0.data(), n};
     k.u_ms_i1 = {ms.i1.data(), n};
@@ -55,12 +55,12 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
     k.u_has_opaque_color = !opaque->radiance_rgba.empty();
     if (k.u_has_opaque_color) k.u_opaque = {opaque->radiance_rgba.data(), {cam.width, cam.height}, 4};
   }
-  k.kSkipEmpty = s.skip_empty;
-  k.kAdaptive = s.adaptive_steps;
-  k.kAtmosphere = s.atmosphere;
-  k.kGlobe = s.globe;
+  k.kSkipEmpty = s.features.skip_empty;
+  k.kAdaptive = s.features.adaptive_steps;
+  k.kAtmosphere = s.features.atmosphere;
+  k.kGlobe = s.features.globe;
   k.kNoise = eroded;
-  k.kTwoStream = s.ms_two_stream;
+  k.kTwoStream = s.medium.ms_two_stream;
 
   ReferenceImage img;
   img.width = cam.width;

@@ -32,8 +32,8 @@ FrameSpec resolve_frame(const Scene& scene, const CloudVolume& volume) {
   f.valid_time_known = vt.iso_utc.find('T') != std::string::npos;
   f.sun = resolve_sun(scene.sun, f.valid_time_known ? std::optional<std::int64_t>(vt.unix_s) : std::nullopt, f.camera.lon_deg);
   f.march = scene.render.march;
-  f.march.view_step_m = resolve_view_step_m(scene.render, g);
-  if (!(f.march.droplet_diameter_um > 0.0)) f.march.droplet_diameter_um = 2.0 * volume.liquid_r_eff_um;  // from the data
+  f.march.quality.view_step_m = resolve_view_step_m(scene.render, g);
+  if (!(f.march.medium.droplet_diameter_um > 0.0)) f.march.medium.droplet_diameter_um = 2.0 * volume.liquid_r_eff_um;  // from the data
   f.accumulate = std::max(1, scene.render.accumulate);
   f.exposure = scene.render.exposure;
   f.auto_exposure = scene.render.auto_exposure;

@@ -40,7 +40,7 @@ void apply_quality(const std::string& name, RenderSettings& render) {
 }
 
 double resolve_view_step_m(const RenderSettings& render, const VolumeGrid& grid) {
-  if (render.march.view_step_m > 0.0) return render.march.view_step_m;
+  if (render.march.quality.view_step_m > 0.0) return render.march.quality.view_step_m;
   const QualityPreset* p = find_quality(render.quality);
   if (!p) p = find_quality("default");
   return p->knobs.view_step_m(grid.alt_m.step);

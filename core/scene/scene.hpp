@@ -39,14 +39,14 @@ struct SunSpec {
 // from the data (CloudVolume::liquid_r_eff_um) when the scene is rendered.
 inline MarchSettings scene_march_defaults() {
   MarchSettings m;
-  m.atmosphere = true;
-  m.globe = true;
-  m.ambient = 1.0;
-  m.droplet_diameter_um = 0.0;  // from the data: twice the effective radius its extinction assumed
+  m.features.atmosphere = true;
+  m.features.globe = true;
+  m.medium.ambient = 1.0;
+  m.medium.droplet_diameter_um = 0.0;  // from the data: twice the effective radius its extinction assumed
   // The two-stream source for multiple scattering: against the Monte Carlo far closer than the
   // octave sum on thick cloud (docs/physics.md), where the octaves leave sunlit cloud darker than
   // the sea. "multiple_scattering": "octaves" in a scene file restores the octave sum.
-  m.ms_two_stream = true;
+  m.medium.ms_two_stream = true;
   return m;
 }
 

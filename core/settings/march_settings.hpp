@@ -66,11 +66,66 @@ constexpr SettingKind setting_kind_of() {
 
 #define CV_SETTING_FIELDS(...) __VA_ARGS__
 
-// The settings of a march, CPU and GPU alike. Members, types and defaults: march_settings.def.
-struct MarchSettings {
-#define CV_MARCH_SETTING(TYPE, NAME, DEF, GROUP, FIELDS) TYPE NAME{DEF};
+// The settings of a march, CPU and GPU alike, split by concern: one struct per group of the table
+// (members, types and defaults: march_settings.def), gathered in MarchSettings. A setting is
+// reached through its group: `m.quality.sun_steps`, `m.medium.ice_g`, `m.features.globe`.
+#define CV_SETTING_GROUP_Medium medium
+#define CV_SETTING_GROUP_Quality quality
+#define CV_SETTING_GROUP_Features features
+#define CV_SETTING_GROUP_PerFrame per_frame
+#define CV_SETTING_GROUP(GROUP) CV_SETTING_GROUP_##GROUP
+#define CV_SETTING_KEEP_Medium_Medium(X) X
+#define CV_SETTING_KEEP_Medium_Quality(X)
+#define CV_SETTING_KEEP_Medium_Features(X)
+#define CV_SETTING_KEEP_Medium_PerFrame(X)
+#define CV_SETTING_KEEP_Quality_Medium(X)
+#define CV_SETTING_KEEP_Quality_Quality(X) X
+#define CV_SETTING_KEEP_Quality_Features(X)
+#define CV_SETTING_KEEP_Quality_PerFrame(X)
+#define CV_SETTING_KEEP_Features_Medium(X)
+#define CV_SETTING_KEEP_Features_Quality(X)
+#define CV_SETTING_KEEP_Features_Features(X) X
+#define CV_SETTING_KEEP_Features_PerFrame(X)
+#define CV_SETTING_KEEP_PerFrame_Medium(X)
+#define CV_SETTING_KEEP_PerFrame_Quality(X)
+#define CV_SETTING_KEEP_PerFrame_Features(X)
+#define CV_SETTING_KEEP_PerFrame_PerFrame(X) X
+// X when the row's GROUP is WANT, nothing otherwise.
+#define CV_SETTING_KEEP(WANT, GROUP, X) CV_SETTING_KEEP_##WANT##_##GROUP(X)
+
+// The medium and the lighting model: what is in the air and how light crosses it.
+struct MediumSettings {
+#define CV_MARCH_SETTING(TYPE, NAME, DEF, GROUP, FIELDS) CV_SETTING_KEEP(Medium, GROUP, TYPE NAME{DEF};)
 #include "settings/march_settings.def"
 #undef CV_MARCH_SETTING
+};
+
+// March quality: steps, cut-offs, jitter (cost against error).
+struct QualitySettings {
+#define CV_MARCH_SETTING(TYPE, NAME, DEF, GROUP, FIELDS) CV_SETTING_KEEP(Quality, GROUP, TYPE NAME{DEF};)
+#include "settings/march_settings.def"
+#undef CV_MARCH_SETTING
+};
+
+// Program features: what the march compiles in or leaves out.
+struct FeatureSettings {
+#define CV_MARCH_SETTING(TYPE, NAME, DEF, GROUP, FIELDS) CV_SETTING_KEEP(Features, GROUP, TYPE NAME{DEF};)
+#include "settings/march_settings.def"
+#undef CV_MARCH_SETTING
+};
+
+// Per-frame state, not part of "the image".
+struct FrameState {
+#define CV_MARCH_SETTING(TYPE, NAME, DEF, GROUP, FIELDS) CV_SETTING_KEEP(PerFrame, GROUP, TYPE NAME{DEF};)
+#include "settings/march_settings.def"
+#undef CV_MARCH_SETTING
+};
+
+struct MarchSettings {
+  MediumSettings medium;
+  QualitySettings quality;
+  FeatureSettings features;
+  FrameState per_frame;
 };
 
 inline constexpr std::size_t kMarchSettingCount = 0
@@ -131,7 +186,7 @@ static_assert(detail::march_setting_rows_consistent(), "march_settings.def: a ro
 template <class Settings, class F>
 void for_each_march_setting(Settings& m, F&& f) {
   std::size_t i = 0;
-#define CV_MARCH_SETTING(TYPE, NAME, DEF, GROUP, FIELDS) f(kMarchSettingRows[i++], m.NAME);
+#define CV_MARCH_SETTING(TYPE, NAME, DEF, GROUP, FIELDS) f(kMarchSettingRows[i++], m.CV_SETTING_GROUP(GROUP).NAME);
 #include "settings/march_settings.def"
 #undef CV_MARCH_SETTING
 }
@@ -140,7 +195,8 @@ void for_each_march_setting(Settings& m, F&& f) {
 template <class A, class B, class F>
 void for_each_march_setting_pair(A& a, B& b, F&& f) {
   std::size_t i = 0;
-#define CV_MARCH_SETTING(TYPE, NAME, DEF, GROUP, FIELDS) f(kMarchSettingRows[i++], a.NAME, b.NAME);
+#define CV_MARCH_SETTING(TYPE, NAME, DEF, GROUP, FIELDS) \
+  f(kMarchSettingRows[i++], a.CV_SETTING_GROUP(GROUP).NAME, b.CV_SETTING_GROUP(GROUP).NAME);
 #include "settings/march_settings.def"
 #undef CV_MARCH_SETTING
 }

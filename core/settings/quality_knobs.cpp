@@ -32,7 +32,7 @@ void apply_knobs(const QualityKnobs& k, double dz_m, RenderSettings& render, boo
 #include "settings/quality_knobs.def"
 #undef CV_QUALITY_KNOB
 #undef CV_QUALITY_STEP_KNOB
-  render.march.view_step_m = dz_m > 0.0 ? k.view_step_m(dz_m) : 0.0;
+  render.march.quality.view_step_m = dz_m > 0.0 ? k.view_step_m(dz_m) : 0.0;
 }
 
 QualityKnobs knobs_of(const RenderSettings& render, double view_step_m, double dz_m) {

@@ -59,9 +59,9 @@ int main(int argc, char** argv) {
     }
     const cv::core::GridMeanExtinction ext = cv::core::grid_mean_extinction(sc.grid, sc.data);
     cv::core::MarchSettings m = sc.march;  // clouds only, as the bench's references
-    m.atmosphere = m.globe = false;
-    m.ambient = 0.0, m.noise_amount = 0.0;
-    if (!(m.droplet_diameter_um > 0.0)) m.droplet_diameter_um = 20.0;
+    m.features.atmosphere = m.features.globe = false;
+    m.medium.ambient = 0.0, m.medium.noise_amount = 0.0;
+    if (!(m.medium.droplet_diameter_um > 0.0)) m.medium.droplet_diameter_um = 20.0;
     cv::core::MonteCarloSettings mc;
     mc.threads = threads;
     mc.peak_mis = peak_mis;

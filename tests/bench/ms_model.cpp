@@ -60,9 +60,9 @@ int main(int argc, char** argv) {
     }
     const cv::core::GridMeanExtinction ext = cv::core::grid_mean_extinction(sc.grid, sc.data);
     cv::core::MarchSettings m = sc.march;
-    m.atmosphere = m.globe = false;
-    m.ambient = 0.0, m.noise_amount = 0.0;
-    if (!(m.droplet_diameter_um > 0.0)) m.droplet_diameter_um = 20.0;
+    m.features.atmosphere = m.features.globe = false;
+    m.medium.ambient = 0.0, m.medium.noise_amount = 0.0;
+    if (!(m.medium.droplet_diameter_um > 0.0)) m.medium.droplet_diameter_um = 20.0;
     cv::core::MonteCarloSettings mc;
     const cv::core::MonteCarloImage img = cv::core::render_monte_carlo(sc.grid, ext, sc.camera, sc.sun, m, mc, spp);
     const std::vector<glm::dvec3> ref = img.radiance();
@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
     std::printf("%-14s %10.4g %6.1f%% |", name.c_str(), lum / ref.size(), 100.0 * std::sqrt(nvar) / lum);
     for (bool two : {false, true}) {
       cv::core::MarchSettings mm = m;
-      mm.ms_two_stream = two;
+      mm.medium.ms_two_stream = two;
       const cv::core::ReferenceImage r = cv::core::render_reference(sc.grid, ext, sc.camera, sc.sun, mm);
       const cv::bench::ImageError e = cv::bench::image_error(r.radiance, ref, var);
       std::printf(" %+7.1f%% %7.1f%% |", 100.0 * e.rel_bias, 100.0 * e.rel_rmse);

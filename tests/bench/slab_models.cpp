@@ -28,8 +28,8 @@ double nadir(const ImportedSlab& s, cv::core::MarchSettings m, double theta0) {
   cam.pitch_deg = -90.0;
   cam.fov_deg = 1e-3;
   cam.width = cam.height = 1;
-  m.view_step_m = 5.0;
-  m.sun_steps = 256;
+  m.quality.view_step_m = 5.0;
+  m.quality.sun_steps = 256;
   const cv::core::ReferenceImage r = cv::core::render_reference(s.grid, s.medium, cam, sun_at_zenith_angle(theta0), m);
   return r.radiance[0].y;
 }
@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
       write_slab_file(path, tau, ph);
       const ImportedSlab s = import_slab(path, ph);
       cv::core::MarchSettings m = march_for(ph, s);
-      m.octaves = octaves;
+      m.quality.octaves = octaves;
       slabcheck::SlabProblem p;
       p.tau = tau;
       p.phase = phase;
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
       for (double z : zeniths) {
         const double ref = sol.nadir_radiance(std::cos(z * kPi / 180.0));
         cv::core::MarchSettings two = m;
-        two.ms_two_stream = true;
+        two.medium.ms_two_stream = true;
         const double a = nadir(s, m, z), b = nadir(s, two, z);
         std::printf("| %s | %g | %g | %.5f | %+.1f %% | %+.1f %% |\n", phase_name(ph), tau, z, ref, 100.0 * (a / ref - 1.0),
                     100.0 * (b / ref - 1.0));

@@ -106,12 +106,12 @@ TEST(EarthShadow, TheSmallestSunCosineBoundsEveryPointOfTheDomain) {
 TEST(EarthShadow, NightLeavesTheReferenceImageAsThePerSampleTestMadeIt) {
   StandardScene sc = standard_scene("cumulus_field", 32, 18);
   sc.sun = sun_just_down(sc);
-  sc.march.atmosphere = sc.march.globe = true;
-  sc.march.ambient = 1.0;
+  sc.march.features.atmosphere = sc.march.features.globe = true;
+  sc.march.medium.ambient = 1.0;
   const GridMeanExtinction medium = grid_mean_extinction(sc.grid, sc.data);
-  sc.march.leave_out_night = false;
+  sc.march.features.leave_out_night = false;
   const ReferenceImage per_sample = render_reference(sc.grid, medium, sc.camera, sc.sun, sc.march);
-  sc.march.leave_out_night = true;
+  sc.march.features.leave_out_night = true;
   const ReferenceImage night = render_reference(sc.grid, medium, sc.camera, sc.sun, sc.march);
   EXPECT_FALSE(per_sample.stats.sun_down);
   EXPECT_TRUE(night.stats.sun_down);

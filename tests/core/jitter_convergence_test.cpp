@@ -17,10 +17,10 @@ using namespace cv;
 std::vector<double> mean_of_frames(const bench::StandardScene& sc, const core::GridMeanExtinction& medium,
                                    bool blue, int first, int count) {
   core::MarchSettings s = sc.march;
-  s.blue_noise = blue;
+  s.quality.blue_noise = blue;
   std::vector<double> sum;
   for (int f = first; f < first + count; ++f) {
-    s.frame = f;
+    s.per_frame.frame = f;
     const core::ReferenceImage img = core::render_reference(sc.grid, medium, sc.camera, sc.sun, s);
     if (sum.empty()) sum.assign(img.radiance.size() * 3, 0.0);
     for (std::size_t i = 0; i < img.radiance.size(); ++i)

@@ -127,8 +127,8 @@ TEST(MonteCarlo, ANonAbsorbingSlabConservesEnergy) {
     // The same slab over a Lambertian ground of albedo 0.5: paths bounce between the two and Russian
     // roulette ends them. Energy out to space plus energy the ground absorbed must be the beam's.
     MarchSettings m;
-    m.globe = true;
-    m.ground_albedo = glm::dvec3(0.5);
+    m.features.globe = true;
+    m.medium.ground_albedo = glm::dvec3(0.5);
     MonteCarloSettings mc;
     mc.roulette_after = 1;
     const MonteCarloRenderer r(slab.grid, slab.ext, nadir_pixel(), Sun{}, m, mc);
@@ -169,9 +169,9 @@ TEST(MonteCarlo, SingleScatteringAgreesWithTheRaymarcher) {
   // The deck seen from above: every pixel looks at cloud of optical depth up to 6.
   const SceneCase c("stratocumulus", 24, 14);
   MarchSettings m = c.scene.march;
-  m.octaves = 1;
-  m.view_step_m = 10.0;
-  m.sun_steps = 128;
+  m.quality.octaves = 1;
+  m.quality.view_step_m = 10.0;
+  m.quality.sun_steps = 128;
   auto t0 = std::chrono::steady_clock::now();
   const ReferenceImage ref = render_reference(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m);
   const double t_ref = seconds_since(t0);
@@ -293,8 +293,8 @@ TEST(MonteCarlo, MeasuresTheOctaveApproximation) {
     res.sd_rel = std::sqrt(noise_var) / mc_lum;
     for (int k = 0; k < 5; ++k) {
       const auto [octaves, gate] = configs[k];
-      m.octaves = octaves;
-      m.octave_gate = gate;
+      m.quality.octaves = octaves;
+      m.features.octave_gate = gate;
       const ReferenceImage ref = render_reference(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m);
       double ref_lum = 0.0, sq = 0.0;
       for (std::size_t i = 0; i < ref.radiance.size(); ++i) {
@@ -362,9 +362,9 @@ struct DeckCase {
   GridMeanExtinction ext = grid_mean_extinction(sc.grid, sc.data);
   MarchSettings m;
   explicit DeckCase(double droplet_um) : m(sc.march) {
-    m.atmosphere = m.globe = false;
-    m.ambient = 0.0, m.noise_amount = 0.0;
-    m.droplet_diameter_um = droplet_um;
+    m.features.atmosphere = m.features.globe = false;
+    m.medium.ambient = 0.0, m.medium.noise_amount = 0.0;
+    m.medium.droplet_diameter_um = droplet_um;
   }
 };
 

@@ -132,15 +132,15 @@ TEST(Pyramid, SkippingEmptySpaceLeavesTheImageUnchanged) {
   const Tower t;
   const GridMeanExtinction m = grid_mean_extinction(t.grid, t.data);
   MarchSettings s;
-  s.view_step_m = 250.0;
-  s.sun_steps = 16;
-  s.octaves = 4;
-  s.min_transmittance = 0.0;  // no early exits: only skipping differs
+  s.quality.view_step_m = 250.0;
+  s.quality.sun_steps = 16;
+  s.quality.octaves = 4;
+  s.quality.min_transmittance = 0.0;  // no early exits: only skipping differs
   for (int frame : {-1, 5}) {
-    s.frame = frame;
-    s.skip_empty = false;
+    s.per_frame.frame = frame;
+    s.features.skip_empty = false;
     const ReferenceImage plain = render_reference(t.grid, m, tower_camera(), tower_sun(), s);
-    s.skip_empty = true;
+    s.features.skip_empty = true;
     const ReferenceImage skip = render_reference(t.grid, m, tower_camera(), tower_sun(), s);
     double max_l = 0.0, worst = 0.0, worst_t = 0.0;
     for (const auto& l : plain.radiance) max_l = std::max(max_l, l.x);
@@ -186,27 +186,27 @@ TEST(Pyramid, AdaptedStepsConvergeFasterOnATowerAtEqualSamples) {
   const Tower t;
   const GridMeanExtinction m = grid_mean_extinction(t.grid, t.data);
   MarchSettings s;
-  s.sun_steps = 16;
-  s.octaves = 4;
-  s.view_step_m = 5.0;  // the reference: a fixed 5 m step (optical depth <= 0.1 per step)
+  s.quality.sun_steps = 16;
+  s.quality.octaves = 4;
+  s.quality.view_step_m = 5.0;  // the reference: a fixed 5 m step (optical depth <= 0.1 per step)
   const ReferenceImage ref = render_reference(t.grid, m, tower_camera(), tower_sun(), s);
-  s.adaptive_steps = true;
-  s.max_step_optical_depth = 0.5;
+  s.features.adaptive_steps = true;
+  s.quality.max_step_optical_depth = 0.5;
   int wins = 0, cases = 0;
   for (double step : {2000.0, 1000.0, 500.0}) {
-    s.adaptive_steps = true;
-    s.view_step_m = step;
+    s.features.adaptive_steps = true;
+    s.quality.view_step_m = step;
     const ReferenceImage adaptive = render_reference(t.grid, m, tower_camera(), tower_sun(), s);
     // The fixed step with at least as many view samples as the adaptive march took.
-    s.adaptive_steps = false;
+    s.features.adaptive_steps = false;
     ReferenceImage fixed;
-    for (s.view_step_m = step; s.view_step_m > 1.0; s.view_step_m *= 0.8) {
+    for (s.quality.view_step_m = step; s.quality.view_step_m > 1.0; s.quality.view_step_m *= 0.8) {
       fixed = render_reference(t.grid, m, tower_camera(), tower_sun(), s);
       if (fixed.stats.view_samples >= adaptive.stats.view_samples) break;
     }
     const double e_a = mean_error(adaptive, ref), e_f = mean_error(fixed, ref);
     std::printf("base step %6.0f m adaptive: %7llu view samples, error %.3g | fixed %6.1f m: %7llu samples, error %.3g\n",
-                step, static_cast<unsigned long long>(adaptive.stats.view_samples), e_a, s.view_step_m,
+                step, static_cast<unsigned long long>(adaptive.stats.view_samples), e_a, s.quality.view_step_m,
                 static_cast<unsigned long long>(fixed.stats.view_samples), e_f);
     ++cases;
     wins += e_a < e_f;

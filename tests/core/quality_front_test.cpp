@@ -252,23 +252,23 @@ TEST(QualityFront, KnobsApplyWhereTheTableSays) {
   k.resolution_scale = 0.25, k.adaptive = true;
   RenderSettings r;
   apply_knobs(k, 400.0, r);
-  EXPECT_DOUBLE_EQ(r.march.view_step_m, 800.0);
-  EXPECT_EQ(r.march.sun_steps, 7);
-  EXPECT_EQ(r.march.octaves, 3);
+  EXPECT_DOUBLE_EQ(r.march.quality.view_step_m, 800.0);
+  EXPECT_EQ(r.march.quality.sun_steps, 7);
+  EXPECT_EQ(r.march.quality.octaves, 3);
   EXPECT_EQ(r.accumulate, 5);
   EXPECT_DOUBLE_EQ(r.resolution_scale, 0.25);
-  EXPECT_TRUE(r.march.adaptive_steps);
+  EXPECT_TRUE(r.march.features.adaptive_steps);
   EXPECT_EQ(knobs_of(r, 800.0, 400.0).sun_steps, 7);
   EXPECT_DOUBLE_EQ(knobs_of(r, 800.0, 400.0).view_step_dz, 2.0);
 
   RenderSettings p;
-  p.resolution_scale = 0.5, p.march.adaptive_steps = true;
+  p.resolution_scale = 0.5, p.march.features.adaptive_steps = true;
   apply_quality("low", p);
   EXPECT_EQ(p.quality, "low");
-  EXPECT_EQ(p.march.view_step_m, 0.0);  // from the grid
-  EXPECT_EQ(p.march.sun_steps, find_quality("low")->knobs.sun_steps);
+  EXPECT_EQ(p.march.quality.view_step_m, 0.0);  // from the grid
+  EXPECT_EQ(p.march.quality.sun_steps, find_quality("low")->knobs.sun_steps);
   EXPECT_DOUBLE_EQ(p.resolution_scale, 0.5);
-  EXPECT_TRUE(p.march.adaptive_steps);
+  EXPECT_TRUE(p.march.features.adaptive_steps);
 }
 
 // Candidates with given front times, most accurate first.

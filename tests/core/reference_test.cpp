@@ -52,8 +52,8 @@ TEST(Reference, SingleScatteringMatchesTheClosedFormAndConvergesWithTheStep) {
   double previous = 1.0;
   for (double step : {100.0, 50.0, 25.0}) {
     MarchSettings s;
-    s.view_step_m = step;
-    s.sun_steps = 64;
+    s.quality.view_step_m = step;
+    s.quality.sun_steps = 64;
     const auto img = render_reference(l.grid, l.data, nadir(), Sun{}, s);
     const double err = std::abs(img.radiance[0].x - expected) / expected;
     std::printf("view step %5.1f m: relative error %.3g\n", step, err);
@@ -87,7 +87,7 @@ TEST(Reference, TheEarthsShadowAndAnEmptySky) {
 TEST(Reference, OctavesBrightenAThickCloudAndNothingIsNaN) {
   Layer l(0.05);  // optical depth 50
   MarchSettings one, eight;
-  eight.octaves = 8;
+  eight.quality.octaves = 8;
   const auto a = render_reference(l.grid, l.data, nadir(), Sun{}, one);
   const auto b = render_reference(l.grid, l.data, nadir(), Sun{}, eight);
   ASSERT_TRUE(std::isfinite(a.radiance[0].x) && std::isfinite(b.radiance[0].x));

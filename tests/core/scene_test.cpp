@@ -121,13 +121,13 @@ TEST(SceneJson, MissingKeysTakeTheDefaultsAndTheDefaultPreset) {
   EXPECT_EQ(s.width, 960);
   EXPECT_EQ(s.sun.mode, SunMode::ValidTime);
   EXPECT_EQ(s.render.quality, "default");
-  EXPECT_EQ(s.render.march.sun_steps, 16);
-  EXPECT_EQ(s.render.march.octaves, 4);
-  EXPECT_EQ(s.render.march.view_step_m, 0.0);  // from the grid
+  EXPECT_EQ(s.render.march.quality.sun_steps, 16);
+  EXPECT_EQ(s.render.march.quality.octaves, 4);
+  EXPECT_EQ(s.render.march.quality.view_step_m, 0.0);  // from the grid
   // A preset named in the file sets the march, and march keys in the file override it.
   const Scene h = scene_from_json(R"({"version": 1, "render": {"quality": "high", "march": {"octaves": 2}}})");
-  EXPECT_EQ(h.render.march.sun_steps, 32);
-  EXPECT_EQ(h.render.march.octaves, 2);
+  EXPECT_EQ(h.render.march.quality.sun_steps, 32);
+  EXPECT_EQ(h.render.march.quality.octaves, 2);
   EXPECT_EQ(h.render.accumulate, 4);
 }
 
@@ -215,12 +215,12 @@ TEST(Quality, PresetsSetTheMarchAndTheViewStepFollowsTheGrid) {
   RenderSettings r;
   apply_quality("low", r);
   EXPECT_EQ(resolve_view_step_m(r, g), 1000.0);
-  EXPECT_EQ(r.march.sun_steps, 8);
-  EXPECT_EQ(r.march.octaves, 1);
+  EXPECT_EQ(r.march.quality.sun_steps, 8);
+  EXPECT_EQ(r.march.quality.octaves, 1);
   apply_quality("default", r);
   EXPECT_EQ(resolve_view_step_m(r, g), 500.0);
-  EXPECT_EQ(r.march.sun_steps, 16);
-  EXPECT_EQ(r.march.octaves, 4);
+  EXPECT_EQ(r.march.quality.sun_steps, 16);
+  EXPECT_EQ(r.march.quality.octaves, 4);
   EXPECT_EQ(r.accumulate, 1);
   apply_quality("high", r);
   EXPECT_EQ(resolve_view_step_m(r, g), 250.0);
@@ -229,7 +229,7 @@ TEST(Quality, PresetsSetTheMarchAndTheViewStepFollowsTheGrid) {
   g.alt_m.step = 20.0;
   apply_quality("default", r);
   EXPECT_EQ(resolve_view_step_m(r, g), 50.0);
-  r.march.view_step_m = 123.0;  // set by hand: used as it is
+  r.march.quality.view_step_m = 123.0;  // set by hand: used as it is
   EXPECT_EQ(resolve_view_step_m(r, g), 123.0);
   EXPECT_THROW(apply_quality("custom", r), std::invalid_argument);
 }

@@ -38,7 +38,7 @@ TEST(SunSteps, ThinCloudTakesFewerSunSamplesForASmallError) {
     const StandardScene sc = standard_scene(name, 48, 27);
     const GridMeanExtinction ext = grid_mean_extinction(sc.grid, sc.data);
     MarchSettings full = sc.march;
-    full.max_sun_step_optical_depth = 0.0;
+    full.quality.max_sun_step_optical_depth = 0.0;
     using clock = std::chrono::steady_clock;
     auto t0 = clock::now();
     const ReferenceImage a = render_reference(sc.grid, ext, sc.camera, sc.sun, full);
@@ -58,7 +58,7 @@ TEST(SunSteps, ThinCloudTakesFewerSunSamplesForASmallError) {
     }
     std::printf("%-14s max sun step optical depth %.3g: sun samples %llu -> %llu, CPU %.2f -> %.2f s; error of the "
                 "brightest pixel mean %.2g, worst %.2g\n",
-                name, sc.march.max_sun_step_optical_depth, static_cast<unsigned long long>(a.stats.sun_samples),
+                name, sc.march.quality.max_sun_step_optical_depth, static_cast<unsigned long long>(a.stats.sun_samples),
                 static_cast<unsigned long long>(b.stats.sun_samples), ta, tb, mean, worst);
     EXPECT_LE(b.stats.sun_samples, a.stats.sun_samples) << name;
     EXPECT_LT(worst, 1e-3) << name;
@@ -162,10 +162,10 @@ TEST(SunSteps, AGrazingSunMatchesTheFineMarch) {
   const StandardScene sc = standard_scene("sunset", 64, 36);
   const GridMeanExtinction ext = grid_mean_extinction(sc.grid, sc.data);
   MarchSettings m = sc.march;
-  m.octaves = 1;
+  m.quality.octaves = 1;
   MarchSettings fine = m;
-  fine.sun_steps = 1024;
-  fine.max_sun_step_optical_depth = 0.0;
+  fine.quality.sun_steps = 1024;
+  fine.quality.max_sun_step_optical_depth = 0.0;
   auto mean_luminance = [&](const MarchSettings& s, ReferenceImage& img) {
     img = render_reference(sc.grid, ext, sc.camera, sc.sun, s);
     double sum = 0.0;
@@ -173,12 +173,12 @@ TEST(SunSteps, AGrazingSunMatchesTheFineMarch) {
     return sum / static_cast<double>(img.radiance.size());
   };
   MarchSettings fixed = m;  // the march before the length limit: 16 steps per segment however long
-  fixed.max_sun_step_m = 1e7;
+  fixed.quality.max_sun_step_m = 1e7;
   ReferenceImage a, b, c;
   const double l_default = mean_luminance(m, a), l_fine = mean_luminance(fine, b), l_fixed = mean_luminance(fixed, c);
   std::printf("sunset 64x36, 1 octave: mean luminance %.5f at %d sun steps (steps <= %.0f m), %.5f at 1024 (%+.2f %%); "
               "sun samples %llu against %llu\n",
-              l_default, m.sun_steps, sun_step_limit_m(sc.grid, cloud_layer(sc.grid, ext), m), l_fine,
+              l_default, m.quality.sun_steps, sun_step_limit_m(sc.grid, cloud_layer(sc.grid, ext), m), l_fine,
               100.0 * (l_default / l_fine - 1.0), static_cast<unsigned long long>(a.stats.sun_samples),
               static_cast<unsigned long long>(b.stats.sun_samples));
   std::printf("without the length limit (16 steps per segment): mean luminance %.5f (%.1fx), sun samples %llu\n", l_fixed,
@@ -194,7 +194,7 @@ TEST(SunSteps, AHighSunsImageIsUnchanged) {
   const StandardScene sc = standard_scene("cumulus_field", 48, 27);
   const GridMeanExtinction ext = grid_mean_extinction(sc.grid, sc.data);
   MarchSettings off = sc.march;
-  off.max_sun_step_m = 1e7;
+  off.quality.max_sun_step_m = 1e7;
   const ReferenceImage a = render_reference(sc.grid, ext, sc.camera, sc.sun, sc.march);
   const ReferenceImage b = render_reference(sc.grid, ext, sc.camera, sc.sun, off);
   ASSERT_EQ(a.radiance.size(), b.radiance.size());

@@ -68,9 +68,9 @@ core::Sun cells_sun() {
 
 core::MarchSettings cells_settings() {
   core::MarchSettings s;
-  s.view_step_m = 200.0;
-  s.sun_steps = 16;
-  s.octaves = 4;
+  s.quality.view_step_m = 200.0;
+  s.quality.sun_steps = 16;
+  s.quality.octaves = 4;
   return s;
 }
 
@@ -105,11 +105,11 @@ TEST(Accel, SkippingEmptyBricksLeavesTheGpuImageUnchanged) {
   CellsOnGpu g;
   core::MarchSettings s = cells_settings();
   for (int frame : {-1, 3}) {
-    s.frame = frame;
-    s.skip_empty = false;
+    s.per_frame.frame = frame;
+    s.features.skip_empty = false;
     const auto plain = g.gpu.render(cells_camera(), cells_sun(), s);
     const core::MarchStats plain_stats = g.gpu.last_stats();
-    s.skip_empty = true;
+    s.features.skip_empty = true;
     const auto skip = g.gpu.render(cells_camera(), cells_sun(), s);
     const core::MarchStats skip_stats = g.gpu.last_stats();
     const auto cpu = core::render_reference(g.sc.grid, g.medium, cells_camera(), cells_sun(), s);
@@ -139,12 +139,12 @@ TEST(Accel, SkippingEmptyBricksLeavesTheGpuImageUnchanged) {
 TEST(Accel, AdaptedStepsOnTheGpuMatchTheReference) {
   CellsOnGpu g;
   core::MarchSettings s = cells_settings();
-  s.adaptive_steps = true;
-  s.max_step_optical_depth = 0.5;
+  s.features.adaptive_steps = true;
+  s.quality.max_step_optical_depth = 0.5;
   const auto img = g.gpu.render(cells_camera(), cells_sun(), s);
   const core::MarchStats gs = g.gpu.last_stats();
   const auto cpu = core::render_reference(g.sc.grid, g.medium, cells_camera(), cells_sun(), s);
-  s.adaptive_steps = false;
+  s.features.adaptive_steps = false;
   const auto fixed = core::render_reference(g.sc.grid, g.medium, cells_camera(), cells_sun(), s);
   const Diff d = compare(img, cpu.radiance, cpu.transmittance);
   std::printf("adapted steps: GPU vs CPU radiance %.3g, transmittance %.3g\n", d.radiance, d.transmittance);

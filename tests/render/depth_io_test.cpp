@@ -40,8 +40,8 @@ struct UniformCloud {
     grid.alt_m = {0.0, 250.0, 17};
     data[core::Field::ExtinctionLiquid].assign(grid.points(), static_cast<float>(kSigma));
     cam.alt_m = 2000.0, cam.pitch_deg = 90.0, cam.fov_deg = 30.0, cam.width = kSize, cam.height = kSize;
-    march.view_step_m = 50.0;
-    march.octaves = 1;
+    march.quality.view_step_m = 50.0;
+    march.quality.octaves = 1;
   }
 };
 

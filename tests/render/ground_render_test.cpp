@@ -60,13 +60,13 @@ core::Sun sun_over(double lat, double lon) {
 
 core::MarchSettings globe_settings(bool atmosphere) {
   core::MarchSettings s;
-  s.view_step_m = 50.0;
-  s.sun_steps = 16;
-  s.octaves = 4;
-  s.atmosphere = atmosphere;
-  s.globe = true;
-  s.ambient = atmosphere ? 1.0 : 0.0;
-  s.ground_texture = render::kNaturalEarthRelief;
+  s.quality.view_step_m = 50.0;
+  s.quality.sun_steps = 16;
+  s.quality.octaves = 4;
+  s.features.atmosphere = atmosphere;
+  s.features.globe = true;
+  s.medium.ambient = atmosphere ? 1.0 : 0.0;
+  s.medium.ground_texture = render::kNaturalEarthRelief;
   return s;
 }
 
@@ -74,7 +74,7 @@ TEST(GroundRender, OpenSeaAtNadirUnderAnOverheadSunStaysInThePhysicalRange) {
   if (!have_data()) GTEST_SKIP() << "python-cartopy-data is not installed (scripts/setup installs it)";
   const core::AlbedoMap map = render::load_albedo_map(render::kNaturalEarthRelief);
   const Slab clear(0.0f);
-  const double mss = p64::cox_munk_mss(core::MarchSettings{}.ocean_wind_m_s);
+  const double mss = p64::cox_munk_mss(core::MarchSettings{}.medium.ocean_wind_m_s);
   // Without air, so the pixel is the ground's own light: pi L / (E mu_s) is its reflectance factor.
   // The sun over (0, -150); a camera 2000 km up at nadir there sees the glint at its centre, and,
   // 40 degrees off nadir (looking 40 degrees from straight down), sea outside it.
@@ -131,8 +131,8 @@ TEST(GroundRender, CloudOfOpticalDepth50AgainstTheSeaBesideIt) {
   for (int variant = 0; variant < 3; ++variant) {
     const bool map_colours = variant == 0;
     core::MarchSettings s = globe_settings(true);
-    s.ground_map_colours = map_colours;
-    s.ms_two_stream = variant == 2;
+    s.medium.ground_map_colours = map_colours;
+    s.medium.ms_two_stream = variant == 2;
     const core::AlbedoMap map = render::load_albedo_map(render::kNaturalEarthRelief, map_colours);
     const auto img = core::render_reference(slab.grid, slab.data, cam, sun, s, nullptr, &map);
     // Luminance (Rec. 709 weights of the linear radiance, per unit irradiance).

@@ -21,21 +21,21 @@ using namespace cv;
 TEST(LeaveOut, NightOnTheGpuIsThePerSampleImage) {
   bench::StandardScene sc = bench::standard_scene("cumulus_field", 32, 18);
   sc.sun = test::sun_just_down(sc);
-  sc.march.atmosphere = sc.march.globe = true;
-  sc.march.ambient = 1.0;
+  sc.march.features.atmosphere = sc.march.features.globe = true;
+  sc.march.medium.ambient = 1.0;
   auto ctx = render::make_headless_context();
   render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
   render::GpuRaymarcher gpu(loader);
   const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
   gpu.upload(sc.grid, medium);
   using clock = std::chrono::steady_clock;
-  sc.march.leave_out_night = false;
+  sc.march.features.leave_out_night = false;
   gpu.render(sc.camera, sc.sun, sc.march);  // warm-up: the first render's timing is not the march's
   auto t0 = clock::now();
   const auto per_sample = gpu.render(sc.camera, sc.sun, sc.march);
   const double t_per_sample = std::chrono::duration<double>(clock::now() - t0).count();
   EXPECT_FALSE(gpu.last_stats().sun_down);
-  sc.march.leave_out_night = true;
+  sc.march.features.leave_out_night = true;
   t0 = clock::now();
   const auto night = gpu.render(sc.camera, sc.sun, sc.march);
   const double t_night = std::chrono::duration<double>(clock::now() - t0).count();
@@ -67,7 +67,7 @@ TEST(LeaveOut, ThinCloudTakesFewerSunStepsOnTheGpu) {
     const bench::StandardScene sc = bench::standard_scene(name, 96, 54);
     gpu.upload(sc.grid, core::grid_mean_extinction(sc.grid, sc.data));
     core::MarchSettings all = sc.march;
-    all.max_sun_step_optical_depth = 0.0;
+    all.quality.max_sun_step_optical_depth = 0.0;
     gpu.render(sc.camera, sc.sun, all);  // warm-up
     double best[2] = {1e30, 1e30};
     std::uint64_t samples[2] = {0, 0};
@@ -102,13 +102,13 @@ namespace {
 // and with the gate off it evaluates them all.
 TEST(LeaveOut, TheGateCountsTheOctaveTermsItLeavesOut) {
   bench::StandardScene sc = bench::standard_scene("thin_cirrus", 32, 18);
-  sc.march.octaves = 4;
+  sc.march.quality.octaves = 4;
   auto ctx = render::make_headless_context();
   render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
   render::GpuRaymarcher gpu(loader);
   const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
   gpu.upload(sc.grid, medium);
-  sc.march.octave_gate = true;
+  sc.march.features.octave_gate = true;
   gpu.render(sc.camera, sc.sun, sc.march);
   const core::MarchStats gated = gpu.last_stats();
   const core::ReferenceImage cpu = core::render_reference(sc.grid, medium, sc.camera, sc.sun, sc.march);
@@ -121,7 +121,7 @@ TEST(LeaveOut, TheGateCountsTheOctaveTermsItLeavesOut) {
   EXPECT_GE(gated.octave_terms * 4, gated.octave_terms_full);  // never fewer than the first octave
   EXPECT_NEAR(double(gated.octave_terms), double(cpu.stats.octave_terms), 1e-3 * double(cpu.stats.octave_terms));
   EXPECT_NEAR(double(gated.octave_terms_full), double(cpu.stats.octave_terms_full), 1e-3 * double(cpu.stats.octave_terms_full));
-  sc.march.octave_gate = false;
+  sc.march.features.octave_gate = false;
   gpu.render(sc.camera, sc.sun, sc.march);
   const core::MarchStats classic = gpu.last_stats();
   EXPECT_EQ(classic.octave_terms, classic.octave_terms_full);

@@ -71,15 +71,15 @@ core::Sun noise_sun() {
 
 core::MarchSettings noise_settings(double amount) {
   core::MarchSettings s;
-  s.view_step_m = 150.0;
-  s.sun_steps = 16;
-  s.octaves = 4;
-  s.noise_amount = amount;
-  s.noise_scale_m = 20000.0;
+  s.quality.view_step_m = 150.0;
+  s.quality.sun_steps = 16;
+  s.quality.octaves = 4;
+  s.medium.noise_amount = amount;
+  s.medium.noise_scale_m = 20000.0;
   // The classic octave sum these tests were measured with: the octave gate darkens this scene's
   // thin cloud against its thick cloud, which raises the plain image's own |Laplacian| / |gradient|
   // (1.78 -> 2.25, measured) and so hides what NoiseAddsFineDetail looks for, the noise's detail.
-  s.octave_gate = false;
+  s.features.octave_gate = false;
   return s;
 }
 
@@ -186,7 +186,7 @@ TEST(NoiseRender, NoiseOnlyRemovesCloudAndStaysFinite) {
   for (double amount : {0.3, 1.0}) {
     for (double scale : {3000.0, 50000.0}) {
       core::MarchSettings s = noise_settings(amount);
-      s.noise_scale_m = scale;
+      s.medium.noise_scale_m = scale;
       const auto img = core::render_reference(sc.grid, medium, cam, noise_sun(), s, &noise);
       int thinner = 0;
       for (std::size_t i = 0; i < img.transmittance.size(); ++i) {

@@ -52,9 +52,9 @@ TEST(Raymarch, GpuMatchesTheCpuReference) {
   core::Sun sun = low_eastern_sun();
   sun.irradiance = glm::dvec3(1.0, 0.8, 0.5);  // distinct channels: a channel mix-up shows
   core::MarchSettings s;
-  s.view_step_m = 200.0;
-  s.sun_steps = 16;
-  s.octaves = 4;
+  s.quality.view_step_m = 200.0;
+  s.quality.sun_steps = 16;
+  s.quality.octaves = 4;
   const auto cpu = core::render_reference(sc.grid, medium, cam, sun, s);
   const auto img = gpu.render(cam, sun, s);
   double max_l = 0.0;
@@ -75,7 +75,7 @@ TEST(Raymarch, GpuMatchesTheCpuReference) {
   EXPECT_LT(worst, 1e-3);
   EXPECT_LT(worst_t, 1e-3);
   // With jittered steps (an accumulation frame) both march through the same points.
-  s.frame = 7;
+  s.per_frame.frame = 7;
   const auto cpu_j = core::render_reference(sc.grid, medium, cam, sun, s);
   const auto gpu_j = gpu.render(cam, sun, s);
   double worst_j = 0.0, changed = 0.0;
@@ -87,7 +87,7 @@ TEST(Raymarch, GpuMatchesTheCpuReference) {
   EXPECT_LT(worst_j, 1e-3);
   EXPECT_GT(changed, 1e-4);  // the jitter does move the samples
   // The white-noise hash the blue noise replaced (march.blue_noise = false) is still the same on both.
-  s.blue_noise = false;
+  s.quality.blue_noise = false;
   const auto cpu_h = core::render_reference(sc.grid, medium, cam, sun, s);
   const auto gpu_h = gpu.render(cam, sun, s);
   double worst_h = 0.0, differs = 0.0;
@@ -108,9 +108,9 @@ TEST(Raymarch, BlueNoiseJitterTilesPastTheMaskOnGpuAsOnCpu) {
   const core::Camera cam = bubble_camera(80, 70);
   const core::Sun sun = low_eastern_sun();
   core::MarchSettings s;
-  s.view_step_m = 400.0;  // coarse: the offsets matter, and llvmpipe stays quick on 5600 pixels
-  s.sun_steps = 8;
-  s.frame = 3;
+  s.quality.view_step_m = 400.0;  // coarse: the offsets matter, and llvmpipe stays quick on 5600 pixels
+  s.quality.sun_steps = 8;
+  s.per_frame.frame = 3;
   const auto cpu = core::render_reference(sc.grid, medium, cam, sun, s);
   const auto img = gpu.render(cam, sun, s);
   double max_l = 0.0;
@@ -138,9 +138,9 @@ TEST(Raymarch, FarCamerasMatchTheCpuReference) {
   sun.subsolar_lat_deg = 5.0;
   sun.subsolar_lon_deg = 20.0;
   core::MarchSettings s;
-  s.view_step_m = 200.0;
-  s.sun_steps = 16;
-  s.octaves = 4;
+  s.quality.view_step_m = 200.0;
+  s.quality.sun_steps = 16;
+  s.quality.octaves = 4;
   for (const auto& [alt, fov] : {std::pair{3.6e7, 0.8}, std::pair{4e8, 0.07}}) {
     core::Camera cam;
     cam.alt_m = alt;
@@ -191,8 +191,8 @@ TEST(Raymarch, TheBundledSampleRendersWithCloudAndWithoutNaN) {
   sun.subsolar_lat_deg = -21.0;
   sun.subsolar_lon_deg = 190.0;
   core::MarchSettings s;
-  s.view_step_m = 500.0;
-  s.octaves = 4;
+  s.quality.view_step_m = 500.0;
+  s.quality.octaves = 4;
   const auto img = gpu.render(cam, sun, s);
   int cloudy = 0, clear = 0;
   for (const auto& p : img) {
@@ -263,9 +263,9 @@ void expect_gpu_matches_cpu(std::initializer_list<GlobalCase> cases) {
   const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
   gpu.upload(sc.grid, medium);
   core::MarchSettings s;
-  s.view_step_m = 250.0;
-  s.sun_steps = 16;
-  s.octaves = 4;
+  s.quality.view_step_m = 250.0;
+  s.quality.sun_steps = 16;
+  s.quality.octaves = 4;
   for (const GlobalCase& c : cases) {
     const auto cpu = core::render_reference(sc.grid, medium, c.cam, c.sun, s);
     const auto img = gpu.render(c.cam, c.sun, s);
@@ -320,11 +320,11 @@ TEST(Raymarch, LiquidPhaseChoiceMatchesTheReference) {
   const core::Camera cam = bubble_camera(32, 18);
   const core::Sun sun = low_eastern_sun();
   core::MarchSettings s;
-  s.view_step_m = 200.0;
-  s.sun_steps = 16;
-  s.octaves = 4;
+  s.quality.view_step_m = 200.0;
+  s.quality.sun_steps = 16;
+  s.quality.octaves = 4;
   const auto mie = core::render_reference(sc.grid, medium, cam, sun, s);
-  s.liquid_phase_hg = true;
+  s.medium.liquid_phase_hg = true;
   const auto cpu = core::render_reference(sc.grid, medium, cam, sun, s);
   const auto img = gpu.render(cam, sun, s);
   double max_l = 0.0, worst = 0.0, change = 0.0;

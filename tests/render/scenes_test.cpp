@@ -74,8 +74,8 @@ TEST_P(StandardScenes, GpuMatchesTheCpuReferenceWithEveryPixelFinite) {
 // the globe (constant albedo) with the clouds' shadows, GPU against CPU within the sky tests' bounds.
 TEST_P(StandardScenes, WithSkyAndGlobeTheGpuMatchesTheCpuReference) {
   bench::StandardScene sc = bench::standard_scene(GetParam(), 32, 18);
-  sc.march.atmosphere = sc.march.globe = true;
-  sc.march.ambient = 1.0;
+  sc.march.features.atmosphere = sc.march.features.globe = true;
+  sc.march.medium.ambient = 1.0;
   const Comparison c = compare_on_gpu(sc);
   ASSERT_GT(c.max_l, 0.0) << "the sky or the ground should be lit";
   std::printf("%-14s with sky and globe: radiance error (of the brightest pixel) mean %.3g, worst %.3g; alpha worst %.3g\n",
@@ -89,7 +89,7 @@ TEST_P(StandardScenes, WithSkyAndGlobeTheGpuMatchesTheCpuReference) {
 // clouds-only bound, every pixel finite.
 TEST_P(StandardScenes, TwoStreamGpuMatchesTheCpuReference) {
   bench::StandardScene sc = bench::standard_scene(GetParam(), 32, 18);
-  sc.march.ms_two_stream = true;
+  sc.march.medium.ms_two_stream = true;
   const Comparison c = compare_on_gpu(sc);
   std::printf("%-14s two-stream: radiance error (of the brightest pixel) mean %.3g, worst %.3g\n", sc.name.c_str(), c.mean,
               c.worst);
@@ -105,9 +105,9 @@ TEST_P(StandardScenes, TwoStreamGpuMatchesTheCpuReference) {
 TEST_P(StandardScenes, SkippingEmptySpaceLeavesTheImageExactlyAsItWas) {
   bench::StandardScene sc = bench::standard_scene(GetParam(), 32, 18);
   const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
-  sc.march.skip_empty = false;
+  sc.march.features.skip_empty = false;
   const auto plain = core::render_reference(sc.grid, medium, sc.camera, sc.sun, sc.march);
-  sc.march.skip_empty = true;
+  sc.march.features.skip_empty = true;
   const auto skipped = core::render_reference(sc.grid, medium, sc.camera, sc.sun, sc.march);
   for (std::size_t i = 0; i < plain.radiance.size(); ++i) {
     ASSERT_EQ(plain.radiance[i], skipped.radiance[i]) << sc.name << " pixel " << i;

@@ -62,14 +62,14 @@ TEST(SkyGlobe, ACloudShadowsTheGroundBesideIt) {
   core::Sun sun;
   sun.subsolar_lon_deg = 70.0;  // 20 degrees above the eastern horizon of (0, 0)
   core::MarchSettings s;
-  s.view_step_m = 100.0;
-  s.sun_steps = 32;
-  s.globe = true;
+  s.quality.view_step_m = 100.0;
+  s.quality.sun_steps = 32;
+  s.features.globe = true;
   const int west = column_at(cam, -0.11), east = column_at(cam, 0.11);
   ASSERT_GT(east, west);
   for (bool atmosphere : {false, true}) {
-    s.atmosphere = atmosphere;
-    s.ambient = atmosphere ? 1.0 : 0.0;
+    s.features.atmosphere = atmosphere;
+    s.medium.ambient = atmosphere ? 1.0 : 0.0;
     const auto img = core::render_reference(sc.grid, sc.data, cam, sun, s);
     auto at = [&](int x) { return img.radiance[static_cast<std::size_t>(4 * cam.width + x)]; };
     // The ground is opaque, and neither pixel looks through the cloud.
@@ -115,18 +115,18 @@ void expect_gpu_matches_cpu_with_sky(std::initializer_list<Case> cases) {
   const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
   gpu.upload(sc.grid, medium);
   core::MarchSettings s;
-  s.view_step_m = 200.0;
-  s.sun_steps = 16;
-  s.octaves = 4;
-  s.atmosphere = true;
-  s.globe = true;
-  s.ambient = 1.0;
+  s.quality.view_step_m = 200.0;
+  s.quality.sun_steps = 16;
+  s.quality.octaves = 4;
+  s.features.atmosphere = true;
+  s.features.globe = true;
+  s.medium.ambient = 1.0;
   // The Natural Earth relief when python-cartopy-data is installed (scripts/setup installs it),
   // else a constant albedo: both paths use the same sampling on both sides.
   std::unique_ptr<core::AlbedoMap> map;
   if (std::filesystem::exists(render::kNaturalEarthRelief)) {
-    s.ground_texture = render::kNaturalEarthRelief;
-    map = std::make_unique<core::AlbedoMap>(render::load_albedo_map(s.ground_texture));
+    s.medium.ground_texture = render::kNaturalEarthRelief;
+    map = std::make_unique<core::AlbedoMap>(render::load_albedo_map(s.medium.ground_texture));
   }
   for (const Case& c : cases) {
     core::Sun sun;

@@ -54,11 +54,11 @@ core::Sun sun_at(double lat, double lon) {
 
 // The clouds' octave sum per unit extinction, sum_i b^i p(mu; c^i g), the larger of liquid's and ice's.
 double octave_phase(const core::MarchSettings& s, double mu) {
-  const p64::MieParams mie = p64::mie_params(s.droplet_diameter_um);
-  const double liquid = s.liquid_phase_hg
-                            ? p64::ms_octaves_hg(1.0, mu, p64::mie_mean_cosine(mie), 0.0, s.octaves, s.octave_a, s.octave_b, s.octave_c)
-                            : p64::ms_octaves_mie(1.0, mu, mie, 0.0, s.octaves, s.octave_a, s.octave_b, s.octave_c);
-  return std::max(liquid, p64::ms_octaves_hg(1.0, mu, s.ice_g, 0.0, s.octaves, s.octave_a, s.octave_b, s.octave_c));
+  const p64::MieParams mie = p64::mie_params(s.medium.droplet_diameter_um);
+  const double liquid = s.medium.liquid_phase_hg
+                            ? p64::ms_octaves_hg(1.0, mu, p64::mie_mean_cosine(mie), 0.0, s.quality.octaves, s.medium.octave_a, s.medium.octave_b, s.medium.octave_c)
+                            : p64::ms_octaves_mie(1.0, mu, mie, 0.0, s.quality.octaves, s.medium.octave_a, s.medium.octave_b, s.medium.octave_c);
+  return std::max(liquid, p64::ms_octaves_hg(1.0, mu, s.medium.ice_g, 0.0, s.quality.octaves, s.medium.octave_a, s.medium.octave_b, s.medium.octave_c));
 }
 
 // The air's largest phase value at mu (its scattering is Rayleigh plus Cornette-Shanks Mie).
@@ -68,10 +68,10 @@ double air_phase(double mu) { return std::max(p64::phase_rayleigh(mu), p64::phas
 // transmittance is t (docs/physics.md): air off, (1 - t) S(mu); air on, the largest of the air's
 // phase, S(mu) plus the ambient sky's 1/(4 pi) per unit strength, and the ground's 1.5 albedo / pi.
 double bound_at(const core::MarchSettings& s, double mu, double t) {
-  if (!s.atmosphere && !s.globe) return (1.0 - t) * octave_phase(s, mu);
-  const double albedo = std::max({s.ground_albedo.x, s.ground_albedo.y, s.ground_albedo.z});
-  return std::max({s.atmosphere ? air_phase(mu) : 0.0, octave_phase(s, mu) + s.ambient / (4.0 * kPi),
-                   s.globe ? 1.5 * albedo / kPi : 0.0});
+  if (!s.features.atmosphere && !s.features.globe) return (1.0 - t) * octave_phase(s, mu);
+  const double albedo = std::max({s.medium.ground_albedo.x, s.medium.ground_albedo.y, s.medium.ground_albedo.z});
+  return std::max({s.features.atmosphere ? air_phase(mu) : 0.0, octave_phase(s, mu) + s.medium.ambient / (4.0 * kPi),
+                   s.features.globe ? 1.5 * albedo / kPi : 0.0});
 }
 
 // The same, maximised over mu: the GPU forms its own mu in float, and near a 0.999 lobe's peak a
@@ -138,7 +138,7 @@ struct Suite {
     const double any_mu_sky = bound_any_mu(s, 0.0);
     const Worst wg = hold_to_bound(
         sun, n, [&](std::size_t i) { return glm::dvec3(img[i]); }, [&](std::size_t i) { return double(img[i].w); },
-        [&](std::size_t, double t) { return s.atmosphere || s.globe ? any_mu_sky : bound_any_mu(s, t); }, 1e-3, 1e-5);
+        [&](std::size_t, double t) { return s.features.atmosphere || s.features.globe ? any_mu_sky : bound_any_mu(s, t); }, 1e-3, 1e-5);
     double max_l = 1e-30, worst = 0.0, mean = 0.0, worst_t = 0.0;
     for (const auto& l : cpu.radiance) max_l = std::max({max_l, l.x, l.y, l.z});
     for (std::size_t i = 0; i < n; ++i) {
@@ -167,10 +167,10 @@ struct Suite {
   void run_accel(const char* name, const core::VolumeGrid& grid, const core::GridMeanExtinction& medium,
                  const core::Camera& cam, const core::Sun& sun, core::MarchSettings s, double err_bound = 1e-3) {
     for (int m = 0; m < 4; ++m) {
-      s.skip_empty = m & 1;
-      s.adaptive_steps = m & 2;
+      s.features.skip_empty = m & 1;
+      s.features.adaptive_steps = m & 2;
       char label[96];
-      std::snprintf(label, sizeof label, "%s%s%s", name, s.skip_empty ? " +skip" : "", s.adaptive_steps ? " +adapt" : "");
+      std::snprintf(label, sizeof label, "%s%s%s", name, s.features.skip_empty ? " +skip" : "", s.features.adaptive_steps ? " +adapt" : "");
       run(label, grid, medium, cam, sun, s, err_bound);
     }
   }
@@ -183,9 +183,9 @@ struct Suite {
 
 core::MarchSettings clouds_only(int octaves = 4) {
   core::MarchSettings s;  // air and globe off
-  s.view_step_m = 100.0;
-  s.sun_steps = 8;
-  s.octaves = octaves;
+  s.quality.view_step_m = 100.0;
+  s.quality.sun_steps = 8;
+  s.quality.octaves = octaves;
   return s;
 }
 
@@ -223,7 +223,7 @@ TEST(Stability, TheBoundIsTightEnoughToCatchADoubledRadiance) {
   Box b(0.0, 0.0, 1e-5);  // optical depth 0.01 through the 1 km layer
   const core::Sun sun = sun_at(0.0, 0.0);
   core::MarchSettings s = clouds_only(1);
-  s.ice_g = 0.0;  // the bound takes the larger phase of liquid and ice: keep ice's below liquid's here
+  s.medium.ice_g = 0.0;  // the bound takes the larger phase of liquid and ice: keep ice's below liquid's here
   // Looking 30 degrees off the sun (the GPU's float mu moves a forward peak's value; not here).
   const core::Camera cam = camera(0.0, 0.0, 0.0, 0.0, 60.0, 8.0);
   const auto img = st.run("thin cloud overhead", b.grid, core::grid_mean_extinction(b.grid, b.data), cam, sun, s);
@@ -250,7 +250,7 @@ TEST(Stability, AsymmetryUpTo0999) {
   for (double g : {0.999, -0.999}) {
     Box b(0.0, 0.0, 2e-4, core::Field::ExtinctionIce);
     core::MarchSettings s = clouds_only();
-    s.ice_g = g;
+    s.medium.ice_g = g;
     const core::Sun sun = sun_at(0.0, 0.0);  // overhead
     // Forward peak: from the ground looking up at the sun through the ice; back peak: from above.
     const core::Camera cam = g > 0 ? camera(0.0, 0.0, 0.0, 0.0, 90.0, 4.0) : camera(0.0, 0.0, 8000.0, 0.0, -90.0, 4.0);
@@ -267,7 +267,7 @@ TEST(Stability, DropletDiametersAtTheMieBranchBoundaries) {
   const auto medium = core::grid_mean_extinction(b.grid, b.data);
   for (double d : {0.0999, 0.1, 0.1001, 1.4999, 1.5, 1.5001, 4.999, 5.0, 5.001, 49.99, 50.0, 50.01}) {
     core::MarchSettings s = clouds_only();
-    s.droplet_diameter_um = d;
+    s.medium.droplet_diameter_um = d;
     char name[64];
     std::snprintf(name, sizeof name, "droplet %.4g um", d);
     st.run(name, b.grid, medium, side_view(0.0, 0.0), sun_at(0.0, 40.0), s);
@@ -282,8 +282,8 @@ TEST(Stability, SunAtAndBelowTheHorizon) {
   for (double lon : {90.0, 90.5, 95.0, 120.0}) {                     // at the horizon of (0, 0), then below
     for (bool air : {false, true}) {
       core::MarchSettings s = clouds_only();
-      s.atmosphere = s.globe = air;
-      s.ambient = air ? 1.0 : 0.0;
+      s.features.atmosphere = s.features.globe = air;
+      s.medium.ambient = air ? 1.0 : 0.0;
       char name[64];
       std::snprintf(name, sizeof name, "sun at lon %.1f, air %s", lon, air ? "on" : "off");
       st.run(name, b.grid, medium, cam, sun_at(0.0, lon), s, air ? 2e-3 : 1e-3);

@@ -38,7 +38,7 @@ TEST(TiledDispatch, TilesGiveTheSamePixelsAsOneDispatch) {
   core::Sun sun;
   sun.subsolar_lat_deg = 20.0, sun.subsolar_lon_deg = 40.0;
   core::MarchSettings s;
-  s.view_step_m = 200.0, s.sun_steps = 8, s.octaves = 2;
+  s.quality.view_step_m = 200.0, s.quality.sun_steps = 8, s.quality.octaves = 2;
 
   const std::vector<glm::vec4> whole = gpu.render(cam, sun, s);
   std::vector<int> reported;

@@ -161,11 +161,11 @@ inline ImportedSlab import_slab(const std::string& path, SlabPhase phase, const 
 // Clouds only (no air, no globe: black space above and the ground absorbs), the slab's phase.
 inline core::MarchSettings march_for(SlabPhase phase, const ImportedSlab& s) {
   core::MarchSettings m;
-  m.atmosphere = false;
-  m.globe = false;
-  m.ice_g = 0.85;
-  m.liquid_phase_hg = false;
-  m.droplet_diameter_um = 2.0 * s.liquid_r_eff_um;  // as core::resolve_frame takes it from the data
+  m.features.atmosphere = false;
+  m.features.globe = false;
+  m.medium.ice_g = 0.85;
+  m.medium.liquid_phase_hg = false;
+  m.medium.droplet_diameter_um = 2.0 * s.liquid_r_eff_um;  // as core::resolve_frame takes it from the data
   (void)phase;
   return m;
 }

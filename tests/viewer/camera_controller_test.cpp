@@ -85,9 +85,9 @@ TEST(ViewerState, IsoTimesAndWhatResetsTheAccumulation) {
   a.camera = camera(1, 2, 3, 4, 5);
   core::Scene b = a;
   b.render.exposure *= 2.0;  // tonemap only
-  b.render.march.frame = 7;  // the accumulation's own counter
+  b.render.march.per_frame.frame = 7;  // the accumulation's own counter
   EXPECT_TRUE(viewer::same_march(a, b));
-  b.render.march.view_step_m += 1.0;
+  b.render.march.quality.view_step_m += 1.0;
   EXPECT_FALSE(viewer::same_march(a, b));
   b = a;
   b.camera->heading_deg += 0.001;
