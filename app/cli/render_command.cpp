@@ -82,7 +82,15 @@ void apply_march_flag(const core::SettingRow& row, const std::string& text, core
     using T = std::decay_t<decltype(value)>;
     if (&r != &row) return;
     if constexpr (std::is_same_v<T, bool>) {
-      value = !def;
+      if (row.kind == core::SettingKind::Choice) {  // one of the two names, as in a scene file
+        if (text != row.choices[0] && text != row.choices[1]) {
+          throw UsageError{"cloudviewer render: " + std::string(row.flag) + ": found '" + text + "', expected " +
+                           core::expected_text(row)};
+        }
+        value = text == row.choices[1];
+      } else {
+        value = !def;
+      }
     } else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, double>) {
       double v = 0.0;
       std::size_t used = 0;
@@ -262,6 +270,8 @@ const char* render_usage() {
           if constexpr (std::is_same_v<std::decay_t<decltype(value)>, bool>) on = &r == &row ? value : on;
         });
         t += "         " + opt + row.key + " " + (on ? "false" : "true") + " (" + (on ? "true" : "false") + ": " + row.doc + ")";
+      } else if (row.kind == core::SettingKind::Choice) {
+        t += "         " + opt + row.key + ": " + row.doc + " (" + row.choices[0] + " or " + row.choices[1] + ")";
       } else {
         t += "         " + opt + row.key + ": " + row.doc + " (" + core::range_text(row) + ")";
       }

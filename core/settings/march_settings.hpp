@@ -43,7 +43,8 @@ struct SettingRow {
   const char* what = nullptr;      // noun phrase of messages: "a view step in metres"
   const char* note = nullptr;      // appended to the range in messages: "0: from the grid"
   bool image = true;               // a change changes the image (the viewer restarts accumulating)
-  const char* flag = nullptr;      // `render`'s option; for a Bool, a flag without a value that sets !default
+  const char* flag = nullptr;      // `render`'s option; for a Bool, a flag without a value that sets !default;
+                                   // for a Choice, one that takes one of the choices' names
   const char* metavar = nullptr;   // its value in the usage text
   const char* label = nullptr;     // the viewer's widget; nullptr: no widget
   double wlo = 0.0, whi = 0.0;     // the widget's range, where all of lo..hi is unusable as a slider
@@ -169,7 +170,7 @@ constexpr bool march_setting_rows_consistent() {
     if (numeric && !(r.lo <= r.hi)) return false;
     if ((r.kind == SettingKind::Real || r.kind == SettingKind::Rgb01) && !r.what) return false;
     if (r.label && numeric && r.kind != SettingKind::Rgb01 && !(r.wlo < r.whi)) return false;
-    if (r.flag && (r.kind == SettingKind::Choice || r.kind == SettingKind::Text || r.kind == SettingKind::Rgb01)) return false;
+    if (r.flag && (r.kind == SettingKind::Text || r.kind == SettingKind::Rgb01)) return false;
     if (r.flag && r.kind != SettingKind::Bool && !r.metavar) return false;
     if (r.needs) {
       bool found = false;
