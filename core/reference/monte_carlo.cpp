@@ -16,8 +16,6 @@
 
 namespace cv::core {
 namespace {
-namespace p64 = cv::physics::f64;
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 const glm::dvec3 kLumWeights(0.2126, 0.7152, 0.0722);
 
@@ -121,50 +119,21 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
   // only lowers extinction (erode_extinction keeps at most the data's value).
   k.u_track_majorant = volume_->sigma_max_per_m;
   k.u_track_bricks = mc.brick_majorants;
-  to_sun_ = glm::normalize(
-      geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, grid.earth_radius_m));
+  k.u_path_max_bounces = mc.max_bounces;
+  k.u_path_roulette_after = mc.roulette_after;
+  k.u_path_peak_mis = mc.peak_mis;
+  k.kGlobe = march.features.globe;
 }
 
 double MonteCarloRenderer::majorant_per_m() const { return kernel_->u_track_majorant; }
 
-void MonteCarloRenderer::extinction(const glm::dvec3& p, double& sl, double& si) const { kernel_->medium_at_point(p, sl, si); }
-
-int MonteCarloRenderer::shell_parts(const glm::dvec3& p, const glm::dvec3& d, double seg[4],
-                                    double& t_ground) const {
-  const double r0 = grid_.earth_radius_m;
-  const double r = glm::length(p), alt = r - r0;
-  const glm::dvec3 up = p / r;
-  const double mu = glm::dot(d, up), nu = glm::length(glm::cross(d, up));
-  t_ground = kInf;
-  double g0, g1;
-  // A rising ray from the ground or above never meets it: a point placed on the ground may round to
-  // a nanometre below it, and must not then find the ground at t = 0.
-  const bool rising = mu >= 0.0 && alt > -1.0;
-  if (!rising && p64::ray_sphere_rel_nu(r0, alt, mu, nu, 0.0, g0, g1) && g1 > 0.0) {
-    t_ground = std::max(g0, 0.0);
-  }
-  glm::dvec4 s;
-  const int n = p64::ray_shell_rel_nu(r0, alt, mu, nu, grid_.alt_m.start, grid_.alt_m.last(), s);
-  int kept = 0;
-  for (int k = 0; k < n; ++k) {
-    const double a = s[2 * k], b = std::min(s[2 * k + 1], t_ground);
-    if (b > a) {
-      seg[2 * kept] = a;
-      seg[2 * kept + 1] = b;
-      ++kept;
-    }
-  }
-  return kept;
-}
 
 double MonteCarloRenderer::free_path(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng,
                                      MonteCarloStats& st, double* ground_m) const {
-  double seg[4], t_ground;
-  const int n = shell_parts(p, d, seg, t_ground);
-  if (ground_m) *ground_m = t_ground;
-  // Delta tracking: a tentative collision is real with probability sigma / majorant.
   kernel::f64::TrackKernel::TrackCounts c = kernel_->track_counts();
-  const double t = kernel_->delta_track(p, d, glm::dvec4(seg[0], seg[1], seg[2], seg[3]), n, rng, c);
+  double t_ground;
+  const double t = kernel_->path_free_path(p, d, rng, c, t_ground);
+  if (ground_m) *ground_m = t_ground < 3.0e38 ? t_ground : kInf;
   st.null_collisions += c.null_collisions;
   st.majorant_exceeded += c.exceeded;
   return t < 3.0e38 ? t : kInf;
@@ -172,141 +141,37 @@ double MonteCarloRenderer::free_path(const glm::dvec3& p, const glm::dvec3& d, P
 
 double MonteCarloRenderer::transmittance(const glm::dvec3& p, const glm::dvec3& d, PathRng& rng,
                                          MonteCarloStats& st) const {
-  double seg[4], t_ground;
-  const int n = shell_parts(p, d, seg, t_ground);
-  if (std::isfinite(t_ground)) return 0.0;  // the Earth's shadow
-  // Ratio tracking, with roulette deep in thick cloud.
   kernel::f64::TrackKernel::TrackCounts c = kernel_->track_counts();
-  const double tr = kernel_->ratio_track(p, d, glm::dvec4(seg[0], seg[1], seg[2], seg[3]), n, rng, c);
+  const double tr = kernel_->path_transmittance(p, d, rng, c);
   st.shadow_lookups += c.lookups;
   st.majorant_exceeded += c.exceeded;
   return tr;
 }
 
+// The path is the kernel's (shaders/kernel/path.glsl), the one the GPU path tracer runs.
 MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec3 d, PathRng& rng,
                                                          MonteCarloStats& st) const {
-  const double r0 = grid_.earth_radius_m;
-  const p64::MieParams mie = p64::mie_params(march_.medium.droplet_diameter_um);
-  const double liquid_g = p64::mie_mean_cosine(mie);  // for liquid_phase_hg
-  // The phase function of a point holding liquid sl and ice si, at scattering cosine mu: the mix by
-  // extinction share, which is also the density of the direction the path draws there.
-  auto phase_at = [&](double sl, double si, double mu) {
-    const double sigma = sl + si;
-    if (!(sigma > 0.0)) return p64::phase_isotropic();
-    return (sl * (march_.medium.liquid_phase_hg ? p64::phase_hg(mu, liquid_g) : p64::phase_mie(mu, mie)) +
-            si * p64::phase_hg(mu, march_.medium.ice_g)) / sigma;
-  };
-  // The second technique for the direction into a vertex (peak_mis): the droplets' HG peak lobe
-  // around the sun, drawn at every cloud vertex holding liquid. q(w) is its density.
-  const bool peak = mc_.peak_mis && !march_.medium.liquid_phase_hg;
-  auto peak_density = [&](const glm::dvec3& w) { return p64::phase_hg_c(glm::dot(w, to_sun_), mie.g_hg, mie.c_hg); };
-  PathResult r;
-  glm::dvec3 beta(1.0);
+  kernel::f64::TrackKernel::TrackCounts c = kernel_->track_counts();
+  kernel::f64::TrackKernel::PathCounts pc = kernel_->path_counts();
+  const kernel::f64::TrackKernel::PathResult k = kernel_->trace_path(p, d, rng, c, pc);
   ++st.paths;
-  // The vertex the current direction was drawn at, when the peak technique could have drawn it too.
-  bool prev_peak = false;
-  double prev_sl = 0.0, prev_si = 0.0;
-  glm::dvec3 prev_d(0.0);
-  for (;;) {
-    double t_ground;
-    const double t = free_path(p, d, rng, st, &t_ground);
-    if (std::isfinite(t)) {
-      p += t * d;
-      double sl, si;
-      extinction(p, sl, si);
-      const double sigma = sl + si;
-      ++r.scatterings;
-      ++st.scatterings;
-      // Next-event estimation: the sun is a delta light, reachable only this way. The scattering
-      // cosine is between the sunlight's propagation (-to_sun) and the light's toward the camera (-d).
-      // Balance heuristic against the peak technique, which could have drawn d at the vertex before.
-      double w = 1.0;
-      if (prev_peak) {
-        const double p_prev = phase_at(prev_sl, prev_si, glm::dot(prev_d, d));
-        w = p_prev / (p_prev + peak_density(d));
-      }
-      r.radiance += beta * sun_.irradiance * (w * phase_at(sl, si, glm::dot(d, to_sun_)) * transmittance(p, to_sun_, rng, st));
-      if (r.scatterings >= mc_.max_bounces) {
-        r.end = End::Truncated;
-        ++st.truncated;
-        break;
-      }
-      if (!roulette(r, beta, rng, st)) break;
-      // The peak technique: a direction w ~ q around the sun, the free path along it, the sun's light
-      // at the vertex it reaches, weighted q / (p + q) (the path's own technique is weighted above).
-      prev_peak = peak && sl > 0.0;
-      if (prev_peak) {
-        ++st.peak_samples;
-        double q;
-        const glm::dvec3 wq = p64::sample_hg(to_sun_, mie.g_hg, glm::dvec2(rng.uniform(), rng.uniform()), q);
-        q = peak_density(wq);  // with c_hg kept apart (the sampler's pdf loses digits near g = 1)
-        const double p_here = phase_at(sl, si, glm::dot(d, wq));
-        const double tq = free_path(p, wq, rng, st);
-        if (std::isfinite(tq) && p_here > 0.0) {
-          const glm::dvec3 x = p + tq * wq;
-          double sl2, si2;
-          extinction(x, sl2, si2);
-          r.radiance += beta * sun_.irradiance *
-                        (p_here / (p_here + q) * phase_at(sl2, si2, glm::dot(wq, to_sun_)) * transmittance(x, to_sun_, rng, st));
-        }
-        prev_sl = sl, prev_si = si, prev_d = d;
-      }
-      // Clouds do not absorb (albedo 1): the new direction is drawn from the phase function of the
-      // component that scattered, chosen by its share of the extinction, and beta is unchanged.
-      double pdf;
-      if (rng.uniform() * sigma < sl || !(sigma > 0.0)) {
-        if (march_.medium.liquid_phase_hg) {
-          d = p64::sample_hg(d, liquid_g, glm::dvec2(rng.uniform(), rng.uniform()), pdf);
-        } else {
-          std::uint32_t state = rng.bits32();
-          d = p64::sample_mie(d, mie, state, pdf);
-        }
-      } else {
-        d = p64::sample_hg(d, march_.medium.ice_g, glm::dvec2(rng.uniform(), rng.uniform()), pdf);
-      }
-    } else if (march_.features.globe && std::isfinite(t_ground)) {
-      // A Lambertian ground of constant albedo: lit by the sun through the clouds, and reflecting
-      // a cosine-distributed new direction with throughput times albedo.
-      p = glm::normalize(p + t_ground * d) * r0;
-      const glm::dvec3 n = p / r0;
-      ++r.scatterings;
-      ++st.scatterings;
-      const double mu_s = glm::dot(n, to_sun_);
-      if (mu_s > 0.0) {
-        const double tr = transmittance(p, to_sun_, rng, st);
-        r.radiance += beta * sun_.irradiance *
-                      p64::ground_radiance(march_.medium.ground_albedo, mu_s, glm::dvec3(tr), glm::dvec3(0.0));
-      }
-      r.absorbed += beta * (glm::dvec3(1.0) - march_.medium.ground_albedo);
-      beta *= march_.medium.ground_albedo;
-      if (r.scatterings >= mc_.max_bounces) {
-        r.end = End::Truncated;
-        ++st.truncated;
-        break;
-      }
-      if (!roulette(r, beta, rng, st)) break;
-      prev_peak = false;  // a cosine draw from the ground: no other technique makes it
-      d = p64::direction_around(n, std::sqrt(rng.uniform()), p64::CV_TWO_PI * rng.uniform());
-    } else {
-      r.end = std::isfinite(t_ground) ? End::Ground : End::Space;
-      break;
-    }
-  }
-  r.weight = beta;
+  st.scatterings += static_cast<std::uint64_t>(k.scatterings);
+  st.null_collisions += c.null_collisions;
+  st.shadow_lookups += c.lookups;
+  st.majorant_exceeded += c.exceeded;
+  st.truncated += pc.truncated;
+  st.roulette_killed += pc.roulette_killed;
+  st.peak_samples += pc.peak_samples;
+  PathResult r;
+  r.radiance = k.radiance;
+  r.weight = k.weight;
+  r.absorbed = k.absorbed;
+  r.scatterings = k.scatterings;
+  r.end = k.end == CV_PATH_GROUND ? End::Ground
+          : k.end == CV_PATH_TRUNCATED ? End::Truncated
+          : k.end == CV_PATH_ROULETTE ? End::Roulette
+                                      : End::Space;
   return r;
-}
-
-bool MonteCarloRenderer::roulette(PathResult& r, glm::dvec3& beta, PathRng& rng, MonteCarloStats& st) const {
-  if (r.scatterings < mc_.roulette_after) return true;
-  const double q = std::min(1.0, std::max({beta.x, beta.y, beta.z}));
-  if (q >= 1.0) return true;
-  if (rng.uniform() >= q) {
-    r.end = End::Roulette;
-    ++st.roulette_killed;
-    return false;
-  }
-  beta /= q;
-  return true;
 }
 
 MonteCarloImage MonteCarloRenderer::start() const {
@@ -327,8 +192,6 @@ void MonteCarloRenderer::add_samples(MonteCarloImage& img, int spp) const {
     throw std::invalid_argument("monte carlo: the accumulator was not made for this camera");
   }
   if (spp <= 0) return;
-  const double r0 = grid_.earth_radius_m, ht = grid_.alt_m.last();
-  const glm::dvec3 cam_ecef = geo::sphere_to_ecef({cam_.lat_deg, cam_.lon_deg, cam_.alt_m}, r0);
   const std::uint64_t first = img.spp;
   unsigned threads = mc_.threads ? mc_.threads : std::max(1u, std::thread::hardware_concurrency());
   threads = std::min<unsigned>(threads, static_cast<unsigned>(cam_.height));
@@ -337,30 +200,14 @@ void MonteCarloRenderer::add_samples(MonteCarloImage& img, int spp) const {
   auto work = [&](unsigned w) {
     for (int py = next_row++; py < cam_.height; py = next_row++) {
       for (int px = 0; px < cam_.width; ++px) {
-        const glm::dvec3 d = camera_ray(cam_, px, py);
-        // A camera above the shell starts its rays where they enter it, on the exact sphere, as
-        // render_reference does: distant cameras then keep the digits of the positions they sample.
-        glm::dvec3 o = cam_ecef;
-        bool misses = false;
-        if (cam_.alt_m > ht) {
-          const glm::dvec3 up = glm::normalize(cam_ecef);
-          double e0, e1;
-          if (!p64::ray_sphere_rel_nu(r0, cam_.alt_m, glm::dot(d, up), glm::length(glm::cross(d, up)), ht, e0,
-                                      e1) ||
-              e1 < 0.0) {
-            misses = true;
-          } else if (e0 > 0.0) {
-            o = glm::normalize(o + e0 * d) * (r0 + ht);
-          }
-        }
+        // The kernel's view ray: a camera above the shell starts where the ray enters it, on the
+        // exact sphere, so distant cameras keep the digits of the positions they sample.
+        const kernel::f64::MarchKernel::MarchRay ray = kernel_->march_ray(glm::ivec2(px, py));
         const std::size_t idx = static_cast<std::size_t>(py) * cam_.width + px;
         // Samples in index order into this pixel's sums: the same sums whichever thread does it.
         for (std::uint64_t s = first; s < first + static_cast<std::uint64_t>(spp); ++s) {
-          glm::dvec3 v(0.0);
-          if (!misses) {
-            PathRng rng(mc_.seed, idx, s);
-            v = trace(o, d, rng, stats[w]).radiance;
-          }
+          PathRng rng(mc_.seed, idx, s);
+          const glm::dvec3 v = trace(ray.origin, ray.d, rng, stats[w]).radiance;
           const double l = glm::dot(v, kLumWeights);
           img.sum[idx] += v;
           img.sum_sq[idx] += v * v;

@@ -115,14 +115,6 @@ class MonteCarloRenderer {
   double majorant_per_m() const;
 
  private:
-  void extinction(const glm::dvec3& p, double& sigma_liquid, double& sigma_ice) const;
-  // The ray's parts inside the cloud shell, cut at the ground; returns their count (<= 2).
-  int shell_parts(const glm::dvec3& p, const glm::dvec3& d, double seg[4], double& t_ground) const;
-  glm::dvec3 sun_light(const glm::dvec3& x, PathRng& rng, MonteCarloStats& st, double& mu_sun_local) const;
-  // Russian roulette on the throughput from roulette_after on: false when it ends the path (r.end set).
-  bool roulette(PathResult& r, glm::dvec3& beta, PathRng& rng, MonteCarloStats& st) const;
-  glm::dvec3 pixel_sample(int px, int py, std::uint64_t sample, MonteCarloStats& st) const;
-
   const VolumeGrid& grid_;
   const GridMeanExtinction& ext_;
   Camera cam_;
@@ -131,10 +123,9 @@ class MonteCarloRenderer {
   MonteCarloSettings mc_;
   const ErosionNoise* noise_ = nullptr;
   std::shared_ptr<const PreparedVolume> volume_;
-  // The march kernel's medium and tracking over volume_ (reference/track_kernel.hpp); its functions
-  // called here write nothing, so the threads share it.
+  // The march kernel's medium, tracking and path over volume_ (reference/track_kernel.hpp); its
+  // functions called here write nothing, so the threads share it.
   std::shared_ptr<kernel::f64::TrackKernel> kernel_;
-  glm::dvec3 to_sun_{0.0};
 };
 
 // One call: a fresh accumulator with `spp` samples per pixel.

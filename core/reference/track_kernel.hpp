@@ -1,6 +1,6 @@
-// The kernel's tracking (shaders/kernel/tracking.glsl) compiled as C++ in double over the march
-// kernel's medium, with the Monte Carlo's counter-based random stream: what the Monte Carlo
-// reference walks its paths with.
+// The kernel's tracking and path (shaders/kernel/tracking.glsl, path.glsl) compiled as C++ in double
+// over the march kernel's medium, with the Monte Carlo's counter-based random stream: the paths the
+// Monte Carlo reference traces, the same code the GPU path tracer runs in float.
 #pragma once
 
 #include "kernel/march_kernel.hpp"
@@ -16,10 +16,15 @@ namespace cv::kernel::f64 {
 struct TrackKernel : MarchKernel {
   using TrackRng = core::PathRng;
   static double track_uniform(TrackRng& rng) { return rng.uniform(); }
+  static uint track_bits(TrackRng& rng) { return rng.bits32(); }
   double u_track_majorant = 0.0;  // the volume's largest extinction, 1/m
   bool u_track_bricks = false;    // the pyramid's brick bounds instead (MonteCarloSettings::brick_majorants)
+  int u_path_max_bounces = 1000;  // MonteCarloSettings::max_bounces
+  int u_path_roulette_after = 4;  // MonteCarloSettings::roulette_after
+  bool u_path_peak_mis = true;    // MonteCarloSettings::peak_mis
 
 #include "kernel/tracking.glsl"
+#include "kernel/path.glsl"
 };
 
 #undef CV_FN
