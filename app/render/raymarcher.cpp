@@ -64,7 +64,18 @@ const GlProgram& GpuRaymarcher::program_for(const kernel::MarchVariant& v) {
   return *p;
 }
 
+const GlProgram& GpuRaymarcher::path_program_for(const kernel::MarchVariant& v) {
+  std::unique_ptr<GlProgram>& p = path_programs_[v.key()];
+  if (!p) {
+    p = std::make_unique<GlProgram>(
+        load_compute(loader_, ShaderLoader::default_shader_dir() / "render" / "pathtrace.comp", ShaderFeatures{}, v.defines()));
+  }
+  return *p;
+}
+
 GpuRaymarcher::~GpuRaymarcher() {
+  if (path_sums_) glDeleteBuffers(1, &path_sums_);
+  if (path_stats_) glDeleteBuffers(1, &path_stats_);
   if (textures_[0]) glDeleteTextures(2, textures_);
   if (state_[0]) glDeleteTextures(3, state_);
   if (ground_) glDeleteTextures(1, &ground_);
@@ -141,16 +152,13 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
   volume_ = std::move(volume);
 }
 
-void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
-                                const DispatchOptions& dispatch, const OpaqueInput& opaque) {
-  if (!volume_) throw GlError("render needs upload() first");
-  const bool noise = s.medium.noise_amount > 0.0;
-  if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
-  if (noise && !(s.medium.noise_scale_m > 0.0)) throw GlError("noise_scale_m must be > 0");
-  if (!(s.quality.view_step_m > 0.0)) throw GlError("view_step_m must be > 0");
+// The march kernel's inputs for a frame, shared by the march and the path tracer: the ground
+// texture (loaded once per path and model), the parameters packed into the uniform block, the
+// two-stream source when it is used, the noise, the pyramid, the counters and the textures bound.
+kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
+                                               const OpaqueInput& opaque) {
   const core::PreparedVolume& v = *volume_;
   const core::VolumeGrid& grid = v.grid;
-  const GLuint p = program_for(kernel::MarchVariant::of(s)).id();
   const bool textured = s.features.globe && !s.medium.ground_texture.empty();
   if (textured && (s.medium.ground_texture != ground_path_ || s.medium.ground_map_colours != ground_map_colours_)) {
     const core::AlbedoMap map = load_albedo_map(s.medium.ground_texture, s.medium.ground_map_colours);
@@ -196,12 +204,10 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glNamedBufferSubData(params_buffer_, 0, sizeof(block), &block);
   glBindBufferBase(GL_UNIFORM_BUFFER, CV_UBO_MARCH, params_buffer_);
   sun_down_ = params.u_sun_down;
-  if (noise) {
+  if (s.medium.noise_amount > 0.0) {
     glBindTextureUnit(CV_TEX_NOISE_LOW, noise_textures_[0]);
     glBindTextureUnit(CV_TEX_NOISE_HIGH, noise_textures_[1]);
   }
-  const double r0 = grid.earth_radius_m;
-  const glm::dvec3 to_sun = params.u_to_sun;
   if (!stats_buffer_) {
     glCreateBuffers(1, &stats_buffer_);
     glNamedBufferStorage(stats_buffer_, 2 * kStatCounters * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -210,6 +216,31 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glNamedBufferSubData(stats_buffer_, 0, sizeof(zeros), zeros);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PYRAMID, pyramid_buffer_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_STATS, stats_buffer_);
+  glBindTextureUnit(CV_TEX_DEPTH, opaque.depth);
+  glBindTextureUnit(CV_TEX_OPAQUE, opaque.color);
+  glBindTextureUnit(CV_TEX_LIQUID, textures_[0]);
+  glBindTextureUnit(CV_TEX_ICE, textures_[1]);
+  glBindTextureUnit(CV_TEX_GROUND, ground_);
+  glBindTextureUnit(CV_TEX_JITTER_MASK, jitter_mask_);
+  glBindTextureUnit(CV_TEX_COLUMN_TAU, column_tau_);
+  glBindTextureUnit(CV_TEX_MS_I0, ms_[0]);
+  glBindTextureUnit(CV_TEX_MS_I1, ms_[1]);
+  return params;
+}
+
+void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
+                                const DispatchOptions& dispatch, const OpaqueInput& opaque) {
+  if (!volume_) throw GlError("render needs upload() first");
+  const bool noise = s.medium.noise_amount > 0.0;
+  if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
+  if (noise && !(s.medium.noise_scale_m > 0.0)) throw GlError("noise_scale_m must be > 0");
+  if (!(s.quality.view_step_m > 0.0)) throw GlError("view_step_m must be > 0");
+  const GLuint p = program_for(kernel::MarchVariant::of(s)).id();
+  const kernel::MarchParams params = bind_inputs(cam, sun, s, opaque);
+  const core::PreparedVolume& v = *volume_;
+  const core::VolumeGrid& grid = v.grid;
+  const double r0 = grid.earth_radius_m;
+  const glm::dvec3 to_sun = params.u_to_sun;
   if (!state_[0] || state_w_ != cam.width || state_h_ != cam.height) {
     if (state_[0]) glDeleteTextures(3, state_);
     glCreateTextures(GL_TEXTURE_2D, 3, state_);
@@ -223,15 +254,6 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glBindImageTexture(CV_IMAGE_STATE_L, state_[0], 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(CV_IMAGE_STATE_DEPTH, state_[1], 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(CV_IMAGE_CLOUD_DEPTH, state_[2], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-  glBindTextureUnit(CV_TEX_DEPTH, opaque.depth);
-  glBindTextureUnit(CV_TEX_OPAQUE, opaque.color);
-  glBindTextureUnit(CV_TEX_LIQUID, textures_[0]);
-  glBindTextureUnit(CV_TEX_ICE, textures_[1]);
-  glBindTextureUnit(CV_TEX_GROUND, ground_);
-  glBindTextureUnit(CV_TEX_JITTER_MASK, jitter_mask_);
-  glBindTextureUnit(CV_TEX_COLUMN_TAU, column_tau_);
-  glBindTextureUnit(CV_TEX_MS_I0, ms_[0]);
-  glBindTextureUnit(CV_TEX_MS_I1, ms_[1]);
   glUseProgram(p);
   const int tile = dispatch.rows_per_tile > 0 ? (dispatch.rows_per_tile + 7) / 8 * 8 : cam.height;
   GLuint query = 0;
@@ -288,6 +310,92 @@ void GpuRaymarcher::read_stats() {
   stats_.sun_samples = count(3), stats_.sun_skipped = count(4), stats_.rays_missed = count(5);
   stats_.sun_down = sun_down_;
   stats_.octave_terms = count(6), stats_.octave_terms_full = count(7);
+}
+
+void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& cam, const core::Sun& sun,
+                                const core::MarchSettings& s, int spp, const PathTraceSettings& pt, PathTraceStats* extra,
+                                const std::function<void(int, int)>& on_samples) {
+  if (!volume_) throw GlError("trace_paths needs upload() first");
+  if (s.features.atmosphere) throw GlError("the path tracer does not model the air: atmosphere must be off");
+  if (pt.max_bounces < 1) throw GlError("the path tracer needs max_bounces >= 1");
+  const bool noise = s.medium.noise_amount > 0.0;
+  if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
+  const std::size_t n = static_cast<std::size_t>(cam.width) * static_cast<std::size_t>(cam.height);
+  if (img.sum.empty() && img.spp == 0) {
+    img.width = cam.width, img.height = cam.height;
+    img.sum.assign(n, glm::dvec3(0.0)), img.sum_sq.assign(n, glm::dvec3(0.0));
+    img.lum_sum.assign(n, 0.0), img.lum_sq.assign(n, 0.0);
+  }
+  if (img.width != cam.width || img.height != cam.height || img.sum.size() != n) {
+    throw GlError("trace_paths: the accumulator was not made for this camera");
+  }
+  if (spp <= 0) return;
+  // Only the globe and the noise change the path; the air is off and the rest is the march's.
+  kernel::MarchVariant variant;
+  variant.globe = s.features.globe;
+  variant.noise = noise;
+  const GLuint p = path_program_for(variant).id();
+  bind_inputs(cam, sun, s, OpaqueInput{});
+  if (!path_sums_ || path_pixels_ != n) {
+    if (path_sums_) glDeleteBuffers(1, &path_sums_);
+    glCreateBuffers(1, &path_sums_);
+    glNamedBufferStorage(path_sums_, static_cast<GLsizeiptr>(n * 2 * sizeof(glm::vec4)), nullptr, GL_DYNAMIC_STORAGE_BIT);
+    path_pixels_ = n;
+  }
+  constexpr int kPathStats = 10;
+  if (!path_stats_) {
+    glCreateBuffers(1, &path_stats_);
+    glNamedBufferStorage(path_stats_, 2 * kPathStats * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  }
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PATH_SUMS, path_sums_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PATH_STATS, path_stats_);
+  glUseProgram(p);
+  glProgramUniform1ui(p, loc(p, "u_seed"), pt.seed);
+  glProgramUniform1i(p, loc(p, "u_row_offset"), 0);
+  glProgramUniform1f(p, loc(p, "u_track_majorant"), static_cast<float>(volume_->sigma_max_per_m));
+  glProgramUniform1i(p, loc(p, "u_track_bricks"), pt.brick_majorants ? 1 : 0);
+  glProgramUniform1i(p, loc(p, "u_path_max_bounces"), pt.max_bounces);
+  glProgramUniform1i(p, loc(p, "u_path_roulette_after"), pt.roulette_after);
+  glProgramUniform1i(p, loc(p, "u_path_peak_mis"), pt.peak_mis ? 1 : 0);
+  glProgramUniform1i(p, loc(p, "u_loop_budget"), loop_budget_ ? 1 : 0);
+  const auto groups_x = static_cast<GLuint>((cam.width + 7) / 8), groups_y = static_cast<GLuint>((cam.height + 7) / 8);
+  const int batch = std::max(1, pt.samples_per_readback);
+  std::vector<glm::vec4> sums(2 * n);
+  const GLuint zero_stats[2 * kPathStats] = {};
+  int done = 0;
+  while (done < spp) {
+    const int k = std::min(batch, spp - done);
+    glClearNamedBufferData(path_sums_, GL_RGBA32F, GL_RGBA, GL_FLOAT, nullptr);
+    glNamedBufferSubData(path_stats_, 0, sizeof(zero_stats), zero_stats);
+    for (int i = 0; i < k; ++i) {
+      glProgramUniform1ui(p, loc(p, "u_sample"), static_cast<GLuint>(img.spp + static_cast<std::uint64_t>(i)));
+      glDispatchCompute(groups_x, groups_y, 1);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(path_sums_, 0, static_cast<GLsizeiptr>(sums.size() * sizeof(glm::vec4)), sums.data());
+    GLuint st[2 * kPathStats] = {};
+    glGetNamedBufferSubData(path_stats_, 0, sizeof(st), st);
+    check_gl("running the path tracer");
+    for (std::size_t i = 0; i < n; ++i) {
+      const glm::vec4 a = sums[2 * i], b = sums[2 * i + 1];
+      img.sum[i] += glm::dvec3(a), img.lum_sum[i] += a.w;
+      img.sum_sq[i] += glm::dvec3(b), img.lum_sq[i] += b.w;
+    }
+    auto counter = [&](int c) { return static_cast<std::uint64_t>(st[2 * c]) | static_cast<std::uint64_t>(st[2 * c + 1]) << 32; };
+    img.stats.paths += counter(0);
+    img.stats.scatterings += counter(1);
+    img.stats.null_collisions += counter(2);
+    img.stats.shadow_lookups += counter(3);
+    img.stats.truncated += counter(4);
+    img.stats.roulette_killed += counter(5);
+    img.stats.peak_samples += counter(6);
+    img.stats.majorant_exceeded += counter(7);
+    if (extra) extra->near_loop_budget += counter(8), extra->non_finite += counter(9);
+    img.spp += static_cast<std::uint64_t>(k);
+    done += k;
+    if (on_samples) on_samples(done, spp);
+  }
 }
 
 const core::MarchStats& GpuRaymarcher::last_stats() {

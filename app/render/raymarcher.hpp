@@ -3,6 +3,7 @@
 // as the CPU reference (core/reference/raymarcher).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <memory>
@@ -15,6 +16,7 @@
 #include "kernel/ms_source.hpp"
 #include "kernel/prepared_volume.hpp"
 #include "noise/noise.hpp"
+#include "reference/monte_carlo.hpp"
 #include "frame/camera.hpp"
 #include "frame/march_stats.hpp"
 #include "frame/sun.hpp"
@@ -70,6 +72,24 @@ int view_steps_per_dispatch(const core::MarchSettings& settings, int sun_march_s
 // rounding up.
 int max_view_steps(double r0_m, double top_m, double view_step_m);
 
+// The GPU path tracer's settings (shaders/render/pathtrace.comp), as the CPU Monte Carlo's
+// (core::MonteCarloSettings): the same path, in float.
+struct PathTraceSettings {
+  int max_bounces = 1000;
+  int roulette_after = 4;
+  bool peak_mis = true;
+  bool brick_majorants = false;
+  std::uint32_t seed = 1;
+  int samples_per_readback = 16;  // samples summed in float on the GPU before the host adds them in double
+};
+
+// What the path tracer did beyond core::MonteCarloStats: samples left out as not finite, and, on a
+// driver with a loop budget (llvmpipe), samples whose walk came near it and may have been cut short.
+struct PathTraceStats {
+  std::uint64_t non_finite = 0;
+  std::uint64_t near_loop_budget = 0;
+};
+
 class GpuRaymarcher {
  public:
   // Needs a current OpenGL 4.5 context; compiles the raymarcher. Keeps a reference to the loader
@@ -100,6 +120,15 @@ class GpuRaymarcher {
   void render_into(GLuint out, const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& settings,
                    const DispatchOptions& dispatch = {}, const OpaqueInput& opaque = {});
 
+  // Adds `spp` path-traced samples per pixel of cam's view into img (made by core::MonteCarloRenderer's
+  // start() for this camera, or empty of the camera's size), continuing its sample indices. The
+  // path is the CPU Monte Carlo's (shaders/kernel/path.glsl): clouds and a ground of constant albedo,
+  // no air (settings.features.atmosphere must be off: GlError otherwise). on_samples(done, spp)
+  // after each readback.
+  void trace_paths(core::MonteCarloImage& img, const core::Camera& cam, const core::Sun& sun,
+                   const core::MarchSettings& settings, int spp, const PathTraceSettings& pt = {},
+                   PathTraceStats* extra = nullptr, const std::function<void(int, int)>& on_samples = {});
+
   // The last frame's cloud depth, for later passes: an R32F texture of its size holding the distance
   // (m) from the camera at which the view transmittance fell to 0.5 (3e38 where it never did).
   GLuint cloud_depth_texture() const { return state_[2]; }
@@ -118,8 +147,15 @@ class GpuRaymarcher {
   void read_stats();  // the Stats buffer into stats_
   // The program of a march variant, compiled on first use (the noise variants need upload_noise first).
   const GlProgram& program_for(const kernel::MarchVariant& v);
+  // The path tracer's program of a variant (only globe and noise matter to it), compiled on first use.
+  const GlProgram& path_program_for(const kernel::MarchVariant& v);
+  kernel::MarchParams bind_inputs(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
+                                  const OpaqueInput& opaque);
   const ShaderLoader& loader_;
   std::unique_ptr<GlProgram> programs_[kernel::MarchVariant::kCount];  // by MarchVariant::key
+  std::unique_ptr<GlProgram> path_programs_[kernel::MarchVariant::kCount];
+  GLuint path_sums_ = 0, path_stats_ = 0;  // the path tracer's per-pixel sums and counters
+  std::size_t path_pixels_ = 0;
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
   GLuint ms_[2] = {0, 0};           // the two-stream source (R32F x2), built for ms_key_ on ms_volume_

@@ -19,3 +19,5 @@
 #define CV_SSBO_PYRAMID 3
 #define CV_SSBO_STATS 4
 #define CV_UBO_MARCH 0
+#define CV_SSBO_PATH_SUMS 5
+#define CV_SSBO_PATH_STATS 6
