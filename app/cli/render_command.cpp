@@ -56,6 +56,12 @@ struct RenderArgs {
   std::string front;              // --front FILE: the measured quality front for --budget-ms
   bool march_overridden = false;  // --steps, --sun-steps, --octaves or --accumulate: quality becomes custom
   bool quality_given = false, adaptive_given = false, budget_given = false;
+  // --quality reference: the GPU path tracer, up to `spp` samples per pixel or until the image's
+  // mean relative standard error falls to target_error (0: all spp).
+  bool reference = false;
+  int spp = 1024;
+  double target_error = 0.0;
+  bool spp_given = false;
 };
 
 int parse_int(const std::string& option, const std::string& text, int lo, int hi, const std::string& what) {
@@ -171,13 +177,17 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
       scene.sun.mode = core::SunMode::DateTime;
       scene.sun.datetime_utc = v;
     } else if (a == "--quality") {
-      if (v == "custom") {
+      if (v == "reference") {
+        r.reference = true;
+        r.quality_given = true;
+      } else if (v == "custom") {
         scene.render.quality = v;
       } else if (core::find_quality(v)) {
         core::apply_quality(v, scene.render);
         r.quality_given = true;
       } else {
-        throw UsageError{"cloudviewer render: --quality: found '" + v + "', expected one of " + core::quality_names()};
+        throw UsageError{"cloudviewer render: --quality: found '" + v + "', expected one of " + core::quality_names() +
+                         " or reference"};
       }
     } else if (const core::SettingRow* row = march_flag(a)) {
       apply_march_flag(*row, v, m);
@@ -194,6 +204,14 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
       scene.render.accumulate = parse_int(a, v, static_cast<int>(acc.lo), static_cast<int>(acc.hi),
                                           core::range_text(acc) + " frames");
       r.march_overridden = true;
+    } else if (a == "--spp") {
+      r.spp = parse_int(a, v, 1, 1000000, "a number of samples per pixel 1..1e6");
+      r.spp_given = true;
+    } else if (a == "--target-error") {
+      r.target_error = parse_number(a, v);
+      if (!(r.target_error > 0.0 && r.target_error < 1.0)) {
+        throw UsageError{"cloudviewer render: --target-error: found '" + v + "', expected a relative standard error between 0 and 1"};
+      }
     } else if (a == "--budget-ms") {
       scene.render.budget_ms = parse_number(a, v);
       if (!(scene.render.budget_ms > 0 && scene.render.budget_ms <= 1e7)) {
@@ -229,6 +247,16 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
     }
   }
   if (r.out.empty()) throw UsageError{"cloudviewer render: expected -o OUT.png"};
+  if (!r.reference && (r.spp_given || r.target_error > 0.0)) {
+    throw UsageError{"cloudviewer render: --spp and --target-error: found them without a path tracer, expected --quality reference"};
+  }
+  if (r.reference && !r.pfm.empty()) {
+    throw UsageError{"cloudviewer render: --pfm: found it with --quality reference, expected one or the other (the path tracer "
+                     "estimates radiance, not the transmittance the PFM pair holds)"};
+  }
+  if (r.reference && r.budget_given) {
+    throw UsageError{"cloudviewer render: --budget-ms: found it with --quality reference, expected one or the other"};
+  }
   // The budget chooses the quality knobs: given together on the command line they contradict each
   // other; options override a scene file's budget as they override its other keys.
   if (r.budget_given && (r.march_overridden || r.quality_given || r.adaptive_given)) {
@@ -257,6 +285,9 @@ const char* render_usage() {
         "  render INPUT -o OUT.png   INPUT: NetCDF, .cvvol or a scene .json (docs/scene.md); options override it:\n"
         "         [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov] [--sun LAT,LON | --sun-time ISO]\n"
         "         [--quality low|default|high|custom] [--accumulate N]\n"
+        "         [--quality reference [--spp N] [--target-error E]]  the GPU path tracer (full multiple scattering,\n"
+        "                           clouds and a ground of constant albedo, no air): N samples per pixel at most (1024),\n"
+        "                           fewer once the image's mean relative standard error is E\n"
         "         [--exposure E|auto] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N]\n"
         "         [--no-sky]  clouds on black: no air, globe or ambient sky light\n";
     for (const core::SettingRow& row : core::kMarchSettingRows) {
@@ -287,6 +318,51 @@ const char* render_usage() {
            "                           the sun stands where it stood at the valid time unless --sun or --sun-time\n";
   }();
   return text.c_str();
+}
+
+// --quality reference: the GPU path tracer at the output size, in batches of samples with progress,
+// until ra.spp samples per pixel or the mean relative standard error of the image (over pixels at
+// least 5 % of the brightest) falls to ra.target_error. rgb = radiance; a = 0 (no transmittance is
+// estimated: no background shows through).
+std::vector<glm::vec4> path_trace(render::GpuRaymarcher& gpu, const core::FrameSpec& frame, const RenderArgs& ra, double& gpu_s) {
+  const auto t0 = clock::now();
+  core::MonteCarloImage img;
+  render::PathTraceStats extra;
+  render::PathTraceSettings pt;
+  pt.samples_per_readback = 8;
+  double error = 0.0;
+  while (img.spp < static_cast<std::uint64_t>(ra.spp)) {
+    const int batch = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(ra.spp) - img.spp, 8));
+    gpu.trace_paths(img, frame.camera, frame.sun, frame.march, batch, pt, &extra);
+    error = img.spp >= 2 ? img.mean_relative_standard_error() : 1.0;
+    std::printf("\rpath traced %llu/%d samples per pixel, mean relative standard error %.4f, %.1f s",
+                static_cast<unsigned long long>(img.spp), ra.spp, error, seconds_since(t0));
+    std::fflush(stdout);
+    if (ra.target_error > 0.0 && img.spp >= 8 && error <= ra.target_error) break;
+  }
+  std::printf("\n");
+  gpu_s = 0.0;
+  std::printf("path tracer: %llu paths, %.2f scatterings per path, %llu null collisions, %llu sun-ray lookups, %llu cut at %d "
+              "bounces, %llu ended by roulette%s\n",
+              static_cast<unsigned long long>(img.stats.paths),
+              double(img.stats.scatterings) / double(std::max<std::uint64_t>(img.stats.paths, 1)),
+              static_cast<unsigned long long>(img.stats.null_collisions), static_cast<unsigned long long>(img.stats.shadow_lookups),
+              static_cast<unsigned long long>(img.stats.truncated), pt.max_bounces,
+              static_cast<unsigned long long>(img.stats.roulette_killed),
+              ra.target_error > 0.0 && error > ra.target_error ? "; the target error was not reached within --spp" : "");
+  if (img.stats.majorant_exceeded) {
+    std::fprintf(stderr, "cloudviewer render: the medium exceeded its majorant at %llu lookups (a bug: the image is biased)\n",
+                 static_cast<unsigned long long>(img.stats.majorant_exceeded));
+  }
+  if (extra.non_finite) std::fprintf(stderr, "cloudviewer render: %llu path samples were not finite and were left out\n",
+                                      static_cast<unsigned long long>(extra.non_finite));
+  if (extra.near_loop_budget) {
+    std::fprintf(stderr, "cloudviewer render: %llu path samples came near the driver's loop budget (llvmpipe) and may be cut short\n",
+                 static_cast<unsigned long long>(extra.near_loop_budget));
+  }
+  std::vector<glm::vec4> out(img.lum_sum.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = glm::vec4(glm::vec3(img.mean(i)), 0.0f);
+  return out;
 }
 
 int cmd_render(const std::vector<std::string>& args) {
@@ -358,12 +434,23 @@ int cmd_render(const std::vector<std::string>& args) {
     std::printf("wrote the scene %s\n", ra.save_scene.c_str());
   }
 
+  if (ra.reference) {  // the path tracer marches nothing: the output size, and no air
+    frame.march_camera = frame.camera;
+    if (frame.march.features.atmosphere) {
+      std::printf("the path tracer does not model the air: clouds and the ground only (as --no-sky with the globe)\n");
+      frame.march.features.atmosphere = false;
+    }
+  }
   const core::RenderSettings& rs = scene.render;
   const core::MarchSettings& march = frame.march;
   const int mw = frame.march_camera.width, mh = frame.march_camera.height;
   const std::string model =
       march.medium.ms_two_stream ? std::string("two-stream multiple scattering") : std::to_string(march.quality.octaves) + " octaves";
-  std::printf("rendering %s, time step %d (%s), %dx%d%s, quality %s: view step %.0f m, %d sun steps, %s, %d frame(s)\n",
+  if (ra.reference) {
+    std::printf("rendering %s, time step %d (%s), %dx%d, quality reference: the GPU path tracer, up to %d samples per pixel%s\n",
+                scene.data.path.c_str(), scene.time_step, vt.iso_utc.c_str(), cam.width, cam.height, ra.spp,
+                ra.target_error > 0.0 ? (", to a relative standard error of " + core::short_number(ra.target_error)).c_str() : "");
+  } else std::printf("rendering %s, time step %d (%s), %dx%d%s, quality %s: view step %.0f m, %d sun steps, %s, %d frame(s)\n",
               scene.data.path.c_str(), scene.time_step, vt.iso_utc.c_str(), cam.width, cam.height,
               mw != cam.width || mh != cam.height ? (" marched at " + std::to_string(mw) + "x" + std::to_string(mh)).c_str() : "",
               rs.quality.c_str(), march.quality.view_step_m, march.quality.sun_steps, model.c_str(), frame.accumulate);
@@ -383,19 +470,25 @@ int cmd_render(const std::vector<std::string>& args) {
   // One frame at step middles (or the scene's frame), or the mean of jittered frames, at the output
   // size in linear radiance.
   std::vector<glm::vec4> marched;  // at the march size, for the automatic exposure
-  std::vector<glm::vec4> pixels = renderer.render(
-      frame, dispatch,
-      [&](int done, int total) {
-        if (total > 1) std::printf("\raccumulated %d/%d frames, %.1f s", done, total, seconds_since(t0));
-        std::fflush(stdout);
-      },
-      &marched);
-  if (frame.accumulate > 1 || dispatch.on_tile) std::printf("\n");
+  std::vector<glm::vec4> pixels;
+  if (ra.reference) {
+    pixels = path_trace(gpu, frame, ra, gpu_s);
+    marched = pixels;
+  } else {
+    pixels = renderer.render(
+        frame, dispatch,
+        [&](int done, int total) {
+          if (total > 1) std::printf("\raccumulated %d/%d frames, %.1f s", done, total, seconds_since(t0));
+          std::fflush(stdout);
+        },
+        &marched);
+    if (frame.accumulate > 1 || dispatch.on_tile) std::printf("\n");
+  }
   const double t_march = seconds_since(t0);
-  if (march.medium.ms_two_stream)
+  if (march.medium.ms_two_stream && !ra.reference)
     std::printf("two-stream source built in %.1f ms (once per time step and sun direction)\n", gpu.ms_source_build_ms());
-  const core::MarchStats& ms = gpu.last_stats();
-  std::printf("march%s: %llu view samples, %llu skipped in %llu empty-brick jumps (view and sun), %llu sun samples, "
+  const core::MarchStats& ms = ra.reference ? core::MarchStats{} : gpu.last_stats();
+  if (!ra.reference) std::printf("march%s: %llu view samples, %llu skipped in %llu empty-brick jumps (view and sun), %llu sun samples, "
               "%llu skipped or cut off, %llu of %d rays missed the cloud shell%s\n",
               frame.accumulate > 1 ? " (last frame)" : "", static_cast<unsigned long long>(ms.view_samples),
               static_cast<unsigned long long>(ms.view_skipped), static_cast<unsigned long long>(ms.bricks_jumped),

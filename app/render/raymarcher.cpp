@@ -75,6 +75,7 @@ const GlProgram& GpuRaymarcher::path_program_for(const kernel::MarchVariant& v) 
 
 GpuRaymarcher::~GpuRaymarcher() {
   if (path_sums_) glDeleteBuffers(1, &path_sums_);
+  if (path_state_) glDeleteBuffers(1, &path_state_);
   if (path_stats_) glDeleteBuffers(1, &path_stats_);
   if (textures_[0]) glDeleteTextures(2, textures_);
   if (state_[0]) glDeleteTextures(3, state_);
@@ -338,17 +339,21 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
   bind_inputs(cam, sun, s, OpaqueInput{});
   if (!path_sums_ || path_pixels_ != n) {
     if (path_sums_) glDeleteBuffers(1, &path_sums_);
+    if (path_state_) glDeleteBuffers(1, &path_state_);
     glCreateBuffers(1, &path_sums_);
     glNamedBufferStorage(path_sums_, static_cast<GLsizeiptr>(n * 2 * sizeof(glm::vec4)), nullptr, GL_DYNAMIC_STORAGE_BIT);
+    glCreateBuffers(1, &path_state_);  // PathState between dispatches (pathtrace.comp), five vec4 per pixel
+    glNamedBufferStorage(path_state_, static_cast<GLsizeiptr>(n * 5 * sizeof(glm::vec4)), nullptr, 0);
     path_pixels_ = n;
   }
-  constexpr int kPathStats = 10;
+  constexpr int kPathStats = 11;
   if (!path_stats_) {
     glCreateBuffers(1, &path_stats_);
     glNamedBufferStorage(path_stats_, 2 * kPathStats * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
   }
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PATH_SUMS, path_sums_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PATH_STATS, path_stats_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PATH_STATE, path_state_);
   glUseProgram(p);
   glProgramUniform1ui(p, loc(p, "u_seed"), pt.seed);
   glProgramUniform1i(p, loc(p, "u_row_offset"), 0);
@@ -368,9 +373,20 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
     glClearNamedBufferData(path_sums_, GL_RGBA32F, GL_RGBA, GL_FLOAT, nullptr);
     glNamedBufferSubData(path_stats_, 0, sizeof(zero_stats), zero_stats);
     for (int i = 0; i < k; ++i) {
+      // Pass 0 starts sample img.spp + i in every pixel; pass 1 resumes the paths still in flight
+      // (on llvmpipe a path stops between vertices before the loop budget) until none is.
       glProgramUniform1ui(p, loc(p, "u_sample"), static_cast<GLuint>(img.spp + static_cast<std::uint64_t>(i)));
-      glDispatchCompute(groups_x, groups_y, 1);
-      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+      for (int pass = 0;; ++pass) {
+        const GLuint zero2[2] = {0, 0};
+        glNamedBufferSubData(path_stats_, 2 * 10 * sizeof(GLuint), sizeof(zero2), zero2);
+        glProgramUniform1i(p, loc(p, "u_pass"), pass == 0 ? 0 : 1);
+        glDispatchCompute(groups_x, groups_y, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        GLuint in_flight = 0;
+        glGetNamedBufferSubData(path_stats_, 2 * 10 * sizeof(GLuint), sizeof(GLuint), &in_flight);
+        if (in_flight == 0) break;
+        if (extra) ++extra->resumed_dispatches;
+      }
     }
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     glGetNamedBufferSubData(path_sums_, 0, static_cast<GLsizeiptr>(sums.size() * sizeof(glm::vec4)), sums.data());

@@ -200,14 +200,19 @@ void MonteCarloRenderer::add_samples(MonteCarloImage& img, int spp) const {
   auto work = [&](unsigned w) {
     for (int py = next_row++; py < cam_.height; py = next_row++) {
       for (int px = 0; px < cam_.width; ++px) {
-        // The kernel's view ray: a camera above the shell starts where the ray enters it, on the
-        // exact sphere, so distant cameras keep the digits of the positions they sample.
-        const kernel::f64::MarchKernel::MarchRay ray = kernel_->march_ray(glm::ivec2(px, py));
+        // The kernel's start of a path (path_camera_origin): a camera above the grid starts where the
+        // ray enters it, on the exact sphere.
+        const glm::dvec3 d = kernel_->pixel_direction(glm::ivec2(px, py));
+        bool misses = false;
+        const glm::dvec3 o = kernel_->path_camera_origin(d, misses);
         const std::size_t idx = static_cast<std::size_t>(py) * cam_.width + px;
         // Samples in index order into this pixel's sums: the same sums whichever thread does it.
         for (std::uint64_t s = first; s < first + static_cast<std::uint64_t>(spp); ++s) {
-          PathRng rng(mc_.seed, idx, s);
-          const glm::dvec3 v = trace(ray.origin, ray.d, rng, stats[w]).radiance;
+          glm::dvec3 v(0.0);
+          if (!misses) {
+            PathRng rng(mc_.seed, idx, s);
+            v = trace(o, d, rng, stats[w]).radiance;
+          }
           const double l = glm::dot(v, kLumWeights);
           img.sum[idx] += v;
           img.sum_sq[idx] += v * v;

@@ -21,3 +21,4 @@
 #define CV_UBO_MARCH 0
 #define CV_SSBO_PATH_SUMS 5
 #define CV_SSBO_PATH_STATS 6
+#define CV_SSBO_PATH_STATE 7

@@ -42,7 +42,29 @@ CV_FN PathCounts path_counts() {
   return c;
 }
 
-// The parts of the ray p + t d (t >= 0) inside the cloud layer, cut at the ground; their count
+// The top of the volume's grid (m): paths cross the whole grid's shell, as the Monte Carlo always has.
+CV_FN real path_grid_top() { return u_grid_start.z + u_grid_step.z * (u_grid_count.z - real(1.0)); }
+
+// Where a pixel's path starts along its view ray d: the camera or, for a camera above the grid,
+// where the ray enters it, on the exact sphere (distant cameras keep the digits of the positions
+// they sample). misses: the ray never meets the grid's shell (nor the Earth inside it).
+CV_FN real3 path_camera_origin(real3 d, CV_OUT(bool) misses) {
+  misses = false;
+  real3 o = u_cam_ecef;
+  real ht = path_grid_top();
+  if (u_cam_alt > ht) {
+    real e0;
+    real e1;
+    if (!ray_sphere_rel_nu(u_r0, u_cam_alt, dot(d, u_cam_up), length(cross(d, u_cam_up)), ht, e0, e1) || e1 < real(0.0)) {
+      misses = true;
+    } else if (e0 > real(0.0)) {
+      o = normalize(o + e0 * d) * (u_r0 + ht);
+    }
+  }
+  return o;
+}
+
+// The parts of the ray p + t d (t >= 0) inside the grid's shell, cut at the ground; their count
 // (<= 2), and in t_ground the distance to the ground (CV_PATH_FAR: never).
 CV_FN int path_shell_parts(real3 p, real3 d, CV_OUT(real4) seg, CV_OUT(real) t_ground) {
   real r = length(p);
@@ -58,9 +80,8 @@ CV_FN int path_shell_parts(real3 p, real3 d, CV_OUT(real4) seg, CV_OUT(real) t_g
   real g0;
   real g1;
   if (!rising && ray_sphere_rel_nu(u_r0, alt, mu, nu, real(0.0), g0, g1) && g1 > real(0.0)) t_ground = max(g0, real(0.0));
-  if (u_cloudless) return 0;
   real4 s;
-  int n = ray_shell_rel_nu(u_r0, alt, mu, nu, u_layer.x, u_layer.y, s);
+  int n = ray_shell_rel_nu(u_r0, alt, mu, nu, u_grid_start.z, u_grid_start.z + u_grid_step.z * (u_grid_count.z - real(1.0)), s);
   int kept = 0;
   for (int k = 0; k < 2; ++k) {
     if (k >= n) break;
@@ -83,6 +104,7 @@ CV_FN int path_shell_parts(real3 p, real3 d, CV_OUT(real4) seg, CV_OUT(real) t_g
 // Distance to the first real collision from p along d (CV_PATH_FAR when the ray leaves the cloud),
 // and the distance to the ground.
 CV_FN real path_free_path(real3 p, real3 d, CV_INOUT(TrackRng) rng, CV_INOUT(TrackCounts) c, CV_OUT(real) t_ground) {
+  c.iterations += 4u;  // path_shell_parts' loop
   real4 seg;
   int n = path_shell_parts(p, d, seg, t_ground);
   return delta_track(p, d, seg, n, rng, c);
@@ -90,6 +112,7 @@ CV_FN real path_free_path(real3 p, real3 d, CV_INOUT(TrackRng) rng, CV_INOUT(Tra
 
 // Transmittance of the cloud from p along d by ratio tracking; 0 when the ray meets the Earth.
 CV_FN real path_transmittance(real3 p, real3 d, CV_INOUT(TrackRng) rng, CV_INOUT(TrackCounts) c) {
+  c.iterations += 4u;  // path_shell_parts' loop
   real4 seg;
   real t_ground;
   int n = path_shell_parts(p, d, seg, t_ground);
@@ -106,89 +129,123 @@ CV_FN real path_phase(real sl, real si, real mu, MieParams mie, real liquid_g) {
   return (sl * liquid + si * phase_hg(mu, u_ice_g)) / sigma;
 }
 
-// Russian roulette on the throughput from u_path_roulette_after vertices on: false when it ends
-// the path (r.end set); a survivor's throughput is divided by its survival probability.
-CV_FN bool path_roulette(CV_INOUT(PathResult) r, CV_INOUT(real3) beta, CV_INOUT(TrackRng) rng, CV_INOUT(PathCounts) pc) {
-  if (r.scatterings < u_path_roulette_after) return true;
-  real q = min(real(1.0), max(beta.x, max(beta.y, beta.z)));
+// A path in flight: where it is, where it goes, what it carries, and the vertex its direction was
+// drawn at when the peak technique could have drawn it too. A path can stop between vertices and
+// resume later (the GPU path tracer does, to stay inside llvmpipe's loop budget).
+struct PathState {
+  real3 p;
+  real3 d;
+  real3 beta;
+  real3 radiance;
+  real3 absorbed;
+  int end;
+  int scatterings;
+  bool done;
+  bool prev_peak;
+  real prev_sl;
+  real prev_si;
+  real3 prev_d;
+};
+
+// A path from p along unit d (the first segment is the view ray).
+CV_FN PathState path_begin(real3 p, real3 d) {
+  PathState s;
+  s.p = p;
+  s.d = d;
+  s.beta = real3(1.0);
+  s.radiance = real3(0.0);
+  s.absorbed = real3(0.0);
+  s.end = CV_PATH_SPACE;
+  s.scatterings = 0;
+  s.done = false;
+  s.prev_peak = false;
+  s.prev_sl = real(0.0);
+  s.prev_si = real(0.0);
+  s.prev_d = real3(0.0);
+  return s;
+}
+
+// Russian roulette on the path's throughput from u_path_roulette_after vertices on: false when it
+// ends the path; a survivor's throughput is divided by its survival probability.
+CV_FN bool path_roulette(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(PathCounts) pc) {
+  if (s.scatterings < u_path_roulette_after) return true;
+  real q = min(real(1.0), max(s.beta.x, max(s.beta.y, s.beta.z)));
   if (q >= real(1.0)) return true;
   if (track_uniform(rng) >= q) {
-    r.end = CV_PATH_ROULETTE;
+    s.end = CV_PATH_ROULETTE;
     pc.roulette_killed += 1u;
     return false;
   }
-  beta /= q;
+  s.beta /= q;
   return true;
 }
 
-// One path from p along unit d (the first segment is the view ray).
-CV_FN PathResult trace_path(real3 p, real3 d, CV_INOUT(TrackRng) rng, CV_INOUT(TrackCounts) c, CV_INOUT(PathCounts) pc) {
+// Advances the path vertex by vertex until it ends (s.done) or the walk's loop iterations
+// (c.iterations) reach max_iterations, checked before each vertex.
+CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(TrackCounts) c, CV_INOUT(PathCounts) pc,
+                        uint max_iterations) {
   MieParams mie = mie_params(u_droplet_um);
   real liquid_g = mie_mean_cosine(mie);  // for u_liquid_phase_hg
   // The second technique for the direction into a vertex: the droplets' HG peak lobe around the
   // sun, drawn at every cloud vertex holding liquid (Henyey-Greenstein liquid has no peak).
   bool peak = u_path_peak_mis && !u_liquid_phase_hg;
-  PathResult r;
-  r.radiance = real3(0.0);
-  r.weight = real3(1.0);
-  r.absorbed = real3(0.0);
-  r.end = CV_PATH_SPACE;
-  r.scatterings = 0;
-  real3 beta = real3(1.0);
-  // The vertex the current direction was drawn at, when the peak technique could have drawn it too.
-  bool prev_peak = false;
-  real prev_sl = real(0.0);
-  real prev_si = real(0.0);
-  real3 prev_d = real3(0.0);
-  for (;;) {
+  while (!s.done && c.iterations < max_iterations) {
+    // This loop's test, and the Mie sampler's rejection loop (a few tries: it accepts at least 1/3).
+    c.iterations += 8u;
     real t_ground;
-    real t = path_free_path(p, d, rng, c, t_ground);
+    real t = path_free_path(s.p, s.d, rng, c, t_ground);
     if (t < CV_PATH_FAR) {
-      p += t * d;
+      s.p += t * s.d;
       real sl;
       real si;
-      medium_at_point(p, sl, si);
+      medium_at_point(s.p, sl, si);
       real sigma = sl + si;
-      r.scatterings += 1;
+      s.scatterings += 1;
       // Next-event estimation: the sun is a delta light, reachable only this way. The scattering
       // cosine is between the sunlight's propagation (-to_sun) and the light's toward the camera
       // (-d). Balance heuristic against the peak technique, which could have drawn d at the vertex before.
       real w = real(1.0);
-      if (prev_peak) {
-        real p_prev = path_phase(prev_sl, prev_si, dot(prev_d, d), mie, liquid_g);
-        w = p_prev / (p_prev + phase_hg_c(dot(d, u_to_sun), mie.g_hg, mie.c_hg));
+      if (s.prev_peak) {
+        real p_prev = path_phase(s.prev_sl, s.prev_si, dot(s.prev_d, s.d), mie, liquid_g);
+        w = p_prev / (p_prev + phase_hg_c(dot(s.d, u_to_sun), mie.g_hg, mie.c_hg));
       }
-      r.radiance += beta * u_irradiance * (w * path_phase(sl, si, dot(d, u_to_sun), mie, liquid_g) * path_transmittance(p, u_to_sun, rng, c));
-      if (r.scatterings >= u_path_max_bounces) {
-        r.end = CV_PATH_TRUNCATED;
+      s.radiance += s.beta * u_irradiance *
+                    (w * path_phase(sl, si, dot(s.d, u_to_sun), mie, liquid_g) * path_transmittance(s.p, u_to_sun, rng, c));
+      if (s.scatterings >= u_path_max_bounces) {
+        s.end = CV_PATH_TRUNCATED;
         pc.truncated += 1u;
+        s.done = true;
         break;
       }
-      if (!path_roulette(r, beta, rng, pc)) break;
+      if (!path_roulette(s, rng, pc)) {
+        s.done = true;
+        break;
+      }
       // The peak technique: a direction wq ~ q around the sun, the free path along it, the sun's
       // light at the vertex it reaches, weighted q / (p + q) (the path's own technique is weighted above).
-      prev_peak = peak && sl > real(0.0);
-      if (prev_peak) {
+      s.prev_peak = peak && sl > real(0.0);
+      if (s.prev_peak) {
         pc.peak_samples += 1u;
         real q;
         real u1 = track_uniform(rng);
         real u2 = track_uniform(rng);
         real3 wq = sample_hg(u_to_sun, mie.g_hg, real2(u1, u2), q);
         q = phase_hg_c(dot(wq, u_to_sun), mie.g_hg, mie.c_hg);  // c_hg kept apart: the sampler's pdf loses digits near g = 1
-        real p_here = path_phase(sl, si, dot(d, wq), mie, liquid_g);
+        real p_here = path_phase(sl, si, dot(s.d, wq), mie, liquid_g);
         real tg2;
-        real tq = path_free_path(p, wq, rng, c, tg2);
+        real tq = path_free_path(s.p, wq, rng, c, tg2);
         if (tq < CV_PATH_FAR && p_here > real(0.0)) {
-          real3 x = p + tq * wq;
+          real3 x = s.p + tq * wq;
           real sl2;
           real si2;
           medium_at_point(x, sl2, si2);
-          r.radiance += beta * u_irradiance *
-                        (p_here / (p_here + q) * path_phase(sl2, si2, dot(wq, u_to_sun), mie, liquid_g) * path_transmittance(x, u_to_sun, rng, c));
+          s.radiance += s.beta * u_irradiance *
+                        (p_here / (p_here + q) * path_phase(sl2, si2, dot(wq, u_to_sun), mie, liquid_g) *
+                         path_transmittance(x, u_to_sun, rng, c));
         }
-        prev_sl = sl;
-        prev_si = si;
-        prev_d = d;
+        s.prev_sl = sl;
+        s.prev_si = si;
+        s.prev_d = s.d;
       }
       // Clouds do not absorb (albedo 1): the new direction is drawn from the phase function of the
       // component that scattered, chosen by its share of the extinction; beta is unchanged.
@@ -197,44 +254,59 @@ CV_FN PathResult trace_path(real3 p, real3 d, CV_INOUT(TrackRng) rng, CV_INOUT(T
         if (u_liquid_phase_hg) {
           real v1 = track_uniform(rng);
           real v2 = track_uniform(rng);
-          d = sample_hg(d, liquid_g, real2(v1, v2), pdf);
+          s.d = sample_hg(s.d, liquid_g, real2(v1, v2), pdf);
         } else {
           uint state = track_bits(rng);
-          d = sample_mie(d, mie, state, pdf);
+          s.d = sample_mie(s.d, mie, state, pdf);
         }
       } else {
         real v1 = track_uniform(rng);
         real v2 = track_uniform(rng);
-        d = sample_hg(d, u_ice_g, real2(v1, v2), pdf);
+        s.d = sample_hg(s.d, u_ice_g, real2(v1, v2), pdf);
       }
     } else if (kGlobe && t_ground < CV_PATH_FAR) {
       // A Lambertian ground of constant albedo: lit by the sun through the clouds, reflecting a
       // cosine-distributed new direction with throughput times albedo.
-      p = normalize(p + t_ground * d) * u_r0;
-      real3 n = p / u_r0;
-      r.scatterings += 1;
+      s.p = normalize(s.p + t_ground * s.d) * u_r0;
+      real3 n = s.p / u_r0;
+      s.scatterings += 1;
       real mu_s = dot(n, u_to_sun);
       if (mu_s > real(0.0)) {
-        real tr = path_transmittance(p, u_to_sun, rng, c);
-        r.radiance += beta * u_irradiance * ground_radiance(u_ground_albedo, mu_s, real3(tr), real3(0.0));
+        real tr = path_transmittance(s.p, u_to_sun, rng, c);
+        s.radiance += s.beta * u_irradiance * ground_radiance(u_ground_albedo, mu_s, real3(tr), real3(0.0));
       }
-      r.absorbed += beta * (real3(1.0) - u_ground_albedo);
-      beta *= u_ground_albedo;
-      if (r.scatterings >= u_path_max_bounces) {
-        r.end = CV_PATH_TRUNCATED;
+      s.absorbed += s.beta * (real3(1.0) - u_ground_albedo);
+      s.beta *= u_ground_albedo;
+      if (s.scatterings >= u_path_max_bounces) {
+        s.end = CV_PATH_TRUNCATED;
         pc.truncated += 1u;
+        s.done = true;
         break;
       }
-      if (!path_roulette(r, beta, rng, pc)) break;
-      prev_peak = false;  // a cosine draw from the ground: no other technique makes it
+      if (!path_roulette(s, rng, pc)) {
+        s.done = true;
+        break;
+      }
+      s.prev_peak = false;  // a cosine draw from the ground: no other technique makes it
       real v1 = track_uniform(rng);
       real v2 = track_uniform(rng);
-      d = direction_around(n, sqrt(v1), CV_TWO_PI * v2);
+      s.d = direction_around(n, sqrt(v1), CV_TWO_PI * v2);
     } else {
-      r.end = t_ground < CV_PATH_FAR ? CV_PATH_GROUND : CV_PATH_SPACE;
-      break;
+      s.end = t_ground < CV_PATH_FAR ? CV_PATH_GROUND : CV_PATH_SPACE;
+      s.done = true;
     }
   }
-  r.weight = beta;
+}
+
+// One whole path from p along unit d.
+CV_FN PathResult trace_path(real3 p, real3 d, CV_INOUT(TrackRng) rng, CV_INOUT(TrackCounts) c, CV_INOUT(PathCounts) pc) {
+  PathState s = path_begin(p, d);
+  path_advance(s, rng, c, pc, 0xFFFFFFFFu);
+  PathResult r;
+  r.radiance = s.radiance;
+  r.weight = s.beta;
+  r.absorbed = s.absorbed;
+  r.end = s.end;
+  r.scatterings = s.scatterings;
   return r;
 }

@@ -12,6 +12,10 @@
 // otherwise look up the medium for hundreds of optical depths to multiply tiny factors.
 #define CV_TRACK_ROULETTE_BELOW real(1e-2)
 
+// A lookup exceeds its majorant when the medium is above it by more than rounding: float's trilinear
+// fetch can land a few ulps above the largest node it interpolates.
+#define CV_TRACK_EXCEED_TOL real(1e-5)
+
 // -log(1 - u): an exponential draw from a uniform one, accurate for small u.
 CV_FN real exponential_draw(real u) {
 #ifdef CV_GLSL
@@ -39,11 +43,14 @@ CV_FN void track_majorant(real3 p, real3 d, real t, real t_end, CV_OUT(real) sig
 }
 
 // A tracking walk's counters: tentative collisions rejected (delta tracking), medium lookups (ratio
-// tracking), and lookups where the medium exceeded the majorant (0 unless a majorant is wrong).
+// tracking), lookups where the medium exceeded the majorant (0 unless a majorant is wrong), and the
+// loop iterations the walk took (llvmpipe ends every loop of an invocation after 65 535 in all:
+// the GPU path tracer compares this count with that budget).
 struct TrackCounts {
   uint null_collisions;
   uint lookups;
   uint exceeded;
+  uint iterations;
 };
 
 CV_FN TrackCounts track_counts() {
@@ -51,14 +58,17 @@ CV_FN TrackCounts track_counts() {
   c.null_collisions = 0u;
   c.lookups = 0u;
   c.exceeded = 0u;
+  c.iterations = 0u;
   return c;
 }
 
 // The next tentative collision of a walk from distance t within [t, b): true with its distance
 // (t updated) and the majorant there; false when the walk has left [t, b).
-CV_FN bool next_tentative(real3 p, real3 d, CV_INOUT(real) t, real b, CV_INOUT(TrackRng) rng, CV_OUT(real) majorant) {
+CV_FN bool next_tentative(real3 p, real3 d, CV_INOUT(real) t, real b, CV_INOUT(TrackRng) rng, CV_OUT(real) majorant,
+                          CV_INOUT(TrackCounts) c) {
   majorant = real(0.0);
   while (t < b) {
+    c.iterations += 1u;
     real lim;
     track_majorant(p, d, t, b, majorant, lim);
     if (!(majorant > real(0.0))) {
@@ -85,12 +95,14 @@ CV_FN real delta_track(real3 p, real3 d, real4 seg, int n, CV_INOUT(TrackRng) rn
     real t = k == 0 ? seg.x : seg.z;
     real b = k == 0 ? seg.y : seg.w;
     real maj;
-    while (next_tentative(p, d, t, b, rng, maj)) {
+    c.iterations += 2u;  // this loop's test and next_tentative's last one
+    while (next_tentative(p, d, t, b, rng, maj, c)) {
+      c.iterations += 1u;
       real sl;
       real si;
       medium_at_point(p + t * d, sl, si);
       real sigma = sl + si;
-      c.exceeded += sigma > maj * real(1.0 + 1e-9) ? 1u : 0u;
+      c.exceeded += sigma > maj * (real(1.0) + CV_TRACK_EXCEED_TOL) ? 1u : 0u;
       if (track_uniform(rng) * maj < sigma) return t;
       c.null_collisions += 1u;
     }
@@ -107,12 +119,14 @@ CV_FN real ratio_track(real3 p, real3 d, real4 seg, int n, CV_INOUT(TrackRng) rn
     real t = k == 0 ? seg.x : seg.z;
     real b = k == 0 ? seg.y : seg.w;
     real maj;
-    while (next_tentative(p, d, t, b, rng, maj)) {
+    c.iterations += 2u;  // this loop's test and next_tentative's last one
+    while (next_tentative(p, d, t, b, rng, maj, c)) {
+      c.iterations += 1u;
       real sl;
       real si;
       medium_at_point(p + t * d, sl, si);
       real sigma = sl + si;
-      c.exceeded += sigma > maj * real(1.0 + 1e-9) ? 1u : 0u;
+      c.exceeded += sigma > maj * (real(1.0) + CV_TRACK_EXCEED_TOL) ? 1u : 0u;
       c.lookups += 1u;
       tr *= max(real(0.0), real(1.0) - sigma / maj);
       if (tr < CV_TRACK_ROULETTE_BELOW) {
