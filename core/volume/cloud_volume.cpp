@@ -25,6 +25,7 @@ const char* field_units(Field f) {
 std::size_t TimeStepData::bytes() const {
   std::size_t b = 0;
   for (const auto& f : fields) b += f.size() * sizeof(float);
+  b += ground_m.size() * sizeof(float);
   for (const auto* m : {&maps.cloud_cover, &maps.cloud_base_m, &maps.cloud_top_m, &maps.optical_depth,
                         &maps.low_cover, &maps.mid_cover, &maps.high_cover}) {
     b += m->size() * sizeof(float);
@@ -65,6 +66,9 @@ void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& o
     for (int i = 0; i < grid.lon_deg.count; ++i) {
       Overlap all, low, mid, high;
       double tau = 0.0, base = nan, top = nan;
+      // Layers by height above the ground where the terrain is known, above sea level otherwise.
+      const std::size_t col = grid.column(i, j);
+      const double ground = col < data.ground_m.size() && std::isfinite(data.ground_m[col]) ? data.ground_m[col] : 0.0;
       bool any_data = false;
       for (int k = grid.alt_m.count - 1; k >= 0; --k) {
         const std::size_t p = grid.index(i, j, k);
@@ -78,7 +82,8 @@ void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& o
         const bool cloudy = frac >= options.min_cloud_fraction && ext >= options.min_extinction_per_m;
         const double c = cloudy ? frac : 0.0;
         const double alt = grid.alt_m.at(k);
-        Overlap& layer = alt < options.low_top_m ? low : alt < options.mid_top_m ? mid : high;
+        const double above = alt - ground;
+        Overlap& layer = above < options.low_top_m ? low : above < options.mid_top_m ? mid : high;
         if (cloudy) {
           all.add(c);
           layer.add(c);
@@ -91,7 +96,6 @@ void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& o
         }
       }
       if (!any_data) continue;
-      const std::size_t col = grid.column(i, j);
       m.cloud_cover[col] = static_cast<float>(all.cover());
       m.low_cover[col] = static_cast<float>(low.cover());
       m.mid_cover[col] = static_cast<float>(mid.cover());

@@ -111,7 +111,7 @@ std::string ImportReport::to_json() const {
     const auto& v = variables[i];
     j += "    {\"role\": " + json_quote(v.role) + ", \"variable\": " + json_quote(v.variable) +
          ", \"units\": " + json_quote(v.units) + ", \"conversion\": " + json_quote(v.conversion) +
-         ", \"before\": " + stats_json(v.before) + ", \"after\": " + stats_json(v.after) +
+         ", \"before\": " + stats_json(v.before) + ", \"after\": " + stats_json(v.after) + ", \"after_units\": " + json_quote(v.after_units) +
          ", \"clamped\": " + std::to_string(v.clamped) + "}" + (i + 1 < variables.size() ? ",\n" : "\n");
   }
   j += "  ],\n  \"warnings\": [";
@@ -126,8 +126,8 @@ std::string ImportReport::to_text() const {
   std::string t = "import report for " + file + " (" + format + ")\n";
   for (const auto& v : variables) {
     t += "  " + v.role + " <- " + v.variable + " [" + (v.units.empty() ? "no units" : v.units) + "]: " +
-         v.conversion + "\n      read " + range_text(v.before) + " (" + std::to_string(v.before.missing) +
-         " missing)" + (v.after.empty() && v.after.missing == 0 ? std::string() : ", stored " + range_text(v.after)) + (v.clamped ? ", " + std::to_string(v.clamped) + " clamped" : "") +
+         v.conversion + "\n      read " + range_text(v.before) + (v.units.empty() || v.before.empty() ? std::string() : " " + v.units) + " (" +
+         std::to_string(v.before.missing) + " missing)" + (v.after.empty() && v.after.missing == 0 ? std::string() : ", stored " + range_text(v.after) + (v.after_units.empty() ? std::string() : " " + v.after_units)) + (v.clamped ? ", " + std::to_string(v.clamped) + " clamped" : "") +
          "\n";
   }
   for (const auto& n : notes) t += "  note: " + n + "\n";

@@ -1,7 +1,9 @@
 // .cvvol and .vti writers.
 #include "volume/volume_io.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -70,6 +72,9 @@ void write_cvvol(const std::string& path, CloudVolume& v, const std::function<vo
   }
   const Maps2D none;
   for (const auto& [name, arr] : map_arrays(none)) maps += std::string(maps.size() > 1 ? ", " : "") + json_quote(name);
+  // The ground's altitude, when the file gave terrain: read back, since the cover maps are derived
+  // again from it.
+  if (v.has_ground) maps += ", \"ground_m\"";
   for (std::size_t t = 0; t < v.times.size(); ++t) {
     times += std::string(t ? ", " : "") + "{\"iso_utc\": " + json_quote(v.times[t].iso_utc) +
              ", \"unix_s\": " + std::to_string(v.times[t].unix_s) + "}";
@@ -96,6 +101,14 @@ void write_cvvol(const std::string& path, CloudVolume& v, const std::function<vo
         put(f, a.data(), a.size() * sizeof(float));
       }
       for (const auto& [name, arr] : map_arrays(d.maps)) put(f, arr->data(), arr->size() * sizeof(float));
+      if (v.has_ground) {
+        if (d.ground_m.size() == v.grid.columns()) {
+          put(f, d.ground_m.data(), d.ground_m.size() * sizeof(float));
+        } else {
+          const std::vector<float> unknown(v.grid.columns(), std::numeric_limits<float>::quiet_NaN());
+          put(f, unknown.data(), unknown.size() * sizeof(float));
+        }
+      }
     }
   });
 }
@@ -172,8 +185,10 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
     t.unix_s = static_cast<std::int64_t>(json_number(header, "unix_s", k, path));
     v.times.push_back(t);
   }
+  const std::vector<std::string> maps = json_strings(header, "maps", path);
+  v.has_ground = std::find(maps.begin(), maps.end(), "ground_m") != maps.end();
   const std::size_t points = v.grid.points(), cols = v.grid.columns();
-  const std::uint64_t step_bytes = (order.size() * points + 7 * cols) * sizeof(float);
+  const std::uint64_t step_bytes = (order.size() * points + (v.has_ground ? 8 : 7) * cols) * sizeof(float);
   const std::uint64_t data0 = 16 + len;
   std::fseek(f, 0, SEEK_END);
   const long long size = std::ftell(f);
@@ -184,7 +199,7 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   v.report.file = path;
   v.report.format = "cloud volume (.cvvol)";
   v.set_loader(
-      [file, order, data0, step_bytes, points, path](std::size_t t, ImportReport&, TimeStepData& out) {
+      [file, order, data0, step_bytes, points, cols, ground = v.has_ground, path](std::size_t t, ImportReport&, TimeStepData& out) {
         if (std::fseek(file.get(), static_cast<long>(data0 + step_bytes * t), SEEK_SET) != 0) {
           throw VolumeFileError(path + ": cannot seek to time step " + std::to_string(t));
         }
@@ -196,7 +211,17 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
             throw VolumeFileError(path + ": truncated at time step " + std::to_string(t));
           }
         }
-        // The maps that follow are derived again from the fields by CloudVolume::step.
+        // The maps that follow are derived again from the fields (and the ground) by CloudVolume::step.
+        out.ground_m.clear();
+        if (ground) {
+          if (std::fseek(file.get(), static_cast<long>(7 * cols * sizeof(float)), SEEK_CUR) != 0) {
+            throw VolumeFileError(path + ": cannot seek to the ground of time step " + std::to_string(t));
+          }
+          out.ground_m.resize(cols);
+          if (std::fread(out.ground_m.data(), sizeof(float), cols, file.get()) != cols) {
+            throw VolumeFileError(path + ": truncated at time step " + std::to_string(t));
+          }
+        }
       },
       cache_steps);
   return v;
