@@ -39,8 +39,9 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
        "  import FILE -o OUT [--region W,E,S,N] [--times FIRST:LAST[:STRIDE] | --times START..END]\n"
        "         [--levels MIN_HPA:MAX_HPA]\n"
        "         [--stride N] [--dz M] [--reff-liquid UM] [--reff-ice UM] [--vti]\n"
-       "         [--diagnose-cloud [--rh-critical RH]]\n"
+       "         [--diagnose-cloud [--rh-critical RH]] [--float32]\n"
        "                           import into OUT.cvvol (+ OUT.report.json, and OUT_tNNN.vti with --vti);\n"
+       "                           fields are stored as half floats (--float32: full floats);\n"
        "                           --diagnose-cloud: a file with temperature and humidity but no cloud field\n"
        "                           gets a cloud diagnosed from relative humidity (Sundqvist, RH_c 0.8 by default)\n"},
       {"gpu-info", "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"},
@@ -154,6 +155,8 @@ int cmd_import(const std::vector<std::string>& args) {
   cv::importers::ImportOptions o;
   std::string input, out;
   bool vti = false;
+  // Fields as half floats unless asked (docs/importers.md states the error bound).
+  cv::core::CvvolEncoding encoding = cv::core::CvvolEncoding::Float16;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto next = [&]() -> const std::string& {
@@ -198,6 +201,8 @@ int cmd_import(const std::vector<std::string>& args) {
     } else if (a == "--reff-ice") {
       o.r_eff_ice_um = parse_number("--reff-ice", next());
       if (!(o.r_eff_ice_um >= 5 && o.r_eff_ice_um <= 200)) throw UsageError{"cloudviewer import: --reff-ice: expected 5..200 um"};
+    } else if (a == "--float32") {
+      encoding = cv::core::CvvolEncoding::Float32;
     } else if (a == "--diagnose-cloud") {
       o.diagnose_cloud = true;
     } else if (a == "--rh-critical") {
@@ -230,7 +235,7 @@ int cmd_import(const std::vector<std::string>& args) {
       std::snprintf(name, sizeof name, "_t%03zu.vti", t);
       cv::core::write_vti(out + name, vol.grid, vol.step(t), vol.has_field);
     }
-  });
+  }, encoding);
   cv::core::write_file_atomically(out + ".report.json", [&](std::FILE* f) {
     const std::string j = vol.report.to_json();
     std::fwrite(j.data(), 1, j.size(), f);

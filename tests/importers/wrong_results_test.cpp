@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string>
 
 #include "cf_layout.hpp"
@@ -400,6 +401,71 @@ TEST_F(CfImportFixes, DiagnosedCloudFromRelativeHumidity) {
     EXPECT_TRUE(any_contains(v.report.warnings, "Sundqvist et al. (1989)"));
     EXPECT_TRUE(any_contains(v.report.warnings, "RH from 'r'"));
   }
+}
+
+}  // namespace
+
+namespace {
+
+// Half floats: exact on representable values, round to nearest even, NaN and infinity kept, and a
+// volume written as float16 reads back within the error bound the format states.
+TEST(VolumeIo, Float16ConversionsAndTheirBound) {
+  using core::float_to_half;
+  using core::half_to_float;
+  for (float x : {0.0f, 1.0f, -2.0f, 0.5f, 65504.0f, 6.103515625e-05f /* 2^-14 */, 5.9604645e-08f /* 2^-24 */, 1024.5f - 0.5f}) {
+    EXPECT_EQ(half_to_float(float_to_half(x)), x) << x;
+  }
+  EXPECT_EQ(float_to_half(1.0f + 1.0f / 2048.0f), float_to_half(1.0f));              // a tie rounds to even
+  EXPECT_EQ(half_to_float(float_to_half(1.0f + 3.0f / 2048.0f)), 1.0f + 2.0f / 1024.0f);  // a tie rounds to even, up
+  EXPECT_TRUE(std::isnan(half_to_float(float_to_half(std::nanf("")))));
+  EXPECT_TRUE(std::isinf(half_to_float(float_to_half(1e6f))));
+  EXPECT_EQ(half_to_float(float_to_half(1e-9f)), 0.0f);
+  // Every value over six decades: relative error <= 2^-11 where normal, absolute <= 2^-25 below.
+  for (int i = 0; i <= 6000; ++i) {
+    const float x = static_cast<float>(1e-8 * std::pow(10.0, i / 1000.0));
+    const float y = half_to_float(float_to_half(x));
+    if (x >= 6.103515625e-05f) EXPECT_LE(std::abs(y - x), x / 2048.0f * (1.0f + 1e-6f)) << x;
+    else EXPECT_LE(std::abs(y - x), 2.9802322e-08f * (1.0f + 1e-6f)) << x;
+  }
+}
+
+TEST(VolumeIo, Float16VolumeReadsBackWithinItsStatedBound) {
+  const auto dir = cv::test::temp_dir("cvvol_half");
+  core::CloudVolume v;
+  v.grid.lon_deg = {0, 1, 4};
+  v.grid.lat_deg = {0, 1, 3};
+  v.grid.alt_m = {0, 500, 5};
+  v.times = {{0, "2024-01-01T00:00:00Z"}};
+  for (int f : {0, 1, 2, 6}) v.has_field[static_cast<std::size_t>(f)] = true;
+  core::TimeStepData d;
+  const std::size_t n = v.grid.points();
+  for (int f : {0, 1, 2, 6}) d.fields[static_cast<std::size_t>(f)].resize(n);
+  for (std::size_t p = 0; p < n; ++p) {
+    d[core::Field::ExtinctionLiquid][p] = static_cast<float>(1e-7 * std::pow(1.7, static_cast<double>(p % 25)));  // 1e-7 .. 0.03 /m
+    d[core::Field::ExtinctionIce][p] = p == 3 ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(3e-11 * p);
+    d[core::Field::CloudFraction][p] = static_cast<float>(p) / static_cast<float>(n);
+    d[core::Field::Temperature][p] = 200.0f + 0.37f * static_cast<float>(p);
+  }
+  core::derive_maps(v.grid, d);
+  v.put(0, d);
+  const std::string path = (dir / "half.cvvol").string();
+  core::write_cvvol(path, v, nullptr, core::CvvolEncoding::Float16);
+  auto r = core::read_cvvol(path);
+  const auto& s = r.step(0);
+  for (std::size_t p = 0; p < n; ++p) {
+    const float e = d[core::Field::ExtinctionLiquid][p];
+    EXPECT_LE(std::abs(s[core::Field::ExtinctionLiquid][p] - e), e / 2048.0f * 1.0001f) << p;
+    if (p == 3) EXPECT_TRUE(std::isnan(s[core::Field::ExtinctionIce][p]));
+    else EXPECT_LE(std::abs(s[core::Field::ExtinctionIce][p] - d[core::Field::ExtinctionIce][p]), 3e-11f) << p;
+    EXPECT_LE(std::abs(s[core::Field::CloudFraction][p] - d[core::Field::CloudFraction][p]), 2.45e-4f) << p;
+    EXPECT_LE(std::abs(s[core::Field::Temperature][p] - d[core::Field::Temperature][p]), 0.125f) << p;
+  }
+  // Half the bytes of float32 for the fields.
+  const std::string full = (dir / "full.cvvol").string();
+  core::write_cvvol(full, v, nullptr);
+  const double field_bytes = 4.0 * static_cast<double>(n) * 4.0;
+  EXPECT_NEAR(static_cast<double>(std::filesystem::file_size(full) - std::filesystem::file_size(path)), field_bytes / 2.0, 200.0);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
