@@ -291,6 +291,32 @@ void read_slab_into(Slab& s, const Era5Source& S, const NcVar& v, int time_index
   }
 }
 
+// Whether any cloud variable holds cloud on source level k at time index t, within the region:
+// a fraction of at least kZeroCloudFraction or water above kZeroWater (int16 packing leaves noise
+// below both where there is none).
+bool level_has_cloud(const Era5Source& S, int k, int time_index) {
+  const CfLayout& L = S.layout;
+  for (Role r : {Role::CloudFraction, Role::Liquid, Role::Ice, Role::Snow}) {
+    const NcVar* v = L.roles[static_cast<int>(r)];
+    if (!v) continue;
+    std::vector<std::size_t> start(v->dims.size(), 0), count(v->dims.size(), 1);
+    for (std::size_t a = 0; a < v->dims.size(); ++a) {
+      const int d = v->dims[a];
+      if (d == L.time.dim) start[a] = static_cast<std::size_t>(time_index);
+      if (d == L.vertical.dim) start[a] = static_cast<std::size_t>(k);
+      if (d == L.lon.dim) start[a] = static_cast<std::size_t>(S.lon_lo), count[a] = static_cast<std::size_t>(S.lon_hi - S.lon_lo + 1);
+      if (d == L.lat.dim) start[a] = static_cast<std::size_t>(S.lat_lo), count[a] = static_cast<std::size_t>(S.lat_hi - S.lat_lo + 1);
+    }
+    const double threshold = (r == Role::CloudFraction ? kZeroCloudFraction : kZeroWater) / L.role_scale[static_cast<int>(r)];
+    thread_local std::vector<float> buf;
+    S.file->read_float_into(buf, *v, start, count);
+    for (float x : buf) {
+      if (x >= threshold) return true;
+    }
+  }
+  return false;
+}
+
 Slab read_slab(const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* info, bool as_double) {
   Slab s;
   read_slab_into(s, S, v, time_index, info, as_double);
@@ -740,6 +766,32 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
     vol.report.warn("no geopotential: level heights come from the standard atmosphere (errors of a few hundred metres)");
   }
   if (!L.roles[static_cast<int>(Role::Temperature)]) vol.report.warn("no temperature: the standard atmosphere's is used");
+  // Levels above the highest one holding cloud at any step imported are empty bricks: they are
+  // left out (with one cloud-free level kept above the cloud, so it fades to zero), unless asked
+  // to keep them. Found by reading the cloud variables a level at a time from the top down.
+  if (!options.keep_cloudless_levels && !S->diagnose && S->levels.size() > 2) {
+    int top = -1;  // index into S->levels of the highest level with cloud
+    for (int l = static_cast<int>(S->levels.size()) - 1; l >= 0 && top < 0; --l) {
+      for (int t : S->steps) {
+        if (level_has_cloud(*S, S->levels[static_cast<std::size_t>(l)], t)) {
+          top = l;
+          break;
+        }
+      }
+    }
+    const std::size_t keep = static_cast<std::size_t>(std::max(top + 2, 2));
+    if (keep < S->levels.size()) {
+      const std::size_t n = S->levels.size();
+      vol.report.notes.push_back(std::to_string(n - keep) + " level(s) from " + fmt(S->level_pa[keep] / 100.0) +
+                                 " hPa (reference pressure) up hold no cloud at any step imported: left out, with the "
+                                 "cloud-free level at " + fmt(S->level_pa[keep - 1] / 100.0) +
+                                 " hPa kept above the cloud (--all-levels keeps them)");
+      S->levels.resize(keep), S->level_pa.resize(keep), S->level_z.resize(keep);
+      if (!S->hyb_a.empty()) S->hyb_a.resize(keep), S->hyb_b.resize(keep);
+      S->lev_lo = *std::min_element(S->levels.begin(), S->levels.end());
+      S->lev_hi = *std::max_element(S->levels.begin(), S->levels.end());
+    }
+  }
   // Altitude grid from the first step's level heights (geometric, above the sphere).
   double zmin = 1e30, zmax = -1e30;
   {

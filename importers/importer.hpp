@@ -39,6 +39,9 @@ struct ImportOptions {
   // A file with temperature and humidity but no cloud field gets a cloud diagnosed from relative
   // humidity (docs/importers.md, "Diagnosed cloud"); only when asked.
   bool diagnose_cloud = false;
+  // Keep the levels above the highest cloud of every step imported (CF files); by default they are
+  // left out, with one cloud-free level kept above the cloud.
+  bool keep_cloudless_levels = false;
   double rh_critical = 0.8;        // the scheme's threshold relative humidity, 0..1
 };
 

@@ -39,9 +39,10 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
        "  import FILE -o OUT [--region W,E,S,N] [--times FIRST:LAST[:STRIDE] | --times START..END]\n"
        "         [--levels MIN_HPA:MAX_HPA]\n"
        "         [--stride N] [--dz M] [--reff-liquid UM] [--reff-ice UM] [--vti]\n"
-       "         [--diagnose-cloud [--rh-critical RH]] [--float32]\n"
+       "         [--diagnose-cloud [--rh-critical RH]] [--float32] [--all-levels]\n"
        "                           import into OUT.cvvol (+ OUT.report.json, and OUT_tNNN.vti with --vti);\n"
-       "                           fields are stored as half floats (--float32: full floats);\n"
+       "                           fields are stored as half floats (--float32: full floats); levels above\n"
+       "                           the highest cloud are left out (--all-levels keeps them);\n"
        "                           --diagnose-cloud: a file with temperature and humidity but no cloud field\n"
        "                           gets a cloud diagnosed from relative humidity (Sundqvist, RH_c 0.8 by default)\n"},
       {"gpu-info", "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"},
@@ -201,6 +202,8 @@ int cmd_import(const std::vector<std::string>& args) {
     } else if (a == "--reff-ice") {
       o.r_eff_ice_um = parse_number("--reff-ice", next());
       if (!(o.r_eff_ice_um >= 5 && o.r_eff_ice_um <= 200)) throw UsageError{"cloudviewer import: --reff-ice: expected 5..200 um"};
+    } else if (a == "--all-levels") {
+      o.keep_cloudless_levels = true;
     } else if (a == "--float32") {
       encoding = cv::core::CvvolEncoding::Float32;
     } else if (a == "--diagnose-cloud") {

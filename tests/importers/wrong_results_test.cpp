@@ -264,6 +264,34 @@ TEST_F(CfImportFixes, CoverClassesAreMeasuredAboveTheGround) {
   EXPECT_NEAR(r.step(0).maps.mid_cover[sea], 0.6, 1e-5);
 }
 
+// Speed and size: levels above the highest cloud of any step imported are left out (one
+// cloud-free level stays above it), and the report says so; --all-levels keeps them.
+TEST_F(CfImportFixes, LevelsAboveTheHighestCloudAreLeftOut) {
+  const std::vector<double> hpa = {1000, 850, 700, 500, 300, 200, 100};
+  auto axes = era5_axes({0, 10}, {0, 10}, hpa);
+  axes[0].values = {0.0, 6.0};
+  const std::string p = path("tops.nc");
+  // Cloud at 850 hPa in the first step and at 500 hPa in the second; packing-noise water above.
+  cv::test::write_cf(p, axes,
+                     {geopotential(hpa), constant("t", "K", "air_temperature", 250.0),
+                      {"cc", kDims, {{"units", "1"}}, {}, [](const Idx& i) { return i[1] == (i[0] == 0 ? 1 : 3) ? 0.5 : 0.0; }},
+                      {"clwc", kDims, {{"units", "kg kg**-1"}}, {}, [](const Idx& i) {
+                         return i[1] == (i[0] == 0 ? 1 : 3) ? 1e-4 : 3e-11;
+                       }}});
+  auto v = importers::import_file(p);
+  EXPECT_NEAR(v.grid.alt_m.last(), level_alt(300), 1e-6);  // 500 hPa holds cloud; 300 hPa is the margin
+  EXPECT_TRUE(any_contains(v.report.notes, "2 level(s) from 200 hPa (reference pressure) up hold no cloud")) << v.report.to_text();
+  importers::ImportOptions o;
+  o.keep_cloudless_levels = true;
+  auto w = importers::import_file(p, o);
+  EXPECT_NEAR(w.grid.alt_m.last(), level_alt(100), 1e-6);
+  // Only the second step has the 500 hPa cloud: importing the first alone stops above 850 hPa.
+  o.keep_cloudless_levels = false;
+  o.time_last = 0;
+  auto f = importers::import_file(p, o);
+  EXPECT_NEAR(f.grid.alt_m.last(), level_alt(700), 1e-6);
+}
+
 // Messages: several vertical axes used by different variables; the real reason is named.
 TEST_F(CfImportFixes, SeveralVerticalAxesNameTheRealReason) {
   const std::vector<std::string> iso = {"time", "isobaric3", "lat", "lon"}, hag = {"time", "height_above_ground1", "lat", "lon"};
