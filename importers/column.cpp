@@ -79,7 +79,12 @@ void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, i
   const bool has_cf = !out.fields[static_cast<std::size_t>(kCf)].empty();
   // Linear interpolation in altitude; outside the column's levels: no data. A node within a
   // micrometre of the top level (the axis was fitted to end there) takes the top level's value.
+  // First each node's level pair and weight, then field by field over the nodes.
   const double z_top = n > 0 ? levels[static_cast<std::size_t>(n - 1)].z_m : kNaN;
+  thread_local std::vector<int> node_level;
+  thread_local std::vector<double> node_weight;
+  node_level.assign(static_cast<std::size_t>(grid.alt_m.count), -1);
+  node_weight.resize(static_cast<std::size_t>(grid.alt_m.count));
   int l = 1;
   for (int z = 0; z < grid.alt_m.count; ++z) {
     double alt = grid.alt_m.at(z);
@@ -88,24 +93,29 @@ void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, i
     if (l >= n) break;
     const double z0 = levels[static_cast<std::size_t>(l - 1)].z_m, z1 = levels[static_cast<std::size_t>(l)].z_m;
     if (!(z0 <= alt) || !(z1 > z0)) continue;
-    const double a = (alt - z0) / (z1 - z0);
-    const std::size_t p = grid.index(x, y, z);
-    auto lerp = [&](int f) {
-      const double* qf = q(f);
-      return qf[l - 1] + a * (qf[l] - qf[l - 1]);
-    };
-    const double cf = has_cf ? lerp(kCf) : kNaN;
-    for (int f = 0; f < core::kFieldCount; ++f) {
-      auto& dst = out.fields[static_cast<std::size_t>(f)];
-      if (dst.empty()) continue;
-      double v = lerp(f);
-      if ((f == kLiq || f == kIce) && has_cf && !std::isnan(cf)) {
-        // In-cloud = grid-box mean / fraction. Water was kept only where the fraction is
-        // meaningful, so where the fraction vanishes the mean does too and the ratio stays bounded
-        // by its neighbours' in-cloud values.
-        v = v > 0.0 && cf > 0.0 ? v / cf : (std::isnan(v) ? v : 0.0);
+    node_level[static_cast<std::size_t>(z)] = l;
+    node_weight[static_cast<std::size_t>(z)] = (alt - z0) / (z1 - z0);
+  }
+  const std::size_t layer = grid.columns(), p0 = grid.index(x, y, 0);
+  const double* qcf = q(kCf);
+  for (int f = 0; f < core::kFieldCount; ++f) {
+    auto& dst = out.fields[static_cast<std::size_t>(f)];
+    if (dst.empty()) continue;
+    const double* qf = q(f);
+    // In-cloud = grid-box mean / fraction. Water was kept only where the fraction is meaningful,
+    // so where the fraction vanishes the mean does too and the ratio stays bounded by its
+    // neighbours' in-cloud values.
+    const bool in_cloud = (f == kLiq || f == kIce) && has_cf;
+    for (int z = 0; z < grid.alt_m.count; ++z) {
+      const int lz = node_level[static_cast<std::size_t>(z)];
+      if (lz < 0) continue;
+      const double a = node_weight[static_cast<std::size_t>(z)];
+      double v = qf[lz - 1] + a * (qf[lz] - qf[lz - 1]);
+      if (in_cloud) {
+        const double cf = qcf[lz - 1] + a * (qcf[lz] - qcf[lz - 1]);
+        if (!std::isnan(cf)) v = v > 0.0 && cf > 0.0 ? v / cf : (std::isnan(v) ? v : 0.0);
       }
-      dst[p] = static_cast<float>(v);
+      dst[p0 + static_cast<std::size_t>(z) * layer] = static_cast<float>(v);
     }
   }
 }

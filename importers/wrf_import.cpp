@@ -574,7 +574,7 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
     }
     double dz = options.dz_m;
     if (dz <= 0.0) {
-      std::sort(thick.begin(), thick.end());
+      std::nth_element(thick.begin(), thick.begin() + static_cast<std::ptrdiff_t>(thick.size() / 2), thick.end());
       dz = std::clamp(thick[thick.size() / 2] / 2.0, 50.0, 500.0);
     }
     vol.grid.alt_m = altitude_axis(zmin, zmax, dz, options.dz_m <= 0.0);

@@ -20,15 +20,17 @@ void ValueStats::add(double v) {
 namespace {
 template <typename T>
 void add_range(ValueStats& s, const T* v, std::size_t n) {
-  T lo = std::numeric_limits<T>::infinity(), hi = -std::numeric_limits<T>::infinity();
+  // Branch-free so the compiler vectorises it (a global step is 10^8 values): a value that is not
+  // finite (|x| <= max is false for NaN and infinity) leaves lo and hi alone and is not counted.
+  const T inf = std::numeric_limits<T>::infinity(), big = std::numeric_limits<T>::max();
+  T lo = inf, hi = -inf;
   std::size_t finite = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const T x = v[i];
-    if (std::isfinite(x)) {
-      lo = x < lo ? x : lo;
-      hi = x > hi ? x : hi;
-      ++finite;
-    }
+    const bool ok = std::abs(x) <= big;
+    lo = std::min(lo, ok ? x : inf);
+    hi = std::max(hi, ok ? x : -inf);
+    finite += ok ? 1 : 0;
   }
   if (finite) {
     s.min = std::min(s.min, static_cast<double>(lo));
