@@ -12,6 +12,7 @@
 
 #include "cf_layout.hpp"
 #include "column.hpp"
+#include "diagnosed_cloud.hpp"
 #include "wrf_import.hpp"
 #include "importer.hpp"
 #include "physics/physics.hpp"
@@ -54,14 +55,29 @@ LonMap map_longitudes(const std::vector<double>& raw, const std::optional<Region
   }
   if (u.size() > 1 && 360.0 - u.back().first + u.front().first < 1e-6) u.pop_back();
   const int m = static_cast<int>(u.size());
-  // The largest gap on the circle separates the domain's east edge from its west edge.
-  int start = 0;
-  double gap = 360.0 - u.back().first + u.front().first;
-  for (int i = 1; i < m; ++i) {
-    if (u[static_cast<std::size_t>(i)].first - u[static_cast<std::size_t>(i - 1)].first > gap) {
-      gap = u[static_cast<std::size_t>(i)].first - u[static_cast<std::size_t>(i - 1)].first;
-      start = i;
+  // Where the circle is cut: the one gap that differs from the grid's step. On a regional grid that
+  // is the gap from its east edge round to its west edge (larger than the step); on a global grid
+  // whose columns do not divide 360 it is the wrap gap (smaller than the step). The step is the
+  // median gap (the smaller of two for a two-column grid); an evenly spaced circle is cut at 0.
+  std::vector<double> gaps(static_cast<std::size_t>(m));  // gaps[i]: from column i - 1 to column i
+  for (int i = 0; i < m; ++i) {
+    gaps[static_cast<std::size_t>(i)] = i == 0 ? 360.0 - u.back().first + u.front().first
+                                               : u[static_cast<std::size_t>(i)].first - u[static_cast<std::size_t>(i - 1)].first;
+  }
+  std::vector<double> sorted_gaps = gaps;
+  std::sort(sorted_gaps.begin(), sorted_gaps.end());
+  const double typical = m == 2 ? sorted_gaps.front() : sorted_gaps[static_cast<std::size_t>(m / 2)];
+  int start = 0, odd = 0;
+  for (int i = 0; i < m; ++i) {
+    if (std::abs(gaps[static_cast<std::size_t>(i)] - typical) > 1e-3 * typical) {
+      if (odd++ == 0) start = i;
     }
+  }
+  if (odd == 1 && gaps[static_cast<std::size_t>(start)] < typical) {
+    notes.push_back("longitudes every " + fmt(typical) + " degrees do not close the circle evenly (the gap from " +
+                    fmt(u[static_cast<std::size_t>((start + m - 1) % m)].first) + " to " +
+                    fmt(u[static_cast<std::size_t>(start)].first) + " is " + fmt(gaps[static_cast<std::size_t>(start)]) +
+                    " degrees): read as a regional grid cut there");
   }
   std::vector<double> lon;
   std::vector<int> idx;
@@ -231,6 +247,9 @@ struct Era5Source {
   std::vector<double> hyb_a, hyb_b;   // hybrid levels: p = a + b ps
   std::vector<int> steps;             // source time indices, in output order
   ImportOptions options;
+  bool diagnose = false;  // a cloud diagnosed from relative humidity (the file has none)
+  DiagnosedCloudScheme scheme;
+  std::string scheme_text;
   // The index ranges of the file that the region, stride and levels need (inclusive): reads cover
   // only these.
   int lon_lo = 0, lon_hi = 0, lat_lo = 0, lat_hi = 0, lev_lo = 0, lev_hi = 0;
@@ -272,6 +291,32 @@ void read_slab_into(Slab& s, const Era5Source& S, const NcVar& v, int time_index
   }
 }
 
+// Whether any cloud variable holds cloud on source level k at time index t, within the region:
+// a fraction of at least kZeroCloudFraction or water above kZeroWater (int16 packing leaves noise
+// below both where there is none).
+bool level_has_cloud(const Era5Source& S, int k, int time_index) {
+  const CfLayout& L = S.layout;
+  for (Role r : {Role::CloudFraction, Role::Liquid, Role::Ice, Role::Snow}) {
+    const NcVar* v = L.roles[static_cast<int>(r)];
+    if (!v) continue;
+    std::vector<std::size_t> start(v->dims.size(), 0), count(v->dims.size(), 1);
+    for (std::size_t a = 0; a < v->dims.size(); ++a) {
+      const int d = v->dims[a];
+      if (d == L.time.dim) start[a] = static_cast<std::size_t>(time_index);
+      if (d == L.vertical.dim) start[a] = static_cast<std::size_t>(k);
+      if (d == L.lon.dim) start[a] = static_cast<std::size_t>(S.lon_lo), count[a] = static_cast<std::size_t>(S.lon_hi - S.lon_lo + 1);
+      if (d == L.lat.dim) start[a] = static_cast<std::size_t>(S.lat_lo), count[a] = static_cast<std::size_t>(S.lat_hi - S.lat_lo + 1);
+    }
+    const double threshold = (r == Role::CloudFraction ? kZeroCloudFraction : kZeroWater) / L.role_scale[static_cast<int>(r)];
+    thread_local std::vector<float> buf;
+    S.file->read_float_into(buf, *v, start, count);
+    for (float x : buf) {
+      if (x >= threshold) return true;
+    }
+  }
+  return false;
+}
+
 Slab read_slab(const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* info, bool as_double) {
   Slab s;
   read_slab_into(s, S, v, time_index, info, as_double);
@@ -298,8 +343,12 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   const int t = S.steps[step];
   std::vector<Slab>& slab = S.scratch;
   bool have[kRoleCount] = {};
+  const bool diagnose = S.diagnose;
   for (int r = 0; r < kRoleCount; ++r) {
     if (!L.roles[r]) continue;
+    // Relative humidity is read only for a diagnosed cloud (humidity of the file's own cloud is
+    // not needed).
+    if (static_cast<Role>(r) == Role::RelativeHumidity && !diagnose) continue;
     UnpackInfo info;
     const bool heights = static_cast<Role>(r) == Role::Geopotential || static_cast<Role>(r) == Role::GeopotentialHeight;
     read_slab_into(slab[static_cast<std::size_t>(r)], S, *L.roles[r], t, &info, heights);
@@ -311,6 +360,13 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     use.before.add_all(slab[r].d.data(), slab[r].d.size());
     if (info.packed && use.conversion.empty()) {
       use.conversion = "unpacked x * " + fmt(info.scale) + " + " + fmt(info.offset) + "; ";
+    }
+    // Units to the conversion's: % to 0..1, g/kg to kg/kg.
+    if (const double k = L.role_scale[r]; k != 1.0) {
+      for (float& x : slab[r].f) x = static_cast<float>(x * k);
+      for (double& x : slab[r].d) x *= k;
+      const std::string what = "x " + fmt(k) + " (units '" + use.units + "'); ";
+      if (use.conversion.find(what) == std::string::npos) use.conversion += what;
     }
   }
   const int nlev = static_cast<int>(S.levels.size());
@@ -333,9 +389,12 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     if (on) out[f].assign(grid.points(), std::numeric_limits<float>::quiet_NaN());
     else out[f].clear();
   };
-  alloc(core::Field::ExtinctionLiquid, have[static_cast<int>(Role::Liquid)]);
-  alloc(core::Field::ExtinctionIce, have[static_cast<int>(Role::Ice)]);
-  alloc(core::Field::CloudFraction, has_cf);
+  alloc(core::Field::ExtinctionLiquid, have[static_cast<int>(Role::Liquid)] || diagnose);
+  alloc(core::Field::ExtinctionIce, have[static_cast<int>(Role::Ice)] || have[static_cast<int>(Role::Snow)] || diagnose);
+  alloc(core::Field::CloudFraction, has_cf || diagnose);
+  // The ground's altitude per column, where the file gives terrain.
+  if (L.surface_geopotential) out.ground_m.assign(grid.columns(), std::numeric_limits<float>::quiet_NaN());
+  else out.ground_m.clear();
   alloc(core::Field::WindU, have[static_cast<int>(Role::U)]);
   alloc(core::Field::WindV, have[static_cast<int>(Role::V)]);
   alloc(core::Field::WindW, have[static_cast<int>(Role::Omega)] || have[static_cast<int>(Role::UpwardVelocity)]);
@@ -434,6 +493,32 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
           }
           *water[ph] = qw;
         }
+        if (has(Role::Snow)) {
+          double qs = value(Role::Snow, i, j0, j1, w, k);
+          if (!std::isnan(qs)) {
+            if (qs < -1e-5 || qs > 0.05) bad(Role::Snow, qs, "a mixing ratio between 0 and 0.05 kg/kg");
+            if (qs < 0.0) {
+              ++W.negative_water;
+              W.worst_negative = std::min(W.worst_negative, qs);
+              qs = 0.0;
+            }
+            c.q_ice = (std::isnan(c.q_ice) ? 0.0 : c.q_ice) + qs;
+          }
+        }
+        if (diagnose) {
+          // Relative humidity from the file, or from specific humidity and q_sat(p, T).
+          double rh = NAN;
+          if (has(Role::RelativeHumidity)) rh = value(Role::RelativeHumidity, i, j0, j1, w, k);
+          else if (has(Role::Humidity)) rh = c.qv / saturation_specific_humidity(c.p_pa, c.t_k);
+          if (!std::isnan(rh) && !std::isnan(c.t_k)) {
+            if (rh < -0.01 || rh > 2.0) bad(has(Role::RelativeHumidity) ? Role::RelativeHumidity : Role::Humidity, rh,
+                                            "a relative humidity between 0 and 200 %");
+            const DiagnosedBox box = diagnose_box(rh, c.p_pa, c.t_k, S.scheme);
+            c.cf = box.cloud_fraction;
+            c.q_liquid = box.q_liquid;
+            c.q_ice = box.q_ice;
+          }
+        }
         if (has(Role::U)) c.u = value(Role::U, i, j0, j1, w, k);
         if (has(Role::V)) c.v = value(Role::V, i, j0, j1, w, k);
         if (has(Role::UpwardVelocity)) c.w = value(Role::UpwardVelocity, i, j0, j1, w, k);
@@ -442,6 +527,13 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
           const double rho = c.p_pa / (kRd * c.t_k * (1.0 + 0.608 * c.qv));
           c.w = -value(Role::Omega, i, j0, j1, w, k) / (rho * kG0);
         }
+      }
+    }
+    if (L.surface_geopotential) {
+      for (int x = 0; x < nx; ++x) {
+        const double raw = surf(zs, S.lon.src[static_cast<std::size_t>(x)], j0, j1, w);
+        const double zg = L.surface_geopotential_scale != 1.0 ? raw : physics::f64::geopotential_to_height_m(raw, grid.earth_radius_m);
+        out.ground_m[grid.column(x, y)] = static_cast<float>(zg);
       }
     }
     for (int x = 0; x < nx; ++x) {
@@ -478,10 +570,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     negative_water += W.negative_water;
     clamped_cf += W.clamped_cf;
     worst_negative = std::min(worst_negative, W.worst_negative);
-    counts.water_without_cf += W.counts.water_without_cf;
-    counts.cf_without_water += W.counts.cf_without_water;
-    counts.nonmonotonic += W.counts.nonmonotonic;
-    counts.most_water_without_cf = std::max(counts.most_water_without_cf, W.counts.most_water_without_cf);
+    counts.merge(W.counts);
   }
   // Report: SI ranges, conversions, consistency.
   const double r_l = S.options.r_eff_liquid_um;
@@ -490,15 +579,25 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     auto& use = report.use(role_name(r));
     if (use.conversion.find(conv) == std::string::npos) use.conversion += conv;
     use.after.add_all(out[f].data(), out[f].size());
+    use.after_units = core::field_units(f);
   };
   after(Role::Liquid, core::Field::ExtinctionLiquid,
-        "in-cloud = q / cloud fraction; LWC = rho q, rho = p / (287.05 T (1 + 0.608 q_v)); sigma = 3 LWC / (2 rho_w r_eff), r_eff " +
-            fmt(r_l) + " um -> liquid extinction 1/m");
+        "LWC = rho q, rho = p / (287.05 T (1 + 0.608 q_v)); sigma = 3 LWC / (2 rho_w r_eff), r_eff " +
+            fmt(r_l) + " um (grid-box mean, interpolated in altitude with the fraction) -> in-cloud liquid extinction = mean / fraction, 1/m");
   after(Role::Ice, core::Field::ExtinctionIce,
-        std::string("in-cloud = q / cloud fraction; IWC = rho q; sigma = 3 IWC / (2 917 kg/m3 r_eff), r_eff ") +
+        std::string("IWC = rho q; sigma = 3 IWC / (2 917 kg/m3 r_eff), r_eff ") +
             (S.options.r_eff_ice_um > 0 ? fmt(S.options.r_eff_ice_um) + " um" : "50 + 0.5 T[C] um in 20..50") +
-            " -> ice extinction 1/m");
+            " (grid-box mean, interpolated with the fraction) -> in-cloud ice extinction = mean / fraction, 1/m");
   after(Role::CloudFraction, core::Field::CloudFraction, "clamped to 0..1");
+  if (diagnose) {
+    auto& use = report.use("diagnosed cloud (not in the file)");
+    use.variable = has(Role::RelativeHumidity) ? L.roles[static_cast<int>(Role::RelativeHumidity)]->name
+                                                : L.roles[static_cast<int>(Role::Humidity)]->name;
+    use.units = L.roles[static_cast<int>(has(Role::RelativeHumidity) ? Role::RelativeHumidity : Role::Humidity)]->text("units");
+    use.conversion = S.scheme_text;
+    use.after.add_all(out[core::Field::CloudFraction].data(), out[core::Field::CloudFraction].size());
+    use.after_units = "cloud fraction";
+  }
   after(Role::U, core::Field::WindU, "interpolated in altitude");
   after(Role::V, core::Field::WindV, "interpolated in altitude");
   after(Role::Omega, core::Field::WindW, "w = -omega / (rho g0)");
@@ -517,6 +616,10 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     report.warn(std::to_string(negative_water) + " negative mixing ratios (down to " + fmt(worst_negative) +
                 " kg/kg) set to 0 at time step " + std::to_string(t));
   }
+  if (diagnose) {
+    // The consistency of a file's own cloud fields; a diagnosed cloud is consistent by construction.
+    counts.water_without_cf = counts.water_without_cf_significant = counts.cf_without_water = 0;
+  }
   report_counts(counts, t, report);
 }
 
@@ -526,6 +629,7 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
   S->options = options;
   const NcFile& f = *S->file;
   if (is_wrf_file(f)) return import_wrf(std::move(S->file), options);
+  if (is_wrf_geogrid_file(f)) throw ImportError(wrf_geogrid_message(f));
   S->layout = detect_cf_layout(f);
   CfLayout& L = S->layout;
   core::CloudVolume vol;
@@ -535,11 +639,38 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
   for (const auto& n : L.notes) vol.report.notes.push_back(n);
   vol.report.notes.push_back("longitude '" + L.lon.var->name + "' recognised " + L.lon.how);
   vol.report.notes.push_back("latitude '" + L.lat.var->name + "' recognised " + L.lat.how);
-  const bool any_cloud = L.roles[static_cast<int>(Role::CloudFraction)] || L.roles[static_cast<int>(Role::Liquid)] ||
-                         L.roles[static_cast<int>(Role::Ice)];
-  if (!any_cloud) {
-    throw ImportError(path + ": no cloud variable; expected at least one of cc / fraction_of_cloud_cover, "
-                      "clwc / specific_cloud_liquid_water_content, ciwc / specific_cloud_ice_water_content");
+  if (!has_cloud(L)) {
+    const bool t = L.roles[static_cast<int>(Role::Temperature)], rh = L.roles[static_cast<int>(Role::RelativeHumidity)],
+               q = L.roles[static_cast<int>(Role::Humidity)];
+    std::string what = path + ": no cloud variable; expected at least one of cloud fraction (cc, fraction_of_cloud_cover, "
+                       "GRIB 0-6-1/22/32), liquid (clwc, cloud_mixing_ratio, GRIB 0-1-22/83), ice (ciwc, "
+                       "ice_water_mixing_ratio, GRIB 0-1-23/84) or snow";
+    if (!options.diagnose_cloud) {
+      if (t && (rh || q)) what += "; the file has temperature and humidity: --diagnose-cloud diagnoses a cloud from them";
+      if (!L.precipitation.empty()) what += " (precipitation alone, '" + L.precipitation.front() + "', is not cloud)";
+      throw ImportError(what);
+    }
+    if (!t || !(rh || q)) {
+      throw ImportError(path + ": --diagnose-cloud needs temperature and relative (or specific) humidity on the levels; "
+                        "the file has " + (t ? "temperature" : "no temperature") + " and " +
+                        (rh || q ? "humidity" : "no humidity"));
+    }
+    S->diagnose = true;
+    S->scheme.rh_critical = options.rh_critical;
+    const NcVar* hum = rh ? L.roles[static_cast<int>(Role::RelativeHumidity)] : L.roles[static_cast<int>(Role::Humidity)];
+    S->scheme_text = "cloud fraction from Sundqvist et al. (1989), 1 - sqrt((1 - RH) / (1 - RH_c)), RH_c " + fmt(options.rh_critical) +
+                     ", RH from '" + hum->name + "'" + (rh ? "" : " / q_sat") + "; in-cloud condensate " +
+                     fmt(S->scheme.condensate_of_saturation) + " q_sat(p, T from '" +
+                     L.roles[static_cast<int>(Role::Temperature)]->name +
+                     "'), liquid share ((T - 250.16) / 23)^2 between -23 and 0 C";
+    vol.report.warn("DIAGNOSED CLOUD: the file has no cloud field; the cloud shown is diagnosed from humidity (" +
+                    S->scheme_text + "). See docs/importers.md, 'Diagnosed cloud'");
+  }
+  for (const auto& p : L.precipitation) {
+    vol.report.notes.push_back("'" + p + "' (precipitation) is not part of the cloud volume");
+  }
+  if (L.roles[static_cast<int>(Role::Snow)]) {
+    vol.report.notes.push_back("snow '" + L.roles[static_cast<int>(Role::Snow)]->name + "' is added to the cloud ice");
   }
   // Horizontal grid.
   S->lon = map_longitudes(L.lon.values, options.region, std::max(1, options.horizontal_stride),
@@ -635,6 +766,32 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
     vol.report.warn("no geopotential: level heights come from the standard atmosphere (errors of a few hundred metres)");
   }
   if (!L.roles[static_cast<int>(Role::Temperature)]) vol.report.warn("no temperature: the standard atmosphere's is used");
+  // Levels above the highest one holding cloud at any step imported are empty bricks: they are
+  // left out (with one cloud-free level kept above the cloud, so it fades to zero), unless asked
+  // to keep them. Found by reading the cloud variables a level at a time from the top down.
+  if (!options.keep_cloudless_levels && !S->diagnose && S->levels.size() > 2) {
+    int top = -1;  // index into S->levels of the highest level with cloud
+    for (int l = static_cast<int>(S->levels.size()) - 1; l >= 0 && top < 0; --l) {
+      for (int t : S->steps) {
+        if (level_has_cloud(*S, S->levels[static_cast<std::size_t>(l)], t)) {
+          top = l;
+          break;
+        }
+      }
+    }
+    const std::size_t keep = static_cast<std::size_t>(std::max(top + 2, 2));
+    if (keep < S->levels.size()) {
+      const std::size_t n = S->levels.size();
+      vol.report.notes.push_back(std::to_string(n - keep) + " level(s) from " + fmt(S->level_pa[keep] / 100.0) +
+                                 " hPa (reference pressure) up hold no cloud at any step imported: left out, with the "
+                                 "cloud-free level at " + fmt(S->level_pa[keep - 1] / 100.0) +
+                                 " hPa kept above the cloud (--all-levels keeps them)");
+      S->levels.resize(keep), S->level_pa.resize(keep), S->level_z.resize(keep);
+      if (!S->hyb_a.empty()) S->hyb_a.resize(keep), S->hyb_b.resize(keep);
+      S->lev_lo = *std::min_element(S->levels.begin(), S->levels.end());
+      S->lev_hi = *std::max_element(S->levels.begin(), S->levels.end());
+    }
+  }
   // Altitude grid from the first step's level heights (geometric, above the sphere).
   double zmin = 1e30, zmax = -1e30;
   {
@@ -697,28 +854,33 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
     if (!(zmax > zmin)) throw ImportError(path + ": the levels' heights span no altitude range");
     double dz = options.dz_m;
     if (dz <= 0.0) {
-      std::sort(thick.begin(), thick.end());
+      // The median (the element a full sort would put in the middle), without sorting 10^7 values.
+      if (!thick.empty()) std::nth_element(thick.begin(), thick.begin() + static_cast<std::ptrdiff_t>(thick.size() / 2), thick.end());
       const double median = thick.empty() ? 500.0 : thick[thick.size() / 2];
       dz = std::clamp(median / 2.0, 50.0, 500.0);
     }
     zmin = std::max(zmin, -500.0);
-    const int nz = static_cast<int>(std::floor((zmax - zmin) / dz)) + 1;
-    vol.grid.alt_m = {zmin, dz, nz};
+    // The axis reaches the highest level: an automatic spacing is fitted to end on it.
+    vol.grid.alt_m = altitude_axis(zmin, zmax, dz, options.dz_m <= 0.0);
   }
   const double bytes = static_cast<double>(vol.grid.points()) * core::kFieldCount * sizeof(float);
   if (bytes > options.max_volume_bytes) {
     throw ImportError(path + ": the volume would take " + fmt(bytes / 1e9) + " GB per time step (limit " +
                       fmt(options.max_volume_bytes / 1e9) + " GB); subset the region, levels or stride, or raise --dz");
   }
-  vol.has_field[static_cast<int>(core::Field::ExtinctionLiquid)] = L.roles[static_cast<int>(Role::Liquid)] != nullptr;
-  vol.has_field[static_cast<int>(core::Field::ExtinctionIce)] = L.roles[static_cast<int>(Role::Ice)] != nullptr;
-  vol.has_field[static_cast<int>(core::Field::CloudFraction)] = L.roles[static_cast<int>(Role::CloudFraction)] != nullptr;
+  vol.has_field[static_cast<int>(core::Field::ExtinctionLiquid)] = L.roles[static_cast<int>(Role::Liquid)] != nullptr || S->diagnose;
+  vol.has_field[static_cast<int>(core::Field::ExtinctionIce)] =
+      L.roles[static_cast<int>(Role::Ice)] != nullptr || L.roles[static_cast<int>(Role::Snow)] != nullptr || S->diagnose;
+  vol.has_field[static_cast<int>(core::Field::CloudFraction)] = L.roles[static_cast<int>(Role::CloudFraction)] != nullptr || S->diagnose;
+  vol.has_ground = L.surface_geopotential != nullptr;
+  vol.report.notes.push_back(vol.has_ground ? "low/mid/high cover by height above the ground ('" + L.surface_geopotential->name + "')"
+                                            : "low/mid/high cover by height above sea level (the file gives no terrain)");
   vol.has_field[static_cast<int>(core::Field::WindU)] = L.roles[static_cast<int>(Role::U)] != nullptr;
   vol.has_field[static_cast<int>(core::Field::WindV)] = L.roles[static_cast<int>(Role::V)] != nullptr;
   vol.has_field[static_cast<int>(core::Field::WindW)] =
       L.roles[static_cast<int>(Role::Omega)] != nullptr || L.roles[static_cast<int>(Role::UpwardVelocity)] != nullptr;
   vol.has_field[static_cast<int>(core::Field::Temperature)] = true;
-  if (!L.roles[static_cast<int>(Role::CloudFraction)]) {
+  if (!L.roles[static_cast<int>(Role::CloudFraction)] && !S->diagnose) {
     vol.report.notes.push_back("no cloud fraction: water is taken as covering whole grid boxes");
   }
   const core::VolumeGrid grid = vol.grid;

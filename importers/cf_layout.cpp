@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <optional>
 #include <regex>
 
 namespace cv::importers {
@@ -32,22 +33,32 @@ double pressure_scale(const std::string& units) {
 
 enum class Kind { None, Lon, Lat, Vertical, Time };
 
+// A units string in one spelling: lower case, spaces as underscores ("degrees north" is UDUNITS'
+// "degrees_north" too).
+std::string units_key(const std::string& units) {
+  std::string u = lower(units);
+  while (!u.empty() && u.back() == ' ') u.pop_back();
+  while (!u.empty() && u.front() == ' ') u.erase(u.begin());
+  std::replace(u.begin(), u.end(), ' ', '_');
+  return u;
+}
+
 Kind classify(const NcVar& v, std::string& how, const std::vector<double>* values) {
-  const std::string units = lower(v.text("units"));
+  const std::string units = units_key(v.text("units"));
   const std::string sn = lower(v.text("standard_name"));
   const std::string axis = lower(v.text("axis"));
   const std::string name = lower(v.name);
-  if (sn == "longitude" || in(units, {"degrees_east", "degree_east", "degree_e", "degrees_e", "degreee", "degreese"}) ||
+  if (sn == "longitude" || in(units, {"degrees_east", "degree_east", "degree_e", "degrees_e", "degreee", "degreese", "deg_e", "degrees_e"}) ||
       (axis == "x" && units.find("degree") != std::string::npos)) {
     how = "by attributes (units '" + v.text("units") + "', standard_name '" + v.text("standard_name") + "')";
     return Kind::Lon;
   }
-  if (sn == "latitude" || in(units, {"degrees_north", "degree_north", "degree_n", "degrees_n", "degreen", "degreesn"}) ||
+  if (sn == "latitude" || in(units, {"degrees_north", "degree_north", "degree_n", "degrees_n", "degreen", "degreesn", "deg_n"}) ||
       (axis == "y" && units.find("degree") != std::string::npos)) {
     how = "by attributes (units '" + v.text("units") + "')";
     return Kind::Lat;
   }
-  if (sn == "time" || axis == "t" || units.find(" since ") != std::string::npos) {
+  if (sn == "time" || axis == "t" || lower(v.text("units")).find(" since ") != std::string::npos) {
     how = "by attributes (units '" + v.text("units") + "')";
     return Kind::Time;
   }
@@ -62,50 +73,150 @@ Kind classify(const NcVar& v, std::string& how, const std::vector<double>* value
   // Name alone is not enough; a conventional name whose values fit the axis is accepted, noted.
   if (values && !values->empty()) {
     const auto [mn, mx] = std::minmax_element(values->begin(), values->end());
+    const std::string why = v.att("units") ? "has units '" + v.text("units") + "', not a CF longitude or latitude unit"
+                                           : "has no units attribute";
     if (in(name, {"lon", "long", "longitude"}) && *mn >= -360.0 && *mx <= 720.0) {
-      how = "by its name and values (" + v.name + " has no units attribute; values within -360..720)";
+      how = "by its name and values (" + v.name + " " + why + "; values within -360..720)";
       return Kind::Lon;
     }
     if (in(name, {"lat", "latitude"}) && *mn >= -90.0 && *mx <= 90.0) {
-      how = "by its name and values (" + v.name + " has no units attribute; values within -90..90)";
+      how = "by its name and values (" + v.name + " " + why + "; values within -90..90)";
       return Kind::Lat;
     }
   }
   return Kind::None;
 }
 
+// How a role is recognised. standard_name first, then GRIB parameter attributes (GRIB2
+// discipline-category-number as netCDF-Java, NCL and cfgrib write them, or the NCEP/ECMWF short
+// name), then the variable's name (lower case, without a netCDF-Java "_isobaric..." or an NCL
+// "_P0_L100_GLL0" suffix). A variable whose units do not fit the role is never taken.
+struct Grib2 {
+  int discipline, category, number;
+};
 struct RoleSpec {
   Role role;
   std::initializer_list<const char*> standard_names;
-  std::initializer_list<const char*> names;
+  std::initializer_list<Grib2> grib;
+  std::initializer_list<const char*> short_names;  // GRIB shortName / NCEP abbreviation, lower case
+  std::initializer_list<const char*> names;        // lower case
 };
 
 const RoleSpec kRoles[] = {
-    {Role::CloudFraction, {"cloud_area_fraction_in_atmosphere_layer", "fraction_of_cloud_cover"}, {"cc", "fraction_of_cloud_cover", "cloud_fraction"}},
-    {Role::Liquid, {"mass_fraction_of_cloud_liquid_water_in_air", "specific_cloud_liquid_water_content"}, {"clwc", "specific_cloud_liquid_water_content"}},
-    {Role::Ice, {"mass_fraction_of_cloud_ice_in_air", "specific_cloud_ice_water_content"}, {"ciwc", "specific_cloud_ice_water_content"}},
-    {Role::Geopotential, {"geopotential"}, {"z", "geopotential"}},
-    {Role::GeopotentialHeight, {"geopotential_height"}, {"gh", "geopotential_height", "Geopotential_height_isobaric"}},
-    {Role::Temperature, {"air_temperature"}, {"t", "air_temperature", "Temperature_isobaric"}},
-    {Role::Humidity, {"specific_humidity"}, {"q", "specific_humidity"}},
-    {Role::U, {"eastward_wind"}, {"u", "eastward_wind"}},
-    {Role::V, {"northward_wind"}, {"v", "northward_wind"}},
-    {Role::Omega, {"lagrangian_tendency_of_air_pressure"}, {"w", "lagrangian_tendency_of_air_pressure"}},
-    {Role::UpwardVelocity, {"upward_air_velocity"}, {}},
+    {Role::CloudFraction, {"cloud_area_fraction_in_atmosphere_layer", "fraction_of_cloud_cover"}, {{0, 6, 32}, {0, 6, 22}, {0, 6, 1}},
+     {"cc", "tcc", "tcdc", "cdcc", "fraccc"}, {"cc", "fraction_of_cloud_cover", "cloud_fraction", "total_cloud_cover", "cloud_cover", "cldfra"}},
+    {Role::Liquid, {"mass_fraction_of_cloud_liquid_water_in_air", "specific_cloud_liquid_water_content", "cloud_liquid_water_mixing_ratio"},
+     {{0, 1, 83}, {0, 1, 22}}, {"clwc", "clwmr"},
+     {"clwc", "specific_cloud_liquid_water_content", "cloud_mixing_ratio", "cloud_water_mixing_ratio", "cloud_liquid_water_mixing_ratio", "clwmr"}},
+    {Role::Ice, {"mass_fraction_of_cloud_ice_in_air", "specific_cloud_ice_water_content", "cloud_ice_mixing_ratio"},
+     {{0, 1, 84}, {0, 1, 23}, {0, 1, 82}}, {"ciwc", "icmr", "cimixr"},
+     {"ciwc", "specific_cloud_ice_water_content", "ice_water_mixing_ratio", "cloud_ice_mixing_ratio", "icmr"}},
+    {Role::Geopotential, {"geopotential"}, {{0, 3, 4}}, {"z", "gp"}, {"z", "geopotential"}},
+    {Role::GeopotentialHeight, {"geopotential_height"}, {{0, 3, 5}}, {"gh", "hgt"}, {"gh", "geopotential_height", "hgt"}},
+    {Role::Temperature, {"air_temperature"}, {{0, 0, 0}}, {"t", "tmp"}, {"t", "air_temperature", "temperature", "tmp"}},
+    {Role::Humidity, {"specific_humidity"}, {{0, 1, 0}}, {"q", "spfh"}, {"q", "specific_humidity", "spfh"}},
+    {Role::U, {"eastward_wind"}, {{0, 2, 2}}, {"u", "ugrd"}, {"u", "eastward_wind", "u-component_of_wind", "u_component_of_wind", "ugrd"}},
+    {Role::V, {"northward_wind"}, {{0, 2, 3}}, {"v", "vgrd"}, {"v", "northward_wind", "v-component_of_wind", "v_component_of_wind", "vgrd"}},
+    {Role::Omega, {"lagrangian_tendency_of_air_pressure"}, {{0, 2, 8}}, {"w", "vvel"},
+     {"w", "lagrangian_tendency_of_air_pressure", "vertical_velocity_pressure", "vvel"}},
+    {Role::UpwardVelocity, {"upward_air_velocity"}, {{0, 2, 9}}, {"wz", "dzdt"}, {"vertical_velocity_geometric", "dzdt"}},
+    {Role::Snow, {"mass_fraction_of_snow_in_air", "specific_snow_water_content"}, {{0, 1, 86}, {0, 1, 25}}, {"cswc", "snmr"},
+     {"cswc", "specific_snow_water_content", "snow_mixing_ratio", "snmr"}},
+    {Role::RelativeHumidity, {"relative_humidity"}, {{0, 1, 1}}, {"r", "rh"}, {"r", "relative_humidity", "rh"}},
 };
+
+// Precipitation, recognised so the report can say it is left out.
+const RoleSpec kPrecipitation[] = {
+    {Role::Liquid, {"mass_fraction_of_rain_in_air", "specific_rain_water_content"}, {{0, 1, 85}, {0, 1, 24}}, {"crwc", "rwmr"},
+     {"crwc", "specific_rain_water_content", "rain_mixing_ratio", "rwmr"}},
+    {Role::Liquid, {"mass_fraction_of_graupel_in_air"}, {{0, 1, 32}}, {"grle"}, {"graupel", "graupel_snow_pellets", "grle"}},
+};
+
+// Whether `units` fit the role, and the factor to the conversion's units. Empty units pass (the
+// values' range checks still apply); wrong ones do not.
+bool units_fit(Role r, const std::string& raw_units, double& scale) {
+  const std::string u = units_key(raw_units);
+  scale = 1.0;
+  if (u.empty()) return true;
+  const bool ratio = in(u, {"kg/kg", "kg_kg-1", "kg_kg**-1", "kg_kg^-1", "kg.kg-1", "1", "kg_kg**(-1)", "kg/kg_(moist_air)"});
+  const bool per_mille = in(u, {"g/kg", "g_kg-1", "g_kg**-1", "g_kg^-1", "g.kg-1"});
+  const bool percent = in(u, {"%", "percent", "pct"});
+  switch (r) {
+    case Role::CloudFraction:
+    case Role::RelativeHumidity:
+      if (percent) scale = 0.01;
+      return percent || in(u, {"1", "(0_-_1)", "0-1", "(0-1)", "fraction", "dimensionless", "-"});
+    case Role::Liquid:
+    case Role::Ice:
+    case Role::Snow:
+    case Role::Humidity:
+      if (per_mille) scale = 1e-3;
+      return ratio || per_mille;
+    case Role::Temperature: return in(u, {"k", "kelvin", "degk", "deg_k", "degrees_k"});
+    case Role::U:
+    case Role::V:
+    case Role::UpwardVelocity:
+      return in(u, {"m_s-1", "m_s**-1", "m/s", "m.s-1", "m_s^-1", "meters/second", "metres/second", "m_sec-1"});
+    default: return true;  // geopotential and omega: their units are settled after detection
+  }
+}
+
+// The GRIB2 parameter a variable's attributes name, if any: netCDF-Java's Grib2_Parameter
+// (discipline, category, number) and Grib_Variable_Id "VAR_0-1-23_L100"; NCL's
+// parameter_discipline_and_category / parameter_template_discipline_category_number.
+std::optional<Grib2> grib2_of(const NcVar& v) {
+  if (const NcAtt* a = v.att("Grib2_Parameter"); a && a->values.size() == 3) {
+    return Grib2{static_cast<int>(a->values[0]), static_cast<int>(a->values[1]), static_cast<int>(a->values[2])};
+  }
+  if (const NcAtt* a = v.att("parameter_template_discipline_category_number"); a && a->values.size() == 4) {
+    return Grib2{static_cast<int>(a->values[1]), static_cast<int>(a->values[2]), static_cast<int>(a->values[3])};
+  }
+  static const std::regex id("^VAR_(\\d+)-(\\d+)-(\\d+)(_|$)");
+  std::smatch m;
+  const std::string vid = v.text("Grib_Variable_Id");
+  if (std::regex_search(vid, m, id)) return Grib2{std::stoi(m[1]), std::stoi(m[2]), std::stoi(m[3])};
+  return std::nullopt;
+}
+
+// The GRIB short name a variable's attributes give (cfgrib's GRIB_shortName, netCDF-Java's and
+// NCEP's abbreviation), lower case.
+std::string short_name_of(const NcVar& v) {
+  for (const char* a : {"GRIB_shortName", "abbreviation", "short_name"}) {
+    if (!v.text(a).empty()) return lower(v.text(a));
+  }
+  return "";
+}
+
+// A variable's name without the level-type suffixes GRIB converters add, lower case:
+// "Ice_water_mixing_ratio_isobaric" -> "ice_water_mixing_ratio", "ICMR_P0_L100_GLL0" -> "icmr".
+std::string base_name(const std::string& name) {
+  std::string n = lower(name);
+  static const std::regex ncl("^([a-z0-9]+)_p[0-9]+_l[0-9]+(_.*)?$");
+  std::smatch m;
+  if (std::regex_match(n, m, ncl)) return m[1];
+  for (const char* suffix : {"_isobaric", "_hybrid", "_height_above_ground", "_sigma", "_altitude_above_msl", "_pressure"}) {
+    const auto at = n.find(suffix);
+    if (at != std::string::npos && at > 0) return n.substr(0, at);
+  }
+  return n;
+}
 }  // namespace
 
 const char* role_name(Role r) {
   static const char* names[kRoleCount] = {"cloud fraction", "cloud liquid water", "cloud ice water", "geopotential",
                                           "geopotential height", "temperature", "specific humidity", "eastward wind",
-                                          "northward wind", "vertical velocity (omega)", "upward air velocity"};
+                                          "northward wind", "vertical velocity (omega)", "upward air velocity",
+                                          "snow (added to the ice)", "relative humidity"};
   return names[static_cast<int>(r)];
 }
 
 CfLayout detect_cf_layout(const NcFile& f) {
   CfLayout L;
   const std::string& path = f.path();
-  // Coordinate variables: 1-D, named like their dimension.
+  // Coordinate variables: 1-D, named like their dimension. A file may hold several of one kind
+  // (GRIB converters write isobaric1, isobaric3, height_above_ground1, ... for the levels different
+  // variables use): each is a candidate, and the axes the variables used sit on are chosen below.
+  std::vector<Axis> candidates[4];  // lon, lat, vertical, time
   for (const auto& v : f.vars()) {
     if (v.dims.size() != 1 || f.dims()[static_cast<std::size_t>(v.dims[0])].name != v.name) continue;
     if (f.size(v) > (1u << 24)) throw ImportError(path + ": coordinate '" + v.name + "' has an implausible length");
@@ -113,22 +224,13 @@ CfLayout detect_cf_layout(const NcFile& f) {
     if (v.type != 2 /* NC_CHAR */) values = f.read(v);
     std::string how;
     const Kind k = classify(v, how, &values);
-    Axis* target = k == Kind::Lon ? &L.lon : k == Kind::Lat ? &L.lat : k == Kind::Vertical ? &L.vertical
-                 : k == Kind::Time ? &L.time : nullptr;
-    if (!target) continue;
-    if (target->var) {
-      throw ImportError(path + ": both '" + target->var->name + "' and '" + v.name +
-                        "' look like the same axis; expected one coordinate per axis");
-    }
-    target->dim = v.dims[0];
-    target->var = &v;
-    target->values = std::move(values);
-    target->how = how;
-    for (double x : target->values) {
-      if (!std::isfinite(x)) {
-        throw ImportError(path + ": coordinate '" + v.name + "' has a missing or infinite value; expected every value set and finite");
-      }
-    }
+    if (k == Kind::None) continue;
+    Axis a;
+    a.dim = v.dims[0];
+    a.var = &v;
+    a.values = std::move(values);
+    a.how = how;
+    candidates[static_cast<int>(k) - 1].push_back(std::move(a));
   }
   // Rotated-pole and projected grids are not longitude/latitude grids, whatever their units say.
   for (const auto& v : f.vars()) {
@@ -138,6 +240,103 @@ CfLayout detect_cf_layout(const NcFile& f) {
         (!mapping.empty() && mapping != "latitude_longitude")) {
       throw ImportError(path + ": variable '" + v.name + "' describes a " + (mapping.empty() ? sn : mapping) +
                         " grid; expected a plain longitude/latitude grid (rotated-pole and projected CF grids are not supported yet)");
+    }
+  }
+  auto on_candidate = [&](const NcVar& v, int kind) {
+    for (const Axis& a : candidates[kind]) {
+      if (std::count(v.dims.begin(), v.dims.end(), a.dim) == 1) return &a;
+    }
+    return static_cast<const Axis*>(nullptr);
+  };
+  // Surface geopotential (or altitude) for heights above ground and hybrid levels.
+  for (const auto& v : f.vars()) {
+    const std::string sn = lower(v.text("standard_name"));
+    if (v.dims.size() < 2 || v.dims.size() > 3) continue;
+    if (sn == "surface_geopotential" && !L.surface_geopotential) L.surface_geopotential = &v;
+    if (sn == "surface_altitude" && !L.surface_geopotential) {
+      L.surface_geopotential = &v;
+      L.surface_geopotential_scale = 9.80665;
+    }
+  }
+  // Roles: standard_name first, then GRIB parameter attributes, then names; only a variable on a
+  // longitude, a latitude and a vertical axis, with units that fit, is taken.
+  auto find_role = [&](const RoleSpec& spec, double& scale) -> const NcVar* {
+    for (int pass = 0; pass < 3; ++pass) {
+      for (const auto& v : f.vars()) {
+        if (&v == L.surface_geopotential) continue;
+        bool match = false;
+        if (pass == 0) {
+          for (const char* sn : spec.standard_names) match |= v.text("standard_name") == sn;
+        } else if (pass == 1) {
+          const auto g = grib2_of(v);
+          for (const Grib2& want : spec.grib) {
+            match |= g && g->discipline == want.discipline && g->category == want.category && g->number == want.number;
+          }
+          const std::string sh = short_name_of(v);
+          for (const char* n : spec.short_names) match |= !sh.empty() && sh == n;
+        } else {
+          const std::string n = lower(v.name), base = base_name(v.name);
+          for (const char* want : spec.names) match |= n == want || base == want;
+        }
+        if (!match || !on_candidate(v, 0) || !on_candidate(v, 1) || !on_candidate(v, 2)) continue;
+        if (!units_fit(spec.role, v.text("units"), scale)) {
+          L.notes.push_back("'" + v.name + "' looks like " + role_name(spec.role) + " but has units '" + v.text("units") +
+                            "': not used");
+          continue;
+        }
+        return &v;
+      }
+    }
+    return nullptr;
+  };
+  for (const RoleSpec& spec : kRoles) {
+    double scale = 1.0;
+    const NcVar* v = find_role(spec, scale);
+    // One variable, one role (a standard_name-less "t" must not also be found as something else).
+    for (int r = 0; v && r < kRoleCount; ++r) {
+      if (L.roles[r] == v) v = nullptr;
+    }
+    L.roles[static_cast<int>(spec.role)] = v;
+    L.role_scale[static_cast<int>(spec.role)] = scale;
+  }
+  for (const RoleSpec& spec : kPrecipitation) {
+    double scale = 1.0;
+    if (const NcVar* v = find_role(spec, scale)) L.precipitation.push_back(v->name);
+  }
+  // The axes: where there are several candidates of a kind, the one the cloud variables (else the
+  // first other variable, in role order) sit on. Variables on another candidate of that kind are
+  // not used, and the report says so.
+  const Role priority[] = {Role::CloudFraction, Role::Liquid, Role::Ice, Role::Snow, Role::Geopotential,
+                           Role::GeopotentialHeight, Role::Temperature, Role::Humidity, Role::RelativeHumidity,
+                           Role::U, Role::V, Role::Omega, Role::UpwardVelocity};
+  Axis* chosen[4] = {&L.lon, &L.lat, &L.vertical, &L.time};
+  for (int kind = 0; kind < 4; ++kind) {
+    if (candidates[kind].empty()) continue;
+    const Axis* pick = &candidates[kind].front();
+    if (candidates[kind].size() > 1) {
+      for (Role r : priority) {
+        const NcVar* v = L.roles[static_cast<int>(r)];
+        if (const Axis* a = v ? on_candidate(*v, kind) : nullptr) {
+          pick = a;
+          break;
+        }
+      }
+      for (int r = 0; r < kRoleCount; ++r) {
+        const NcVar* v = L.roles[r];
+        if (!v || std::count(v->dims.begin(), v->dims.end(), pick->dim) == 1) continue;
+        if (const Axis* other = on_candidate(*v, kind)) {
+          L.notes.push_back("'" + v->name + "' (" + role_name(static_cast<Role>(r)) + ") lies on '" + other->var->name +
+                            "', not on '" + pick->var->name + "' where the other variables are: not used");
+          L.roles[r] = nullptr;
+        }
+      }
+    }
+    *chosen[kind] = *pick;
+    for (double x : chosen[kind]->values) {
+      if (!std::isfinite(x)) {
+        throw ImportError(path + ": coordinate '" + chosen[kind]->var->name +
+                          "' has a missing or infinite value; expected every value set and finite");
+      }
     }
   }
   if (!L.lon.var) throw ImportError(path + ": no longitude coordinate (expected units degrees_east or standard_name longitude)");
@@ -214,31 +413,6 @@ CfLayout detect_cf_layout(const NcFile& f) {
     L.vertical_kind = Vertical::Height;
     L.height_scale_to_m = hs;
     L.height_above_ground = vsn == "height";
-  }
-  // Surface geopotential (or altitude) for heights above ground and hybrid levels.
-  for (const auto& v : f.vars()) {
-    const std::string sn = lower(v.text("standard_name"));
-    if (v.dims.size() < 2 || v.dims.size() > 3) continue;
-    if (sn == "surface_geopotential" && !L.surface_geopotential) L.surface_geopotential = &v;
-    if (sn == "surface_altitude" && !L.surface_geopotential) {
-      L.surface_geopotential = &v;
-      L.surface_geopotential_scale = 9.80665;
-    }
-  }
-  // Roles: standard_name first, then the known short and long names.
-  for (const RoleSpec& spec : kRoles) {
-    const NcVar* found = nullptr;
-    for (const auto& v : f.vars()) {
-      for (const char* sn : spec.standard_names) {
-        if (v.text("standard_name") == sn) found = found ? found : &v;
-      }
-    }
-    for (const char* n : spec.names) {
-      if (!found) found = f.find(n);
-    }
-    if (found && found->dims.size() < 3) found = nullptr;  // a 2-D field of that name is not the 3-D one
-    if (found && found == L.surface_geopotential) found = nullptr;
-    L.roles[static_cast<int>(spec.role)] = found;
   }
   // Names are not units: a "z" in metres is a geopotential height, a "w" in m/s an upward velocity.
   auto units_of = [](const NcVar* v) { return lower(v->text("units")); };
@@ -325,6 +499,13 @@ CfLayout detect_cf_layout(const NcFile& f) {
     L.notes.push_back("no time coordinate: steps are numbered, valid times unknown");
   }
   return L;
+}
+
+bool has_cloud(const CfLayout& L) {
+  for (Role r : {Role::CloudFraction, Role::Liquid, Role::Ice, Role::Snow}) {
+    if (L.roles[static_cast<int>(r)]) return true;
+  }
+  return false;
 }
 
 }  // namespace cv::importers

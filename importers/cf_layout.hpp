@@ -11,8 +11,12 @@
 
 namespace cv::importers {
 
-enum class Role { CloudFraction, Liquid, Ice, Geopotential, GeopotentialHeight, Temperature, Humidity, U, V, Omega, UpwardVelocity };
-inline constexpr int kRoleCount = 11;
+enum class Role {
+  CloudFraction, Liquid, Ice, Geopotential, GeopotentialHeight, Temperature, Humidity, U, V, Omega, UpwardVelocity,
+  Snow,              // added to the ice, as the WRF reader does with QSNOW
+  RelativeHumidity,  // read only for a diagnosed cloud (--diagnose-cloud)
+};
+inline constexpr int kRoleCount = 13;
 
 // The kinds of vertical coordinate the CF reader understands.
 enum class Vertical { Pressure, Height, Hybrid };
@@ -40,10 +44,18 @@ struct CfLayout {
   std::vector<core::ValidTime> times;
   bool times_uneven = false;
   const NcVar* roles[kRoleCount] = {};
+  // Multiplier from each role variable's units to the SI (or 0..1) values the conversion takes:
+  // 0.01 for a cloud fraction or relative humidity in %, 1e-3 for water in g/kg.
+  double role_scale[kRoleCount] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+  // Precipitation recognised in the file (rain, graupel): not part of the cloud volume.
+  std::vector<std::string> precipitation;
   std::vector<std::string> notes;
 };
 
 // Detects the layout; throws ImportError naming what is missing or inconsistent.
 CfLayout detect_cf_layout(const NcFile& f);
+
+// True when the layout has a cloud fraction, liquid, ice or snow variable.
+bool has_cloud(const CfLayout& L);
 
 }  // namespace cv::importers

@@ -5,6 +5,7 @@
 
 #include <limits>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "volume/cloud_volume.hpp"
@@ -34,16 +35,38 @@ struct ConversionOptions {
   double r_eff_ice_um = 0.0;  // 0 = temperature-dependent
 };
 
+// Counts over the model boxes a reader passed to place_column (the file's boxes for CF files read
+// at their own rows; resampled columns x model levels for WRF, which counts its file boxes apart).
 struct ColumnCounts {
-  std::size_t water_without_cf = 0, cf_without_water = 0, nonmonotonic = 0;
+  std::size_t water_without_cf = 0;              // water > 0 but cloud fraction below kZeroCloudFraction
+  std::size_t water_without_cf_significant = 0;  // ... of which water > kZeroWater
+  std::size_t cf_without_water = 0, nonmonotonic = 0;
   double most_water_without_cf = 0.0;
+  void merge(const ColumnCounts& o);
 };
+
+// A cloud fraction below this is zero to within int16 packing (whose step is ~1.5e-5 over 0..1).
+inline constexpr double kZeroCloudFraction = 1e-4;
+// Water below this counts as none for the consistency checks: int16 packing leaves a step or two
+// (~5e-8 kg/kg) where there is none, and 1e-7 kg/kg gives an optical depth of ~0.015 per km.
+inline constexpr double kZeroWater = 1e-7;
 
 // Converts the levels and interpolates them linearly in altitude into column (x, y) of `out`, whose
 // fields were allocated by the caller (absent fields stay empty). Outside the column's levels,
 // nothing is written (the NaN stays: no data is invented).
+//
+// What is interpolated is what the renderer uses: the grid-box-mean extinction (of the box's mean
+// water) and the cloud fraction. The stored in-cloud extinction is their ratio at each node, so
+// fraction x in-cloud extinction is exactly the interpolated grid-box mean. Water in a box whose
+// fraction is below kZeroCloudFraction has no meaningful in-cloud value: it is left out (no cloud is
+// invented there) and counted.
 void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, int x, int y,
                   const ConversionOptions& options, core::TimeStepData& out, ColumnCounts& counts);
+
+// The regular altitude axis from the lowest to the highest model level: the spacing is dz_m, or
+// the largest spacing not above dz_m that divides the span when `fit` (automatic spacing), so the
+// top node sits on the highest level; with a fixed spacing the top node lies at or above it.
+core::RegularAxis altitude_axis(double zmin_m, double zmax_m, double dz_m, bool fit);
 
 // True when a valid time lies in the options' ISO range (ISO 8601 UTC strings of one format order
 // as the times they name).
@@ -52,5 +75,7 @@ bool in_time_range(const core::ValidTime& t, const ImportOptions& options);
 
 // Adds the report's consistency warnings for one time step.
 void report_counts(const ColumnCounts& c, int time_index, core::ImportReport& report);
+// The same, naming what was counted ("resampled points", "file boxes", ...).
+void report_counts(const ColumnCounts& c, int time_index, const std::string& what, core::ImportReport& report);
 
 }  // namespace cv::importers

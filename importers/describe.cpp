@@ -14,11 +14,42 @@ std::string fmt(double v) {
 }
 }  // namespace
 
-std::string describe_file(const std::string& path) {
+// "importable: ..." from the import itself (setup only: time steps load lazily), so `info` and
+// `import` always agree.
+std::string importable(const std::string& path, const ImportOptions& options, bool cloud_missing, bool can_diagnose) {
+  try {
+    const core::CloudVolume v = import_file(path, options);
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "importable: yes (grid %d x %d x %d, %zu time step(s))", v.grid.lon_deg.count,
+                  v.grid.lat_deg.count, v.grid.alt_m.count, v.times.size());
+    std::string s = buf;
+    if (options.diagnose_cloud && cloud_missing) s += ", with a DIAGNOSED cloud (--diagnose-cloud)";
+    return s + "\n";
+  } catch (const ImportError& e) {
+    std::string s = std::string("importable: no: ") + e.what() + "\n";
+    if (cloud_missing && can_diagnose && !options.diagnose_cloud) {
+      ImportOptions d = options;
+      d.diagnose_cloud = true;
+      try {
+        import_file(path, d);
+        s += "importable with --diagnose-cloud: yes (a cloud diagnosed from relative humidity)\n";
+      } catch (const ImportError& e2) {
+        s += std::string("importable with --diagnose-cloud: no: ") + e2.what() + "\n";
+      }
+    }
+    return s;
+  }
+}
+
+std::string describe_file(const std::string& path, const ImportOptions& options) {
   NcFile f(path);
   std::string out = "file: " + path + "\n";
   auto line = [&](const std::string& s) { out += s + "\n"; };
-  if (is_wrf_file(f)) return out + describe_wrf(f);
+  if (is_wrf_file(f)) return out + describe_wrf(f) + importable(path, options, false, false);
+  if (is_wrf_geogrid_file(f)) {
+    return out + "format: WRF GEOGRID static file (" + f.global_text("TITLE") + ")\n" + "importable: no: " +
+           wrf_geogrid_message(f) + "\n";
+  }
   const CfLayout L = detect_cf_layout(f);
   line("format: CF-style gridded file (Conventions '" + f.global_text("Conventions") + "')");
   auto axis = [&](const char* what, const Axis& a) {
@@ -57,10 +88,10 @@ std::string describe_file(const std::string& path) {
             : std::string("absent")));
   }
   for (const auto& n : L.notes) line("note: " + n);
-  const bool cloud = L.roles[static_cast<int>(Role::CloudFraction)] || L.roles[static_cast<int>(Role::Liquid)] ||
-                     L.roles[static_cast<int>(Role::Ice)];
-  line(cloud ? "importable: yes" : "importable: no (no cloud fraction, liquid or ice water)");
-  return out;
+  for (const auto& p : L.precipitation) line("note: '" + p + "' is precipitation, not part of the cloud volume");
+  const bool can_diagnose = L.roles[static_cast<int>(Role::Temperature)] &&
+                            (L.roles[static_cast<int>(Role::RelativeHumidity)] || L.roles[static_cast<int>(Role::Humidity)]);
+  return out + importable(path, options, !has_cloud(L), can_diagnose);
 }
 
 }  // namespace cv::importers

@@ -36,10 +36,18 @@ struct ImportOptions {
   double r_eff_ice_um = 0.0;       // 0 = temperature-dependent (see docs/importers.md)
   std::size_t cache_steps = 2;     // time steps kept in memory
   double max_volume_bytes = 8e9;   // refuse volumes larger than this per time step
+  // A file with temperature and humidity but no cloud field gets a cloud diagnosed from relative
+  // humidity (docs/importers.md, "Diagnosed cloud"); only when asked.
+  bool diagnose_cloud = false;
+  // Keep the levels above the highest cloud of every step imported (CF files); by default they are
+  // left out, with one cloud-free level kept above the cloud.
+  bool keep_cloudless_levels = false;
+  double rh_critical = 0.8;        // the scheme's threshold relative humidity, 0..1
 };
 
-// What the importer understands of a file (grid, axes, variables it will use, times), as text.
-std::string describe_file(const std::string& path);
+// What the importer understands of a file (grid, axes, variables it will use, times), as text,
+// ending with whether `import_file(path, options)` succeeds and, when not, its message.
+std::string describe_file(const std::string& path, const ImportOptions& options = {});
 
 // Opens the file, checks it, fixes the grid, and returns a volume whose time steps load lazily.
 core::CloudVolume import_file(const std::string& path, const ImportOptions& options = {});

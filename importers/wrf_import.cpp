@@ -107,8 +107,10 @@ struct Sample {
 
 struct WrfSource {
   std::unique_ptr<NcFile> file;
+  std::unique_ptr<WrfProjection> proj;
   int nx = 0, ny = 0, nz = 0;
-  std::vector<Sample> samples;  // per output column
+  std::vector<Sample> samples;  // per output column (of the first step when the nest moves)
+  bool moving = false;          // XLAT/XLONG change between steps: each step is placed on its own
   std::vector<int> steps;
   ImportOptions options;
   int dim_time = -1;
@@ -170,9 +172,94 @@ core::ValidTime wrf_time(const std::string& s, const std::string& where) {
   return t;
 }
 
+// A 2-D mass-grid variable (XLAT, XLONG, COSALPHA, ...) at time index t (ignored without a Time
+// dimension).
+std::vector<double> read_mass2d(const WrfSource& S, const char* name, int t) {
+  const NcFile& f = *S.file;
+  const NcVar& v = f.var(name);
+  std::vector<std::size_t> start(v.dims.size(), 0), count;
+  for (std::size_t d = 0; d < v.dims.size(); ++d) count.push_back(f.dim_length(v, d));
+  if (v.dims.size() == 3) count[0] = 1, start[0] = static_cast<std::size_t>(t);
+  if (v.dims.size() < 2 || v.dims.size() > 3 || count[count.size() - 1] != static_cast<std::size_t>(S.nx) ||
+      count[count.size() - 2] != static_cast<std::size_t>(S.ny)) {
+    throw ImportError(f.path() + ": variable '" + std::string(name) + "' is not on the mass grid (" + std::to_string(S.ny) + " x " +
+                      std::to_string(S.nx) + ")");
+  }
+  return f.read(v, start, count);
+}
+
+// Where each output column falls in the mass grid whose first point is (lat0, lon0), with the
+// grid-to-earth wind rotation: COSALPHA/SINALPHA interpolated bilinearly like any field, or the
+// projection's meridian convergence. Checks that the projection reproduces the far corner.
+std::vector<Sample> place_samples(const WrfSource& S, const core::VolumeGrid& grid, const std::vector<double>& xlat,
+                                  const std::vector<double>& xlon, const std::vector<double>& cos_alpha,
+                                  const std::vector<double>& sin_alpha, int t, double* corner_error_m) {
+  const WrfProjection& proj = *S.proj;
+  const std::string& path = S.file->path();
+  double x0, y0, g;
+  proj.forward(xlat[0], xlon[0], x0, y0, g);
+  {
+    const std::size_t last = xlat.size() - 1;
+    double xc, yc;
+    proj.forward(xlat[last], xlon[last], xc, yc, g);
+    const double ex = xc - (x0 + (S.nx - 1) * proj.dx()), ey = yc - (y0 + (S.ny - 1) * proj.dy());
+    if (std::hypot(ex, ey) > 0.25 * std::min(proj.dx(), proj.dy())) {
+      throw ImportError(path + ": the map projection (MAP_PROJ, TRUELAT1/2, STAND_LON, DX, DY) puts the last mass point " +
+                        fmt(std::hypot(ex, ey)) + " m from XLAT/XLONG at time step " + std::to_string(t) +
+                        "; expected under a quarter of a grid cell");
+    }
+    if (corner_error_m) *corner_error_m = std::hypot(ex, ey);
+  }
+  std::vector<Sample> samples(grid.columns());
+  auto at = [&](const std::vector<double>& a, int i, int j) {
+    return a[static_cast<std::size_t>(j) * static_cast<std::size_t>(S.nx) + static_cast<std::size_t>(i)];
+  };
+  for (int y = 0; y < grid.lat_deg.count; ++y) {
+    for (int x = 0; x < grid.lon_deg.count; ++x) {
+      double px, py, gamma;
+      proj.forward(grid.lat_deg.at(y), grid.lon_deg.at(x), px, py, gamma);
+      const double fi = (px - x0) / proj.dx(), fj = (py - y0) / proj.dy();
+      Sample& s = samples[grid.column(x, y)];
+      if (fi < -1e-9 || fj < -1e-9 || fi > S.nx - 1 + 1e-9 || fj > S.ny - 1 + 1e-9) continue;
+      s.inside = true;
+      s.i0 = std::clamp(static_cast<int>(std::floor(fi)), 0, S.nx - 2);
+      s.j0 = std::clamp(static_cast<int>(std::floor(fj)), 0, S.ny - 2);
+      s.wi = std::clamp(fi - s.i0, 0.0, 1.0);
+      s.wj = std::clamp(fj - s.j0, 0.0, 1.0);
+      if (!cos_alpha.empty()) {
+        auto lerp2 = [&](const std::vector<double>& a) {
+          return (1 - s.wj) * ((1 - s.wi) * at(a, s.i0, s.j0) + s.wi * at(a, s.i0 + 1, s.j0)) +
+                 s.wj * ((1 - s.wi) * at(a, s.i0, s.j0 + 1) + s.wi * at(a, s.i0 + 1, s.j0 + 1));
+        };
+        s.cos_a = lerp2(cos_alpha);
+        s.sin_a = lerp2(sin_alpha);
+      } else {
+        // Grid north lies gamma degrees clockwise of true north.
+        s.cos_a = std::cos(-gamma * kDeg);
+        s.sin_a = std::sin(-gamma * kDeg);
+      }
+    }
+  }
+  return samples;
+}
+
+// The samples of time index t, from that step's own XLAT/XLONG (a moving nest).
+std::vector<Sample> samples_at(const WrfSource& S, const core::VolumeGrid& grid, int t) {
+  std::vector<double> ca, sa;
+  if (S.file->find("COSALPHA") && S.file->find("SINALPHA")) ca = read_mass2d(S, "COSALPHA", t), sa = read_mass2d(S, "SINALPHA", t);
+  return place_samples(S, grid, read_mass2d(S, "XLAT", t), read_mass2d(S, "XLONG", t), ca, sa, t, nullptr);
+}
+
 }  // namespace
 
 bool is_wrf_file(const NcFile& f) { return f.find("XLAT") && f.global_number("MAP_PROJ").has_value(); }
+
+bool is_wrf_geogrid_file(const NcFile& f) { return !f.find("XLAT") && f.find("XLAT_M") && f.find("XLONG_M"); }
+
+std::string wrf_geogrid_message(const NcFile& f) {
+  return f.path() + ": a WRF GEOGRID static file (XLAT_M, XLONG_M" + (f.find("HGT_M") ? ", HGT_M" : "") +
+         "): it holds terrain and land use, no cloud; expected WRF model output (wrfout: XLAT, XLONG and QCLOUD, QICE or CLDFRA)";
+}
 
 std::pair<double, double> wrf_rotation_from_projection(const NcFile& f, double lat, double lon) {
   const WrfProjection proj(f);
@@ -202,7 +289,7 @@ void load_wrf_step(const WrfSource& S, const core::VolumeGrid& grid, std::size_t
   stats("pressure (perturbation)", "P", p, "p = P + PB");
   stats("potential temperature perturbation", "T", th, "T = (T + 300) (p / 1e5)^(R_d / c_p)");
   stats("water vapour mixing ratio", "QVAPOR", qv, "specific humidity q = r / (1 + r), for air density");
-  const std::string in_cloud = cf.present ? "in-cloud = q / CLDFRA" : "no CLDFRA: q fills the box";
+  const std::string in_cloud = cf.present ? "grid-box mean interpolated with CLDFRA, in-cloud = mean / CLDFRA" : "no CLDFRA: q fills the box";
   stats("cloud liquid water", "QCLOUD", qc, "mixing ratio to specific; " + in_cloud + "; sigma = 3 rho q / (2 rho_w r_eff)");
   stats("cloud ice water", "QICE", qi, "QICE + QSNOW; " + in_cloud + "; sigma = 3 rho q / (2 917 kg/m3 r_eff)");
   stats("snow (counted as ice)", "QSNOW", qs, "added to QICE");
@@ -225,6 +312,27 @@ void load_wrf_step(const WrfSource& S, const core::VolumeGrid& grid, std::size_t
   alloc(core::Field::WindV, u.present && v.present);
   alloc(core::Field::WindW, w.present);
   alloc(core::Field::Temperature, true);
+  out.ground_m.assign(grid.columns(), std::numeric_limits<float>::quiet_NaN());
+  // A moving nest: this step's own grid.
+  std::vector<Sample> own;
+  if (S.moving) own = samples_at(S, grid, t);
+  const std::vector<Sample>& samples = S.moving ? own : S.samples;
+  // The consistency counts over the file's own boxes (the resampled points are counted apart).
+  ColumnCounts file_counts;
+  if (cf.present && (qc.present || qi.present || qs.present)) {
+    for (std::size_t n = 0; n < cf.v.size(); ++n) {
+      double total = 0.0;
+      for (const Field3* q : {&qc, &qi, &qs}) {
+        if (q->present && q->v[n] > 0.0) total += q->v[n];
+      }
+      if (total > 0.0 && cf.v[n] < kZeroCloudFraction) {
+        ++file_counts.water_without_cf;
+        if (total > kZeroWater) ++file_counts.water_without_cf_significant;
+        file_counts.most_water_without_cf = std::max(file_counts.most_water_without_cf, total);
+      }
+      if (cf.v[n] > 0.1 && total <= kZeroWater) ++file_counts.cf_without_water;
+    }
+  }
   ColumnCounts counts;
   ConversionOptions conv{S.options.r_eff_liquid_um, S.options.r_eff_ice_um};
   std::vector<LevelSample> column(static_cast<std::size_t>(S.nz));
@@ -235,8 +343,9 @@ void load_wrf_step(const WrfSource& S, const core::VolumeGrid& grid, std::size_t
   };
   for (int y = 0; y < grid.lat_deg.count; ++y) {
     for (int x = 0; x < grid.lon_deg.count; ++x) {
-      const Sample& s = S.samples[grid.column(x, y)];
+      const Sample& s = samples[grid.column(x, y)];
       if (!s.inside) continue;  // outside the model domain: no data, never an invented value
+      out.ground_m[grid.column(x, y)] = static_cast<float>((bilinear(ph, s, 0) + bilinear(phb, s, 0)) / kWrfG);
       for (int k = 0; k < S.nz; ++k) {
         LevelSample& c = column[static_cast<std::size_t>(k)];
         c = LevelSample{};
@@ -283,9 +392,12 @@ void load_wrf_step(const WrfSource& S, const core::VolumeGrid& grid, std::size_t
   }
   if (negative) report.warn(std::to_string(negative) + " negative mixing ratios set to 0 at time step " + std::to_string(t));
   if (clamped) report.use("cloud fraction").clamped += clamped;
-  report_counts(counts, t, report);
+  report_counts(file_counts, t, "file boxes", report);
+  report_counts(counts, t, "resampled points (output columns x model levels)", report);
   auto after = [&](const char* role, core::Field f) {
-    report.use(role).after.add_all(out[f].data(), out[f].size());
+    auto& use = report.use(role);
+    use.after.add_all(out[f].data(), out[f].size());
+    use.after_units = core::field_units(f);
   };
   if (qc.present) after("cloud liquid water", core::Field::ExtinctionLiquid);
   if (qi.present) after("cloud ice water", core::Field::ExtinctionIce);
@@ -301,7 +413,8 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
   S->options = options;
   const NcFile& f = *S->file;
   const std::string& path = f.path();
-  const WrfProjection proj(f);
+  S->proj = std::make_unique<WrfProjection>(f);
+  const WrfProjection& proj = *S->proj;
   core::CloudVolume vol;
   vol.liquid_r_eff_um = options.r_eff_liquid_um;
   vol.report.file = path;
@@ -355,41 +468,55 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
   if (options.level_min_hpa > 0.0 || options.level_max_hpa < 1e9) {
     vol.report.warn("--levels applies to pressure-level files; a WRF file is read on all its model levels");
   }
-  // XLAT/XLONG, with or without a Time dimension.
-  auto read2 = [&](const char* name) {
-    const NcVar& v = f.var(name);
-    std::vector<std::size_t> start(v.dims.size(), 0), count;
-    for (std::size_t d = 0; d < v.dims.size(); ++d) count.push_back(f.dim_length(v, d));
-    if (v.dims.size() == 3) count[0] = 1;
-    if (count[count.size() - 1] != static_cast<std::size_t>(S->nx) || count[count.size() - 2] != static_cast<std::size_t>(S->ny)) {
-      throw ImportError(path + ": variable '" + std::string(name) + "' is not on the mass grid (" + std::to_string(S->ny) + " x " +
-                        std::to_string(S->nx) + ")");
+  // Time steps (their grids may differ: a moving nest).
+  std::vector<std::string> times;
+  if (const NcVar* tv = f.find("Times")) times = f.read_strings(*tv);
+  const int nt = S->dim_time >= 0 ? static_cast<int>(f.dims()[static_cast<std::size_t>(S->dim_time)].length) : 1;
+  const int last = options.time_last < 0 ? nt - 1 : std::min(options.time_last, nt - 1);
+  for (int t = std::max(0, options.time_first); t <= last; t += std::max(1, options.time_stride)) {
+    const core::ValidTime vt = static_cast<std::size_t>(t) < times.size()
+                                   ? wrf_time(times[static_cast<std::size_t>(t)], path + ": variable 'Times'")
+                                   : core::ValidTime{0, "step " + std::to_string(t)};
+    if (!in_time_range(vt, options)) continue;
+    S->steps.push_back(t);
+    vol.times.push_back(vt);
+  }
+  if (S->steps.empty()) throw ImportError(path + ": no time step in the requested range (the file has " + std::to_string(nt) + ")");
+  // XLAT/XLONG, with or without a Time dimension. When they change from step to step (a
+  // vortex-following nest), every step is placed with its own grid, in a box that holds them all.
+  const std::vector<double> xlat = read_mass2d(*S, "XLAT", S->steps.front()), xlon = read_mass2d(*S, "XLONG", S->steps.front());
+  double lon_min = 1e9, lon_max = -1e9, lat_min = 1e9, lat_max = -1e9;
+  auto extend = [&](const std::vector<double>& la, const std::vector<double>& lo) {
+    for (std::size_t n = 0; n < la.size(); ++n) {
+      const double lon = xlon[0] + std::remainder(lo[n] - xlon[0], 360.0);
+      lon_min = std::min(lon_min, lon), lon_max = std::max(lon_max, lon);
+      lat_min = std::min(lat_min, la[n]), lat_max = std::max(lat_max, la[n]);
     }
-    return f.read(v, start, count);
   };
-  const std::vector<double> xlat = read2("XLAT"), xlon = read2("XLONG");
-  // Anchor the projection on the first mass point and check it reproduces the opposite corner.
-  double x0, y0, g;
-  proj.forward(xlat[0], xlon[0], x0, y0, g);
-  {
-    const std::size_t last = xlat.size() - 1;
-    double xc, yc;
-    proj.forward(xlat[last], xlon[last], xc, yc, g);
-    const double ex = xc - (x0 + (S->nx - 1) * proj.dx()), ey = yc - (y0 + (S->ny - 1) * proj.dy());
-    if (std::hypot(ex, ey) > 0.25 * std::min(proj.dx(), proj.dy())) {
-      throw ImportError(path + ": the map projection (MAP_PROJ, TRUELAT1/2, STAND_LON, DX, DY) puts the last mass point " +
-                        fmt(std::hypot(ex, ey)) + " m from XLAT/XLONG; expected under a quarter of a grid cell");
+  extend(xlat, xlon);
+  double moved_km = 0.0;
+  if (f.var("XLAT").dims.size() == 3 && S->steps.size() > 1) {
+    for (std::size_t k = 1; k < S->steps.size(); ++k) {
+      const std::vector<double> la = read_mass2d(*S, "XLAT", S->steps[k]), lo = read_mass2d(*S, "XLONG", S->steps[k]);
+      double diff = 0.0;
+      for (std::size_t n = 0; n < la.size(); ++n) {
+        diff = std::max({diff, std::abs(la[n] - xlat[n]), std::abs(std::remainder(lo[n] - xlon[n], 360.0))});
+      }
+      if (diff > 1e-4) {
+        S->moving = true;
+        extend(la, lo);
+        double xa, ya, xb, yb, g;
+        proj.forward(xlat[0], xlon[0], xa, ya, g);
+        proj.forward(la[0], lo[0], xb, yb, g);
+        moved_km = std::max(moved_km, std::hypot(xb - xa, yb - ya) / 1000.0);
+      }
     }
-    vol.report.notes.push_back("projection checked against XLAT/XLONG: the far corner lies " + fmt(std::hypot(ex, ey)) +
-                               " m from where the grid puts it");
+  }
+  if (S->moving) {
+    vol.report.warn("the nest moves: XLAT/XLONG change between time steps (its first mass point moves up to " + fmt(moved_km) +
+                    " km from the first step's); each step is placed with its own grid");
   }
   // Output lon/lat grid: the domain's bounding box at about the model's spacing.
-  double lon_min = 1e9, lon_max = -1e9, lat_min = 1e9, lat_max = -1e9;
-  for (std::size_t n = 0; n < xlat.size(); ++n) {
-    const double lon = xlon[0] + std::remainder(xlon[n] - xlon[0], 360.0);
-    lon_min = std::min(lon_min, lon), lon_max = std::max(lon_max, lon);
-    lat_min = std::min(lat_min, xlat[n]), lat_max = std::max(lat_max, xlat[n]);
-  }
   if (options.region) {
     const auto& r = *options.region;
     double w = r.lon_west_deg, e = r.lon_east_deg;
@@ -409,57 +536,26 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
   vol.report.notes.push_back("resampled bilinearly from the " + std::to_string(S->nx) + " x " + std::to_string(S->ny) +
                              " model grid onto " + std::to_string(vol.grid.lon_deg.count) + " x " +
                              std::to_string(vol.grid.lat_deg.count) + " lon/lat columns; columns outside the domain hold no data");
-  // Where each output column falls, and its wind rotation.
+  // Where each output column falls (the first step's grid), and its wind rotation.
   const NcVar* cosa = f.find("COSALPHA");
   const NcVar* sina = f.find("SINALPHA");
   std::vector<double> cos_alpha, sin_alpha;
-  if (cosa && sina) cos_alpha = read2("COSALPHA"), sin_alpha = read2("SINALPHA");
-  S->samples.resize(vol.grid.columns());
+  if (cosa && sina) cos_alpha = read_mass2d(*S, "COSALPHA", S->steps.front()), sin_alpha = read_mass2d(*S, "SINALPHA", S->steps.front());
+  double corner = 0.0;
+  S->samples = place_samples(*S, vol.grid, xlat, xlon, cos_alpha, sin_alpha, S->steps.front(), &corner);
+  vol.report.notes.push_back("projection checked against XLAT/XLONG: the far corner lies " + fmt(corner) +
+                             " m from where the grid puts it");
   std::size_t inside = 0;
-  for (int y = 0; y < vol.grid.lat_deg.count; ++y) {
-    for (int x = 0; x < vol.grid.lon_deg.count; ++x) {
-      double px, py, gamma;
-      proj.forward(vol.grid.lat_deg.at(y), vol.grid.lon_deg.at(x), px, py, gamma);
-      const double fi = (px - x0) / proj.dx(), fj = (py - y0) / proj.dy();
-      Sample& s = S->samples[vol.grid.column(x, y)];
-      if (fi < -1e-9 || fj < -1e-9 || fi > S->nx - 1 + 1e-9 || fj > S->ny - 1 + 1e-9) continue;
-      s.inside = true;
-      ++inside;
-      s.i0 = std::clamp(static_cast<int>(std::floor(fi)), 0, S->nx - 2);
-      s.j0 = std::clamp(static_cast<int>(std::floor(fj)), 0, S->ny - 2);
-      s.wi = std::clamp(fi - s.i0, 0.0, 1.0);
-      s.wj = std::clamp(fj - s.j0, 0.0, 1.0);
-      if (!cos_alpha.empty()) {
-        const std::size_t n = static_cast<std::size_t>(s.j0) * static_cast<std::size_t>(S->nx) + static_cast<std::size_t>(s.i0);
-        s.cos_a = cos_alpha[n];
-        s.sin_a = sin_alpha[n];
-      } else {
-        // Grid north lies gamma degrees clockwise of true north.
-        s.cos_a = std::cos(-gamma * kDeg);
-        s.sin_a = std::sin(-gamma * kDeg);
-      }
-    }
-  }
-  if (inside == 0) throw ImportError(path + ": no output column falls inside the WRF domain");
-  // Times: the Times character variable; XTIME's units are often empty.
-  std::vector<std::string> times;
-  if (const NcVar* tv = f.find("Times")) times = f.read_strings(*tv);
-  const int nt = S->dim_time >= 0 ? static_cast<int>(f.dims()[static_cast<std::size_t>(S->dim_time)].length) : 1;
-  const int last = options.time_last < 0 ? nt - 1 : std::min(options.time_last, nt - 1);
-  for (int t = std::max(0, options.time_first); t <= last; t += std::max(1, options.time_stride)) {
-    const core::ValidTime vt = static_cast<std::size_t>(t) < times.size()
-                                   ? wrf_time(times[static_cast<std::size_t>(t)], path + ": variable 'Times'")
-                                   : core::ValidTime{0, "step " + std::to_string(t)};
-    if (!in_time_range(vt, options)) continue;
-    S->steps.push_back(t);
-    vol.times.push_back(vt);
-  }
-  if (S->steps.empty()) throw ImportError(path + ": no time step in the requested range (the file has " + std::to_string(nt) + ")");
-  // Altitude grid from the first step's mass-level heights over the domain.
+  for (const Sample& smp : S->samples) inside += smp.inside ? 1 : 0;
+  if (inside == 0 && !S->moving) throw ImportError(path + ": no output column falls inside the WRF domain");
+  // Altitude grid from the mass-level heights over the domain: the first step's, or every step's
+  // when the nest moves over different terrain.
   {
-    const Field3 ph = read3(*S, "PH", S->steps.front(), true), phb = read3(*S, "PHB", S->steps.front(), true);
     double zmin = 1e30, zmax = -1e30;
     std::vector<double> thick;
+    const std::vector<int> probe = S->moving ? S->steps : std::vector<int>{S->steps.front()};
+    for (int t : probe) {
+    const Field3 ph = read3(*S, "PH", t, true), phb = read3(*S, "PHB", t, true);
     for (int j = 0; j < S->ny; ++j) {
       for (int i = 0; i < S->nx; ++i) {
         double prev = NAN;
@@ -470,17 +566,18 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
             throw ImportError(path + ": variable 'PH' gives a height of " + fmt(z) + " m, expected -1 km to 100 km");
           }
           zmin = std::min(zmin, z), zmax = std::max(zmax, z);
-          if (!std::isnan(prev)) thick.push_back(z - prev);
+          if (!std::isnan(prev) && t == probe.front()) thick.push_back(z - prev);
           prev = z;
         }
       }
     }
+    }
     double dz = options.dz_m;
     if (dz <= 0.0) {
-      std::sort(thick.begin(), thick.end());
+      std::nth_element(thick.begin(), thick.begin() + static_cast<std::ptrdiff_t>(thick.size() / 2), thick.end());
       dz = std::clamp(thick[thick.size() / 2] / 2.0, 50.0, 500.0);
     }
-    vol.grid.alt_m = {zmin, dz, static_cast<int>(std::floor((zmax - zmin) / dz)) + 1};
+    vol.grid.alt_m = altitude_axis(zmin, zmax, dz, options.dz_m <= 0.0);
   }
   const double bytes = static_cast<double>(vol.grid.points()) * core::kFieldCount * sizeof(float);
   if (bytes > options.max_volume_bytes) {
@@ -493,6 +590,8 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
   vol.has_field[static_cast<int>(core::Field::WindV)] = vol.has_field[static_cast<int>(core::Field::WindU)];
   vol.has_field[static_cast<int>(core::Field::WindW)] = f.find("W") != nullptr;
   vol.has_field[static_cast<int>(core::Field::Temperature)] = true;
+  vol.has_ground = true;
+  vol.report.notes.push_back("low/mid/high cover by height above the ground ((PH + PHB) / g at the lowest staggered level)");
   if (!f.find("QCLOUD") && !f.find("QICE") && !f.find("QSNOW") && !f.find("CLDFRA")) {
     throw ImportError(path + ": no cloud variable; expected QCLOUD, QICE, QSNOW or CLDFRA");
   }

@@ -33,12 +33,18 @@ using cv::cli::UsageError;
 // Each command's lines of the usage text, in the order `cloudviewer --help` lists them.
 std::vector<std::pair<std::string, std::string>> command_usages() {
   return {
-      {"info", "  info FILE                what the importer understands of a NetCDF file (or a .cvvol volume)\n"},
+      {"info", "  info FILE [--diagnose-cloud]\n"
+               "                           what the importer understands of a NetCDF file (or a .cvvol volume)\n"},
       {"import",
        "  import FILE -o OUT [--region W,E,S,N] [--times FIRST:LAST[:STRIDE] | --times START..END]\n"
        "         [--levels MIN_HPA:MAX_HPA]\n"
        "         [--stride N] [--dz M] [--reff-liquid UM] [--reff-ice UM] [--vti]\n"
-       "                           import into OUT.cvvol (+ OUT.report.json, and OUT_tNNN.vti with --vti)\n"},
+       "         [--diagnose-cloud [--rh-critical RH]] [--float32] [--all-levels]\n"
+       "                           import into OUT.cvvol (+ OUT.report.json, and OUT_tNNN.vti with --vti);\n"
+       "                           fields are stored as half floats (--float32: full floats); levels above\n"
+       "                           the highest cloud are left out (--all-levels keeps them);\n"
+       "                           --diagnose-cloud: a file with temperature and humidity but no cloud field\n"
+       "                           gets a cloud diagnosed from relative humidity (Sundqvist, RH_c 0.8 by default)\n"},
       {"gpu-info", "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"},
       {"phase", "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"},
       {"render", cv::cli::render_usage()},
@@ -113,8 +119,15 @@ int cmd_phase(const std::vector<std::string>& args) {
 }
 
 int cmd_info(const std::vector<std::string>& args) {
-  if (args.size() != 1) throw UsageError{"cloudviewer info: expected one FILE argument"};
-  const std::string& path = args[0];
+  cv::importers::ImportOptions options;
+  std::vector<std::string> files;
+  for (const auto& a : args) {
+    if (a == "--diagnose-cloud") options.diagnose_cloud = true;
+    else if (!a.empty() && a[0] == '-') throw UsageError{"cloudviewer info: unknown option '" + a + "'"};
+    else files.push_back(a);
+  }
+  if (files.size() != 1) throw UsageError{"cloudviewer info: expected one FILE argument"};
+  const std::string& path = files[0];
   if (path.size() > 6 && path.substr(path.size() - 6) == ".cvvol") {
     const cv::core::CloudVolume v = cv::core::read_cvvol(path);
     const auto& g = v.grid;
@@ -135,7 +148,7 @@ int cmd_info(const std::vector<std::string>& args) {
     std::printf("\n");
     return 0;
   }
-  std::printf("%s", cv::importers::describe_file(path).c_str());
+  std::printf("%s", cv::importers::describe_file(path, options).c_str());
   return 0;
 }
 
@@ -143,6 +156,8 @@ int cmd_import(const std::vector<std::string>& args) {
   cv::importers::ImportOptions o;
   std::string input, out;
   bool vti = false;
+  // Fields as half floats unless asked (docs/importers.md states the error bound).
+  cv::core::CvvolEncoding encoding = cv::core::CvvolEncoding::Float16;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto next = [&]() -> const std::string& {
@@ -187,6 +202,15 @@ int cmd_import(const std::vector<std::string>& args) {
     } else if (a == "--reff-ice") {
       o.r_eff_ice_um = parse_number("--reff-ice", next());
       if (!(o.r_eff_ice_um >= 5 && o.r_eff_ice_um <= 200)) throw UsageError{"cloudviewer import: --reff-ice: expected 5..200 um"};
+    } else if (a == "--all-levels") {
+      o.keep_cloudless_levels = true;
+    } else if (a == "--float32") {
+      encoding = cv::core::CvvolEncoding::Float32;
+    } else if (a == "--diagnose-cloud") {
+      o.diagnose_cloud = true;
+    } else if (a == "--rh-critical") {
+      o.rh_critical = parse_number("--rh-critical", next());
+      if (!(o.rh_critical >= 0.5 && o.rh_critical < 1.0)) throw UsageError{"cloudviewer import: --rh-critical: expected 0.5 <= RH < 1"};
     } else if (!a.empty() && a[0] == '-') {
       throw UsageError{"cloudviewer import: unknown option '" + a + "'"};
     } else if (input.empty()) {
@@ -199,6 +223,9 @@ int cmd_import(const std::vector<std::string>& args) {
   if (out.size() > 6 && out.substr(out.size() - 6) == ".cvvol") out.resize(out.size() - 6);
   o.cache_steps = 1;  // steps are written one after another: keep only the current one
   cv::core::CloudVolume vol = cv::importers::import_file(input, o);
+  for (const auto& w : vol.report.warnings) {
+    if (w.rfind("DIAGNOSED CLOUD", 0) == 0) std::fprintf(stderr, "cloudviewer import: %s\n", w.c_str());
+  }
   std::printf("grid: %d x %d x %d (lon %.4g..%.4g, lat %.4g..%.4g, alt %.0f..%.0f m), %zu time step(s)\n",
               vol.grid.lon_deg.count, vol.grid.lat_deg.count, vol.grid.alt_m.count, vol.grid.lon_deg.start,
               vol.grid.lon_deg.last(), vol.grid.lat_deg.start, vol.grid.lat_deg.last(), vol.grid.alt_m.start,
@@ -211,7 +238,7 @@ int cmd_import(const std::vector<std::string>& args) {
       std::snprintf(name, sizeof name, "_t%03zu.vti", t);
       cv::core::write_vti(out + name, vol.grid, vol.step(t), vol.has_field);
     }
-  });
+  }, encoding);
   cv::core::write_file_atomically(out + ".report.json", [&](std::FILE* f) {
     const std::string j = vol.report.to_json();
     std::fwrite(j.data(), 1, j.size(), f);

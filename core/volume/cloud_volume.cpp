@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 namespace cv::core {
 
@@ -25,6 +26,7 @@ const char* field_units(Field f) {
 std::size_t TimeStepData::bytes() const {
   std::size_t b = 0;
   for (const auto& f : fields) b += f.size() * sizeof(float);
+  b += ground_m.size() * sizeof(float);
   for (const auto* m : {&maps.cloud_cover, &maps.cloud_base_m, &maps.cloud_top_m, &maps.optical_depth,
                         &maps.low_cover, &maps.mid_cover, &maps.high_cover}) {
     b += m->size() * sizeof(float);
@@ -61,44 +63,65 @@ void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& o
     v->assign(ncol, nan);
   }
   const double dz = grid.alt_m.step;
+  // A row of columns at a time, levels outer and longitudes inner: the fields are read along their
+  // contiguous axis (a column's levels lie a whole layer apart). Each column's arithmetic is the
+  // same as walking it alone from the top.
+  const int nx = grid.lon_deg.count;
+  struct ColumnState {
+    Overlap all, low, mid, high;
+    double tau = 0.0, base = std::numeric_limits<double>::quiet_NaN(), top = std::numeric_limits<double>::quiet_NaN();
+    double ground = 0.0;
+    bool any_data = false;
+  };
+  std::vector<ColumnState> row(static_cast<std::size_t>(nx));
   for (int j = 0; j < grid.lat_deg.count; ++j) {
-    for (int i = 0; i < grid.lon_deg.count; ++i) {
-      Overlap all, low, mid, high;
-      double tau = 0.0, base = nan, top = nan;
-      bool any_data = false;
-      for (int k = grid.alt_m.count - 1; k >= 0; --k) {
-        const std::size_t p = grid.index(i, j, k);
+    for (int i = 0; i < nx; ++i) {
+      ColumnState& st = row[static_cast<std::size_t>(i)];
+      st = ColumnState{};
+      // Layers by height above the ground where the terrain is known, above sea level otherwise.
+      const std::size_t col = grid.column(i, j);
+      st.ground = col < data.ground_m.size() && std::isfinite(data.ground_m[col]) ? data.ground_m[col] : 0.0;
+    }
+    for (int k = grid.alt_m.count - 1; k >= 0; --k) {
+      const double alt = grid.alt_m.at(k);
+      const std::size_t p0 = grid.index(0, j, k);
+      for (int i = 0; i < nx; ++i) {
+        ColumnState& st = row[static_cast<std::size_t>(i)];
+        const std::size_t p = p0 + static_cast<std::size_t>(i);
         const double ext = (el.empty() || std::isnan(el[p]) ? 0.0 : el[p]) + (ei.empty() || std::isnan(ei[p]) ? 0.0 : ei[p]);
         const bool have = (!cf.empty() && !std::isnan(cf[p])) || (!el.empty() && !std::isnan(el[p])) ||
                           (!ei.empty() && !std::isnan(ei[p]));
         if (!have) continue;
-        any_data = true;
+        st.any_data = true;
         // Without a cloud-fraction field, a point with water counts as fully cloudy.
         const double frac = cf.empty() || std::isnan(cf[p]) ? (ext > 0.0 ? 1.0 : 0.0) : cf[p];
         const bool cloudy = frac >= options.min_cloud_fraction && ext >= options.min_extinction_per_m;
         const double c = cloudy ? frac : 0.0;
-        const double alt = grid.alt_m.at(k);
-        Overlap& layer = alt < options.low_top_m ? low : alt < options.mid_top_m ? mid : high;
+        const double above = alt - st.ground;
+        Overlap& layer = above < options.low_top_m ? st.low : above < options.mid_top_m ? st.mid : st.high;
         if (cloudy) {
-          all.add(c);
+          st.all.add(c);
           layer.add(c);
-          tau += c * ext * dz;
-          top = std::isnan(top) ? alt : top;
-          base = alt;
+          st.tau += c * ext * dz;
+          st.top = std::isnan(st.top) ? alt : st.top;
+          st.base = alt;
         } else {
-          all.gap();
+          st.all.gap();
           layer.gap();
         }
       }
-      if (!any_data) continue;
+    }
+    for (int i = 0; i < nx; ++i) {
+      const ColumnState& st = row[static_cast<std::size_t>(i)];
+      if (!st.any_data) continue;
       const std::size_t col = grid.column(i, j);
-      m.cloud_cover[col] = static_cast<float>(all.cover());
-      m.low_cover[col] = static_cast<float>(low.cover());
-      m.mid_cover[col] = static_cast<float>(mid.cover());
-      m.high_cover[col] = static_cast<float>(high.cover());
-      m.optical_depth[col] = static_cast<float>(tau);
-      m.cloud_base_m[col] = static_cast<float>(base);
-      m.cloud_top_m[col] = static_cast<float>(top);
+      m.cloud_cover[col] = static_cast<float>(st.all.cover());
+      m.low_cover[col] = static_cast<float>(st.low.cover());
+      m.mid_cover[col] = static_cast<float>(st.mid.cover());
+      m.high_cover[col] = static_cast<float>(st.high.cover());
+      m.optical_depth[col] = static_cast<float>(st.tau);
+      m.cloud_base_m[col] = static_cast<float>(st.base);
+      m.cloud_top_m[col] = static_cast<float>(st.top);
     }
   }
 }

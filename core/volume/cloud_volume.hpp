@@ -66,7 +66,7 @@ struct Maps2D {
   std::vector<float> cloud_base_m;       // lowest cloudy altitude
   std::vector<float> cloud_top_m;        // highest cloudy altitude
   std::vector<float> optical_depth;      // column integral of cloud fraction x in-cloud extinction
-  std::vector<float> low_cover;          // below 2 km
+  std::vector<float> low_cover;          // below 2 km above the ground (above sea level without terrain)
   std::vector<float> mid_cover;          // 2 to 6 km
   std::vector<float> high_cover;         // above 6 km
 };
@@ -81,6 +81,9 @@ struct MapOptions {
 
 struct TimeStepData {
   std::array<std::vector<float>, kFieldCount> fields;
+  // Per column, the ground's altitude (m) where the file gives terrain; empty (or NaN in a column)
+  // where it does not. Low/mid/high cover is measured from here.
+  std::vector<float> ground_m;
   Maps2D maps;
   std::vector<float>& operator[](Field f) { return fields[static_cast<std::size_t>(f)]; }
   const std::vector<float>& operator[](Field f) const { return fields[static_cast<std::size_t>(f)]; }
@@ -111,6 +114,8 @@ class CloudVolume {
   // the renderer's approximate Mie phase takes its droplet diameter, 2 r_eff, from here.
   double liquid_r_eff_um = 10.0;
   std::array<bool, kFieldCount> has_field{};
+  // Whether the steps carry the ground's altitude (TimeStepData::ground_m).
+  bool has_ground = false;
   ImportReport report;
 
   void set_loader(Loader loader, std::size_t cache_steps = 2);

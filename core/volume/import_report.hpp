@@ -30,6 +30,7 @@ struct VariableUse {
   std::string conversion;  // what was done, in words and formula
   ValueStats before;       // as read (unpacked), per time step loaded
   ValueStats after;        // in the volume, SI
+  std::string after_units; // units of `after` (what the volume stores), e.g. "1/m" for extinction
   std::size_t clamped = 0; // values clamped into their physical range
 };
 

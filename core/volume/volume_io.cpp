@@ -1,7 +1,10 @@
 // .cvvol and .vti writers.
 #include "volume/volume_io.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -33,7 +36,49 @@ MapArrays map_arrays(const Maps2D& m) {
            {"optical_depth", &m.optical_depth}, {"low_cover", &m.low_cover}, {"mid_cover", &m.mid_cover},
            {"high_cover", &m.high_cover}}};
 }
+// Stored value = SI value x this, for the float16 encoding.
+float half_scale(int field) {
+  return field == static_cast<int>(Field::ExtinctionLiquid) || field == static_cast<int>(Field::ExtinctionIce) ? 1000.0f : 1.0f;
+}
 }  // namespace
+
+std::uint16_t float_to_half(float f) {
+  std::uint32_t x;
+  std::memcpy(&x, &f, sizeof x);
+  const std::uint32_t sign = (x >> 16) & 0x8000u;
+  const std::uint32_t abs = x & 0x7fffffffu;
+  if (abs > 0x7f800000u) return static_cast<std::uint16_t>(sign | 0x7e00u);  // NaN
+  if (abs >= 0x477ff000u) return static_cast<std::uint16_t>(sign | 0x7c00u);  // rounds past 65504: infinity
+  if (abs < 0x38800000u) {
+    // Below the smallest normal half (2^-14): a subnormal, in units of 2^-24, rounded to even.
+    if (abs < 0x33000000u) return static_cast<std::uint16_t>(sign);  // under half of 2^-24
+    const std::uint32_t mant = (abs & 0x7fffffu) | 0x800000u;
+    const int shift = 126 - static_cast<int>(abs >> 23);  // value / 2^-24 = mant / 2^shift, shift 14..24
+    const std::uint32_t q = mant >> shift, rem = mant & ((1u << shift) - 1u), half = 1u << (shift - 1);
+    return static_cast<std::uint16_t>(sign | (q + (rem > half || (rem == half && (q & 1u)) ? 1u : 0u)));
+  }
+  // Normal: rebias the exponent (127 -> 15) and round the 23-bit mantissa to 10 bits, to even.
+  const std::uint32_t rebased = abs - 0x38000000u;
+  const std::uint32_t q = rebased >> 13, rem = rebased & 0x1fffu;
+  return static_cast<std::uint16_t>(sign | (q + (rem > 0x1000u || (rem == 0x1000u && (q & 1u)) ? 1u : 0u)));
+}
+
+float half_to_float(std::uint16_t h) {
+  const std::uint32_t sign = static_cast<std::uint32_t>(h & 0x8000u) << 16;
+  const std::uint32_t exp = (h >> 10) & 0x1fu, mant = h & 0x3ffu;
+  std::uint32_t x;
+  if (exp == 0x1fu) {
+    x = sign | 0x7f800000u | (mant << 13);  // infinity or NaN
+  } else if (exp == 0) {
+    const float v = std::ldexp(static_cast<float>(mant), -24);  // subnormal (or zero)
+    return sign ? -v : v;
+  } else {
+    x = sign | ((exp + 112u) << 23) | (mant << 13);
+  }
+  float f;
+  std::memcpy(&f, &x, sizeof f);
+  return f;
+}
 
 void write_file_atomically(const std::string& path, const std::function<void(std::FILE*)>& write) {
   const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
@@ -61,7 +106,9 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   }
 }
 
-void write_cvvol(const std::string& path, CloudVolume& v, const std::function<void(std::size_t, std::size_t)>& progress) {
+void write_cvvol(const std::string& path, CloudVolume& v, const std::function<void(std::size_t, std::size_t)>& progress,
+                 CvvolEncoding encoding) {
+  const bool half = encoding == CvvolEncoding::Float16;
   std::string fields = "[", maps = "[", times = "[";
   for (int i = 0; i < kFieldCount; ++i) {
     if (v.has_field[static_cast<std::size_t>(i)]) {
@@ -70,6 +117,9 @@ void write_cvvol(const std::string& path, CloudVolume& v, const std::function<vo
   }
   const Maps2D none;
   for (const auto& [name, arr] : map_arrays(none)) maps += std::string(maps.size() > 1 ? ", " : "") + json_quote(name);
+  // The ground's altitude, when the file gave terrain: read back, since the cover maps are derived
+  // again from it.
+  if (v.has_ground) maps += ", \"ground_m\"";
   for (std::size_t t = 0; t < v.times.size(); ++t) {
     times += std::string(t ? ", " : "") + "{\"iso_utc\": " + json_quote(v.times[t].iso_utc) +
              ", \"unix_s\": " + std::to_string(v.times[t].unix_s) + "}";
@@ -77,9 +127,13 @@ void write_cvvol(const std::string& path, CloudVolume& v, const std::function<vo
   const std::string header = "{\"format\": \"cvvol\", \"version\": 1,\n \"grid\": {\"lon_deg\": " + axis_json(v.grid.lon_deg) +
                              ", \"lat_deg\": " + axis_json(v.grid.lat_deg) + ", \"alt_m\": " + axis_json(v.grid.alt_m) +
                              ", \"earth_radius_m\": " + std::to_string(v.grid.earth_radius_m) + "},\n \"liquid_r_eff_um\": " +
-                             std::to_string(v.liquid_r_eff_um) + ",\n \"times\": " + times +
+                             std::to_string(v.liquid_r_eff_um) + ",\n" +
+                             (half ? " \"encoding\": \"float16\", \"field_scale\": \"extinction x 1000 (1/km); others x 1\",\n"
+                                   : "") +
+                             " \"times\": " + times +
                              "],\n \"fields\": " + fields + "],\n \"maps\": " + maps +
-                             "],\n \"layout\": \"float32 little-endian; per time step, each field (lon fastest, then lat, "
+                             "],\n \"layout\": \"" + (half ? "fields float16, maps float32" : "float32") +
+                             " little-endian; per time step, each field (lon fastest, then lat, "
                              "then alt) then each map (lon fastest, then lat); NaN = no data\"}\n";
   write_file_atomically(path, [&](std::FILE* f) {
     put(f, "CVVOL01\n");
@@ -93,9 +147,28 @@ void write_cvvol(const std::string& path, CloudVolume& v, const std::function<vo
         if (!v.has_field[static_cast<std::size_t>(i)]) continue;
         const auto& a = d.fields[static_cast<std::size_t>(i)];
         if (a.size() != v.grid.points()) throw std::runtime_error(std::string("field ") + field_name(static_cast<Field>(i)) + " has the wrong size");
-        put(f, a.data(), a.size() * sizeof(float));
+        if (half) {
+          // Converted a slice at a time, so no second copy of the volume exists.
+          const float k = half_scale(i);
+          std::vector<std::uint16_t> buf(std::min<std::size_t>(a.size(), std::size_t(1) << 20));
+          for (std::size_t at = 0; at < a.size(); at += buf.size()) {
+            const std::size_t n = std::min(buf.size(), a.size() - at);
+            for (std::size_t j = 0; j < n; ++j) buf[j] = float_to_half(a[at + j] * k);
+            put(f, buf.data(), n * sizeof(std::uint16_t));
+          }
+        } else {
+          put(f, a.data(), a.size() * sizeof(float));
+        }
       }
       for (const auto& [name, arr] : map_arrays(d.maps)) put(f, arr->data(), arr->size() * sizeof(float));
+      if (v.has_ground) {
+        if (d.ground_m.size() == v.grid.columns()) {
+          put(f, d.ground_m.data(), d.ground_m.size() * sizeof(float));
+        } else {
+          const std::vector<float> unknown(v.grid.columns(), std::numeric_limits<float>::quiet_NaN());
+          put(f, unknown.data(), unknown.size() * sizeof(float));
+        }
+      }
     }
   });
 }
@@ -172,8 +245,12 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
     t.unix_s = static_cast<std::int64_t>(json_number(header, "unix_s", k, path));
     v.times.push_back(t);
   }
+  const std::vector<std::string> maps = json_strings(header, "maps", path);
+  v.has_ground = std::find(maps.begin(), maps.end(), "ground_m") != maps.end();
   const std::size_t points = v.grid.points(), cols = v.grid.columns();
-  const std::uint64_t step_bytes = (order.size() * points + 7 * cols) * sizeof(float);
+  const bool half = header.find("\"encoding\": \"float16\"") != std::string::npos;
+  const std::size_t value_bytes = half ? sizeof(std::uint16_t) : sizeof(float);
+  const std::uint64_t step_bytes = order.size() * points * value_bytes + (v.has_ground ? 8 : 7) * cols * sizeof(float);
   const std::uint64_t data0 = 16 + len;
   std::fseek(f, 0, SEEK_END);
   const long long size = std::ftell(f);
@@ -184,7 +261,7 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   v.report.file = path;
   v.report.format = "cloud volume (.cvvol)";
   v.set_loader(
-      [file, order, data0, step_bytes, points, path](std::size_t t, ImportReport&, TimeStepData& out) {
+      [file, order, data0, step_bytes, points, cols, half, ground = v.has_ground, path](std::size_t t, ImportReport&, TimeStepData& out) {
         if (std::fseek(file.get(), static_cast<long>(data0 + step_bytes * t), SEEK_SET) != 0) {
           throw VolumeFileError(path + ": cannot seek to time step " + std::to_string(t));
         }
@@ -192,11 +269,31 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
         for (int i : order) {
           auto& a = out.fields[static_cast<std::size_t>(i)];
           a.resize(points);
-          if (std::fread(a.data(), sizeof(float), points, file.get()) != points) {
+          if (half) {
+            const float k = 1.0f / half_scale(i);
+            std::vector<std::uint16_t> buf(std::min<std::size_t>(points, std::size_t(1) << 20));
+            for (std::size_t at = 0; at < points; at += buf.size()) {
+              const std::size_t n = std::min(buf.size(), points - at);
+              if (std::fread(buf.data(), sizeof(std::uint16_t), n, file.get()) != n) {
+                throw VolumeFileError(path + ": truncated at time step " + std::to_string(t));
+              }
+              for (std::size_t j = 0; j < n; ++j) a[at + j] = half_to_float(buf[j]) * k;
+            }
+          } else if (std::fread(a.data(), sizeof(float), points, file.get()) != points) {
             throw VolumeFileError(path + ": truncated at time step " + std::to_string(t));
           }
         }
-        // The maps that follow are derived again from the fields by CloudVolume::step.
+        // The maps that follow are derived again from the fields (and the ground) by CloudVolume::step.
+        out.ground_m.clear();
+        if (ground) {
+          if (std::fseek(file.get(), static_cast<long>(7 * cols * sizeof(float)), SEEK_CUR) != 0) {
+            throw VolumeFileError(path + ": cannot seek to the ground of time step " + std::to_string(t));
+          }
+          out.ground_m.resize(cols);
+          if (std::fread(out.ground_m.data(), sizeof(float), cols, file.get()) != cols) {
+            throw VolumeFileError(path + ": truncated at time step " + std::to_string(t));
+          }
+        }
       },
       cache_steps);
   return v;

@@ -93,6 +93,35 @@ TEST(RealFiles, FilesWithoutCloudVariablesSayWhatIsMissing) {
   }
 }
 
+// Neither file has a cloud field; the ERA5-style one has temperature and relative humidity, so a
+// cloud can be diagnosed when asked; GFS has temperature and heights only, and is told why not.
+TEST(RealFiles, DiagnosedCloudWhereTheFileHasHumidity) {
+  REAL_FILE(accf, "met-accf-pl.nc");
+  importers::ImportOptions o;
+  o.diagnose_cloud = true;
+  auto vol = importers::import_file(accf, o);
+  ASSERT_TRUE(vol.has_field[static_cast<int>(core::Field::CloudFraction)]);
+  const auto& d = vol.step(0);
+  float most = 0.0f;
+  for (float c : d[core::Field::CloudFraction]) {
+    if (!std::isnan(c)) most = std::max(most, c);
+  }
+  EXPECT_GT(most, 0.5f);  // 100-350 hPa over the North Atlantic in November: ice-supersaturated layers
+  EXPECT_LE(most, 1.0f);
+  bool loud = false;
+  for (const auto& w : vol.report.warnings) loud |= w.find("DIAGNOSED CLOUD") != std::string::npos && w.find("RH from 'r'") != std::string::npos;
+  EXPECT_TRUE(loud) << vol.report.to_text();
+  const std::string info = importers::describe_file(accf);
+  EXPECT_NE(info.find("importable with --diagnose-cloud: yes"), std::string::npos) << info;
+  REAL_FILE(gfs, "GFS_global.nc");
+  try {
+    importers::import_file(gfs, o);
+    ADD_FAILURE() << "GFS has no humidity";
+  } catch (const importers::ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("has temperature and no humidity"), std::string::npos) << e.what();
+  }
+}
+
 TEST(RealFiles, GfsTimeUnitsAndSeamAreUnderstood) {
   REAL_FILE(path, "GFS_global.nc");
   const std::string info = importers::describe_file(path);

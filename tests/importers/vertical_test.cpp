@@ -62,6 +62,7 @@ TEST(Vertical, HeightLevelsInKilometres) {
   }
   importers::ImportOptions o;
   o.dz_m = 500.0;
+  o.keep_cloudless_levels = true;  // the axis of every level, not only up to the cloud
   auto v = importers::import_file(p, o);
   EXPECT_DOUBLE_EQ(v.grid.alt_m.start, 500.0);
   EXPECT_EQ(v.grid.alt_m.count, 10);
@@ -243,6 +244,7 @@ TEST(Vertical, ColumnsWithHundredsOfLevels) {
   }
   importers::ImportOptions o;
   o.dz_m = 50.0;
+  o.keep_cloudless_levels = true;  // the axis of every level, not only up to the cloud
   auto v = importers::import_file(p, o);
   EXPECT_EQ(v.grid.alt_m.count, 300);
   EXPECT_NEAR(v.step(0)[core::Field::CloudFraction][v.grid.index(1, 1, 150)], 0.5, 1e-6);
