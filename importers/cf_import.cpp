@@ -10,6 +10,7 @@
 #include <numeric>
 #include <thread>
 
+#include "checks.hpp"
 #include "cf_layout.hpp"
 #include "column.hpp"
 #include "wrf_import.hpp"
@@ -702,9 +703,10 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
       dz = std::clamp(median / 2.0, 50.0, 500.0);
     }
     zmin = std::max(zmin, -500.0);
-    const int nz = static_cast<int>(std::floor((zmax - zmin) / dz)) + 1;
+    const int nz = checked_level_count(path, zmin, zmax, dz, options.dz_m > 0.0 ? "--dz (dz_m)" : "the levels' spacing");
     vol.grid.alt_m = {zmin, dz, nz};
   }
+  check_imported_grid(path, vol.grid);
   const double bytes = static_cast<double>(vol.grid.points()) * core::kFieldCount * sizeof(float);
   if (bytes > options.max_volume_bytes) {
     throw ImportError(path + ": the volume would take " + fmt(bytes / 1e9) + " GB per time step (limit " +

@@ -83,7 +83,10 @@ void NcFile::fail(int status, const std::string& what) const {
 
 NcFile::NcFile(const std::string& path) : path_(path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw ImportError(path + ": no such file");
+  // A FIFO, a device or a folder is refused before netCDF opens it (it would block or read forever).
+  if (const std::string kind = core::file_kind(path); !kind.empty()) {
+    throw ImportError(path + (kind == "no such file" ? ": no such file" : ": is " + kind + ", expected a regular NetCDF file"));
+  }
   file_bytes_ = static_cast<long long>(std::filesystem::file_size(path, ec));
   const int st = nc_open(path.c_str(), NC_NOWRITE, &id_);
   if (st != NC_NOERR) {
@@ -203,6 +206,8 @@ std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start,
   if (v.type == NC_CHAR || v.type == NC_STRING) {
     throw ImportError(path_ + ": variable '" + v.name + "' holds text, expected numbers");
   }
+  core::require_within_memory_limit(path_, "variable '" + v.name + "': a read of " + std::to_string(n) + " values",
+                                    core::checked_product({n, sizeof(double)}));
   std::vector<double> out(n);
   if (n == 0) return out;
   if (const int s = nc_get_vara_double(id_, v.id, start.data(), count.data(), out.data()); s != NC_NOERR) {
@@ -292,7 +297,12 @@ std::vector<std::string> NcFile::read_strings(const NcVar& v) const {
     throw ImportError(path_ + ": variable '" + v.name + "': expected a 2-D character array");
   }
   const std::size_t rows = dim_length(v, 0), cols = dim_length(v, 1);
-  if (rows * cols > (1u << 24)) throw ImportError(path_ + ": variable '" + v.name + "' is implausibly large");
+  // rows * cols checked for overflow: a wrapped product passed the bound and read past the buffer.
+  const auto chars = core::checked_product({rows, cols});
+  if (!chars || *chars > (1u << 24)) {
+    throw ImportError(path_ + ": variable '" + v.name + "' is " + std::to_string(rows) + " x " + std::to_string(cols) +
+                      " characters, expected at most 16 Mi characters of text");
+  }
   std::vector<char> buf(rows * cols);
   if (!buf.empty()) {
     if (const int s = nc_get_var_text(id_, v.id, buf.data()); s != NC_NOERR) fail(s, "variable '" + v.name + "'");
