@@ -206,8 +206,12 @@ std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start,
   if (v.type == NC_CHAR || v.type == NC_STRING) {
     throw ImportError(path_ + ": variable '" + v.name + "' holds text, expected numbers");
   }
-  core::require_within_memory_limit(path_, "variable '" + v.name + "': a read of " + std::to_string(n) + " values",
-                                    core::checked_product({n, sizeof(double)}));
+  try {
+    core::require_within_memory_limit(path_, "variable '" + v.name + "': a read of " + std::to_string(n) + " values",
+                                      core::checked_product({n, sizeof(double)}));
+  } catch (const core::InputError& e) {
+    throw ImportError(e.what());
+  }
   std::vector<double> out(n);
   if (n == 0) return out;
   if (const int s = nc_get_vara_double(id_, v.id, start.data(), count.data(), out.data()); s != NC_NOERR) {

@@ -94,8 +94,10 @@ double json_number(const std::string& j, const std::string& key, std::size_t fro
   char* end = nullptr;
   const double v = std::strtod(text, &end);
   if (end == text || !std::isfinite(v)) {
-    throw VolumeFileError(path + ": header key '" + key + "': found '" + j.substr(k + key.size() + 3, 24) +
-                          "', expected a finite number");
+    std::string found = j.substr(k + key.size() + 3, 24);
+    found.erase(0, found.find_first_not_of(' '));
+    found = found.substr(0, found.find_first_of(",}]"));
+    throw VolumeFileError(path + ": header key '" + key + "': found '" + found + "', expected a finite number");
   }
   return v;
 }
@@ -107,15 +109,18 @@ RegularAxis json_axis(const std::string& j, const std::string& key, const std::s
   a.step = json_number(j, "step", k, path);
   const double count = json_number(j, "count", k, path);
   if (!(count >= 1 && count <= 1000000) || count != std::floor(count)) {
-    throw VolumeFileError(path + ": axis '" + key + "' count: found " + std::to_string(count) + ", expected an integer 1..1000000");
+    char found[32];
+    std::snprintf(found, sizeof found, "%.17g", count);
+    throw VolumeFileError(path + ": axis '" + key + "' count: found " + found + ", expected an integer 1..1000000");
   }
   a.count = static_cast<int>(count);
   return a;
 }
 // The quoted string that starts at j[q] (a '"'), or a VolumeFileError for one left open.
-std::string json_quoted(const std::string& j, std::size_t q, const std::string& key, const std::string& path) {
-  const std::size_t e = j.find('"', q + 1);
-  if (q == std::string::npos || e == std::string::npos) {
+std::string json_quoted(const std::string& j, std::size_t q, const std::string& key, const std::string& path,
+                        std::size_t before = std::string::npos) {
+  const std::size_t e = q == std::string::npos ? q : j.find('"', q + 1);
+  if (q == std::string::npos || e == std::string::npos || e > before) {
     throw VolumeFileError(path + ": header key '" + key + "': found a string without its closing quote, expected \"...\"");
   }
   return j.substr(q + 1, e - q - 1);
@@ -127,7 +132,7 @@ std::vector<std::string> json_strings(const std::string& j, const std::string& k
   if (close == std::string::npos) throw VolumeFileError(path + ": header key '" + key + "': found no [ ... ] list, expected one");
   std::vector<std::string> out;
   for (std::size_t q = j.find('"', open); q < close; q = j.find('"', q + 1)) {
-    out.push_back(json_quoted(j, q, key, path));
+    out.push_back(json_quoted(j, q, key, path, close));
     q += out.back().size() + 1;
     if (out.size() > static_cast<std::size_t>(kFieldCount)) {
       throw VolumeFileError(path + ": header key '" + key + "': found more than " + std::to_string(kFieldCount) +
