@@ -143,6 +143,7 @@ void apply_march_flag(const core::SettingRow& row, const std::string& text, core
 void check_outputs(const RenderArgs& r, const core::Scene& scene) {
   const std::string& ground = scene.render.march.ground_texture;
   if (!ground.empty() && ground != "none") core::require_regular_file(ground, "render.march.ground_texture, the ground image");
+  if (!r.front.empty()) core::require_regular_file(r.front, "the quality front");
   std::vector<std::pair<std::string, std::string>> outputs = {{r.out, "-o"}};
   core::check_output_extension(r.out, "-o", {".png"});
   if (!r.pfm.empty()) {
