@@ -8,7 +8,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -268,6 +270,28 @@ TEST_F(HostileImport, ReadsBeyondTheMemoryLimitAreRefusedBeforeAllocating) {
   core::set_memory_limit_bytes(0);
   EXPECT_NE(msg.find("values would take"), std::string::npos) << msg;
   EXPECT_NE(msg.find("expected at most the memory limit 1 KiB (set CLOUDVIEWER_MEMORY_LIMIT to change it)"), std::string::npos) << msg;
+}
+
+TEST_F(HostileImport, CorruptClassicHeaderIsRefusedBeforeNetcdfReadsIt) {
+  // A name length of 2^32 - 1 in a classic header made netCDF-C memcpy a negative size (a crash
+  // fuzz_netcdf found); a large one made it calloc that much. The 64-bit-offset real file with its
+  // first dimension's name length patched.
+  REAL_FILE(real, "met-accf-pl.nc");
+  const std::string p = copy_of(real, "header.nc");
+  EXPECT_NO_THROW(importers::NcFile{p});  // the file as it is opens
+  for (const std::uint32_t declared : {0xFFFFFFFFu, 0x7FFFFFF0u}) {
+    {
+      std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+      f.seekp(16);  // magic, record count, the dimension list's tag and count
+      const unsigned char be[4] = {static_cast<unsigned char>(declared >> 24), static_cast<unsigned char>(declared >> 16),
+                                   static_cast<unsigned char>(declared >> 8), static_cast<unsigned char>(declared)};
+      f.write(reinterpret_cast<const char*>(be), 4);
+    }
+    const std::string msg = import_error(p);
+    EXPECT_NE(msg.find(p + ": the netCDF classic header is corrupt: the name of dimension 0 declares " + std::to_string(declared)),
+              std::string::npos)
+        << msg;
+  }
 }
 
 }  // namespace
