@@ -10,6 +10,7 @@
 #include <numeric>
 #include <thread>
 
+#include "checks.hpp"
 #include "cf_layout.hpp"
 #include "column.hpp"
 #include "diagnosed_cloud.hpp"
@@ -860,9 +861,12 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
       dz = std::clamp(median / 2.0, 50.0, 500.0);
     }
     zmin = std::max(zmin, -500.0);
-    // The axis reaches the highest level: an automatic spacing is fitted to end on it.
+    // Refused first where the span is nothing or the levels too many; then the axis reaches the
+    // highest level (an automatic spacing is fitted to end on it).
+    checked_level_count(path, zmin, zmax, dz, options.dz_m > 0.0 ? "--dz (dz_m)" : "the levels' spacing");
     vol.grid.alt_m = altitude_axis(zmin, zmax, dz, options.dz_m <= 0.0);
   }
+  check_imported_grid(path, vol.grid);
   const double bytes = static_cast<double>(vol.grid.points()) * core::kFieldCount * sizeof(float);
   if (bytes > options.max_volume_bytes) {
     throw ImportError(path + ": the volume would take " + fmt(bytes / 1e9) + " GB per time step (limit " +

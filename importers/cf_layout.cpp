@@ -261,6 +261,10 @@ CfLayout detect_cf_layout(const NcFile& f) {
   // Roles: standard_name first, then GRIB parameter attributes, then names; only a variable on a
   // longitude, a latitude and a vertical axis, with units that fit, is taken.
   auto find_role = [&](const RoleSpec& spec, double& scale) -> const NcVar* {
+    // Cloud water on one level only cannot fill a volume: said when nothing else takes the role,
+    // never dropped without a word.
+    const bool cloud_role = spec.role == Role::CloudFraction || spec.role == Role::Liquid || spec.role == Role::Ice;
+    const NcVar* flat = nullptr;
     for (int pass = 0; pass < 3; ++pass) {
       for (const auto& v : f.vars()) {
         if (&v == L.surface_geopotential) continue;
@@ -278,6 +282,7 @@ CfLayout detect_cf_layout(const NcFile& f) {
           const std::string n = lower(v.name), base = base_name(v.name);
           for (const char* want : spec.names) match |= n == want || base == want;
         }
+        if (match && cloud_role && !flat && !v.dims.empty() && v.dims.size() < 3) flat = &v;
         if (!match || !on_candidate(v, 0) || !on_candidate(v, 1) || !on_candidate(v, 2)) continue;
         if (!units_fit(spec.role, v.text("units"), scale)) {
           L.notes.push_back("'" + v.name + "' looks like " + role_name(spec.role) + " but has units '" + v.text("units") +
@@ -286,6 +291,13 @@ CfLayout detect_cf_layout(const NcFile& f) {
         }
         return &v;
       }
+    }
+    if (flat) {
+      std::string dims;
+      for (int d : flat->dims) dims += (dims.empty() ? "" : ", ") + f.dims()[static_cast<std::size_t>(d)].name;
+      throw ImportError(path + ": variable '" + flat->name + "' (" + role_name(spec.role) + ") has " +
+                        std::to_string(flat->dims.size()) + " dimension(s) (" + dims +
+                        "), expected a 3-D field on longitude, latitude and levels");
     }
     return nullptr;
   };
@@ -341,6 +353,26 @@ CfLayout detect_cf_layout(const NcFile& f) {
   }
   if (!L.lon.var) throw ImportError(path + ": no longitude coordinate (expected units degrees_east or standard_name longitude)");
   if (!L.lat.var) throw ImportError(path + ": no latitude coordinate (expected units degrees_north or standard_name latitude)");
+  // Each longitude and latitude names its own place: all-equal values (a step of 0) or two turns
+  // interleaved (0..720) give no grid. Longitudes equal modulo 360 are allowed only as the first
+  // and last value (a wrap column).
+  for (const Axis* a : {&L.lon, &L.lat}) {
+    std::vector<double> v = a->values;
+    const bool lon = a == &L.lon;
+    if (lon) {
+      for (double& x : v) x = std::fmod(std::fmod(x, 360.0) + 360.0, 360.0);
+    }
+    std::sort(v.begin(), v.end());
+    std::size_t same = 0;
+    for (std::size_t i = 1; i < v.size(); ++i) same += std::abs(v[i] - v[i - 1]) <= 1e-9 * std::max(1.0, std::abs(v[i]));
+    const bool wrap = lon && same == 1 && a->values.size() > 2 &&
+                      std::abs(std::abs(a->values.back() - a->values.front()) - 360.0) <= 1e-6;
+    if (same > (wrap ? 1u : 0u)) {
+      throw ImportError(path + ": coordinate '" + a->var->name + "' has " + std::to_string(same + 1 - (wrap ? 1 : 0)) +
+                        " values at the same " + (lon ? "longitude (modulo 360)" : "latitude") + ", expected " +
+                        std::to_string(a->values.size()) + " distinct " + (lon ? "longitudes within one turn" : "latitudes"));
+    }
+  }
   if (!L.vertical.var) {
     throw ImportError(path + ": no vertical coordinate (expected pressure levels in Pa/hPa/mb, or standard_name air_pressure)");
   }
@@ -416,6 +448,17 @@ CfLayout detect_cf_layout(const NcFile& f) {
   }
   // Names are not units: a "z" in metres is a geopotential height, a "w" in m/s an upward velocity.
   auto units_of = [](const NcVar* v) { return lower(v->text("units")); };
+  // Water is read as a mass fraction (kg/kg): other units would scale it silently.
+  for (Role r : {Role::Liquid, Role::Ice}) {
+    const NcVar* w = L.roles[static_cast<int>(r)];
+    if (!w) continue;
+    std::string u = units_of(w);
+    u.erase(std::remove(u.begin(), u.end(), ' '), u.end());
+    if (!in(u, {"", "1", "kgkg-1", "kg/kg", "kgkg**-1", "kgkg^-1", "kg.kg-1", "kg*kg-1", "kgkg-1(mass)", "kg(kg)-1", "-", "dimensionless"})) {
+      throw ImportError(path + ": variable '" + w->name + "' (" + role_name(r) + ") has units '" + w->text("units") +
+                        "', expected a mass fraction in kg kg-1 (or 1)");
+    }
+  }
   if (const NcVar* z = L.roles[static_cast<int>(Role::Geopotential)]) {
     const std::string u = units_of(z);
     if (in(u, {"m", "gpm", "meter", "meters", "metre", "metres"})) {
@@ -495,6 +538,15 @@ CfLayout detect_cf_layout(const NcFile& f) {
       if (d1 != d0) L.times_uneven = true;
     }
   } else {
+    // A coordinate variable on the time dimension that was not recognised has units nobody can read:
+    // said, not taken as "no time coordinate".
+    if (time_dim >= 0) {
+      const std::string& dn = f.dims()[static_cast<std::size_t>(time_dim)].name;
+      if (const NcVar* tv = f.find(dn); tv && tv->dims.size() == 1 && tv->dims[0] == time_dim && tv->type != 2 /* NC_CHAR */) {
+        throw ImportError(path + ": variable '" + tv->name + "' (the time coordinate) has units '" + tv->text("units") +
+                          "', expected '<unit> since YYYY-MM-DD[ hh:mm:ss]'");
+      }
+    }
     for (std::size_t i = 0; i < nt; ++i) L.times.push_back({0, "step " + std::to_string(i) + " (no time coordinate)"});
     L.notes.push_back("no time coordinate: steps are numbered, valid times unknown");
   }

@@ -5,11 +5,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "io/input_file.hpp"
+
 namespace cv::importers {
 
-class ImportError : public std::runtime_error {
+class ImportError : public core::InputError {
  public:
-  using std::runtime_error::runtime_error;
+  using core::InputError::InputError;
 };
 
 }  // namespace cv::importers

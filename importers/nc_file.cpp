@@ -3,7 +3,10 @@
 
 #include <netcdf.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 
@@ -42,6 +45,101 @@ std::vector<NcAtt> read_atts(int ncid, int varid, int natts, const std::string& 
     out.push_back(std::move(att));
   }
   return out;
+}
+
+// netCDF-C's classic-format reader trusts the lengths its header declares: a name length of
+// 2^32 - 1 makes it memcpy a negative size (a crash), a large one makes it calloc 16 GiB and more
+// (both found by fuzz/fuzz_netcdf). The header is walked here first, every declared length and
+// count held to the bytes the file has, before netCDF opens it.
+class ClassicHeader {
+ public:
+  ClassicHeader(const std::string& path, const std::vector<unsigned char>& b, std::uint64_t file_bytes)
+      : path_(path), b_(b), file_bytes_(file_bytes), version_(b.size() > 3 ? b[3] : 0) {}
+  void check() {
+    pos_ = 4;
+    take(version_ == 5 ? 8 : 4, "the record count");
+    list(0x0A, "dimension", [&](std::uint64_t i) {
+      name("dimension", i);
+      take(version_ == 5 ? 8 : 4, "a dimension length");
+    });
+    attributes("global");
+    list(0x0B, "variable", [&](std::uint64_t i) {
+      name("variable", i);
+      const std::uint64_t nd = count("variable " + std::to_string(i) + "'s dimensions", version_ == 5 ? 8 : 4);
+      skip(nd, version_ == 5 ? 8 : 4, "variable " + std::to_string(i) + "'s dimension ids");
+      attributes("variable " + std::to_string(i));
+      take(4, "a variable's type");
+      take(version_ == 5 ? 8 : 4, "a variable's size");
+      take(version_ == 1 ? 4 : 8, "a variable's offset");
+    });
+  }
+
+ private:
+  [[noreturn]] void corrupt(const std::string& what, std::uint64_t declared) const {
+    throw ImportError(path_ + ": the netCDF classic header is corrupt: " + what + " declares " + std::to_string(declared) +
+                      " where " + std::to_string(file_bytes_ > pos_ ? file_bytes_ - pos_ : 0) +
+                      " bytes of the file are left; expected a complete netCDF file");
+  }
+  std::uint64_t take(std::size_t n, const std::string& what) {
+    if (pos_ + n > b_.size()) {
+      if (pos_ + n <= file_bytes_) throw ImportError(path_ + ": the netCDF classic header is larger than 64 MiB; expected a smaller header");
+      corrupt(what, n);
+    }
+    std::uint64_t v = 0;
+    for (std::size_t i = 0; i < n; ++i) v = (v << 8) | b_[pos_ + i];
+    pos_ += n;
+    return v;
+  }
+  std::uint64_t count(const std::string& what, std::size_t width) {
+    const std::uint64_t n = take(width, what);
+    if (n > file_bytes_) corrupt(what, n);  // every element takes at least a byte
+    return n;
+  }
+  void skip(std::uint64_t n, std::uint64_t each, const std::string& what) {
+    const std::uint64_t padded = (n * each + 3) / 4 * 4;
+    if (n > file_bytes_ || padded > file_bytes_ - std::min<std::uint64_t>(file_bytes_, pos_)) corrupt(what, n * each);
+    pos_ += padded;
+    if (pos_ > b_.size()) take(1, what);  // past what was read: larger than 64 MiB or cut short
+  }
+  void name(const std::string& of, std::uint64_t i) {
+    const std::uint64_t n = count("the name of " + of + " " + std::to_string(i), version_ == 5 ? 8 : 4);
+    skip(n, 1, "the name of " + of + " " + std::to_string(i));
+  }
+  template <class F>
+  void list(std::uint64_t tag, const char* what, F each) {
+    const std::uint64_t t = take(4, std::string("the ") + what + " list's tag");
+    const std::uint64_t n = count(std::string("the ") + what + " count", version_ == 5 ? 8 : 4);
+    if (t == 0 && n == 0) return;  // absent
+    if (t != tag) corrupt(std::string("the ") + what + " list's tag", t);
+    for (std::uint64_t i = 0; i < n; ++i) each(i);
+  }
+  void attributes(const std::string& of) {
+    list(0x0C, "attribute", [&](std::uint64_t i) {
+      const std::string what = "attribute " + std::to_string(i) + " of " + of;
+      name("attribute", i);
+      const std::uint64_t type = take(4, what + "'s type");
+      static const std::uint64_t bytes[] = {0, 1, 1, 2, 4, 4, 8, 1, 2, 4, 8, 8};
+      if (type < 1 || type > 11 || (version_ != 5 && type > 6)) corrupt(what + "'s type", type);
+      const std::uint64_t n = count(what + "'s length", version_ == 5 ? 8 : 4);
+      skip(n, bytes[type], what + "'s values");
+    });
+  }
+  const std::string& path_;
+  const std::vector<unsigned char>& b_;
+  std::uint64_t file_bytes_;
+  unsigned version_;
+  std::uint64_t pos_ = 0;
+};
+
+void check_classic_header(const std::string& path, std::uint64_t file_bytes) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return;  // netCDF's open says why
+  std::vector<unsigned char> b(static_cast<std::size_t>(std::min<std::uint64_t>(file_bytes, 64u << 20)));
+  const std::size_t got = b.empty() ? 0 : std::fread(b.data(), 1, b.size(), f);
+  std::fclose(f);
+  b.resize(got);
+  if (b.size() < 4 || b[0] != 'C' || b[1] != 'D' || b[2] != 'F' || (b[3] != 1 && b[3] != 2 && b[3] != 5)) return;  // not classic
+  ClassicHeader(path, b, file_bytes).check();
 }
 
 bool is_integer_type(int t) {
@@ -83,8 +181,12 @@ void NcFile::fail(int status, const std::string& what) const {
 
 NcFile::NcFile(const std::string& path) : path_(path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw ImportError(path + ": no such file");
+  // A FIFO, a device or a folder is refused before netCDF opens it (it would block or read forever).
+  if (const std::string kind = core::file_kind(path); !kind.empty()) {
+    throw ImportError(path + (kind == "no such file" ? ": no such file" : ": is " + kind + ", expected a regular NetCDF file"));
+  }
   file_bytes_ = static_cast<long long>(std::filesystem::file_size(path, ec));
+  check_classic_header(path, static_cast<std::uint64_t>(std::max<long long>(file_bytes_, 0)));
   const int st = nc_open(path.c_str(), NC_NOWRITE, &id_);
   if (st != NC_NOERR) {
     throw ImportError(path + ": not a readable NetCDF file (" + nc_strerror(st) +
@@ -203,6 +305,12 @@ std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start,
   if (v.type == NC_CHAR || v.type == NC_STRING) {
     throw ImportError(path_ + ": variable '" + v.name + "' holds text, expected numbers");
   }
+  try {
+    core::require_within_memory_limit(path_, "variable '" + v.name + "': a read of " + std::to_string(n) + " values",
+                                      core::checked_product({n, sizeof(double)}));
+  } catch (const core::InputError& e) {
+    throw ImportError(e.what());
+  }
   std::vector<double> out(n);
   if (n == 0) return out;
   if (const int s = nc_get_vara_double(id_, v.id, start.data(), count.data(), out.data()); s != NC_NOERR) {
@@ -292,7 +400,12 @@ std::vector<std::string> NcFile::read_strings(const NcVar& v) const {
     throw ImportError(path_ + ": variable '" + v.name + "': expected a 2-D character array");
   }
   const std::size_t rows = dim_length(v, 0), cols = dim_length(v, 1);
-  if (rows * cols > (1u << 24)) throw ImportError(path_ + ": variable '" + v.name + "' is implausibly large");
+  // rows * cols checked for overflow: a wrapped product passed the bound and read past the buffer.
+  const auto chars = core::checked_product({rows, cols});
+  if (!chars || *chars > (1u << 24)) {
+    throw ImportError(path_ + ": variable '" + v.name + "' is " + std::to_string(rows) + " x " + std::to_string(cols) +
+                      " characters, expected at most 16 Mi characters of text");
+  }
   std::vector<char> buf(rows * cols);
   if (!buf.empty()) {
     if (const int s = nc_get_var_text(id_, v.id, buf.data()); s != NC_NOERR) fail(s, "variable '" + v.name + "'");

@@ -11,9 +11,11 @@
 #include <memory>
 
 #include "cf_time.hpp"
+#include "checks.hpp"
 #include "column.hpp"
 #include "importer.hpp"
 #include "nc_file.hpp"
+#include "scene/framing.hpp"
 #include "wrf_import.hpp"
 
 namespace cv::importers {
@@ -48,8 +50,16 @@ class WrfProjection {
     stand_lon_ = need("STAND_LON");
     dx_ = need("DX");
     dy_ = need("DY");
-    if (!(dx_ > 0 && dy_ > 0 && dx_ < 1e6 && dy_ < 1e6)) {
-      throw ImportError(path_ + ": DX/DY are " + fmt(dx_) + "/" + fmt(dy_) + " m, expected grid spacings between 0 and 1000 km");
+    for (const auto& [name, value] : {std::pair{"TRUELAT1", truelat1_}, std::pair{"TRUELAT2", truelat2_}}) {
+      if (!(std::abs(value) <= 90.0)) {
+        throw ImportError(path_ + ": global attribute '" + name + "' is " + fmt(value) + ", expected a latitude within -90..90");
+      }
+    }
+    if (!(std::abs(stand_lon_) <= 360.0)) {
+      throw ImportError(path_ + ": global attribute 'STAND_LON' is " + fmt(stand_lon_) + ", expected a longitude within -360..360");
+    }
+    if (!(dx_ >= 1 && dy_ >= 1 && dx_ < 1e6 && dy_ < 1e6)) {
+      throw ImportError(path_ + ": DX/DY are " + fmt(dx_) + "/" + fmt(dy_) + " m, expected grid spacings between 1 m and 1000 km");
     }
     if (proj_ == 1) {
       lcc_ = std::make_unique<GeographicLib::LambertConformalConic>(kWrfEarthRadiusM, 0.0, truelat1_, truelat2_, 1.0);
@@ -165,8 +175,12 @@ core::ValidTime wrf_time(const std::string& s, const std::string& where) {
     throw ImportError(where + ": time '" + s + "', expected YYYY-MM-DD_hh:mm:ss");
   }
   core::ValidTime t;
-  char buf[32];
+  char buf[96];
   std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02dZ", y, mo, d, h, mi, se);
+  // Every field in its range (month 1..12, the day within its month, hh:mm:ss of a day).
+  if (y < 1 || y > 9999 || !core::parse_iso_utc(buf)) {
+    throw ImportError(where + ": time '" + s + "' is no real date and time, expected YYYY-MM-DD_hh:mm:ss with each field in range");
+  }
   t.iso_utc = buf;
   t.unix_s = days_from_civil(y, mo, d) * 86400 + h * 3600 + mi * 60 + se;
   return t;
@@ -493,11 +507,24 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
       lat_min = std::min(lat_min, la[n]), lat_max = std::max(lat_max, la[n]);
     }
   };
+  // Every mass point's coordinates in range (a NaN XLAT would otherwise size the grid from NaN).
+  auto check_coordinates = [&](const std::vector<double>& la, const std::vector<double>& lo) {
+    for (std::size_t n = 0; n < la.size(); ++n) {
+      if (!(std::abs(la[n]) <= 90.0) || !(std::abs(lo[n]) <= 360.0)) {
+        const bool lat = !(std::abs(la[n]) <= 90.0);
+        throw ImportError(path + ": variable '" + (lat ? "XLAT" : "XLONG") + "' has value " + fmt(lat ? la[n] : lo[n]) +
+                          " at mass point " + std::to_string(n) + ", expected " +
+                          (lat ? "a latitude within -90..90" : "a longitude within -360..360"));
+      }
+    }
+  };
+  check_coordinates(xlat, xlon);
   extend(xlat, xlon);
   double moved_km = 0.0;
   if (f.var("XLAT").dims.size() == 3 && S->steps.size() > 1) {
     for (std::size_t k = 1; k < S->steps.size(); ++k) {
       const std::vector<double> la = read_mass2d(*S, "XLAT", S->steps[k]), lo = read_mass2d(*S, "XLONG", S->steps[k]);
+      check_coordinates(la, lo);
       double diff = 0.0;
       for (std::size_t n = 0; n < la.size(); ++n) {
         diff = std::max({diff, std::abs(la[n] - xlat[n]), std::abs(std::remainder(lo[n] - xlon[n], 360.0))});
@@ -541,6 +568,9 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
   const NcVar* sina = f.find("SINALPHA");
   std::vector<double> cos_alpha, sin_alpha;
   if (cosa && sina) cos_alpha = read_mass2d(*S, "COSALPHA", S->steps.front()), sin_alpha = read_mass2d(*S, "SINALPHA", S->steps.front());
+  core::require_within_memory_limit(path, "the resampling of " + std::to_string(vol.grid.lon_deg.count) + " x " +
+                                              std::to_string(vol.grid.lat_deg.count) + " columns",
+                                    core::checked_product({vol.grid.columns(), sizeof(Sample)}));
   double corner = 0.0;
   S->samples = place_samples(*S, vol.grid, xlat, xlon, cos_alpha, sin_alpha, S->steps.front(), &corner);
   vol.report.notes.push_back("projection checked against XLAT/XLONG: the far corner lies " + fmt(corner) +
@@ -577,8 +607,10 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
       std::nth_element(thick.begin(), thick.begin() + static_cast<std::ptrdiff_t>(thick.size() / 2), thick.end());
       dz = std::clamp(thick[thick.size() / 2] / 2.0, 50.0, 500.0);
     }
+    checked_level_count(path, zmin, zmax, dz, options.dz_m > 0.0 ? "--dz (dz_m)" : "PH/PHB");
     vol.grid.alt_m = altitude_axis(zmin, zmax, dz, options.dz_m <= 0.0);
   }
+  check_imported_grid(path, vol.grid);
   const double bytes = static_cast<double>(vol.grid.points()) * core::kFieldCount * sizeof(float);
   if (bytes > options.max_volume_bytes) {
     throw ImportError(path + ": the volume would take " + fmt(bytes / 1e9) + " GB per time step; subset the region or stride, or raise --dz");

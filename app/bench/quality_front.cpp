@@ -187,8 +187,12 @@ std::string front_to_json(const QualityFront& front) {
 QualityFront front_from_json(const std::string& text, const std::string& source) {
   json root;
   try {
-    root = json::parse(text);
-  } catch (const json::parse_error& e) {
+    // Nesting bounded while parsing (a front nests 4 deep): deep values cost stack in every walk.
+    root = json::parse(text, [&](int depth, json::parse_event_t, json&) {
+      if (depth > 32) throw FrontError(source + ": found values nested more than 32 levels deep, expected a quality front");
+      return true;
+    });
+  } catch (const json::exception& e) {  // parse errors, and numbers beyond a double (out_of_range)
     std::string what = e.what();
     for (char& ch : what) ch = (ch == '\n' ? ' ' : ch);
     throw FrontError(source + ": not valid JSON: " + what);
@@ -248,11 +252,13 @@ QualityFront front_from_json(const std::string& text, const std::string& source)
 }
 
 QualityFront load_front(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FrontError(path + ": cannot open the quality front (missing or unreadable)");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return front_from_json(text.str(), path);
+  std::string text;
+  try {
+    text = core::read_regular_file(path, "the quality front", 64u << 20);  // a FIFO or /dev/zero is refused, never read
+  } catch (const core::InputError& e) {
+    throw FrontError(e.what());
+  }
+  return front_from_json(text, path);
 }
 
 void save_front(const QualityFront& front, const std::string& path) {

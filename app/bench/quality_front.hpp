@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "io/input_file.hpp"
 #include "settings/quality_knobs.hpp"
 
 namespace cv::core {}
@@ -19,9 +20,9 @@ using namespace cv::core;
 
 // A quality front that cannot be used. One line: the file, the key, what was found and expected,
 // e.g. "quality_front.json: configs[2].sun_steps: found "x", expected an integer 1..1024".
-class FrontError : public std::runtime_error {
+class FrontError : public core::InputError {
  public:
-  using std::runtime_error::runtime_error;
+  using core::InputError::InputError;
 };
 
 // What one configuration measured on one scene.

@@ -37,4 +37,21 @@ std::vector<double> parse_list(const std::string& option, const std::string& tex
   return out;
 }
 
+std::optional<std::pair<int, int>> parse_size(const std::string& text, int lo, int hi) {
+  const std::size_t x = text.find('x');
+  if (x == std::string::npos) return std::nullopt;
+  auto whole = [&](const std::string& part) -> std::optional<int> {
+    if (part.empty() || part.size() > 9) return std::nullopt;  // 9 digits cannot overflow an int
+    for (char c : part) {
+      if (c < '0' || c > '9') return std::nullopt;
+    }
+    const int v = std::stoi(part);
+    if (v < lo || v > hi) return std::nullopt;
+    return v;
+  };
+  const auto w = whole(text.substr(0, x)), h = whole(text.substr(x + 1));
+  if (!w || !h) return std::nullopt;
+  return std::pair{*w, *h};
+}
+
 }  // namespace cv::cli

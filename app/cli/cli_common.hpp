@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -21,5 +23,8 @@ double parse_number(const std::string& option, const std::string& text);
 // min_n..max_n finite numbers separated by `sep`, or UsageError naming the option and `expected`.
 std::vector<double> parse_list(const std::string& option, const std::string& text, char sep, std::size_t min_n,
                                std::size_t max_n, const char* expected);
+
+// "WxH" with both whole numbers in lo..hi (digits only: "4294967328x18" is refused, not wrapped).
+std::optional<std::pair<int, int>> parse_size(const std::string& text, int lo, int hi);
 
 }  // namespace cv::cli

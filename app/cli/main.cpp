@@ -1,5 +1,6 @@
 // The `cloudviewer` command: batch subcommands (more arrive with the importers and the renderer).
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -11,6 +12,9 @@
 #include <vector>
 
 #include "importer.hpp"
+#include "io/input_file.hpp"
+#include "io/output_file.hpp"
+#include "scene/framing.hpp"
 #include "physics/physics.hpp"
 #include "volume/volume_io.hpp"
 #include "render/albedo_map.hpp"
@@ -61,7 +65,10 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
 void print_usage() {
   std::printf("usage: cloudviewer <command> [options]\ncommands:\n");
   for (const auto& [name, text] : command_usages()) std::printf("%s", text.c_str());
+  std::printf("  help COMMAND             that command's usage (as COMMAND --help)\n");
   std::printf("  --version                print the version\n");
+  std::printf("environment: CLOUDVIEWER_MEMORY_LIMIT  the most memory one input may ask for (bytes, or 512M, 4G, ...;\n"
+              "                           default half the machine's memory); larger declared sizes are refused\n");
 }
 
 // `cloudviewer COMMAND --help`: that command's usage, exit 0. False for an unknown command.
@@ -175,7 +182,9 @@ int cmd_import(const std::vector<std::string>& args) {
       const std::string r = next();
       static const std::regex iso(R"(^(\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}Z)?$)");
       const std::string from = r.substr(0, r.find("..")), to = r.substr(r.find("..") + 2);
-      if (!std::regex_match(from, iso) || !std::regex_match(to, iso)) {
+      // The form, then the date itself (2020-02-30 has the form of a date and is none).
+      if (!std::regex_match(from, iso) || !std::regex_match(to, iso) || (!from.empty() && !cv::core::parse_iso_utc(from)) ||
+          (!to.empty() && !cv::core::parse_iso_utc(to))) {
         throw UsageError{"cloudviewer import: --times: found '" + r + "', expected START..END as YYYY-MM-DDThh:mm:ssZ"};
       }
       o.time_from_iso = from;
@@ -194,8 +203,11 @@ int cmd_import(const std::vector<std::string>& args) {
       o.horizontal_stride = static_cast<int>(parse_number("--stride", next()));
       if (o.horizontal_stride < 1) throw UsageError{"cloudviewer import: --stride: expected an integer >= 1"};
     } else if (a == "--dz") {
-      o.dz_m = parse_number("--dz", next());
-      if (!(o.dz_m > 0)) throw UsageError{"cloudviewer import: --dz: expected a spacing in metres > 0"};
+      const std::string v = next();
+      o.dz_m = parse_number("--dz", v);
+      if (!(o.dz_m >= 1.0 && o.dz_m <= 1e5)) {  // the range a scene's data.dz_m takes (0 there: the default)
+        throw UsageError{"cloudviewer import: --dz: found '" + v + "', expected a spacing in metres 1..100000"};
+      }
     } else if (a == "--reff-liquid") {
       o.r_eff_liquid_um = parse_number("--reff-liquid", next());
       if (!(o.r_eff_liquid_um >= 1 && o.r_eff_liquid_um <= 50)) throw UsageError{"cloudviewer import: --reff-liquid: expected 1..50 um"};
@@ -221,28 +233,53 @@ int cmd_import(const std::vector<std::string>& args) {
   }
   if (input.empty() || out.empty()) throw UsageError{"cloudviewer import: expected FILE and -o OUT"};
   if (out.size() > 6 && out.substr(out.size() - 6) == ".cvvol") out.resize(out.size() - 6);
+  {  // OUT names a volume: an extension of another format is a mistake, not part of the name
+    std::string ext = fs::path(out).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    for (const char* other : {".nc", ".nc4", ".cdf", ".h5", ".png", ".pfm", ".jpg", ".json", ".vti", ".mp4", ".exr", ".tif", ".tiff"}) {
+      if (ext == other) {
+        throw UsageError{"cloudviewer import: -o: found '" + out + "', expected OUT or OUT.cvvol (it writes a .cvvol volume, "
+                         "its .report.json and .vti files, not " + ext + ")"};
+      }
+    }
+  }
+  // Every output checked before the import starts: its folder, and none of them the input.
+  std::vector<std::string> outputs = {out + ".cvvol", out + ".report.json"};
+  if (vti) outputs.push_back(out + "_t000.vti");
+  for (const std::string& p : outputs) {
+    cv::core::check_output_path(p, "-o");
+    cv::core::check_output_not_input(p, "-o", input, "the input");
+  }
   o.cache_steps = 1;  // steps are written one after another: keep only the current one
   cv::core::CloudVolume vol = cv::importers::import_file(input, o);
   for (const auto& w : vol.report.warnings) {
     if (w.rfind("DIAGNOSED CLOUD", 0) == 0) std::fprintf(stderr, "cloudviewer import: %s\n", w.c_str());
   }
+  for (std::size_t t = 0; vti && t < vol.times.size(); ++t) {
+    char name[32];
+    std::snprintf(name, sizeof name, "_t%03zu.vti", t);
+    cv::core::check_output_not_input(out + name, "-o", input, "the input");
+  }
   std::printf("grid: %d x %d x %d (lon %.4g..%.4g, lat %.4g..%.4g, alt %.0f..%.0f m), %zu time step(s)\n",
               vol.grid.lon_deg.count, vol.grid.lat_deg.count, vol.grid.alt_m.count, vol.grid.lon_deg.start,
               vol.grid.lon_deg.last(), vol.grid.lat_deg.start, vol.grid.lat_deg.last(), vol.grid.alt_m.start,
               vol.grid.alt_m.last(), vol.times.size());
-  cv::core::write_cvvol(out + ".cvvol", vol, [&](std::size_t t, std::size_t n) {
+  // The volume, its report and its VTI files belong together: committed together or not at all.
+  cv::core::OutputGroup group;
+  cv::core::write_cvvol(group, out + ".cvvol", vol, [&](std::size_t t, std::size_t n) {
     std::printf("importing time step %zu/%zu (%s)\n", t + 1, n, vol.times[t].iso_utc.c_str());
     std::fflush(stdout);
     if (vti) {
       char name[32];
       std::snprintf(name, sizeof name, "_t%03zu.vti", t);
-      cv::core::write_vti(out + name, vol.grid, vol.step(t), vol.has_field);
+      cv::core::write_vti(group, out + name, vol.grid, vol.step(t), vol.has_field);
     }
   }, encoding);
-  cv::core::write_file_atomically(out + ".report.json", [&](std::FILE* f) {
+  group.write(out + ".report.json", [&](std::FILE* f) {
     const std::string j = vol.report.to_json();
     std::fwrite(j.data(), 1, j.size(), f);
   });
+  group.commit();
   std::printf("%s", vol.report.to_text().c_str());
   std::printf("wrote %s.cvvol and %s.report.json%s\n", out.c_str(), out.c_str(), vti ? " and .vti files" : "");
   return 0;
@@ -251,10 +288,26 @@ int cmd_import(const std::vector<std::string>& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A SIGTERM or SIGINT during a write removes the temporary it was writing.
+  cv::core::install_output_cleanup();
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "-h" || args[0] == "--help") {
     print_usage();
     return args.empty() ? kExitBadInput : 0;
+  }
+  if (const char* limit = std::getenv("CLOUDVIEWER_MEMORY_LIMIT"); limit && *limit && !cv::core::parse_byte_size(limit)) {
+    std::fprintf(stderr, "cloudviewer: CLOUDVIEWER_MEMORY_LIMIT: found '%s', expected a size in bytes such as 512M or 4G\n", limit);
+    return kExitBadInput;
+  }
+  if (args[0] == "help") {  // `cloudviewer help COMMAND`: as `cloudviewer COMMAND --help`
+    if (args.size() == 1) {
+      print_usage();
+      return 0;
+    }
+    if (args.size() == 2 && print_command_usage(args[1])) return 0;
+    std::fprintf(stderr, "cloudviewer help: found '%s', expected one command: info, import, gpu-info, phase, render, bench or view\n",
+                 args.size() == 2 ? args[1].c_str() : "several arguments");
+    return kExitBadInput;
   }
   const std::string cmd = args[0];
   args.erase(args.begin());
@@ -291,6 +344,10 @@ int main(int argc, char** argv) {
     return kExitBadInput;
   } catch (const cv::importers::ImportError& e) {
     // Bad input files: one line naming the file and variable, exit code 2.
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  } catch (const cv::core::InputError& e) {
+    // Every other reader's bad input (a FIFO given as a file, a size beyond the memory limit, an output path that cannot be).
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
   } catch (const std::exception& e) {

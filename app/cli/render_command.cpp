@@ -14,9 +14,12 @@
 #include <type_traits>
 #include <utility>
 
+#include <unistd.h>
+
 #include <glm/glm.hpp>
 
 #include "cli_common.hpp"
+#include "io/output_file.hpp"
 #include "importer.hpp"
 #include "noise/noise.hpp"
 #include "quality_budget.hpp"
@@ -49,6 +52,40 @@ bool ends_with(const std::string& s, const std::string& tail) {
 }
 
 double seconds_since(clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); }
+
+// The most view steps one ray may take: beyond it a render runs for hours (a step of 1 m across a
+// 20 km layer is a million steps per ray), so it is refused before it starts.
+constexpr int kMaxViewStepsPerRay = 250000;
+
+void check_view_steps(double view_step_m, double r0_m, double top_m) {
+  const int steps = render::max_view_steps(r0_m, top_m, view_step_m);
+  if (steps <= kMaxViewStepsPerRay) return;
+  const double top = std::max(top_m, 0.0);
+  const double chord = 2.0 * std::sqrt((r0_m + top) * (r0_m + top) - r0_m * r0_m);
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                "cloudviewer render: view_step_m (--steps): found %g m, which takes up to %d steps per ray across this volume's "
+                "cloud layer (top %.0f m); expected at most %d steps: a step of at least %.3g m (range 1..1e7 m)",
+                view_step_m, steps, top_m, kMaxViewStepsPerRay, chord / (kMaxViewStepsPerRay - 4));
+  throw UsageError{buf};
+}
+
+// Progress on one line that rewrites itself on a terminal; piped or written to a file, one line
+// each, so the lines do not run together.
+bool g_progress_open = false;
+template <class... A>
+void progress_line(const char* format, A... args) {
+  const bool tty = ::isatty(::fileno(stdout)) != 0;
+  if (tty) std::printf("\r");
+  std::printf(format, args...);
+  if (!tty) std::printf("\n");
+  g_progress_open = tty;
+  std::fflush(stdout);
+}
+void end_progress() {
+  if (g_progress_open) std::printf("\n");
+  g_progress_open = false;
+}
 
 // What the options ask for, applied on top of the scene file (or the defaults) in one place.
 struct RenderArgs {
@@ -114,6 +151,36 @@ void apply_march_flag(const core::SettingRow& row, const std::string& text, core
   });
 }
 
+// Before any work: every output has a name the command can write, in a folder that exists and can
+// be written, none is an input (the render's input, the scene's data, its ground image, the front)
+// and no two are the same file; the scene's ground image is a regular file.
+void check_outputs(const RenderArgs& r, const core::Scene& scene) {
+  const std::string& ground = scene.render.march.ground_texture;
+  if (!ground.empty() && ground != "none") core::require_regular_file(ground, "render.march.ground_texture, the ground image");
+  if (!r.front.empty()) core::require_regular_file(r.front, "the quality front");
+  std::vector<std::pair<std::string, std::string>> outputs = {{r.out, "-o"}};
+  core::check_output_extension(r.out, "-o", {".png"});
+  if (!r.pfm.empty()) {
+    core::check_output_extension(r.pfm, "--pfm", {".pfm"});
+    outputs.push_back({r.pfm, "--pfm"});
+    outputs.push_back({render::transmittance_pfm_path(r.pfm), "--pfm (its transmittance beside it)"});
+  }
+  if (!r.save_scene.empty()) {
+    core::check_output_extension(r.save_scene, "--save-scene", {".json"});
+    outputs.push_back({r.save_scene, "--save-scene"});
+  }
+  const std::pair<std::string, std::string> inputs[] = {{r.input, "the input"},
+                                                        {scene.data.path, "the data (data.path)"},
+                                                        {ground == "none" ? "" : ground, "the ground image"},
+                                                        {r.front, "the quality front (--front)"}};
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const auto& [path, option] = outputs[i];
+    core::check_output_path(path, option);
+    for (const auto& [in, what] : inputs) core::check_output_not_input(path, option, in, what);
+    for (std::size_t j = 0; j < i; ++j) core::check_output_not_input(path, option, outputs[j].first, "the output of " + outputs[j].second);
+  }
+}
+
 // The options, applied to `scene` in the order given (later ones win).
 RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& scene) {
   RenderArgs r;
@@ -148,12 +215,9 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
     else if (a == "--pfm") r.pfm = v;
     else if (a == "--save-scene") r.save_scene = v;
     else if (a == "--size") {
-      int w = 0, h = 0;
-      char extra = 0;
-      if (std::sscanf(v.c_str(), "%dx%d%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 16384 || h > 16384) {
-        throw UsageError{"cloudviewer render: --size: found '" + v + "', expected WxH with 1..16384 each"};
-      }
-      scene.width = w, scene.height = h;
+      const auto size = parse_size(v, 1, 16384);
+      if (!size) throw UsageError{"cloudviewer render: --size: found '" + v + "', expected WxH with 1..16384 each"};
+      scene.width = size->first, scene.height = size->second;
     } else if (a == "--time") {
       scene.time_step = parse_int(a, v, 0, 1 << 30, "a time-step index >= 0");
     } else if (a == "--camera") {
@@ -273,6 +337,7 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
   if (scene.data.path.empty()) {
     throw UsageError{"cloudviewer render: " + r.input + ": data.path: found nothing, expected the NetCDF or .cvvol file to render"};
   }
+  check_outputs(r, scene);
   return r;
 }
 
@@ -335,12 +400,11 @@ std::vector<glm::vec4> path_trace(render::GpuRaymarcher& gpu, const core::FrameS
     const int batch = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(ra.spp) - img.spp, 8));
     gpu.trace_paths(img, frame.camera, frame.sun, frame.march, batch, pt, &extra);
     error = img.spp >= 2 ? img.mean_relative_standard_error() : 1.0;
-    std::printf("\rpath traced %llu/%d samples per pixel, mean relative standard error %.4f, %.1f s",
-                static_cast<unsigned long long>(img.spp), ra.spp, error, seconds_since(t0));
-    std::fflush(stdout);
+    progress_line("path traced %llu/%d samples per pixel, mean relative standard error %.4f, %.1f s",
+                  static_cast<unsigned long long>(img.spp), ra.spp, error, seconds_since(t0));
     if (ra.target_error > 0.0 && img.spp >= 8 && error <= ra.target_error) break;
   }
-  std::printf("\n");
+  end_progress();
   gpu_s = 0.0;
   std::printf("path tracer: %llu paths, %.2f scatterings per path, %llu null collisions, %llu sun-ray lookups, %llu cut at %d "
               "bounces, %llu ended by roulette%s\n",
@@ -386,6 +450,7 @@ int cmd_render(const std::vector<std::string>& args) {
 
   // Resolve everything the scene left automatic, so the saved scene reproduces this image exactly.
   core::FrameSpec frame = render::resolve_frame(scene, vol);
+  check_view_steps(frame.march.view_step_m, g.earth_radius_m, prepared->layer.empty ? g.alt_m.last() : prepared->layer.top_m);
   const core::Camera& cam = frame.camera;
   const core::Sun& sun = frame.sun;
   const core::ValidTime& vt = vol.times[static_cast<std::size_t>(scene.time_step)];
@@ -422,6 +487,7 @@ int cmd_render(const std::vector<std::string>& args) {
     scene.render.budget_ms = 0.0;  // a saved scene holds the chosen settings, so it renders this image again
     frame = render::resolve_frame(scene, vol);
   }
+  core::OutputGroup outputs;  // the image, its PFMs and the saved scene: committed together or not at all
   if (!ra.save_scene.empty()) {
     core::Scene saved = scene;
     // Data beside or below the saved scene: a path relative to its folder (as load_scene resolves
@@ -430,8 +496,8 @@ int cmd_render(const std::vector<std::string>& args) {
     const fs::path data = fs::absolute(scene.data.path).lexically_normal();
     const fs::path rel = data.lexically_relative(folder);
     saved.data.path = (rel.empty() || *rel.begin() == "..") ? data.string() : rel.string();
-    core::save_scene(saved, ra.save_scene);
-    std::printf("wrote the scene %s\n", ra.save_scene.c_str());
+    const std::string text = core::scene_to_json(saved);
+    outputs.write(ra.save_scene, [&](std::FILE* f) { std::fwrite(text.data(), 1, text.size(), f); });
   }
 
   if (ra.reference) {  // the path tracer marches nothing: the output size, and no air
@@ -463,8 +529,7 @@ int cmd_render(const std::vector<std::string>& args) {
   if (frame.accumulate == 1 && pixels_per_frame > kTilePixels) {
     dispatch.rows_per_tile = std::max(8, static_cast<int>(kTilePixels / mw));
     dispatch.on_tile = [&](int done, int total) {
-      std::printf("\rmarched %d/%d rows (%.0f%%), %.1f s", done, total, 100.0 * done / total, seconds_since(t0));
-      std::fflush(stdout);
+      progress_line("marched %d/%d rows (%.0f%%), %.1f s", done, total, 100.0 * done / total, seconds_since(t0));
     };
   }
   // One frame at step middles (or the scene's frame), or the mean of jittered frames, at the output
@@ -478,11 +543,10 @@ int cmd_render(const std::vector<std::string>& args) {
     pixels = renderer.render(
         frame, dispatch,
         [&](int done, int total) {
-          if (total > 1) std::printf("\raccumulated %d/%d frames, %.1f s", done, total, seconds_since(t0));
-          std::fflush(stdout);
+          if (total > 1) progress_line("accumulated %d/%d frames, %.1f s", done, total, seconds_since(t0));
         },
         &marched);
-    if (frame.accumulate > 1 || dispatch.on_tile) std::printf("\n");
+    end_progress();
   }
   const double t_march = seconds_since(t0);
   if (march.medium.ms_two_stream && !ra.reference)
@@ -502,8 +566,16 @@ int cmd_render(const std::vector<std::string>& args) {
   }
 
   t0 = clock::now();
-  std::size_t bad = 0;
-  for (const auto& p : pixels) bad += !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w));
+  std::size_t bad = 0, first_bad = 0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    const auto& p = pixels[i];
+    if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w)) && bad++ == 0) first_bad = i;
+  }
+  if (bad) {  // a wrong image is not written: nothing at the outputs, what was there stays
+    throw std::runtime_error(scene.data.path + ": " + std::to_string(bad) + " of " + std::to_string(pixels.size()) +
+                             " pixels came out not finite (the first at x " + std::to_string(first_bad % cam.width) + ", y " +
+                             std::to_string(first_bad / cam.width) + "), expected finite radiance; nothing written");
+  }
   render::ToneSettings tone;
   tone.exposure = frame.auto_exposure ? render::auto_exposure(marched) : frame.exposure;
   if (frame.auto_exposure) std::printf("exposure %.4g (auto: the 99th percentile of lit pixels' luminance at 0.8; --exposure E sets it)\n", tone.exposure);
@@ -511,12 +583,14 @@ int cmd_render(const std::vector<std::string>& args) {
   const std::vector<unsigned char> rgb8 = render::tonemap_srgb8(pixels, tone);
   const double t_tone = seconds_since(t0);
   t0 = clock::now();
-  render::write_png(ra.out, cam.width, cam.height, rgb8);
+  outputs.write(ra.out, [&](std::FILE* f) { render::encode_png(f, cam.width, cam.height, rgb8); });
   const std::string transmittance_pfm = ra.pfm.empty() ? "" : render::transmittance_pfm_path(ra.pfm);
   if (!ra.pfm.empty()) {  // radiance alone, and the transmittance as its own file
-    render::write_pfm(ra.pfm, cam.width, cam.height, pixels);
-    render::write_pfm_transmittance(transmittance_pfm, cam.width, cam.height, pixels);
+    outputs.write(ra.pfm, [&](std::FILE* f) { render::encode_pfm(f, cam.width, cam.height, pixels); });
+    outputs.write(transmittance_pfm, [&](std::FILE* f) { render::encode_pfm_transmittance(f, cam.width, cam.height, pixels); });
   }
+  outputs.commit();
+  if (!ra.save_scene.empty()) std::printf("wrote the scene %s\n", ra.save_scene.c_str());
   const double t_write = seconds_since(t0);
   char gpu_text[48];
   // GL_TIME_ELAPSED as the driver reports it (Mesa's llvmpipe runs compute on the CPU and reports
@@ -526,10 +600,9 @@ int cmd_render(const std::vector<std::string>& args) {
   std::printf("timings (%s):\n  load/import %.3f s\n  upload      %.3f s\n  march       %.3f s wall, GPU %s\n"
               "  composite/tonemap %.3f s\n  write       %.3f s\n",
               ctx->info().renderer.c_str(), t_load, t_upload, t_march, gpu_text, t_tone, t_write);
-  if (bad) std::fprintf(stderr, "cloudviewer render: %zu pixels were not finite (drawn white)\n", bad);
   std::printf("wrote %s%s\n", ra.out.c_str(),
               ra.pfm.empty() ? "" : (", " + ra.pfm + " (radiance) and " + transmittance_pfm + " (transmittance)").c_str());
-  return bad ? 1 : 0;
+  return 0;
 }
 
 }  // namespace cv::cli

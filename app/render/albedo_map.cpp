@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <mutex>
 
@@ -86,7 +87,27 @@ glm::vec3 land_albedo_of_map_colour(glm::vec3 srgb) {
 
 core::AlbedoMap load_albedo_map(const std::string& path, bool map_colours, const std::string& gshhs_dir) {
   int w = 0, h = 0, channels = 0;
-  std::unique_ptr<unsigned char, void (*)(void*)> data(stbi_load(path.c_str(), &w, &h, &channels, 3), stbi_image_free);
+  // Read as a regular file of bounded size (a FIFO or /dev/zero would be read forever), its
+  // declared size checked against the memory limit before it is decoded.
+  std::string bytes;
+  try {
+    bytes = core::read_regular_file(path, "the ground image", kMaxGroundImageBytes);
+  } catch (const core::InputError& e) {
+    throw GroundImageError(e.what());
+  }
+  if (bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max())) throw GroundImageError(path + ": the ground image is too large");
+  const auto* raw = reinterpret_cast<const stbi_uc*>(bytes.data());
+  const int len = static_cast<int>(bytes.size());
+  if (stbi_info_from_memory(raw, len, &w, &h, &channels)) {
+    try {
+      // The decoded image, then the map of four floats per texel.
+      core::require_within_memory_limit(path, "the ground image of " + std::to_string(w) + " x " + std::to_string(h) + " pixels",
+                                        core::checked_product({static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h), 3 + 16 + 16}));
+    } catch (const core::InputError& e) {
+      throw GroundImageError(e.what());
+    }
+  }
+  std::unique_ptr<unsigned char, void (*)(void*)> data(stbi_load_from_memory(raw, len, &w, &h, &channels, 3), stbi_image_free);
   if (!data) {
     throw GroundImageError(path + ": cannot read the ground image (" + stbi_failure_reason() +
                            "), expected an equirectangular PNG or JPEG");

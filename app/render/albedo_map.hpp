@@ -9,6 +9,7 @@
 #include <glm/vec3.hpp>
 
 #include "frame/albedo_map.hpp"
+#include "io/input_file.hpp"
 #include "render/land_sea_mask.hpp"
 
 namespace cv::render {
@@ -17,10 +18,12 @@ namespace cv::render {
 constexpr const char* kNaturalEarthRelief = "/usr/share/cartopy/data/raster/natural_earth/50-natural-earth-1-downsampled.png";
 
 // A ground image that cannot be used (not an image, too small): bad input, one line naming the file.
-class GroundImageError : public std::runtime_error {
+class GroundImageError : public core::InputError {
  public:
-  using std::runtime_error::runtime_error;
+  using core::InputError::InputError;
 };
+// Ground images larger than this are refused before they are decoded.
+inline constexpr std::uint64_t kMaxGroundImageBytes = 512u << 20;
 
 // Decodes an 8-bit image (PNG, JPEG, ...) into the globe's ground. map_colours (ground_model "map"):
 // its sRGB colours decoded to linear albedo everywhere, no water. Otherwise ("physical"): the water

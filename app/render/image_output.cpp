@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 
 #include "volume/volume_io.hpp"
@@ -85,39 +87,47 @@ std::vector<unsigned char> tonemap_srgb8(const std::vector<glm::vec4>& pixels, c
   return out;
 }
 
+void encode_png(std::FILE* f, int width, int height, const std::vector<unsigned char>& rgb8) {
+  // A C callback cannot throw: a short write shows in ferror() below.
+  auto sink = [](void* ctx, void* data, int size) { std::fwrite(data, 1, static_cast<std::size_t>(size), static_cast<std::FILE*>(ctx)); };
+  if (!stbi_write_png_to_func(sink, f, width, height, 3, rgb8.data(), width * 3)) throw std::runtime_error("PNG encoding failed");
+  if (std::ferror(f)) throw core::WriteError(std::string("write failed (") + std::strerror(errno) + ")");
+}
+
 void write_png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb8) {
-  core::write_file_atomically(path, [&](std::FILE* f) {
-    // A C callback cannot throw: a short write shows in ferror() below.
-    auto sink = [](void* ctx, void* data, int size) { std::fwrite(data, 1, static_cast<std::size_t>(size), static_cast<std::FILE*>(ctx)); };
-    if (!stbi_write_png_to_func(sink, f, width, height, 3, rgb8.data(), width * 3)) throw std::runtime_error("PNG encoding failed");
-    if (std::ferror(f)) throw std::runtime_error("write failed");
-  });
+  core::write_file_atomically(path, [&](std::FILE* f) { encode_png(f, width, height, rgb8); });
 }
 
 namespace {
 // PFM stores rows bottom to top; a negative scale means little-endian (floats as the host has them).
-void write_pfm_channels(const std::string& path, int width, int height, const std::vector<glm::vec4>& pixels,
-                        int first, int channels) {
-  core::write_file_atomically(path, [&](std::FILE* f) {
-    std::fprintf(f, "%s\n%d %d\n-1.0\n", channels == 3 ? "PF" : "Pf", width, height);
-    std::vector<float> row(static_cast<std::size_t>(width) * channels);
-    for (int y = height - 1; y >= 0; --y) {
-      for (int x = 0; x < width; ++x) {
-        const auto& p = pixels[static_cast<std::size_t>(y) * width + x];
-        for (int c = 0; c < channels; ++c) row[static_cast<std::size_t>(x) * channels + c] = p[first + c];
-      }
-      if (std::fwrite(row.data(), sizeof(float), row.size(), f) != row.size()) throw std::runtime_error("write failed");
+void encode_pfm_channels(std::FILE* f, int width, int height, const std::vector<glm::vec4>& pixels, int first, int channels) {
+  std::fprintf(f, "%s\n%d %d\n-1.0\n", channels == 3 ? "PF" : "Pf", width, height);
+  std::vector<float> row(static_cast<std::size_t>(width) * channels);
+  for (int y = height - 1; y >= 0; --y) {
+    for (int x = 0; x < width; ++x) {
+      const auto& p = pixels[static_cast<std::size_t>(y) * width + x];
+      for (int c = 0; c < channels; ++c) row[static_cast<std::size_t>(x) * channels + c] = p[first + c];
     }
-  });
+    if (std::fwrite(row.data(), sizeof(float), row.size(), f) != row.size()) {
+      throw core::WriteError(std::string("write failed (") + std::strerror(errno) + ")");
+    }
+  }
 }
 }  // namespace
 
+void encode_pfm(std::FILE* f, int width, int height, const std::vector<glm::vec4>& pixels) {
+  encode_pfm_channels(f, width, height, pixels, 0, 3);
+}
+void encode_pfm_transmittance(std::FILE* f, int width, int height, const std::vector<glm::vec4>& pixels) {
+  encode_pfm_channels(f, width, height, pixels, 3, 1);
+}
+
 void write_pfm(const std::string& path, int width, int height, const std::vector<glm::vec4>& pixels) {
-  write_pfm_channels(path, width, height, pixels, 0, 3);
+  core::write_file_atomically(path, [&](std::FILE* f) { encode_pfm(f, width, height, pixels); });
 }
 
 void write_pfm_transmittance(const std::string& path, int width, int height, const std::vector<glm::vec4>& pixels) {
-  write_pfm_channels(path, width, height, pixels, 3, 1);
+  core::write_file_atomically(path, [&](std::FILE* f) { encode_pfm_transmittance(f, width, height, pixels); });
 }
 
 std::string transmittance_pfm_path(const std::string& radiance_pfm) {

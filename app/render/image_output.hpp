@@ -2,6 +2,7 @@
 // linear values themselves as PFM (float) for analysis. Both written atomically.
 #pragma once
 
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,11 @@ double auto_exposure(const std::vector<glm::vec4>& linear);
 // rgb = radiance, a = transmittance, rows top to bottom; composited over the background.
 std::vector<unsigned char> tonemap_srgb8(const std::vector<glm::vec4>& pixels, const ToneSettings& tone);
 void write_png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb8);
+// The same files' contents into an open stream (an OutputFile or a member of an OutputGroup);
+// core::WriteError when the stream fails.
+void encode_png(std::FILE* f, int width, int height, const std::vector<unsigned char>& rgb8);
+void encode_pfm(std::FILE* f, int width, int height, const std::vector<glm::vec4>& pixels);
+void encode_pfm_transmittance(std::FILE* f, int width, int height, const std::vector<glm::vec4>& pixels);
 // Portable float map ("PF", 3 channels): the linear radiance alone, nothing composited behind it
 // (rgb of `pixels`; no background, no exposure).
 void write_pfm(const std::string& path, int width, int height, const std::vector<glm::vec4>& pixels);

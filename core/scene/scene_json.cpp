@@ -27,8 +27,26 @@ using json = nlohmann::json;
 using ojson = nlohmann::ordered_json;
 
 // What a value looked like, for messages: JSON as written (strings keep their quotes), shortened.
+// Written by hand with a budget, so a huge or deep value costs no more than the 40 characters shown.
+void show_into(const json& v, std::string& out, std::size_t budget) {
+  if (out.size() > budget) return;
+  if (v.is_array() || v.is_object()) {
+    out += v.is_array() ? '[' : '{';
+    bool first = true;
+    for (auto it = v.begin(); it != v.end() && out.size() <= budget; ++it) {
+      if (!first) out += ',';
+      first = false;
+      if (v.is_object()) out += json(it.key()).dump() + ':';
+      show_into(*it, out, budget);
+    }
+    out += v.is_array() ? ']' : '}';
+  } else {
+    out += v.dump();
+  }
+}
 std::string shown(const json& v) {
-  std::string s = v.dump();
+  std::string s;
+  show_into(v, s, 40);
   if (s.size() > 40) s = s.substr(0, 37) + "...";
   return s;
 }
@@ -259,8 +277,22 @@ ojson march_to_json(const MarchSettings& m) {
 Scene scene_from_json(const std::string& text, const std::string& source) {
   json root;
   try {
-    root = json::parse(text);
-  } catch (const json::parse_error& e) {
+    // Nesting is bounded while parsing, before a deep value exists: nothing in a scene nests
+    // deeper than 3, and deep values cost stack in every walk over them.
+    root = json::parse(text, [&](int depth, json::parse_event_t, json&) {
+      if (depth > kMaxSceneDepth) {
+        throw SceneError(source + ": found values nested more than " + std::to_string(kMaxSceneDepth) +
+                         " levels deep, expected a scene object (docs/scene.md)");
+      }
+      return true;
+    });
+  } catch (const json::out_of_range& e) {
+    // A number beyond a double's range (1e400): nlohmann's message names it.
+    std::string what = e.what();
+    const std::size_t q = what.find('\'');
+    throw SceneError(source + ": found the number " + (q == std::string::npos ? what : what.substr(q)) +
+                     ", expected a finite number (at most 1.8e308 in size)");
+  } catch (const json::exception& e) {
     // nlohmann's message names the byte and what it expected; keep it on one line.
     std::string what = e.what();
     for (char& c : what) c = (c == '\n' ? ' ' : c);
@@ -334,15 +366,21 @@ std::string scene_to_json(const Scene& s) {
 }
 
 Scene load_scene(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path + ": cannot open the scene file (missing or unreadable)");
-  std::ostringstream text;
-  text << in.rdbuf();
-  Scene scene = scene_from_json(text.str(), path);
-  namespace fs = std::filesystem;
-  if (!scene.data.path.empty() && fs::path(scene.data.path).is_relative()) {
-    scene.data.path = (fs::path(path).parent_path() / scene.data.path).lexically_normal().string();
+  std::string text;
+  if (file_kind(path) == "no such file") throw SceneError(path + ": cannot open the scene file (missing or unreadable)");
+  try {
+    text = read_regular_file(path, "the scene file", kMaxSceneBytes);
+  } catch (const InputError& e) {
+    throw SceneError(e.what());
   }
+  Scene scene = scene_from_json(text, path);
+  // Paths in a scene are relative to its folder, wherever it is run from.
+  namespace fs = std::filesystem;
+  auto beside = [&](std::string& p) {
+    if (!p.empty() && fs::path(p).is_relative()) p = (fs::path(path).parent_path() / p).lexically_normal().string();
+  };
+  beside(scene.data.path);
+  if (scene.render.march.ground_texture != "none") beside(scene.render.march.ground_texture);
   return scene;
 }
 

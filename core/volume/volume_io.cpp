@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <cstring>
+#include <limits>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
@@ -14,13 +16,8 @@
 namespace cv::core {
 namespace {
 
-// A failure of the file itself (disk full, I/O error), as opposed to one of the data being written.
-struct WriteFailure : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
 void put(std::FILE* f, const void* p, std::size_t n) {
-  if (n && std::fwrite(p, 1, n, f) != n) throw WriteFailure(std::string("write failed (") + std::strerror(errno) + ")");
+  if (n && std::fwrite(p, 1, n, f) != n) throw WriteError(std::string("write failed (") + std::strerror(errno) + ")");
 }
 void put(std::FILE* f, const std::string& s) { put(f, s.data(), s.size()); }
 
@@ -80,34 +77,10 @@ float half_to_float(std::uint16_t h) {
   return f;
 }
 
-void write_file_atomically(const std::string& path, const std::function<void(std::FILE*)>& write) {
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw std::runtime_error(path + ": cannot create (" + std::strerror(errno) + ")");
-  try {
-    write(f);
-    if (std::fflush(f) != 0 || ::fsync(::fileno(f)) != 0) throw WriteFailure(std::string("flush failed (") + std::strerror(errno) + ")");
-  } catch (const WriteFailure& e) {
-    std::fclose(f);
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": " + e.what());
-  } catch (...) {
-    // Anything else (bad data found while loading a step) leaves no file and keeps its own message.
-    std::fclose(f);
-    std::remove(tmp.c_str());
-    throw;
-  }
-  std::fclose(f);
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot rename into place (" + ec.message() + ")");
-  }
-}
-
-void write_cvvol(const std::string& path, CloudVolume& v, const std::function<void(std::size_t, std::size_t)>& progress,
-                 CvvolEncoding encoding) {
+namespace {
+void write_cvvol_to(const std::function<void(const std::string&, const std::function<void(std::FILE*)>&)>& writer,
+                    const std::string& path, CloudVolume& v, const std::function<void(std::size_t, std::size_t)>& progress,
+                    CvvolEncoding encoding) {
   const bool half = encoding == CvvolEncoding::Float16;
   std::string fields = "[", maps = "[", times = "[";
   for (int i = 0; i < kFieldCount; ++i) {
@@ -135,7 +108,7 @@ void write_cvvol(const std::string& path, CloudVolume& v, const std::function<vo
                              "],\n \"layout\": \"" + (half ? "fields float16, maps float32" : "float32") +
                              " little-endian; per time step, each field (lon fastest, then lat, "
                              "then alt) then each map (lon fastest, then lat); NaN = no data\"}\n";
-  write_file_atomically(path, [&](std::FILE* f) {
+  writer(path, [&](std::FILE* f) {
     put(f, "CVVOL01\n");
     const std::uint64_t len = header.size();
     put(f, &len, sizeof len);
@@ -172,13 +145,35 @@ void write_cvvol(const std::string& path, CloudVolume& v, const std::function<vo
     }
   });
 }
+}  // namespace
+
+void write_cvvol(const std::string& path, CloudVolume& v, const std::function<void(std::size_t, std::size_t)>& progress,
+                 CvvolEncoding encoding) {
+  write_cvvol_to(write_file_atomically, path, v, progress, encoding);
+}
+
+void write_cvvol(OutputGroup& group, const std::string& path, CloudVolume& v,
+                 const std::function<void(std::size_t, std::size_t)>& progress, CvvolEncoding encoding) {
+  write_cvvol_to([&](const std::string& p, const std::function<void(std::FILE*)>& w) { group.write(p, w); }, path, v, progress,
+                 encoding);
+}
 
 namespace {
-// Minimal readers for the header this file writes (not a general JSON parser).
+// Minimal readers for the header this file writes (not a general JSON parser); every value is
+// checked to be there, to be a number, and finite.
 double json_number(const std::string& j, const std::string& key, std::size_t from, const std::string& path) {
   const std::size_t k = j.find("\"" + key + "\":", from);
   if (k == std::string::npos) throw VolumeFileError(path + ": header has no '" + key + "'");
-  return std::stod(j.substr(k + key.size() + 3));
+  const char* text = j.c_str() + k + key.size() + 3;
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  if (end == text || !std::isfinite(v)) {
+    std::string found = j.substr(k + key.size() + 3, 24);
+    found.erase(0, found.find_first_not_of(' '));
+    found = found.substr(0, found.find_first_of(",}]"));
+    throw VolumeFileError(path + ": header key '" + key + "': found '" + found + "', expected a finite number");
+  }
+  return v;
 }
 RegularAxis json_axis(const std::string& j, const std::string& key, const std::string& path) {
   const std::size_t k = j.find("\"" + key + "\":");
@@ -186,27 +181,80 @@ RegularAxis json_axis(const std::string& j, const std::string& key, const std::s
   RegularAxis a;
   a.start = json_number(j, "start", k, path);
   a.step = json_number(j, "step", k, path);
-  a.count = static_cast<int>(json_number(j, "count", k, path));
-  if (a.count < 1 || a.count > 1000000) throw VolumeFileError(path + ": axis '" + key + "' has an implausible count");
+  const double count = json_number(j, "count", k, path);
+  if (!(count >= 1 && count <= 1000000) || count != std::floor(count)) {
+    char found[32];
+    std::snprintf(found, sizeof found, "%.17g", count);
+    throw VolumeFileError(path + ": axis '" + key + "' count: found " + found + ", expected an integer 1..1000000");
+  }
+  a.count = static_cast<int>(count);
   return a;
+}
+// The quoted string that starts at j[q] (a '"'), or a VolumeFileError for one left open.
+std::string json_quoted(const std::string& j, std::size_t q, const std::string& key, const std::string& path,
+                        std::size_t before = std::string::npos) {
+  const std::size_t e = q == std::string::npos ? q : j.find('"', q + 1);
+  if (q == std::string::npos || e == std::string::npos || e > before) {
+    throw VolumeFileError(path + ": header key '" + key + "': found a string without its closing quote, expected \"...\"");
+  }
+  return j.substr(q + 1, e - q - 1);
 }
 std::vector<std::string> json_strings(const std::string& j, const std::string& key, const std::string& path) {
   const std::size_t k = j.find("\"" + key + "\":");
   if (k == std::string::npos) throw VolumeFileError(path + ": header has no '" + key + "'");
-  const std::size_t open = j.find('[', k), close = j.find(']', k);
+  const std::size_t open = j.find('[', k), close = open == std::string::npos ? open : j.find(']', open);
+  if (close == std::string::npos) throw VolumeFileError(path + ": header key '" + key + "': found no [ ... ] list, expected one");
   std::vector<std::string> out;
   for (std::size_t q = j.find('"', open); q < close; q = j.find('"', q + 1)) {
-    const std::size_t e = j.find('"', q + 1);
-    out.push_back(j.substr(q + 1, e - q - 1));
-    q = e;
+    out.push_back(json_quoted(j, q, key, path, close));
+    q += out.back().size() + 1;
+    if (out.size() > static_cast<std::size_t>(kFieldCount)) {
+      throw VolumeFileError(path + ": header key '" + key + "': found more than " + std::to_string(kFieldCount) +
+                            " names, expected each field at most once");
+    }
   }
   return out;
 }
 }  // namespace
 
+std::string grid_problem(const VolumeGrid& g) {
+  const std::pair<const char*, const RegularAxis*> axes[] = {{"lon_deg", &g.lon_deg}, {"lat_deg", &g.lat_deg}, {"alt_m", &g.alt_m}};
+  for (const auto& [name, a] : axes) {
+    char buf[256];
+    if (!std::isfinite(a->start) || !std::isfinite(a->step) || !(a->step > 0.0) || a->count < 1 || a->count > 1000000) {
+      std::snprintf(buf, sizeof buf, "axis %s: found start %g, step %g, count %d; expected a finite start, a step > 0 and 1..1000000 points",
+                    name, a->start, a->step, a->count);
+      return buf;
+    }
+  }
+  char buf[256];
+  if (g.lon_deg.step * (g.lon_deg.count - 1) > 360.0 + 1e-6 || std::abs(g.lon_deg.start) > 720.0) {
+    std::snprintf(buf, sizeof buf, "axis lon_deg: found %g..%g, expected at most one turn (360 degrees) within -720..720",
+                  g.lon_deg.start, g.lon_deg.last());
+    return buf;
+  }
+  if (g.lat_deg.start < -90.0 - 1e-6 || g.lat_deg.last() > 90.0 + 1e-6) {
+    std::snprintf(buf, sizeof buf, "axis lat_deg: found %g..%g, expected latitudes within -90..90", g.lat_deg.start, g.lat_deg.last());
+    return buf;
+  }
+  if (g.alt_m.start < -1000.0 - 1e-6 || g.alt_m.last() > 1.0e5 + 1e-6) {
+    std::snprintf(buf, sizeof buf, "axis alt_m: found %g..%g m, expected altitudes within -1000..100000 m", g.alt_m.start, g.alt_m.last());
+    return buf;
+  }
+  if (!(g.earth_radius_m >= 1e6 && g.earth_radius_m <= 1e8)) {
+    std::snprintf(buf, sizeof buf, "earth_radius_m: found %g, expected 1e6..1e8 m", g.earth_radius_m);
+    return buf;
+  }
+  return "";
+}
+
 CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) throw VolumeFileError(path + ": cannot open (" + std::strerror(errno) + ")");
+  std::FILE* f = nullptr;
+  try {
+    f = open_regular_file(path, "the cloud volume");
+  } catch (const InputError& e) {
+    throw VolumeFileError(e.what());
+  }
   std::shared_ptr<std::FILE> file(f, [](std::FILE* p) { std::fclose(p); });
   char magic[8];
   std::uint64_t len = 0;
@@ -221,6 +269,7 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   v.grid.lat_deg = json_axis(header, "lat_deg", path);
   v.grid.alt_m = json_axis(header, "alt_m", path);
   v.grid.earth_radius_m = json_number(header, "earth_radius_m", 0, path);
+  if (const std::string problem = grid_problem(v.grid); !problem.empty()) throw VolumeFileError(path + ": header " + problem);
   // Volumes written before the effective radius was recorded were all made with 10 um.
   if (header.find("\"liquid_r_eff_um\":") != std::string::npos) v.liquid_r_eff_um = json_number(header, "liquid_r_eff_um", 0, path);
   if (!(v.liquid_r_eff_um > 0.0 && v.liquid_r_eff_um < 1000.0)) {
@@ -239,24 +288,42 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   }
   // Times: pairs of iso_utc and unix_s, in order.
   for (std::size_t k = header.find("\"iso_utc\":"); k != std::string::npos; k = header.find("\"iso_utc\":", k + 1)) {
-    const std::size_t q = header.find('"', k + 10);
     ValidTime t;
-    t.iso_utc = header.substr(q + 1, header.find('"', q + 1) - q - 1);
+    t.iso_utc = json_quoted(header, header.find('"', k + 10), "iso_utc", path);
     t.unix_s = static_cast<std::int64_t>(json_number(header, "unix_s", k, path));
     v.times.push_back(t);
   }
   const std::vector<std::string> maps = json_strings(header, "maps", path);
   v.has_ground = std::find(maps.begin(), maps.end(), "ground_m") != maps.end();
-  const std::size_t points = v.grid.points(), cols = v.grid.columns();
   const bool half = header.find("\"encoding\": \"float16\"") != std::string::npos;
-  const std::size_t value_bytes = half ? sizeof(std::uint16_t) : sizeof(float);
-  const std::uint64_t step_bytes = order.size() * points * value_bytes + (v.has_ground ? 8 : 7) * cols * sizeof(float);
+  const std::uint64_t value_bytes = half ? sizeof(std::uint16_t) : sizeof(float);
+  const std::uint64_t map_count = v.has_ground ? 8 : 7;
+  // Sizes from the header, multiplied with overflow checks: one time step (held in memory as
+  // float32) must fit the memory limit, and the file must hold exactly the steps the header declares.
+  const std::size_t points = v.grid.points(), cols = v.grid.columns();
+  const auto field_values = checked_product({order.size(), points});
+  const auto map_values = checked_product({map_count, cols});
+  const auto step_values = field_values && map_values ? checked_product({1, *field_values + *map_values}) : std::nullopt;
+  const auto memory_bytes = step_values ? checked_product({*step_values, sizeof(float)}) : std::nullopt;
+  const auto field_bytes = field_values ? checked_product({*field_values, value_bytes}) : std::nullopt;
+  const auto map_bytes = map_values ? checked_product({*map_values, sizeof(float)}) : std::nullopt;
+  char grid_text[96];
+  std::snprintf(grid_text, sizeof grid_text, "one time step of %d x %d x %d points", v.grid.lon_deg.count, v.grid.lat_deg.count,
+                v.grid.alt_m.count);
+  try {
+    require_within_memory_limit(path, grid_text, memory_bytes);
+  } catch (const InputError& e) {
+    throw VolumeFileError(e.what());
+  }
+  const std::uint64_t step_bytes = *field_bytes + *map_bytes;
   const std::uint64_t data0 = 16 + len;
+  const auto payload = checked_product({step_bytes, v.times.size()});
   std::fseek(f, 0, SEEK_END);
   const long long size = std::ftell(f);
-  if (static_cast<std::uint64_t>(size) != data0 + step_bytes * v.times.size()) {
+  if (!payload || *payload > std::numeric_limits<std::uint64_t>::max() - data0 || static_cast<std::uint64_t>(size) != data0 + *payload) {
     throw VolumeFileError(path + ": holds " + std::to_string(size) + " bytes, expected " +
-                             std::to_string(data0 + step_bytes * v.times.size()) + " for its header (truncated?)");
+                          (payload ? std::to_string(data0 + *payload) : std::string("more than 2^64")) +
+                          " for its header's " + std::to_string(v.times.size()) + " time step(s) (truncated?)");
   }
   v.report.file = path;
   v.report.format = "cloud volume (.cvvol)";
@@ -299,7 +366,9 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   return v;
 }
 
-void write_vti(const std::string& path, const VolumeGrid& g, const TimeStepData& d, const std::array<bool, kFieldCount>& has) {
+namespace {
+void write_vti_to(const std::function<void(const std::string&, const std::function<void(std::FILE*)>&)>& writer,
+                  const std::string& path, const VolumeGrid& g, const TimeStepData& d, const std::array<bool, kFieldCount>& has) {
   // Altitude in km so the box keeps a sensible aspect next to degrees in ParaView.
   char head[512];
   std::snprintf(head, sizeof head,
@@ -321,7 +390,7 @@ void write_vti(const std::string& path, const VolumeGrid& g, const TimeStepData&
     offset += sizeof(std::uint64_t) + a.size() * sizeof(float);
   }
   xml += "</PointData>\n</Piece>\n</ImageData>\n<AppendedData encoding=\"raw\">\n_";
-  write_file_atomically(path, [&](std::FILE* f) {
+  writer(path, [&](std::FILE* f) {
     put(f, xml);
     for (const auto* a : arrays) {
       const std::uint64_t n = a->size() * sizeof(float);
@@ -330,6 +399,17 @@ void write_vti(const std::string& path, const VolumeGrid& g, const TimeStepData&
     }
     put(f, "\n</AppendedData>\n</VTKFile>\n");
   });
+}
+
+}  // namespace
+
+void write_vti(const std::string& path, const VolumeGrid& g, const TimeStepData& d, const std::array<bool, kFieldCount>& has) {
+  write_vti_to(write_file_atomically, path, g, d, has);
+}
+
+void write_vti(OutputGroup& group, const std::string& path, const VolumeGrid& g, const TimeStepData& d,
+               const std::array<bool, kFieldCount>& has) {
+  write_vti_to([&](const std::string& p, const std::function<void(std::FILE*)>& w) { group.write(p, w); }, path, g, d, has);
 }
 
 }  // namespace cv::core

@@ -7,13 +7,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "io/input_file.hpp"
+#include "io/output_file.hpp"
 #include "volume/cloud_volume.hpp"
 
 namespace cv::core {
-
-// Writes `data` to `path` through a temporary file in the same folder and a rename, so a reader
-// never sees a half-written file. Throws std::runtime_error naming the path on failure.
-void write_file_atomically(const std::string& path, const std::function<void(std::FILE*)>& write);
 
 // How the 3-D fields are stored. Float16: IEEE half precision, extinction in 1/km (so values down
 // to 6.1e-8 /m stay normal), the others in their SI units: relative error at most 2^-11 (4.9e-4)
@@ -22,7 +20,11 @@ void write_file_atomically(const std::string& path, const std::function<void(std
 enum class CvvolEncoding { Float32, Float16 };
 
 // Writes every time step (loading each in turn); progress(step, count) is called before each.
+// Written atomically (io/output_file.hpp): alone, or as a member of `group`, committed with it.
 void write_cvvol(const std::string& path, CloudVolume& volume,
+                 const std::function<void(std::size_t, std::size_t)>& progress = {},
+                 CvvolEncoding encoding = CvvolEncoding::Float32);
+void write_cvvol(OutputGroup& group, const std::string& path, CloudVolume& volume,
                  const std::function<void(std::size_t, std::size_t)>& progress = {},
                  CvvolEncoding encoding = CvvolEncoding::Float32);
 
@@ -30,9 +32,9 @@ void write_cvvol(const std::string& path, CloudVolume& volume,
 std::uint16_t float_to_half(float f);
 float half_to_float(std::uint16_t h);
 // A .cvvol that cannot be read: missing, of another kind, truncated or corrupt (bad input).
-class VolumeFileError : public std::runtime_error {
+class VolumeFileError : public InputError {
  public:
-  using std::runtime_error::runtime_error;
+  using InputError::InputError;
 };
 
 // Opens a .cvvol written by write_cvvol: grid, times and fields come from its header; time steps
@@ -42,5 +44,12 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps = 2);
 
 void write_vti(const std::string& path, const VolumeGrid& grid, const TimeStepData& data,
                const std::array<bool, kFieldCount>& has_field);
+void write_vti(OutputGroup& group, const std::string& path, const VolumeGrid& grid, const TimeStepData& data,
+               const std::array<bool, kFieldCount>& has_field);
+
+// What is wrong with a grid, or "" when nothing: each axis has a finite start, a finite step > 0
+// and 1..1e6 points; longitudes span at most one turn, latitudes lie within -90..90, altitudes
+// within -1 km..100 km, and the Earth's radius lies within 1000..100 000 km.
+std::string grid_problem(const VolumeGrid& grid);
 
 }  // namespace cv::core

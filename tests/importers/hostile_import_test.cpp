@@ -1,0 +1,297 @@
+// Hostile NetCDF (issue 13): each defect the fuzzing pass found, reproduced on a copy of a real file
+// mutated with netCDF (or a small file written here), and refused with one line naming the file,
+// the variable and what was expected, instead of a crash, a wrong volume or a library's message.
+#include <gtest/gtest.h>
+
+#include <netcdf.h>
+#include <sys/stat.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "importer.hpp"
+#include "nc_file.hpp"
+#include "support/nc_builder.hpp"
+#include "support/real_data.hpp"
+
+namespace {
+using namespace cv;
+namespace fs = std::filesystem;
+using cv::test::nc_check;
+
+class HostileImport : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("cv_hostile_import_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  // A writable copy of a real file; "" (and the test skipped) when the real files are absent.
+  std::string copy_of(const std::string& real, const std::string& name) {
+    const std::string dst = (dir_ / name).string();
+    fs::copy_file(real, dst, fs::copy_options::overwrite_existing);
+    fs::permissions(dst, fs::perms::owner_read | fs::perms::owner_write);
+    return dst;
+  }
+  // The ImportError's message of importing `path` (fails the test when it imports).
+  static std::string import_error(const std::string& path, const importers::ImportOptions& o = {}) {
+    try {
+      core::CloudVolume v = importers::import_file(path, o);
+      v.step(0);
+      for (std::size_t t = 0; t < v.times.size(); ++t) v.step(t);
+    } catch (const importers::ImportError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << path << " was imported; expected an ImportError";
+    return "";
+  }
+  fs::path dir_;
+};
+
+// Opens a file for changes in define mode.
+struct Edit {
+  int id = -1;
+  explicit Edit(const std::string& path) {
+    nc_check(nc_open(path.c_str(), NC_WRITE, &id), "open " + path);
+    nc_redef(id);
+  }
+  ~Edit() { nc_close(id); }
+  int var(const char* name) {
+    int v = -1;
+    nc_check(nc_inq_varid(id, name, &v), std::string("var ") + name);
+    return v;
+  }
+  void number(int var, const char* att, double value, nc_type type = NC_FLOAT) {
+    nc_check(nc_put_att_double(id, var, att, type, 1, &value), att);
+  }
+  void text(int var, const char* att, const std::string& value) {
+    nc_check(nc_put_att_text(id, var, att, value.size(), value.c_str()), att);
+  }
+  // Every value of a numeric variable set by f(index).
+  template <class F>
+  void fill(const char* name, F f) {
+    nc_enddef(id);
+    const int v = var(name);
+    int nd = 0;
+    int dims[NC_MAX_VAR_DIMS];
+    nc_check(nc_inq_varndims(id, v, &nd), "ndims");
+    nc_check(nc_inq_vardimid(id, v, dims), "dims");
+    std::size_t n = 1;
+    for (int d = 0; d < nd; ++d) {
+      std::size_t len = 0;
+      nc_inq_dimlen(id, dims[d], &len);
+      n *= len;
+    }
+    std::vector<double> values(n);
+    for (std::size_t i = 0; i < n; ++i) values[i] = f(i);
+    nc_check(nc_put_var_double(id, v, values.data()), std::string("put ") + name);
+  }
+};
+
+TEST_F(HostileImport, NanTrueLatitudeIsNamedNotLeftToGeographicLib) {
+  REAL_FILE(real, "wrf_d01_allvars_cropped.nc");
+  const std::string p = copy_of(real, "truelat.nc");
+  {
+    Edit e(p);
+    e.number(NC_GLOBAL, "TRUELAT1", std::nan(""));
+  }
+  const std::string msg = import_error(p);
+  EXPECT_NE(msg.find(p + ": global attribute 'TRUELAT1' is nan, expected a latitude within -90..90"), std::string::npos) << msg;
+}
+
+TEST_F(HostileImport, NanXlatIsNamedNotAVectorLengthError) {
+  REAL_FILE(real, "wrf_d01_allvars_cropped.nc");
+  const std::string p = copy_of(real, "xlat.nc");
+  {
+    Edit e(p);
+    e.fill("XLAT", [](std::size_t i) { return i == 5 ? std::nan("") : 30.0 + 0.01 * static_cast<double>(i); });
+  }
+  const std::string msg = import_error(p);
+  EXPECT_NE(msg.find("variable 'XLAT' has value nan at mass point 5, expected a latitude within -90..90"), std::string::npos) << msg;
+}
+
+TEST_F(HostileImport, ImpossibleWrfTimeIsRefused) {
+  REAL_FILE(real, "wrf_d01_allvars_cropped.nc");
+  const std::string p = copy_of(real, "times.nc");
+  {
+    Edit e(p);
+    nc_enddef(e.id);
+    const std::string bad = "2005-13-41_25:61:61";
+    const std::size_t start[2] = {1, 0}, count[2] = {1, bad.size()};
+    nc_check(nc_put_vara_text(e.id, e.var("Times"), start, count, bad.c_str()), "Times");
+  }
+  const std::string msg = import_error(p);
+  EXPECT_NE(msg.find("variable 'Times': time '2005-13-41_25:61:61' is no real date and time"), std::string::npos) << msg;
+}
+
+TEST_F(HostileImport, ConstantGeopotentialGivesNoOneLevelVolume) {
+  REAL_FILE(real, "wrf_d01_allvars_cropped.nc");
+  const std::string p = copy_of(real, "flat.nc");
+  {
+    Edit e(p);
+    e.fill("PH", [](std::size_t) { return 0.0; });
+    e.fill("PHB", [](std::size_t) { return 9.81 * 5000.0; });
+  }
+  const std::string msg = import_error(p);
+  EXPECT_NE(msg.find(p + ": the levels' heights span no altitude range (all at 5000 m)"), std::string::npos) << msg;
+}
+
+TEST_F(HostileImport, HugeDzGivesNoOneLevelVolume) {
+  REAL_FILE(real, "met-era5-cocip1.nc");
+  importers::ImportOptions o;
+  o.dz_m = 1e300;
+  const std::string msg = import_error(real, o);
+  EXPECT_NE(msg.find("--dz (dz_m): found a spacing of 1e+300 m"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("expected 2 to 1000000 levels"), std::string::npos) << msg;
+  o.dz_m = 1e-300;  // and the other way: a count no int holds (float-cast-overflow before)
+  const std::string tiny = import_error(real, o);
+  EXPECT_NE(tiny.find("--dz (dz_m): found a spacing of 1e-300 m"), std::string::npos) << tiny;
+}
+
+TEST_F(HostileImport, AllEqualLongitudesAreRefused) {
+  REAL_FILE(real, "met-era5-cocip1.nc");
+  const std::string p = copy_of(real, "lon_equal.nc");
+  {
+    Edit e(p);
+    e.fill("longitude", [](std::size_t) { return 10.0; });
+  }
+  const std::string msg = import_error(p);
+  EXPECT_NE(msg.find(p + ": coordinate 'longitude' has 16 values at the same longitude (modulo 360), expected 16 distinct longitudes"),
+            std::string::npos)
+      << msg;
+}
+
+TEST_F(HostileImport, TwoInterleavedTurnsOfLongitudeAreRefused) {
+  REAL_FILE(real, "met-era5-cocip1.nc");
+  const std::string p = copy_of(real, "lon_720.nc");
+  {
+    Edit e(p);
+    // 0, 360, 45, 405, ...: 0..720 with every place twice.
+    e.fill("longitude", [](std::size_t i) { return 45.0 * static_cast<double>(i / 2) + 360.0 * static_cast<double>(i % 2); });
+  }
+  const std::string msg = import_error(p);
+  EXPECT_NE(msg.find("coordinate 'longitude' has"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("at the same longitude (modulo 360)"), std::string::npos) << msg;
+}
+
+TEST_F(HostileImport, GarbageTimeUnitsAreNamedNotTakenAsNoTimeCoordinate) {
+  REAL_FILE(real, "met-era5-cocip1.nc");
+  const std::string p = copy_of(real, "time_units.nc");
+  {
+    Edit e(p);
+    e.text(e.var("time"), "units", "fortnights, roughly");
+  }
+  const std::string msg = import_error(p);
+  EXPECT_NE(msg.find(p + ": variable 'time' (the time coordinate) has units 'fortnights, roughly', expected '<unit> since"),
+            std::string::npos)
+      << msg;
+}
+
+TEST_F(HostileImport, WaterInGramsPerKilogramIsNotReadAsKilogramsPerKilogram) {
+  REAL_FILE(real, "met-era5-cocip1.nc");
+  const std::string p = copy_of(real, "gkg.nc");
+  {
+    Edit e(p);
+    e.text(e.var("specific_cloud_ice_water_content"), "units", "g kg-1");
+  }
+  const std::string msg = import_error(p);
+  EXPECT_NE(msg.find(p + ": variable 'specific_cloud_ice_water_content' (cloud ice water) has units 'g kg-1', expected a mass fraction in kg kg-1"),
+            std::string::npos)
+      << msg;
+}
+
+TEST_F(HostileImport, TwoDimensionalCloudWaterIsNamedNotDropped) {
+  const std::string p = (dir_ / "clwc2d.nc").string();
+  {
+    test::NcBuilder b(p);
+    const int dx = b.dim("longitude", 4), dy = b.dim("latitude", 3), dz = b.dim("level", 3);
+    const int lon = b.var("longitude", NC_DOUBLE, {dx}), lat = b.var("latitude", NC_DOUBLE, {dy}), lev = b.var("level", NC_DOUBLE, {dz});
+    b.text(lon, "units", "degrees_east");
+    b.text(lat, "units", "degrees_north");
+    b.text(lev, "units", "hPa");
+    const int cc = b.var("cc", NC_FLOAT, {dz, dy, dx});
+    const int clwc = b.var("clwc", NC_FLOAT, {dy, dx});
+    b.put(lon, {0, 1, 2, 3});
+    b.put(lat, {10, 11, 12});
+    b.put(lev, {500, 700, 850});
+    b.put(cc, std::vector<double>(36, 0.5));
+    b.put(clwc, std::vector<double>(12, 1e-4));
+    b.close();
+  }
+  const std::string msg = import_error(p);
+  EXPECT_NE(msg.find(p + ": variable 'clwc' (cloud liquid water) has 2 dimension(s) (latitude, longitude), expected a 3-D field"),
+            std::string::npos)
+      << msg;
+}
+
+TEST_F(HostileImport, TextVariableWhoseSizeWrapsIsRefusedBeforeAnyRead) {
+  // char Times(2^33, 2^31): rows * cols is 2^64, which wrapped to 0 and passed the size check,
+  // and netCDF then wrote the whole variable into an empty buffer (a heap overflow).
+  const std::string p = (dir_ / "times_wrap.nc").string();
+  {
+    int id = -1, d[2], v = -1;
+    nc_check(nc_create(p.c_str(), NC_CLOBBER | NC_NETCDF4, &id), "create");
+    nc_check(nc_def_dim(id, "Time", std::size_t(1) << 33, &d[0]), "dim");
+    nc_check(nc_def_dim(id, "DateStrLen", std::size_t(1) << 31, &d[1]), "dim");
+    const std::size_t chunks[2] = {1, 1024};
+    nc_check(nc_def_var(id, "Times", NC_CHAR, 2, d, &v), "var");
+    nc_check(nc_def_var_chunking(id, v, NC_CHUNKED, chunks), "chunking");
+    nc_check(nc_close(id), "close");
+  }
+  importers::NcFile f(p);
+  try {
+    f.read_strings(f.var("Times"));
+    ADD_FAILURE() << "read";
+  } catch (const importers::ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find(p + ": variable 'Times' is 8589934592 x 2147483648 characters, expected at most 16 Mi"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST_F(HostileImport, FifoAndDeviceAreRefusedWithoutBlocking) {
+  const std::string fifo = (dir_ / "pipe.nc").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(import_error(fifo), fifo + ": is a FIFO (named pipe), expected a regular NetCDF file");
+  EXPECT_EQ(import_error("/dev/zero"), "/dev/zero: is a character device, expected a regular NetCDF file");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+}
+
+TEST_F(HostileImport, ReadsBeyondTheMemoryLimitAreRefusedBeforeAllocating) {
+  REAL_FILE(real, "met-era5-cocip1.nc");
+  core::set_memory_limit_bytes(1024);  // smaller than one read of the file's variables
+  const std::string msg = import_error(real);
+  core::set_memory_limit_bytes(0);
+  EXPECT_NE(msg.find("values would take"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("expected at most the memory limit 1 KiB (set CLOUDVIEWER_MEMORY_LIMIT to change it)"), std::string::npos) << msg;
+}
+
+TEST_F(HostileImport, CorruptClassicHeaderIsRefusedBeforeNetcdfReadsIt) {
+  // A name length of 2^32 - 1 in a classic header made netCDF-C memcpy a negative size (a crash
+  // fuzz_netcdf found); a large one made it calloc that much. The 64-bit-offset real file with its
+  // first dimension's name length patched.
+  REAL_FILE(real, "met-accf-pl.nc");
+  const std::string p = copy_of(real, "header.nc");
+  EXPECT_NO_THROW(importers::NcFile{p});  // the file as it is opens
+  for (const std::uint32_t declared : {0xFFFFFFFFu, 0x7FFFFFF0u}) {
+    {
+      std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+      f.seekp(16);  // magic, record count, the dimension list's tag and count
+      const unsigned char be[4] = {static_cast<unsigned char>(declared >> 24), static_cast<unsigned char>(declared >> 16),
+                                   static_cast<unsigned char>(declared >> 8), static_cast<unsigned char>(declared)};
+      f.write(reinterpret_cast<const char*>(be), 4);
+    }
+    const std::string msg = import_error(p);
+    EXPECT_NE(msg.find(p + ": the netCDF classic header is corrupt: the name of dimension 0 declares " + std::to_string(declared)),
+              std::string::npos)
+        << msg;
+  }
+}
+
+}  // namespace
