@@ -155,7 +155,7 @@ void apply_march_flag(const core::SettingRow& row, const std::string& text, core
 // be written, none is an input (the render's input, the scene's data, its ground image, the front)
 // and no two are the same file; the scene's ground image is a regular file.
 void check_outputs(const RenderArgs& r, const core::Scene& scene) {
-  const std::string& ground = scene.render.march.ground_texture;
+  const std::string& ground = scene.render.march.medium.ground_texture;
   if (!ground.empty() && ground != "none") core::require_regular_file(ground, "render.march.ground_texture, the ground image");
   if (!r.front.empty()) core::require_regular_file(r.front, "the quality front");
   std::vector<std::pair<std::string, std::string>> outputs = {{r.out, "-o"}};
@@ -450,7 +450,7 @@ int cmd_render(const std::vector<std::string>& args) {
 
   // Resolve everything the scene left automatic, so the saved scene reproduces this image exactly.
   core::FrameSpec frame = render::resolve_frame(scene, vol);
-  check_view_steps(frame.march.view_step_m, g.earth_radius_m, prepared->layer.empty ? g.alt_m.last() : prepared->layer.top_m);
+  check_view_steps(frame.march.quality.view_step_m, g.earth_radius_m, prepared->layer.empty ? g.alt_m.last() : prepared->layer.top_m);
   const core::Camera& cam = frame.camera;
   const core::Sun& sun = frame.sun;
   const core::ValidTime& vt = vol.times[static_cast<std::size_t>(scene.time_step)];

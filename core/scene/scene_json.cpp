@@ -380,7 +380,7 @@ Scene load_scene(const std::string& path) {
     if (!p.empty() && fs::path(p).is_relative()) p = (fs::path(path).parent_path() / p).lexically_normal().string();
   };
   beside(scene.data.path);
-  if (scene.render.march.ground_texture != "none") beside(scene.render.march.ground_texture);
+  if (scene.render.march.medium.ground_texture != "none") beside(scene.render.march.medium.ground_texture);
   return scene;
 }
 

@@ -199,7 +199,9 @@ std::string json_quoted(const std::string& j, std::size_t q, const std::string& 
   }
   return j.substr(q + 1, e - q - 1);
 }
-std::vector<std::string> json_strings(const std::string& j, const std::string& key, const std::string& path) {
+// The names in the header's list `key`, at most max_names of them.
+std::vector<std::string> json_strings(const std::string& j, const std::string& key, const std::string& path,
+                                      std::size_t max_names) {
   const std::size_t k = j.find("\"" + key + "\":");
   if (k == std::string::npos) throw VolumeFileError(path + ": header has no '" + key + "'");
   const std::size_t open = j.find('[', k), close = open == std::string::npos ? open : j.find(']', open);
@@ -208,9 +210,9 @@ std::vector<std::string> json_strings(const std::string& j, const std::string& k
   for (std::size_t q = j.find('"', open); q < close; q = j.find('"', q + 1)) {
     out.push_back(json_quoted(j, q, key, path, close));
     q += out.back().size() + 1;
-    if (out.size() > static_cast<std::size_t>(kFieldCount)) {
-      throw VolumeFileError(path + ": header key '" + key + "': found more than " + std::to_string(kFieldCount) +
-                            " names, expected each field at most once");
+    if (out.size() > max_names) {
+      throw VolumeFileError(path + ": header key '" + key + "': found more than " + std::to_string(max_names) +
+                            " names, expected each at most once");
     }
   }
   return out;
@@ -275,7 +277,7 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   if (!(v.liquid_r_eff_um > 0.0 && v.liquid_r_eff_um < 1000.0)) {
     throw VolumeFileError(path + ": liquid_r_eff_um is " + std::to_string(v.liquid_r_eff_um) + ", expected 0..1000 um");
   }
-  const std::vector<std::string> fields = json_strings(header, "fields", path);
+  const std::vector<std::string> fields = json_strings(header, "fields", path, static_cast<std::size_t>(kFieldCount));
   std::vector<int> order;
   for (const auto& name : fields) {
     int found = -1;
@@ -293,20 +295,16 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
     t.unix_s = static_cast<std::int64_t>(json_number(header, "unix_s", k, path));
     v.times.push_back(t);
   }
-  const std::vector<std::string> maps = json_strings(header, "maps", path);
-  v.has_ground = std::find(maps.begin(), maps.end(), "ground_m") != maps.end();
   const bool half = header.find("\"encoding\": \"float16\"") != std::string::npos;
   const std::uint64_t value_bytes = half ? sizeof(std::uint16_t) : sizeof(float);
-  const std::uint64_t map_count = v.has_ground ? 8 : 7;
   // Sizes from the header, multiplied with overflow checks: one time step (held in memory as
-  // float32) must fit the memory limit, and the file must hold exactly the steps the header declares.
+  // float32, with at least the seven maps every volume has) must fit the memory limit before
+  // anything else is read, and the file must hold exactly the steps the header declares.
   const std::size_t points = v.grid.points(), cols = v.grid.columns();
   const auto field_values = checked_product({order.size(), points});
-  const auto map_values = checked_product({map_count, cols});
-  const auto step_values = field_values && map_values ? checked_product({1, *field_values + *map_values}) : std::nullopt;
+  const auto least_maps = checked_product({7, cols});
+  const auto step_values = field_values && least_maps ? checked_product({1, *field_values + *least_maps}) : std::nullopt;
   const auto memory_bytes = step_values ? checked_product({*step_values, sizeof(float)}) : std::nullopt;
-  const auto field_bytes = field_values ? checked_product({*field_values, value_bytes}) : std::nullopt;
-  const auto map_bytes = map_values ? checked_product({*map_values, sizeof(float)}) : std::nullopt;
   char grid_text[96];
   std::snprintf(grid_text, sizeof grid_text, "one time step of %d x %d x %d points", v.grid.lon_deg.count, v.grid.lat_deg.count,
                 v.grid.alt_m.count);
@@ -315,6 +313,14 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   } catch (const InputError& e) {
     throw VolumeFileError(e.what());
   }
+  // The maps: the seven derived ones and, where the file gave terrain, the ground's altitude.
+  const std::vector<std::string> maps = json_strings(header, "maps", path, 16);
+  v.has_ground = std::find(maps.begin(), maps.end(), "ground_m") != maps.end();
+  const std::uint64_t map_count = v.has_ground ? 8 : 7;
+  const auto map_values = checked_product({map_count, cols});
+  const auto field_bytes = field_values ? checked_product({*field_values, value_bytes}) : std::nullopt;
+  const auto map_bytes = map_values ? checked_product({*map_values, sizeof(float)}) : std::nullopt;
+  if (!field_bytes || !map_bytes) throw VolumeFileError(path + ": one time step's size overflows 64 bits");
   const std::uint64_t step_bytes = *field_bytes + *map_bytes;
   const std::uint64_t data0 = 16 + len;
   const auto payload = checked_product({step_bytes, v.times.size()});

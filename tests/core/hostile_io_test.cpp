@@ -171,10 +171,10 @@ TEST_F(HostileInput, GroundTextureIsTakenFromTheScenesFolder) {
   fs::create_directories(dir_ / "scenes");
   write("scenes/s.json", R"({"version": 1, "data": {"path": "d.nc"}, "render": {"march": {"ground_texture": "relief.png"}}})");
   const Scene s = load_scene(path("scenes/s.json"));
-  EXPECT_EQ(s.render.march.ground_texture, path("scenes/relief.png"));
+  EXPECT_EQ(s.render.march.medium.ground_texture, path("scenes/relief.png"));
   EXPECT_EQ(s.data.path, path("scenes/d.nc"));
   write("scenes/none.json", R"({"version": 1, "render": {"march": {"ground_texture": "none"}}})");
-  EXPECT_EQ(load_scene(path("scenes/none.json")).render.march.ground_texture, "none");
+  EXPECT_EQ(load_scene(path("scenes/none.json")).render.march.medium.ground_texture, "none");
 }
 
 TEST_F(HostileInput, ASceneFileWritesNothingAndRunsNothing) {

@@ -105,8 +105,8 @@ TEST(SceneJson, FullyPopulatedSceneRoundTripsExactly) {
   const fs::path file = fs::temp_directory_path() / "cv_scene_roundtrip.json";
   save_scene(s, file.string());
   Scene expected = s;
-  if (fs::path(s.render.march.ground_texture).is_relative()) {
-    expected.render.march.ground_texture = (file.parent_path() / s.render.march.ground_texture).lexically_normal().string();
+  if (fs::path(s.render.march.medium.ground_texture).is_relative()) {
+    expected.render.march.medium.ground_texture = (file.parent_path() / s.render.march.medium.ground_texture).lexically_normal().string();
   }
   expect_equal(load_scene(file.string()), expected);
   fs::remove(file);

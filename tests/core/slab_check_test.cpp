@@ -209,7 +209,9 @@ TEST_F(SlabCheck, DropletSlabNadirRadianceMatchesTheSolver) {
   // standard error from the same samples stays small (the sweep's run here: 0.0145 +- 0.0004
   // against 0.0186); in a few, a sample catches it and the standard error balloons. With 8e6
   // samples at tau 1 the mean comes within 1.5 standard errors (docs/physics.md).
-  const McCase c{2, 30, 100000, 30000};
+  // 4e5 samples: at 1e5 the realised standard error still swung between 2.2 % and 5.1 % of the mean
+  // with the same seed when a change of the grid's top moved where the paths start (a heavy tail).
+  const McCase c{2, 30, 400000, 30000};
   const ImportedSlab s = slab(c.tau, SlabPhase::Mie);
   const McResult r = compare(s, SlabPhase::Mie, c, false, 0.0, 0.003);
   // What it looks like, against HG 0.85 on the same slab: 12 batches of 1e4 samples each.
