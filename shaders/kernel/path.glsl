@@ -180,6 +180,22 @@ CV_FN bool path_roulette(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT
   return true;
 }
 
+// After a vertex's light is added: whether the path goes on past it. It ends (s.done, s.end set)
+// at u_path_max_bounces vertices (truncated) or when Russian roulette ends it.
+CV_FN bool path_continues(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(PathCounts) pc) {
+  if (s.scatterings >= u_path_max_bounces) {
+    s.end = CV_PATH_TRUNCATED;
+    pc.truncated += 1u;
+    s.done = true;
+    return false;
+  }
+  if (!path_roulette(s, rng, pc)) {
+    s.done = true;
+    return false;
+  }
+  return true;
+}
+
 // Advances the path vertex by vertex until it ends (s.done) or the walk's loop iterations
 // (c.iterations) reach max_iterations, checked before each vertex.
 CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(TrackCounts) c, CV_INOUT(PathCounts) pc,
@@ -211,16 +227,7 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
       }
       s.radiance += s.beta * u_irradiance *
                     (w * path_phase(sl, si, dot(s.d, u_to_sun), mie, liquid_g) * path_transmittance(s.p, u_to_sun, rng, c));
-      if (s.scatterings >= u_path_max_bounces) {
-        s.end = CV_PATH_TRUNCATED;
-        pc.truncated += 1u;
-        s.done = true;
-        break;
-      }
-      if (!path_roulette(s, rng, pc)) {
-        s.done = true;
-        break;
-      }
+      if (!path_continues(s, rng, pc)) break;
       // The peak technique: a direction wq ~ q around the sun, the free path along it, the sun's
       // light at the vertex it reaches, weighted q / (p + q) (the path's own technique is weighted above).
       s.prev_peak = peak && sl > real(0.0);
@@ -277,16 +284,7 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
       }
       s.absorbed += s.beta * (real3(1.0) - u_ground_albedo);
       s.beta *= u_ground_albedo;
-      if (s.scatterings >= u_path_max_bounces) {
-        s.end = CV_PATH_TRUNCATED;
-        pc.truncated += 1u;
-        s.done = true;
-        break;
-      }
-      if (!path_roulette(s, rng, pc)) {
-        s.done = true;
-        break;
-      }
+      if (!path_continues(s, rng, pc)) break;
       s.prev_peak = false;  // a cosine draw from the ground: no other technique makes it
       real v1 = track_uniform(rng);
       real v2 = track_uniform(rng);

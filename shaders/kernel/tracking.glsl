@@ -87,6 +87,18 @@ CV_FN bool next_tentative(real3 p, real3 d, CV_INOUT(real) t, real b, CV_INOUT(T
   return false;
 }
 
+// The medium's extinction at a tentative collision x, counted as a loop iteration and, where it
+// exceeds the majorant maj beyond rounding, as a wrong majorant.
+CV_FN real tentative_sigma(real3 x, real maj, CV_INOUT(TrackCounts) c) {
+  c.iterations += 1u;
+  real sl;
+  real si;
+  medium_at_point(x, sl, si);
+  real sigma = sl + si;
+  c.exceeded += sigma > maj * (real(1.0) + CV_TRACK_EXCEED_TOL) ? 1u : 0u;
+  return sigma;
+}
+
 // Delta tracking along the ray's parts in the cloud shell, seg[0..2n) (distances from p): the
 // distance to the first real collision (a tentative one is real with probability sigma /
 // majorant), or 3e38 when the ray leaves them.
@@ -97,12 +109,7 @@ CV_FN real delta_track(real3 p, real3 d, real4 seg, int n, CV_INOUT(TrackRng) rn
     real maj;
     c.iterations += 2u;  // this loop's test and next_tentative's last one
     while (next_tentative(p, d, t, b, rng, maj, c)) {
-      c.iterations += 1u;
-      real sl;
-      real si;
-      medium_at_point(p + t * d, sl, si);
-      real sigma = sl + si;
-      c.exceeded += sigma > maj * (real(1.0) + CV_TRACK_EXCEED_TOL) ? 1u : 0u;
+      real sigma = tentative_sigma(p + t * d, maj, c);
       if (track_uniform(rng) * maj < sigma) return t;
       c.null_collisions += 1u;
     }
@@ -121,12 +128,7 @@ CV_FN real ratio_track(real3 p, real3 d, real4 seg, int n, CV_INOUT(TrackRng) rn
     real maj;
     c.iterations += 2u;  // this loop's test and next_tentative's last one
     while (next_tentative(p, d, t, b, rng, maj, c)) {
-      c.iterations += 1u;
-      real sl;
-      real si;
-      medium_at_point(p + t * d, sl, si);
-      real sigma = sl + si;
-      c.exceeded += sigma > maj * (real(1.0) + CV_TRACK_EXCEED_TOL) ? 1u : 0u;
+      real sigma = tentative_sigma(p + t * d, maj, c);
       c.lookups += 1u;
       tr *= max(real(0.0), real(1.0) - sigma / maj);
       if (tr < CV_TRACK_ROULETTE_BELOW) {
