@@ -11,6 +11,7 @@
 
 #include "importer.hpp"
 #include "support/nc_builder.hpp"
+#include "support/wrf_writer.hpp"
 
 namespace {
 using namespace cv;
@@ -36,63 +37,18 @@ double lon_of(const WrfSpec& s, int t, int i) { return s.lon0 + (s.shift_cells[s
 double lat_of(const WrfSpec& s, int j) { return merc_lat(merc_y(s.lat0) + j * kDx); }
 
 void write_wrf(const std::string& p, const WrfSpec& s) {
-  cv::test::NcBuilder b(p);
-  const int dt = b.dim("Time", static_cast<std::size_t>(s.nt)), dxd = b.dim("west_east", static_cast<std::size_t>(s.nx));
-  const int dyd = b.dim("south_north", static_cast<std::size_t>(s.ny)), dzd = b.dim("bottom_top", static_cast<std::size_t>(s.nz));
-  const int dzs = b.dim("bottom_top_stag", static_cast<std::size_t>(s.nz + 1));
-  const int dxs = b.dim("west_east_stag", static_cast<std::size_t>(s.nx + 1)), dys = b.dim("south_north_stag", static_cast<std::size_t>(s.ny + 1));
-  b.number(NC_GLOBAL, "MAP_PROJ", NC_INT, {3});
-  for (const char* a : {"TRUELAT1", "TRUELAT2", "STAND_LON"}) b.number(NC_GLOBAL, a, NC_FLOAT, {0.0});
-  b.number(NC_GLOBAL, "DX", NC_FLOAT, {kDx});
-  b.number(NC_GLOBAL, "DY", NC_FLOAT, {kDx});
-  const std::vector<int> d2 = s.nt > 1 ? std::vector<int>{dt, dyd, dxd} : std::vector<int>{dyd, dxd};
-  const int vlat = b.var("XLAT", NC_DOUBLE, d2), vlon = b.var("XLONG", NC_DOUBLE, d2);
-  int vca = -1, vsa = -1, vcf = -1;
-  if (s.cosalpha) vca = b.var("COSALPHA", NC_DOUBLE, d2), vsa = b.var("SINALPHA", NC_DOUBLE, d2);
-  const int ph = b.var("PH", NC_FLOAT, {dt, dzs, dyd, dxd}), phb = b.var("PHB", NC_FLOAT, {dt, dzs, dyd, dxd});
-  const int pp = b.var("P", NC_FLOAT, {dt, dzd, dyd, dxd}), pb = b.var("PB", NC_FLOAT, {dt, dzd, dyd, dxd});
-  const int th = b.var("T", NC_FLOAT, {dt, dzd, dyd, dxd}), qc = b.var("QCLOUD", NC_DOUBLE, {dt, dzd, dyd, dxd});
-  const int u = b.var("U", NC_FLOAT, {dt, dzd, dyd, dxs}), v = b.var("V", NC_FLOAT, {dt, dzd, dys, dxd});
-  if (s.cldfra) vcf = b.var("CLDFRA", NC_FLOAT, {dt, dzd, dyd, dxd});
-  const std::size_t n2 = static_cast<std::size_t>(s.nx) * static_cast<std::size_t>(s.ny);
-  std::vector<double> lat, lon, ca, sa, vph, vphb, vp, vpb, vth, vqc, vu, vv, vcfd;
-  for (int t = 0; t < s.nt; ++t) {
-    for (int j = 0; j < s.ny; ++j) {
-      for (int i = 0; i < s.nx; ++i) {
-        lat.push_back(lat_of(s, j));
-        lon.push_back(lon_of(s, t, i));
-        ca.push_back(0.9 + 0.01 * i);  // interpolated bilinearly, these give 0.9 + 0.01 fi and 0.1 + 0.02 fj
-        sa.push_back(0.1 + 0.02 * j);
-      }
-    }
-    for (int k = 0; k <= s.nz; ++k) vph.insert(vph.end(), n2, 0.0), vphb.insert(vphb.end(), n2, 9.81 * 1000.0 * k);
-    for (int k = 0; k < s.nz; ++k) {
-      vp.insert(vp.end(), n2, 0.0);
-      vpb.insert(vpb.end(), n2, 95000.0 - 10000.0 * k);
-      vth.insert(vth.end(), n2, 0.0);
-      for (int j = 0; j < s.ny; ++j) {
-        for (int i = 0; i < s.nx; ++i) {
-          vqc.push_back(k == 1 ? s.qcloud(lon_of(s, t, i)) : 0.0);
-          vcfd.push_back(k == 1 ? s.cldfra_at(i, j) : 0.0);
-        }
-      }
-      vu.insert(vu.end(), static_cast<std::size_t>(s.nx + 1) * static_cast<std::size_t>(s.ny), 10.0);
-      vv.insert(vv.end(), static_cast<std::size_t>(s.nx) * static_cast<std::size_t>(s.ny + 1), 0.0);
-    }
-  }
-  b.put(vlat, lat);
-  b.put(vlon, lon);
-  if (s.cosalpha) b.put(vca, ca), b.put(vsa, sa);
-  b.put(ph, vph);
-  b.put(phb, vphb);
-  b.put(pp, vp);
-  b.put(pb, vpb);
-  b.put(th, vth);
-  b.put(qc, vqc);
-  b.put(u, vu);
-  b.put(v, vv);
-  if (s.cldfra) b.put(vcf, vcfd);
-  b.close();
+  cv::test::WrfFile f;
+  f.nx = s.nx, f.ny = s.ny, f.nz = s.nz, f.nt = s.nt;
+  f.map_proj = 3;  // Mercator, true latitude 0, STAND_LON 0
+  f.dx = kDx;
+  f.latlon_per_step = s.nt > 1;
+  f.latlon = [&s](int t, int i, int j) { return std::pair{lat_of(s, j), lon_of(s, t, i)}; };
+  f.qcloud = [&s](int t, int k, int i, int) { return k == 1 ? s.qcloud(lon_of(s, t, i)) : 0.0; };
+  if (s.cldfra) f.cldfra = [&s](int, int k, int i, int j) { return k == 1 ? s.cldfra_at(i, j) : 0.0; };
+  // Interpolated bilinearly, these give 0.9 + 0.01 fi and 0.1 + 0.02 fj.
+  if (s.cosalpha) f.cos_sin_alpha = [](int i, int j) { return std::pair{0.9 + 0.01 * i, 0.1 + 0.02 * j}; };
+  f.winds = true;  // grid u = 10, v = 0
+  cv::test::write_wrf_file(p, f);
 }
 
 // Mass level 1 (1.5 km, p = 85 000 Pa, T = 300 (0.85)^(R_d/c_p), no vapour): sigma of q.

@@ -8,6 +8,7 @@
 #include "importer.hpp"
 #include "support/nc_builder.hpp"
 #include "support/real_data.hpp"
+#include "support/wrf_writer.hpp"
 #include "nc_file.hpp"
 #include "wrf_import.hpp"
 
@@ -153,32 +154,16 @@ std::string write_polar_wrf(const std::filesystem::path& dir, bool north) {
       lon.push_back(lo + stand_lon);
     }
   }
-  cv::test::NcBuilder b(p);
-  const int dt = b.dim("Time", 1), dxd = b.dim("west_east", nx), dyd = b.dim("south_north", ny), dzd = b.dim("bottom_top", nz);
-  const int dzs = b.dim("bottom_top_stag", nz + 1);
-  b.number(NC_GLOBAL, "MAP_PROJ", NC_INT, {2});
-  b.number(NC_GLOBAL, "TRUELAT1", NC_FLOAT, {truelat});
-  b.number(NC_GLOBAL, "TRUELAT2", NC_FLOAT, {truelat});
-  b.number(NC_GLOBAL, "STAND_LON", NC_FLOAT, {stand_lon});
-  b.number(NC_GLOBAL, "DX", NC_FLOAT, {dx});
-  b.number(NC_GLOBAL, "DY", NC_FLOAT, {dx});
-  const int vlat = b.var("XLAT", NC_DOUBLE, {dyd, dxd}), vlon = b.var("XLONG", NC_DOUBLE, {dyd, dxd});
-  const int ph = b.var("PH", NC_FLOAT, {dt, dzs, dyd, dxd}), phb = b.var("PHB", NC_FLOAT, {dt, dzs, dyd, dxd});
-  const int pp = b.var("P", NC_FLOAT, {dt, dzd, dyd, dxd}), pb = b.var("PB", NC_FLOAT, {dt, dzd, dyd, dxd});
-  const int th = b.var("T", NC_FLOAT, {dt, dzd, dyd, dxd}), qc = b.var("QCLOUD", NC_FLOAT, {dt, dzd, dyd, dxd});
-  const std::size_t n2 = static_cast<std::size_t>(nx) * ny;
-  std::vector<double> vph(n2 * (nz + 1), 0.0), vphb, vp(n2 * nz, 0.0), vpb, vth(n2 * nz, 0.0), vqc;
-  for (int k = 0; k <= nz; ++k) vphb.insert(vphb.end(), n2, 9.81 * 1000.0 * k);  // staggered levels at 0, 1, 2, 3 km
-  for (int k = 0; k < nz; ++k) vpb.insert(vpb.end(), n2, 95000.0 - 10000.0 * k), vqc.insert(vqc.end(), n2, k == 1 ? 1e-4 : 0.0);
-  b.put(vlat, lat);
-  b.put(vlon, lon);
-  b.put(ph, vph);
-  b.put(phb, vphb);
-  b.put(pp, vp);
-  b.put(pb, vpb);
-  b.put(th, vth);
-  b.put(qc, vqc);
-  b.close();
+  cv::test::WrfFile f;
+  f.nx = nx, f.ny = ny, f.nz = nz;
+  f.map_proj = 2;
+  f.truelat1 = f.truelat2 = truelat;
+  f.stand_lon = stand_lon;
+  f.dx = dx;
+  f.latlon = [&](int, int i, int j) { return std::pair{lat[static_cast<std::size_t>(j * nx + i)], lon[static_cast<std::size_t>(j * nx + i)]}; };
+  f.qcloud = [](int, int k, int, int) { return k == 1 ? 1e-4 : 0.0; };
+  f.qcloud_type = NC_FLOAT;
+  cv::test::write_wrf_file(p, f);
   return p;
 }
 
