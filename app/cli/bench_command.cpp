@@ -19,6 +19,7 @@
 #include "cli_common.hpp"
 #include "quality_budget.hpp"
 #include "geo/geodesy.hpp"
+#include "io/output_file.hpp"
 #include "reference/monte_carlo.hpp"
 #include "render/context.hpp"
 #include "render/image_output.hpp"
@@ -264,6 +265,7 @@ int cmd_bench(const std::vector<std::string>& args) {
   std::error_code ec;
   fs::create_directories(a.out, ec);
   if (ec || !fs::is_directory(a.out)) throw UsageError{"cloudviewer bench: --out: cannot create the folder '" + a.out + "'"};
+  core::check_output_path((fs::path(a.out) / "results.csv").string(), "--out");  // the folder can be written
   auto ctx = render::make_headless_context();
   const std::string machine = ctx->info().summary();
   std::printf("bench: %zu scene(s) at %dx%d, references %d spp, %d repeat(s), into %s; %s\n", a.scenes.size(), a.width,

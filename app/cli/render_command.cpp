@@ -566,16 +566,7 @@ int cmd_render(const std::vector<std::string>& args) {
   }
 
   t0 = clock::now();
-  std::size_t bad = 0, first_bad = 0;
-  for (std::size_t i = 0; i < pixels.size(); ++i) {
-    const auto& p = pixels[i];
-    if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w)) && bad++ == 0) first_bad = i;
-  }
-  if (bad) {  // a wrong image is not written: nothing at the outputs, what was there stays
-    throw std::runtime_error(scene.data.path + ": " + std::to_string(bad) + " of " + std::to_string(pixels.size()) +
-                             " pixels came out not finite (the first at x " + std::to_string(first_bad % cam.width) + ", y " +
-                             std::to_string(first_bad / cam.width) + "), expected finite radiance; nothing written");
-  }
+  render::check_finite_pixels(pixels, cam.width, scene.data.path);  // a wrong image is not written: what was there stays
   render::ToneSettings tone;
   tone.exposure = frame.auto_exposure ? render::auto_exposure(marched) : frame.exposure;
   if (frame.auto_exposure) std::printf("exposure %.4g (auto: the 99th percentile of lit pixels' luminance at 0.8; --exposure E sets it)\n", tone.exposure);

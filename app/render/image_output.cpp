@@ -137,4 +137,17 @@ std::string transmittance_pfm_path(const std::string& radiance_pfm) {
   return (has_ext ? radiance_pfm.substr(0, radiance_pfm.size() - ext.size()) : radiance_pfm) + ".transmittance.pfm";
 }
 
+void check_finite_pixels(const std::vector<glm::vec4>& pixels, int width, const std::string& what) {
+  std::size_t bad = 0, first_bad = 0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    const auto& p = pixels[i];
+    if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w)) && bad++ == 0) first_bad = i;
+  }
+  if (bad == 0) return;
+  const std::size_t w = static_cast<std::size_t>(std::max(width, 1));
+  throw std::runtime_error(what + ": " + std::to_string(bad) + " of " + std::to_string(pixels.size()) +
+                           " pixels came out not finite (the first at x " + std::to_string(first_bad % w) + ", y " +
+                           std::to_string(first_bad / w) + "), expected finite radiance; nothing written");
+}
+
 }  // namespace cv::render

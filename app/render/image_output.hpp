@@ -31,6 +31,11 @@ std::vector<glm::vec4> upscale_linear(const std::vector<glm::vec4>& in, int iw, 
 inline constexpr double kDefaultExposure = 4.0;
 double auto_exposure(const std::vector<glm::vec4>& linear);
 
+// Throws std::runtime_error "WHAT: N of M pixels came out not finite (the first at x X, y Y),
+// expected finite radiance; nothing written" when any channel of a pixel is NaN or infinite, so
+// that a wrong image is never written (rows top to bottom, `width` pixels each).
+void check_finite_pixels(const std::vector<glm::vec4>& pixels, int width, const std::string& what);
+
 // rgb = radiance, a = transmittance, rows top to bottom; composited over the background.
 std::vector<unsigned char> tonemap_srgb8(const std::vector<glm::vec4>& pixels, const ToneSettings& tone);
 void write_png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb8);

@@ -15,6 +15,7 @@
 #include <cstdio>
 
 #include "importer.hpp"
+#include "io/output_file.hpp"
 #include "noise/noise.hpp"
 #include "render/albedo_map.hpp"
 #include "render/context.hpp"
@@ -190,8 +191,13 @@ int cmd_view(const std::vector<std::string>& args) {
     if (!o.screenshot.empty() && o.frames == 0) {
       throw ViewerInputError("cloudviewer view: --screenshot: expected --frames N as well (the frame to save is the Nth)");
     }
+    if (!o.screenshot.empty()) {  // checked before the window opens, so a bad path costs no frames
+      core::check_output_extension(o.screenshot, "--screenshot", {".png"});
+      core::check_output_path(o.screenshot, "--screenshot");
+      core::check_output_not_input(o.screenshot, "--screenshot", o.input, "the input");
+    }
     if (ends_with(o.input, ".json")) o.scene = core::load_scene(o.input);
-  } catch (const std::runtime_error& e) {  // ViewerInputError and core::SceneError
+  } catch (const std::runtime_error& e) {  // ViewerInputError, core::InputError and core::SceneError
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
   }

@@ -95,6 +95,30 @@ TEST_F(CliHostile, OutputsAreCheckedBeforeTheRenderStarts) {
   EXPECT_EQ(files(), 1u);  // the input alone
 }
 
+// The viewer's screenshot and the bench's folder too: refused before a window opens or a
+// reference is rendered (no display is needed to be told).
+TEST_F(CliHostile, ScreenshotAndBenchOutputsAreCheckedFirst) {
+  const std::string env = "env -u DISPLAY ";
+  expect_refused(cloudviewer("view " + sample_ + " --frames 2 --screenshot " + path("no/such/x.png"), env),
+                 "--screenshot: found '" + path("no/such/x.png") + "': its folder '" + path("no/such") + "' does not exist");
+  expect_refused(cloudviewer("view " + sample_ + " --frames 2 --screenshot " + path("x.jpg"), env),
+                 "--screenshot: found '" + path("x.jpg") + "', expected a file name ending in .png");
+  fs::create_symlink(sample_, path("alias.png"));
+  expect_refused(cloudviewer("view " + sample_ + " --frames 2 --screenshot " + path("alias.png"), env), "which is the input");
+  write("plain", "a file, not a folder");
+  expect_refused(cloudviewer("bench --out " + path("plain")), "cloudviewer bench: --out: cannot create the folder '" + path("plain") + "'");
+  ::chmod(dir_.c_str(), 0555);
+  const bool root = ::access(dir_.c_str(), W_OK) == 0;  // root writes anywhere: the check cannot be seen
+  ::chmod(dir_.c_str(), 0755);
+  if (!root) {
+    fs::create_directories(path("ro"));
+    ::chmod(path("ro").c_str(), 0555);
+    expect_refused(cloudviewer("bench --out " + path("ro")), "--out");
+    ::chmod(path("ro").c_str(), 0755);
+  }
+  EXPECT_EQ(fs::file_size(path("plain")), std::string("a file, not a folder").size());
+}
+
 TEST_F(CliHostile, AnOutputThatIsAnInputIsRefusedAndTheInputKept) {
   const auto size = fs::file_size(sample_);
   // The data through a link named like an image, and a scene saved over the scene it renders.

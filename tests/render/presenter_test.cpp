@@ -300,3 +300,22 @@ TEST(ImageOutput, AutoExposurePutsTheBrightCloudsAtPointEight) {
   EXPECT_EQ(auto_exposure(std::vector<glm::vec4>(64, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f))), kDefaultExposure);
   EXPECT_EQ(auto_exposure({}), kDefaultExposure);
 }
+
+// A frame with a NaN or an infinite channel is refused before anything is written, and the
+// message names the input, the count and the first pixel's place (issue 13: "N pixels were not
+// finite" used to leave the PNG written).
+TEST(ImageOutput, NonFinitePixelsAreRefusedWithTheirCountAndPlace) {
+  const int w = 5;
+  std::vector<glm::vec4> px(20, glm::vec4(0.1f, 0.2f, 0.3f, 0.5f));
+  EXPECT_NO_THROW(check_finite_pixels(px, w, "in.nc"));
+  px[7].y = std::numeric_limits<float>::quiet_NaN();  // x 2, y 1
+  px[13].w = std::numeric_limits<float>::infinity();
+  px[19].x = -std::numeric_limits<float>::infinity();
+  try {
+    check_finite_pixels(px, w, "in.nc");
+    ADD_FAILURE() << "three non-finite pixels were accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "in.nc: 3 of 20 pixels came out not finite (the first at x 2, y 1), expected finite radiance; nothing written");
+  }
+}
