@@ -131,17 +131,6 @@ class ClassicHeader {
   std::uint64_t pos_ = 0;
 };
 
-void check_classic_header(const std::string& path, std::uint64_t file_bytes) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return;  // netCDF's open says why
-  std::vector<unsigned char> b(static_cast<std::size_t>(std::min<std::uint64_t>(file_bytes, 64u << 20)));
-  const std::size_t got = b.empty() ? 0 : std::fread(b.data(), 1, b.size(), f);
-  std::fclose(f);
-  b.resize(got);
-  if (b.size() < 4 || b[0] != 'C' || b[1] != 'D' || b[2] != 'F' || (b[3] != 1 && b[3] != 2 && b[3] != 5)) return;  // not classic
-  ClassicHeader(path, b, file_bytes).check();
-}
-
 bool is_integer_type(int t) {
   return t == NC_BYTE || t == NC_SHORT || t == NC_INT || t == NC_UBYTE || t == NC_USHORT || t == NC_UINT ||
          t == NC_INT64 || t == NC_UINT64;
@@ -156,6 +145,17 @@ std::size_t type_bytes(int t) {
   }
 }
 }  // namespace
+
+void check_classic_header(const std::string& path, std::uint64_t file_bytes) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return;  // netCDF's open says why
+  std::vector<unsigned char> b(static_cast<std::size_t>(std::min<std::uint64_t>(file_bytes, 64u << 20)));
+  const std::size_t got = b.empty() ? 0 : std::fread(b.data(), 1, b.size(), f);
+  std::fclose(f);
+  b.resize(got);
+  if (b.size() < 4 || b[0] != 'C' || b[1] != 'D' || b[2] != 'F' || (b[3] != 1 && b[3] != 2 && b[3] != 5)) return;  // not classic
+  ClassicHeader(path, b, file_bytes).check();
+}
 
 const NcAtt* NcVar::att(const std::string& n) const {
   for (const auto& a : atts) {

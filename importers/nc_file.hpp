@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,6 +44,12 @@ struct UnpackInfo {
   bool packed = false;
   std::size_t missing = 0;  // values that became NaN
 };
+
+// netCDF-C's classic-format reader trusts the lengths its header declares (a crash and 16 GiB
+// callocs, found by fuzzing): walks a classic (CDF-1, -2, -5) header first and throws ImportError
+// when a declared length or count exceeds the file's bytes. Other formats pass. NcFile calls it
+// before netCDF opens a file; anything else that hands netCDF untrusted bytes must too.
+void check_classic_header(const std::string& path, std::uint64_t file_bytes);
 
 class NcFile {
  public:

@@ -1,0 +1,42 @@
+// The NetCDF importers' fuzz body, shared by the byte-level target (fuzz_netcdf) and the semantic
+// one (fuzz_netcdf_semantic): `info`'s description, the import and every time step (up to 4)
+// loaded. Bad input must end in an InputError (exit 2 on the command line); anything else that
+// escapes, a crash, a sanitizer report or a hang is a finding.
+//
+// Only netCDF classic inputs (CDF-1, -2 and -5) are taken: NetCDF-4 files are HDF5, whose own
+// readers HDF5 fuzzes; our code sees the same values from either (the seeds are CDF-5 copies of
+// the real files).
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+
+#include "fuzz_common.hpp"
+#include "importer.hpp"
+
+namespace cv::fuzz {
+
+inline bool is_classic_netcdf(const std::uint8_t* data, std::size_t size) {
+  return size >= 4 && std::memcmp(data, "CDF", 3) == 0 && (data[3] == 1 || data[3] == 2 || data[3] == 5);
+}
+
+inline int run_netcdf_input(const std::uint8_t* data, std::size_t size) {
+  if (!is_classic_netcdf(data, size)) return -1;
+  limit_memory();
+  const MemFile file(data, size, ".nc");
+  if (file.path().empty()) return 0;
+  try {
+    (void)importers::describe_file(file.path());
+  } catch (const core::InputError&) {
+  }
+  try {
+    importers::ImportOptions o;
+    o.cache_steps = 1;
+    core::CloudVolume v = importers::import_file(file.path(), o);
+    for (std::size_t t = 0; t < v.times.size() && t < 4; ++t) (void)v.step(t);
+  } catch (const core::InputError&) {
+  }
+  return 0;
+}
+
+}  // namespace cv::fuzz
