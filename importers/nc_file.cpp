@@ -229,7 +229,12 @@ NcFile::NcFile(const std::string& path) : path_(path) {
     long double need = 0;
     for (const auto& v : vars_) need += static_cast<long double>(size(v)) * type_bytes(v.type);
     if (need > static_cast<long double>(file_bytes_)) {
-      throw ImportError(path + ": its variables need " + std::to_string(static_cast<long long>(need)) + " bytes but the file has " +
+      // Beyond 2^63 the count is no integer type's (a declared record count of 2^62 gets here):
+      // written as a float.
+      char needed[32];
+      if (need < 9.0e18L) std::snprintf(needed, sizeof needed, "%lld", static_cast<long long>(need));
+      else std::snprintf(needed, sizeof needed, "%.3Lg", need);
+      throw ImportError(path + ": its variables need " + needed + " bytes but the file has " +
                         std::to_string(file_bytes_) + " (truncated); expected a complete file");
     }
   }

@@ -294,4 +294,32 @@ TEST_F(HostileImport, CorruptClassicHeaderIsRefusedBeforeNetcdfReadsIt) {
   }
 }
 
+TEST_F(HostileImport, ARecordCountBeyondAnyIntegerIsNamedNotOverflowed) {
+  // fuzz_netcdf: a classic header declaring 2^62 records made the truncation check's byte count
+  // overflow its conversion to long long (undefined behaviour; UBSan's float-cast-overflow). A
+  // CDF-5 file with a record variable of two records, its record count patched.
+  const std::string p = (dir_ / "records.nc").string();
+  {
+    int nc, t, x, v;
+    ASSERT_EQ(nc_create(p.c_str(), NC_CLOBBER | NC_64BIT_DATA, &nc), NC_NOERR);
+    ASSERT_EQ(nc_def_dim(nc, "time", NC_UNLIMITED, &t), NC_NOERR);
+    ASSERT_EQ(nc_def_dim(nc, "x", 4, &x), NC_NOERR);
+    const int dims[2] = {t, x};
+    ASSERT_EQ(nc_def_var(nc, "v", NC_FLOAT, 2, dims, &v), NC_NOERR);
+    ASSERT_EQ(nc_enddef(nc), NC_NOERR);
+    const std::size_t start[2] = {0, 0}, count[2] = {2, 4};
+    const std::vector<double> ones(8, 1.0);
+    ASSERT_EQ(nc_put_vara_double(nc, v, start, count, ones.data()), NC_NOERR);
+    ASSERT_EQ(nc_close(nc), NC_NOERR);
+  }
+  {
+    std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(4);  // after the magic: the record count, 8 bytes big-endian in CDF-5
+    const unsigned char be[8] = {0x40, 0, 0, 0, 0, 0, 0, 0};
+    f.write(reinterpret_cast<const char*>(be), 8);
+  }
+  const std::string msg = import_error(p);
+  EXPECT_NE(msg.find(p + ": its variables need 7.38e+19 bytes but the file has "), std::string::npos) << msg;
+}
+
 }  // namespace
