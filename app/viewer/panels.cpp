@@ -29,7 +29,7 @@ bool slider_double(const char* label, double* v, double lo, double hi, const cha
   return ImGui::SliderScalar(label, ImGuiDataType_Double, v, &lo, &hi, fmt, flags | ImGuiSliderFlags_AlwaysClamp);
 }
 
-void data_panel(ViewerState& s) {
+void data_panel(ViewerState& s, const PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Data", ImGuiTreeNodeFlags_DefaultOpen)) return;
   const auto& g = s.volume.grid;
   ImGui::TextWrapped("file: %s", s.scene.data.path.c_str());
@@ -42,8 +42,11 @@ void data_panel(ViewerState& s) {
   }
   ImGui::TextWrapped("fields: %s", fields.empty() ? "(none)" : fields.c_str());
   const int n = static_cast<int>(s.volume.times.size());
-  if (n > 1) ImGui::SliderInt("time step", &s.scene.time_step, 0, n - 1, "%d", ImGuiSliderFlags_AlwaysClamp);
-  if (s.scene.time_step < n) ImGui::Text("valid time: %s", s.volume.times[static_cast<std::size_t>(s.scene.time_step)].iso_utc.c_str());
+  if (n > 1 && ImGui::SliderInt("time step", &s.scene.time_step, 0, n - 1, "%d", ImGuiSliderFlags_AlwaysClamp)) {
+    s.scene.time.valid_utc.clear();  // the slider picks a step: the instant follows it
+  }
+  ImGui::Text("valid time: %s", ctx.instant_text.c_str());
+  if (!ctx.time_warning.empty()) ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.4f, 1.0f), "%s", ctx.time_warning.c_str());
   if (ImGui::TreeNode("import report")) {
     ImGui::BeginChild("report", ImVec2(0, 160), true, ImGuiWindowFlags_HorizontalScrollbar);
     ImGui::TextUnformatted(s.import_report.c_str());
@@ -87,7 +90,7 @@ void camera_panel(ViewerState& s, PanelContext& ctx) {
 void sun_panel(ViewerState& s, PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Sun & date/time")) return;
   int mode = static_cast<int>(s.scene.sun.mode);
-  ImGui::Combo("sun from", &mode, "valid time\0date/time (UTC)\0subsolar point\0");
+  ImGui::Combo("sun from", &mode, "valid time\0date/time (UTC)\0subsolar point\0local noon (teaching)\0");
   s.scene.sun.mode = static_cast<core::SunMode>(mode);
   if (s.scene.sun.mode == core::SunMode::DateTime) ImGui::InputText("UTC", &s.scene.sun.datetime_utc);
   if (s.scene.sun.mode == core::SunMode::Manual) {
@@ -209,7 +212,7 @@ void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats)
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(340, 520), ImGuiCond_FirstUseEver);
   if (ImGui::Begin("cloudviewer")) {
-    data_panel(state);
+    data_panel(state, ctx);
     camera_panel(state, ctx);
     sun_panel(state, ctx);
     lighting_panel(state);

@@ -32,6 +32,8 @@ struct PanelContext {
   std::string scene_message;    // result of the last load/save
   double auto_exposure = 4.0;   // what the automatic exposure chose, shown while it is on
   std::string budget_text;      // the frame budget's candidate and its source, when the budget is on
+  std::string instant_text;     // the scene's instant, and how the medium there was made
+  std::string time_warning;     // why `advected` fell back to `linear` (no winds), shown on screen
 };
 
 void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats);

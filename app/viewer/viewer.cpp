@@ -316,7 +316,20 @@ int run_viewer(const ViewerOptions& o) {
     s.scene.camera->width = mw;
     s.scene.camera->height = mh;
     s.scene.time_step = std::clamp(s.scene.time_step, 0, static_cast<int>(s.volume.times.size()) - 1);
-    renderer.use_volume(volumes.get(s.scene.data.path, s.volume, static_cast<std::size_t>(s.scene.time_step)));
+    {  // the scene's instant: between steps the medium is interpolated once per instant (core::PreparedVolumeCache)
+      core::Instant at;
+      try {
+        at = core::scene_instant(s.scene, s.volume, s.scene.data.path);
+      } catch (const core::TimeError& e) {
+        std::fprintf(stderr, "%s; the time step is used instead\n", e.what());
+        s.scene.time.valid_utc.clear();
+        at = core::instant_at_step(s.volume.times, static_cast<std::size_t>(s.scene.time_step), s.scene.data.path);
+      }
+      core::TimeInterpolationReport interp;
+      renderer.use_volume(volumes.get(s.scene.data.path, s.volume, at, s.scene.time.interpolation, &interp));
+      ctx.time_warning = interp.warning;
+      ctx.instant_text = at.iso_utc + (at.between() ? std::string(" (") + core::time_interpolation_name(interp.used) + " between steps)" : "");
+    }
     if (presenter.width() != mw || presenter.height() != mh) presenter.resize(mw, mh);
     // The frame as `render` resolves it (camera at the march size, sun, settings).
     core::FrameSpec spec;
