@@ -57,8 +57,10 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
       {"bench", cv::cli::bench_usage()},
       {"time-error", cv::cli::time_error_usage()},
       {"view",
-       "  view INPUT [--size WxH] [--time N] [--scale S] [--hide-ui] [--frame-budget MS]\n"
+       "  view INPUT [--size WxH] [--time ISO|N] [--play H] [--scale S] [--hide-ui] [--frame-budget MS]\n"
        "             [--frames N --screenshot OUT.png]\n"
+       "                           --time: an instant (UTC) or a step; --play H: start playing at H forecast\n"
+       "                           hours per second (the timeline is in the data panel)\n"
        "                           the interactive viewer (GLFW window); with --frames it renders N frames,\n"
        "                           saves the window to OUT.png and exits; --frame-budget: the quality panel's\n"
        "                           frame budget (0 off)\n"},

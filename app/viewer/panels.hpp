@@ -20,6 +20,7 @@ struct FrameStats {
   int march_w = 0, march_h = 0;
   core::MarchStats march;   // what the last marched frame sampled and left out
   std::string renderer;     // GL_RENDERER
+  std::string prefetch;     // the prefetcher's resident instants, memory and hit rate (playback)
 };
 
 // What the panels need besides the state, and what they ask of the main loop.
