@@ -60,7 +60,8 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
        "  view INPUT [--size WxH] [--time ISO|N] [--play H] [--scale S] [--hide-ui] [--frame-budget MS]\n"
        "             [--frames N --screenshot OUT.png]\n"
        "                           --time: an instant (UTC) or a step; --play H: start playing at H forecast\n"
-       "                           hours per second (the timeline is in the data panel)\n"
+       "                           hours per second (the timeline is in the data panel); with --frames it moves\n"
+       "                           one instant per frame and waits for each, unless --realtime (wall time, no wait)\n"
        "                           the interactive viewer (GLFW window); with --frames it renders N frames,\n"
        "                           saves the window to OUT.png and exits; --frame-budget: the quality panel's\n"
        "                           frame budget (0 off)\n"},

@@ -86,7 +86,7 @@ void data_panel(ViewerState& s, const PanelContext& ctx) {
   if (n > 1 && ImGui::SliderInt("time step", &s.scene.time_step, 0, n - 1, "%d", ImGuiSliderFlags_AlwaysClamp)) {
     s.scene.time.valid_utc.clear();  // the slider picks a step: the instant follows it
   }
-  if (n > 1 && core::times_known(s.volume.times)) time_controls(s);
+  if (n > 1 && s.timeline) time_controls(s);
   ImGui::TextWrapped("valid time: %s", ctx.instant_text.c_str());
   if (!ctx.time_warning.empty()) ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.4f, 1.0f), "%s", ctx.time_warning.c_str());
   if (ImGui::TreeNode("import report")) {

@@ -194,6 +194,8 @@ int cmd_view(const std::vector<std::string>& args) {
         if (!(o.frame_budget_ms >= 0.0 && o.frame_budget_ms <= 1e7)) {
           throw ViewerInputError("cloudviewer view: --frame-budget: found '" + v + "', expected a frame time in ms 0..1e7 (0: off)");
         }
+      } else if (a == "--realtime") {
+        o.realtime = true;
       } else if (a == "--hide-ui") {
         o.hide_ui = true;
       } else if (!a.empty() && a[0] == '-') {
@@ -243,7 +245,15 @@ int run_viewer(const ViewerOptions& o) {
   s.import_report = s.volume.report.to_text();
   if (!o.scene || o.time_given) s.scene.time_step = o.time_step, s.scene.time.valid_utc = o.time_utc;
   // The timeline: from the scene's instant; a file with one step is a still (with a note).
-  const bool timeline = core::times_known(s.volume.times) && s.volume.times.size() > 1;
+  bool timeline = core::times_known(s.volume.times) && s.volume.times.size() > 1;
+  if (timeline) {
+    try {
+      core::check_time_axis(s.volume.times, s.scene.data.path);
+    } catch (const core::TimeError& e) {  // steps by index still work; instants between them do not
+      std::fprintf(stderr, "%s; the timeline is off\n", e.what());
+      timeline = false;
+    }
+  }
   if (s.volume.times.size() == 1) std::printf("%s has one time step (%s): it shows as a still\n", o.input.c_str(), s.volume.times[0].iso_utc.c_str());
   try {
     s.play.t_s = double(core::scene_instant(s.scene, s.volume, s.scene.data.path).unix_s);
@@ -266,6 +276,7 @@ int run_viewer(const ViewerOptions& o) {
   constexpr std::size_t kResidentInstants = 6;
   std::unique_ptr<Prefetcher> prefetch;
   if (timeline) prefetch = std::make_unique<Prefetcher>(s.scene, kResidentInstants);
+  s.timeline = timeline;
   std::int64_t shown_instant = INT64_MIN;  // the instant whose medium is on the GPU
   bool have_volume = false;
   s.scene.width = o.width;
@@ -367,7 +378,7 @@ int run_viewer(const ViewerOptions& o) {
     if (prefetch && s.play.playing) {
       if (s.scene.time.valid_utc.empty()) s.play.t_s = double(s.volume.times[static_cast<std::size_t>(s.scene.time_step)].unix_s);
       if (frame > 0 && have_volume) {
-        if (o.frames > 0) s.play.advance_one();
+        if (o.frames > 0 && !o.realtime) s.play.advance_one();
         else s.play.advance(dt);
       }
       s.scene.time.valid_utc = core::format_iso_utc(s.play.shown());
@@ -382,7 +393,7 @@ int run_viewer(const ViewerOptions& o) {
       prefetch->want(wanted, s.scene.time.interpolation);
       core::TimeInterpolationReport interp;
       const bool first_ask = want_t != shown_instant;
-      auto v = first_ask ? prefetch->get(want_t, o.frames > 0 || !have_volume, &interp) : nullptr;
+      auto v = first_ask ? prefetch->get(want_t, (o.frames > 0 && !o.realtime) || !have_volume, &interp) : nullptr;
       if (v) {
         renderer.use_volume(v);
         shown_instant = want_t;
@@ -496,6 +507,7 @@ int run_viewer(const ViewerOptions& o) {
                   o.screenshot.c_str(), fbw, fbh, accumulated, std::chrono::duration<double>(clock::now() - start).count(),
                   stats.march_ms, stats.renderer.c_str());
       if (budget.on()) std::printf("frame budget %g ms: ended on %s\n", s.scene.render.budget_ms, budget.status().c_str());
+      if (!stats.prefetch.empty()) std::printf("%s\n", stats.prefetch.c_str());
     }
     win->swap_buffers();
     ++fps_frames;

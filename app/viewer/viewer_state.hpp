@@ -27,6 +27,7 @@ struct ViewerState {
   std::string import_report;  // the importer's report as text, for the data panel
   bool fly_mode = false;      // the camera panel's mode; mouse and keys follow it
   Playhead play;              // the timeline: where in the file's times, playing or not
+  bool timeline = false;      // the file has two or more ascending UTC valid times: play, scrub
 };
 
 
