@@ -15,6 +15,7 @@
 #include "io/input_file.hpp"
 #include "io/output_file.hpp"
 #include "scene/framing.hpp"
+#include "scene/instant.hpp"
 #include "physics/physics.hpp"
 #include "volume/volume_io.hpp"
 #include "render/albedo_map.hpp"
@@ -23,6 +24,7 @@
 #include "cli_common.hpp"
 #include "render_command.hpp"
 #include "bench_command.hpp"
+#include "time_error_command.hpp"
 #include "scene/scene_json.hpp"
 #include "viewer/viewer.hpp"
 
@@ -53,9 +55,13 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
       {"phase", "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"},
       {"render", cv::cli::render_usage()},
       {"bench", cv::cli::bench_usage()},
+      {"time-error", cv::cli::time_error_usage()},
       {"view",
-       "  view INPUT [--size WxH] [--time N] [--scale S] [--hide-ui] [--frame-budget MS]\n"
+       "  view INPUT [--size WxH] [--time ISO|N] [--play H] [--scale S] [--hide-ui] [--frame-budget MS]\n"
        "             [--frames N --screenshot OUT.png]\n"
+       "                           --time: an instant (UTC) or a step; --play H: start playing at H forecast\n"
+       "                           hours per second (the timeline is in the data panel); with --frames it moves\n"
+       "                           one instant per frame and waits for each, unless --realtime (wall time, no wait)\n"
        "                           the interactive viewer (GLFW window); with --frames it renders N frames,\n"
        "                           saves the window to OUT.png and exits; --frame-budget: the quality panel's\n"
        "                           frame budget (0 off)\n"},
@@ -305,7 +311,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (args.size() == 2 && print_command_usage(args[1])) return 0;
-    std::fprintf(stderr, "cloudviewer help: found '%s', expected one command: info, import, gpu-info, phase, render, bench or view\n",
+    std::fprintf(stderr, "cloudviewer help: found '%s', expected one command: info, import, gpu-info, phase, render, bench, time-error or view\n",
                  args.size() == 2 ? args[1].c_str() : "several arguments");
     return kExitBadInput;
   }
@@ -327,12 +333,16 @@ int main(int argc, char** argv) {
     if (cmd == "phase") return cmd_phase(args);
     if (cmd == "render") return cv::cli::cmd_render(args);
     if (cmd == "bench") return cv::cli::cmd_bench(args);
+    if (cmd == "time-error") return cv::cli::cmd_time_error(args);
     if (cmd == "view") return cv::viewer::cmd_view(args);
-    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase, render, bench or view"};
+    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase, render, bench, time-error or view"};
   } catch (const UsageError& e) {
     std::fprintf(stderr, "%s\n", e.message.c_str());
     return kExitBadInput;
   } catch (const cv::core::SceneError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  } catch (const cv::core::TimeError& e) {  // a time outside the file, a time axis that does not ascend
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
   } catch (const cv::core::VolumeFileError& e) {

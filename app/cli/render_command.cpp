@@ -29,7 +29,10 @@
 #include "render/machine_id.hpp"
 #include "render/raymarcher.hpp"
 #include "render/shader_loader.hpp"
+#include "geo/geodesy.hpp"
+#include "reference/earth_shadow.hpp"
 #include "scene/framing.hpp"
+#include "scene/instant.hpp"
 #include "scene/quality.hpp"
 #include "scene/scene_json.hpp"
 #include "kernel/volume_cache.hpp"
@@ -99,7 +102,33 @@ struct RenderArgs {
   int spp = 1024;
   double target_error = 0.0;
   bool spp_given = false;
+  // --times START..END --every DURATION: a numbered PNG sequence into the folder -o names.
+  std::string times_from, times_to;
+  std::int64_t every_s = 0;
 };
+
+// "90s", "30m", "1h", "1.5h" (or a bare number of seconds) in whole seconds, or nothing.
+std::optional<std::int64_t> parse_duration_s(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  double unit = 1.0;
+  std::string num = text;
+  const char last = text.back();
+  if (last == 's' || last == 'm' || last == 'h') {
+    unit = last == 'h' ? 3600.0 : last == 'm' ? 60.0 : 1.0;
+    num = text.substr(0, text.size() - 1);
+  }
+  double v = 0.0;
+  std::size_t used = 0;
+  try {
+    v = std::stod(num, &used);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (used != num.size() || !(v > 0.0) || !(v * unit <= 1e9)) return std::nullopt;
+  const double s = std::round(v * unit);
+  if (s < 1.0) return std::nullopt;
+  return static_cast<std::int64_t>(s);
+}
 
 int parse_int(const std::string& option, const std::string& text, int lo, int hi, const std::string& what) {
   const double v = parse_number(option, text);
@@ -158,6 +187,19 @@ void check_outputs(const RenderArgs& r, const core::Scene& scene) {
   const std::string& ground = scene.render.march.medium.ground_texture;
   if (!ground.empty() && ground != "none") core::require_regular_file(ground, "render.march.ground_texture, the ground image");
   if (!r.front.empty()) core::require_regular_file(r.front, "the quality front");
+  if (!r.times_from.empty()) {  // a folder of frames: it exists as a folder, or its parent does
+    const fs::path dir(r.out);
+    std::error_code ec;
+    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) {
+      throw UsageError{"cloudviewer render: -o: found '" + r.out + "', which is not a folder, expected a folder for the frames of --times"};
+    }
+    const fs::path parent = fs::absolute(dir).lexically_normal().parent_path();
+    if (!fs::exists(dir, ec) && !fs::is_directory(parent, ec)) {
+      throw UsageError{"cloudviewer render: -o: found '" + r.out + "', whose folder " + parent.string() +
+                       " does not exist, expected a folder for the frames of --times"};
+    }
+    return;
+  }
   std::vector<std::pair<std::string, std::string>> outputs = {{r.out, "-o"}};
   core::check_output_extension(r.out, "-o", {".png"});
   if (!r.pfm.empty()) {
@@ -218,8 +260,34 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
       const auto size = parse_size(v, 1, 16384);
       if (!size) throw UsageError{"cloudviewer render: --size: found '" + v + "', expected WxH with 1..16384 each"};
       scene.width = size->first, scene.height = size->second;
-    } else if (a == "--time") {
-      scene.time_step = parse_int(a, v, 0, 1 << 30, "a time-step index >= 0");
+    } else if (a == "--time") {  // a UTC instant, or a step index (still accepted, and converted)
+      if (core::parse_iso_utc(v)) {
+        scene.time.valid_utc = v;
+      } else {
+        scene.time_step = parse_int(a, v, 0, 1 << 30, "a UTC date-time YYYY-MM-DDThh:mm:ssZ or a time-step index >= 0");
+        scene.time.valid_utc.clear();
+      }
+    } else if (a == "--times") {
+      const std::size_t dots = v.find("..");
+      if (dots == std::string::npos || !core::parse_iso_utc(v.substr(0, dots)) || !core::parse_iso_utc(v.substr(dots + 2)) ||
+          *core::parse_iso_utc(v.substr(dots + 2)) < *core::parse_iso_utc(v.substr(0, dots))) {
+        throw UsageError{"cloudviewer render: --times: found '" + v +
+                         "', expected START..END, two UTC date-times YYYY-MM-DDThh:mm:ssZ with START <= END"};
+      }
+      r.times_from = v.substr(0, dots), r.times_to = v.substr(dots + 2);
+    } else if (a == "--every") {
+      const auto d = parse_duration_s(v);
+      if (!d) throw UsageError{"cloudviewer render: --every: found '" + v + "', expected a duration such as 30m, 1h or 90s (at least 1 s)"};
+      r.every_s = *d;
+    } else if (a == "--interpolation") {
+      if (!core::parse_time_interpolation(v, scene.time.interpolation)) {
+        throw UsageError{"cloudviewer render: --interpolation: found '" + v + "', expected auto, nearest, linear or advected"};
+      }
+    } else if (a == "--sun-mode") {
+      if (v != "valid_time" && v != "local_noon") {
+        throw UsageError{"cloudviewer render: --sun-mode: found '" + v + "', expected valid_time or local_noon"};
+      }
+      core::parse_sun_mode(v, scene.sun.mode);
     } else if (a == "--camera") {
       const auto c = parse_list(a, v, ',', 6, 6, "lat,lon,alt_m,heading,pitch,fov in degrees and metres");
       if (!(c[2] >= 0.0 && c[2] <= 4e8) || !(c[5] > 0.0 && c[5] < 180.0) || std::abs(c[0]) > 90.0 || std::abs(c[4]) > 90.0) {
@@ -311,6 +379,19 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
     }
   }
   if (r.out.empty()) throw UsageError{"cloudviewer render: expected -o OUT.png"};
+  if (!r.times_from.empty() || r.every_s > 0) {
+    if (r.times_from.empty() || r.every_s <= 0) {
+      throw UsageError{"cloudviewer render: --times and --every: found one without the other, expected both (--times START..END --every 30m)"};
+    }
+    if (!r.pfm.empty() || !r.save_scene.empty() || r.reference || scene.render.budget_ms > 0) {
+      throw UsageError{"cloudviewer render: --times: found it with --pfm, --save-scene, --quality reference or a budget, "
+                       "expected a sequence of PNGs alone"};
+    }
+    const std::int64_t count = (*core::parse_iso_utc(r.times_to) - *core::parse_iso_utc(r.times_from)) / r.every_s + 1;
+    if (count > 100000) {
+      throw UsageError{"cloudviewer render: --times and --every: found " + std::to_string(count) + " frames, expected at most 100000"};
+    }
+  }
   if (!r.reference && (r.spp_given || r.target_error > 0.0)) {
     throw UsageError{"cloudviewer render: --spp and --target-error: found them without a path tracer, expected --quality reference"};
   }
@@ -348,8 +429,18 @@ const char* render_usage() {
   static const std::string text = [] {
     std::string t =
         "  render INPUT -o OUT.png   INPUT: NetCDF, .cvvol or a scene .json (docs/scene.md); options override it:\n"
-        "         [--size WxH] [--time N] [--camera lat,lon,alt_m,heading,pitch,fov] [--sun LAT,LON | --sun-time ISO]\n"
+        "         [--size WxH] [--time ISO|N] [--camera lat,lon,alt_m,heading,pitch,fov] [--sun LAT,LON | --sun-time ISO]\n"
         "         [--quality low|default|high|custom] [--accumulate N]\n"
+        "         [--time YYYY-MM-DDThh:mm:ssZ]  any instant within the file's times (between steps the medium is\n"
+        "                           interpolated); a step index N is still accepted\n"
+        "         [--interpolation auto|nearest|linear|advected]  time.interpolation: between steps, the nearest step,\n"
+        "                           a blend, or both neighbours carried along the winds then blended (auto: advected\n"
+        "                           where the file has winds, else linear)\n"
+        "         [--times START..END --every DURATION]  -o names a folder: frame_00000.png, ... at START, START +\n"
+        "                           DURATION (30m, 1h, 90s), ... up to END, with progress; frames already written\n"
+        "                           whole are skipped, so a stopped run resumes\n"
+        "         [--sun-mode valid_time|local_noon]  sun.mode: the physical sun at the instant, or for teaching the\n"
+        "                           sun at local noon over the camera (the instant's declination), so no frame is dark\n"
         "         [--quality reference [--spp N] [--target-error E]]  the GPU path tracer (full multiple scattering,\n"
         "                           clouds and a ground of constant albedo, no air): N samples per pixel at most (1024),\n"
         "                           fewer once the image's mean relative standard error is E\n"
@@ -429,14 +520,113 @@ std::vector<glm::vec4> path_trace(render::GpuRaymarcher& gpu, const core::FrameS
   return out;
 }
 
+// Whether `path` holds a whole PNG (its signature first, its IEND chunk last): a frame a run
+// that was stopped already wrote (frames are written atomically, so a partial one never has the name).
+bool complete_png(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return false;
+  const auto size = fs::file_size(path, ec);
+  if (ec || size < 20) return false;
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  unsigned char head[8], tail[8];
+  const bool ok = std::fread(head, 1, 8, f) == 8 && std::fseek(f, -8, SEEK_END) == 0 && std::fread(tail, 1, 8, f) == 8;
+  std::fclose(f);
+  static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  return ok && std::equal(head, head + 8, sig) && std::equal(tail, tail + 4, reinterpret_cast<const unsigned char*>("IEND"));
+}
+
+// --times START..END --every D: frame_00000.png, ... at START, START + D, ... up to END, each at its
+// instant (the medium interpolated, the sun at the instant), skipping frames already written whole.
+int render_series(const RenderArgs& ra, core::Scene scene) {
+  const auto t_start = clock::now();
+  core::CloudVolume vol = importers::load_scene_volume(scene, 2);
+  const auto& g = vol.grid;
+  if (g.lon_deg.count < 2 || g.lat_deg.count < 2 || g.alt_m.count < 2) {
+    throw UsageError{"cloudviewer render: " + scene.data.path + ": the volume is too small to render (at least 2 points along each axis)"};
+  }
+  core::instant_at_time(vol.times, ra.times_from, scene.data.path);  // both ends within the file (TimeError otherwise)
+  core::instant_at_time(vol.times, ra.times_to, scene.data.path);
+  const std::int64_t from = *core::parse_iso_utc(ra.times_from), to = *core::parse_iso_utc(ra.times_to);
+  std::vector<std::int64_t> instants;
+  for (std::int64_t t = from; t <= to; t += ra.every_s) instants.push_back(t);
+  std::error_code ec;
+  fs::create_directories(ra.out, ec);
+  if (!fs::is_directory(ra.out)) throw UsageError{"cloudviewer render: -o: cannot create the folder '" + ra.out + "' for the frames"};
+  auto ctx = render::make_headless_context();
+  const render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::FrameRenderer renderer(loader);
+  core::PreparedVolumeCache volumes;
+  std::printf("rendering %zu frames of %s from %s to %s every %lld s, %dx%d, quality %s, interpolation %s, sun %s, into %s\n",
+              instants.size(), scene.data.path.c_str(), ra.times_from.c_str(), ra.times_to.c_str(), static_cast<long long>(ra.every_s),
+              scene.width, scene.height, scene.render.quality.c_str(), core::time_interpolation_name(scene.time.interpolation),
+              core::sun_mode_name(scene.sun.mode), ra.out.c_str());
+  std::optional<double> exposure;  // automatic: from the first instant, so the sequence does not flicker
+  if (!scene.render.auto_exposure) exposure = scene.render.exposure;
+  int written = 0, skipped = 0, dark = 0;
+  std::string warned;
+  for (std::size_t i = 0; i < instants.size(); ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%05zu.png", i);
+    const fs::path path = fs::path(ra.out) / name;
+    const std::string iso = core::format_iso_utc(instants[i]);
+    if (complete_png(path) && exposure) {
+      ++skipped;
+      std::printf("frame %zu/%zu %s: %s already written, skipped\n", i + 1, instants.size(), iso.c_str(), path.c_str());
+      continue;
+    }
+    const auto t0 = clock::now();
+    scene.time.valid_utc = iso;
+    const core::Instant at = core::scene_instant(scene, vol, scene.data.path);
+    core::TimeInterpolationReport rep;
+    renderer.use_volume(volumes.get(scene.data.path, vol, at, scene.time.interpolation, &rep));
+    if (!rep.warning.empty() && warned != rep.warning) std::printf("warning: %s\n", (warned = rep.warning).c_str());
+    const core::FrameSpec frame = render::resolve_frame(scene, vol);
+    if (i == 0) check_view_steps(frame.march.quality.view_step_m, g.earth_radius_m, g.alt_m.last());
+    std::vector<glm::vec4> marched;
+    const std::vector<glm::vec4> pixels = renderer.render(frame, {}, {}, &marched);
+    if (!exposure) exposure = render::auto_exposure(marched);
+    const auto prepared_layer = renderer.raymarcher().last_stats().sun_down;
+    const bool in_shadow = prepared_layer || (scene.sun.mode != core::SunMode::LocalNoon &&
+        core::layer_in_earth_shadow(g, volumes.get(scene.data.path, vol, at, scene.time.interpolation)->layer,
+                                    glm::normalize(geo::sphere_to_ecef({frame.sun.subsolar_lat_deg, frame.sun.subsolar_lon_deg, 0.0}, g.earth_radius_m))));
+    dark += in_shadow ? 1 : 0;
+    if (complete_png(path)) {  // rendered only for the sequence's exposure
+      ++skipped;
+      std::printf("frame %zu/%zu %s: %s already written, skipped (rendered for the exposure)\n", i + 1, instants.size(), iso.c_str(), path.c_str());
+      continue;
+    }
+    render::ToneSettings tone;
+    tone.exposure = *exposure;
+    if (frame.march.features.atmosphere || frame.march.features.globe) tone.background = glm::dvec3(0.0);
+    const std::vector<unsigned char> rgb8 = render::tonemap_srgb8(pixels, tone);
+    core::write_file_atomically(path.string(), [&](std::FILE* f) { render::encode_png(f, frame.camera.width, frame.camera.height, rgb8); });
+    ++written;
+    std::printf("frame %zu/%zu %s: %s, %s%s %.1f ms, %.2f s in all%s\n", i + 1, instants.size(), iso.c_str(), path.c_str(),
+                at.between() ? "interpolated " : "at a step", at.between() ? core::time_interpolation_name(rep.used) : "",
+                rep.cost_ms, seconds_since(t0), in_shadow ? " (dark: the cloud layer is in the Earth's shadow)" : "");
+    std::fflush(stdout);
+  }
+  std::printf("wrote %d frame(s), skipped %d already written, in %.1f s; exposure %.4g\n", written, skipped, seconds_since(t_start), *exposure);
+  if (dark > 0 && scene.sun.mode != core::SunMode::LocalNoon) {
+    std::printf("hint: %d frame(s) are dark (the whole cloud layer in the Earth's shadow); --sun-mode local_noon keeps the clouds lit for teaching\n", dark);
+  }
+  return 0;
+}
+
 int cmd_render(const std::vector<std::string>& args) {
   core::Scene scene;
   const RenderArgs ra = parse_render_args(args, scene);
+  if (!ra.times_from.empty()) return render_series(ra, scene);
   auto t0 = clock::now();
-  core::CloudVolume vol = importers::load_scene_volume(scene, 1);  // one time step is rendered
-  if (static_cast<std::size_t>(scene.time_step) >= vol.times.size()) {
+  core::CloudVolume vol = importers::load_scene_volume(scene, 2);  // an instant between steps needs both
+  if (scene.time.valid_utc.empty() && static_cast<std::size_t>(scene.time_step) >= vol.times.size()) {
     throw UsageError{"cloudviewer render: --time (time_step): found " + std::to_string(scene.time_step) + ", the input has " +
                      std::to_string(vol.times.size()) + " time step(s)"};
+  }
+  const core::Instant instant = core::scene_instant(scene, vol, scene.data.path);
+  if (vol.times.size() == 1 && !scene.time.valid_utc.empty()) {
+    std::printf("the input has one time step (%s): it renders as a still\n", vol.times[0].iso_utc.c_str());
   }
   const auto& g = vol.grid;
   if (g.lon_deg.count < 2 || g.lat_deg.count < 2 || g.alt_m.count < 2) {
@@ -445,21 +635,36 @@ int cmd_render(const std::vector<std::string>& args) {
                      " points; rendering needs at least 2 along each axis"};
   }
   core::PreparedVolumeCache volumes;
-  const auto prepared = volumes.get(scene.data.path, vol, static_cast<std::size_t>(scene.time_step));
+  core::TimeInterpolationReport interp;
+  const auto prepared = volumes.get(scene.data.path, vol, instant, scene.time.interpolation, &interp);
   const double t_load = seconds_since(t0);
+  if (instant.between()) {
+    const core::ValidTime& a = vol.times[instant.step0];
+    const core::ValidTime& b = vol.times[instant.step1];
+    std::printf("time %s: between steps %zu (%s) and %zu (%s) at %.3f of the %.4g h gap, interpolation %s",
+                instant.iso_utc.c_str(), instant.step0, a.iso_utc.c_str(), instant.step1, b.iso_utc.c_str(), instant.fraction,
+                instant.gap_s / 3600.0, core::time_interpolation_name(interp.used));
+    if (interp.used == core::TimeInterpolation::Advected) {
+      std::printf(" (%d trajectory sub-step(s), winds up to %.3g cells over the gap%s)", interp.substeps, interp.max_courant,
+                  interp.vertical_wind ? ", vertical wind included" : ", no vertical wind in the file");
+    }
+    std::printf(": %.1f ms on the CPU, once per instant (each frame of an animation at a new instant pays it)\n", interp.cost_ms);
+    if (!interp.warning.empty()) std::printf("warning: %s\n", interp.warning.c_str());
+  }
 
   // Resolve everything the scene left automatic, so the saved scene reproduces this image exactly.
   core::FrameSpec frame = render::resolve_frame(scene, vol);
   check_view_steps(frame.march.quality.view_step_m, g.earth_radius_m, prepared->layer.empty ? g.alt_m.last() : prepared->layer.top_m);
   const core::Camera& cam = frame.camera;
   const core::Sun& sun = frame.sun;
-  const core::ValidTime& vt = vol.times[static_cast<std::size_t>(scene.time_step)];
+  const core::ValidTime vt{instant.unix_s, instant.iso_utc};
   if (scene.sun.mode == core::SunMode::ValidTime && !frame.valid_time_known) {
     std::printf("the input has no valid times: the sun is put at noon over the camera (set it with --sun)\n");
   }
   std::printf("sun overhead at %.2f, %.2f (%s)\n", sun.subsolar_lat_deg, sun.subsolar_lon_deg,
-              scene.sun.mode == core::SunMode::Manual     ? "set by hand"
-              : scene.sun.mode == core::SunMode::DateTime ? scene.sun.datetime_utc.c_str()
+              scene.sun.mode == core::SunMode::Manual      ? "set by hand"
+              : scene.sun.mode == core::SunMode::DateTime  ? scene.sun.datetime_utc.c_str()
+              : scene.sun.mode == core::SunMode::LocalNoon ? "sun mode local_noon: noon over the camera, for teaching"
               : frame.valid_time_known                    ? "from the valid time"
                                                           : "default");
   auto ctx = render::make_headless_context();
@@ -479,6 +684,7 @@ int cmd_render(const std::vector<std::string>& args) {
   scene.render.march.quality.view_step_m = frame.march.quality.view_step_m;
   if (ra.march_overridden) scene.render.quality = "custom";
   scene.camera = cam;
+  const core::SunMode scene_sun_mode = scene.sun.mode;
   scene.sun.mode = core::SunMode::Manual;
   scene.sun.subsolar_lat_deg = sun.subsolar_lat_deg, scene.sun.subsolar_lon_deg = sun.subsolar_lon_deg;
   if (scene.render.budget_ms > 0.0) {  // the quality knobs chosen here, on this scene at this size
@@ -513,11 +719,11 @@ int cmd_render(const std::vector<std::string>& args) {
   const std::string model =
       march.medium.ms_two_stream ? std::string("two-stream multiple scattering") : std::to_string(march.quality.octaves) + " octaves";
   if (ra.reference) {
-    std::printf("rendering %s, time step %d (%s), %dx%d, quality reference: the GPU path tracer, up to %d samples per pixel%s\n",
-                scene.data.path.c_str(), scene.time_step, vt.iso_utc.c_str(), cam.width, cam.height, ra.spp,
+    std::printf("rendering %s, time step %zu (%s), %dx%d, quality reference: the GPU path tracer, up to %d samples per pixel%s\n",
+                scene.data.path.c_str(), instant.step0, vt.iso_utc.c_str(), cam.width, cam.height, ra.spp,
                 ra.target_error > 0.0 ? (", to a relative standard error of " + core::short_number(ra.target_error)).c_str() : "");
-  } else std::printf("rendering %s, time step %d (%s), %dx%d%s, quality %s: view step %.0f m, %d sun steps, %s, %d frame(s)\n",
-              scene.data.path.c_str(), scene.time_step, vt.iso_utc.c_str(), cam.width, cam.height,
+  } else std::printf("rendering %s, time step %zu (%s), %dx%d%s, quality %s: view step %.0f m, %d sun steps, %s, %d frame(s)\n",
+              scene.data.path.c_str(), instant.step0, vt.iso_utc.c_str(), cam.width, cam.height,
               mw != cam.width || mh != cam.height ? (" marched at " + std::to_string(mw) + "x" + std::to_string(mh)).c_str() : "",
               rs.quality.c_str(), march.quality.view_step_m, march.quality.sun_steps, model.c_str(), frame.accumulate);
 
@@ -559,6 +765,11 @@ int cmd_render(const std::vector<std::string>& args) {
               static_cast<unsigned long long>(ms.sun_samples), static_cast<unsigned long long>(ms.sun_skipped),
               static_cast<unsigned long long>(ms.rays_missed), mw * mh, march.features.skip_empty ? "" : " (skipping off)");
   if (ms.sun_down) std::printf("the sun is below the horizon for the whole cloud layer: sun marches and octave sums left out\n");
+  if (!ra.reference && scene_sun_mode != core::SunMode::LocalNoon && !prepared->layer.empty &&
+      core::layer_in_earth_shadow(g, prepared->layer, glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, g.earth_radius_m)))) {
+    std::printf("hint: at %s the whole cloud layer is in the Earth's shadow, so the image is dark; --sun-mode local_noon "
+                "(sun.mode \"local_noon\") keeps the clouds lit for teaching\n", vt.iso_utc.c_str());
+  }
   if (ms.octave_terms_full > ms.octave_terms) {
     std::printf("octave gate: %llu of %llu octave terms evaluated at sunlit samples (%.1f %% left out where the cloud is thin)\n",
                 static_cast<unsigned long long>(ms.octave_terms), static_cast<unsigned long long>(ms.octave_terms_full),

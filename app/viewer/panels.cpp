@@ -17,6 +17,7 @@
 #include "viewer/camera_controller.hpp"
 #include "scene/quality.hpp"
 #include "scene/scene_json.hpp"
+#include "scene/instant.hpp"
 
 namespace cv::viewer {
 namespace {
@@ -29,7 +30,47 @@ bool slider_double(const char* label, double* v, double lo, double hi, const cha
   return ImGui::SliderScalar(label, ImGuiDataType_Double, v, &lo, &hi, fmt, flags | ImGuiSliderFlags_AlwaysClamp);
 }
 
-void data_panel(ViewerState& s) {
+// The timeline: play/pause, step back and forward, loop, speed, frames per step, the interpolation,
+// and a scrubber in hours with the file's steps marked under it.
+void time_controls(ViewerState& s) {
+  Playhead& p = s.play;
+  const auto& times = s.volume.times;
+  const auto follow = [&] { s.scene.time.valid_utc = core::format_iso_utc(p.shown()); };
+  if (s.scene.time.valid_utc.empty()) p.t_s = double(times[static_cast<std::size_t>(s.scene.time_step)].unix_s);
+  if (ImGui::Button(p.playing ? "pause" : "play")) {
+    p.playing = !p.playing;
+    follow();
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("<")) p.step(times, -1), follow();
+  ImGui::SameLine();
+  if (ImGui::Button(">")) p.step(times, +1), follow();
+  ImGui::SameLine();
+  ImGui::Checkbox("loop", &p.loop);
+  float speed = static_cast<float>(p.speed_h_per_s);
+  if (ImGui::SliderFloat("forecast h / s", &speed, 0.05f, 48.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) p.speed_h_per_s = speed;
+  if (ImGui::SliderInt("frames per step", &p.frames_per_step, 1, 64)) p.reset(times);
+  int mode = static_cast<int>(s.scene.time.interpolation);
+  if (ImGui::Combo("between steps", &mode, "auto\0nearest\0linear\0advected\0")) s.scene.time.interpolation = static_cast<core::TimeInterpolation>(mode);
+  const float span_h = static_cast<float>((p.last_s - p.first_s) / 3600.0);
+  float h = static_cast<float>((p.t_s - p.first_s) / 3600.0);
+  if (ImGui::SliderFloat("hours", &h, 0.0f, span_h, "%.2f")) {
+    p.t_s = p.first_s + double(h) * 3600.0;
+    follow();
+  }
+  // The steps, as ticks under the scrubber's track.
+  const ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
+  const float pad = ImGui::GetStyle().GrabMinSize * 0.5f + ImGui::GetStyle().FramePadding.x * 0.5f;
+  const float x0 = a.x + pad, x1 = a.x + ImGui::CalcItemWidth() - pad;
+  ImDrawList* dl = ImGui::GetWindowDrawList();
+  for (const auto& v : times) {
+    const float f = span_h > 0.0f ? static_cast<float>((double(v.unix_s) - p.first_s) / 3600.0) / span_h : 0.0f;
+    const float x = x0 + f * (x1 - x0);
+    dl->AddLine(ImVec2(x, b.y - 4.0f), ImVec2(x, b.y), IM_COL32(255, 220, 120, 255), 2.0f);
+  }
+}
+
+void data_panel(ViewerState& s, const PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Data", ImGuiTreeNodeFlags_DefaultOpen)) return;
   const auto& g = s.volume.grid;
   ImGui::TextWrapped("file: %s", s.scene.data.path.c_str());
@@ -42,8 +83,12 @@ void data_panel(ViewerState& s) {
   }
   ImGui::TextWrapped("fields: %s", fields.empty() ? "(none)" : fields.c_str());
   const int n = static_cast<int>(s.volume.times.size());
-  if (n > 1) ImGui::SliderInt("time step", &s.scene.time_step, 0, n - 1, "%d", ImGuiSliderFlags_AlwaysClamp);
-  if (s.scene.time_step < n) ImGui::Text("valid time: %s", s.volume.times[static_cast<std::size_t>(s.scene.time_step)].iso_utc.c_str());
+  if (n > 1 && ImGui::SliderInt("time step", &s.scene.time_step, 0, n - 1, "%d", ImGuiSliderFlags_AlwaysClamp)) {
+    s.scene.time.valid_utc.clear();  // the slider picks a step: the instant follows it
+  }
+  if (n > 1 && s.timeline) time_controls(s);
+  ImGui::TextWrapped("valid time: %s", ctx.instant_text.c_str());
+  if (!ctx.time_warning.empty()) ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.4f, 1.0f), "%s", ctx.time_warning.c_str());
   if (ImGui::TreeNode("import report")) {
     ImGui::BeginChild("report", ImVec2(0, 160), true, ImGuiWindowFlags_HorizontalScrollbar);
     ImGui::TextUnformatted(s.import_report.c_str());
@@ -87,7 +132,7 @@ void camera_panel(ViewerState& s, PanelContext& ctx) {
 void sun_panel(ViewerState& s, PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Sun & date/time")) return;
   int mode = static_cast<int>(s.scene.sun.mode);
-  ImGui::Combo("sun from", &mode, "valid time\0date/time (UTC)\0subsolar point\0");
+  ImGui::Combo("sun from", &mode, "valid time\0date/time (UTC)\0subsolar point\0local noon (teaching)\0");
   s.scene.sun.mode = static_cast<core::SunMode>(mode);
   if (s.scene.sun.mode == core::SunMode::DateTime) ImGui::InputText("UTC", &s.scene.sun.datetime_utc);
   if (s.scene.sun.mode == core::SunMode::Manual) {
@@ -209,7 +254,7 @@ void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats)
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(340, 520), ImGuiCond_FirstUseEver);
   if (ImGui::Begin("cloudviewer")) {
-    data_panel(state);
+    data_panel(state, ctx);
     camera_panel(state, ctx);
     sun_panel(state, ctx);
     lighting_panel(state);
@@ -240,6 +285,7 @@ void draw_stats_overlay(const FrameStats& s, int target) {
     ImGui::Text("octave terms %llu of %llu (the gate left out the rest)", static_cast<unsigned long long>(m.octave_terms),
                 static_cast<unsigned long long>(m.octave_terms_full));
     if (m.sun_down) ImGui::Text("night over the whole cloud layer: sun marches left out");
+    if (!s.prefetch.empty()) ImGui::Text("%s", s.prefetch.c_str());
   }
   ImGui::End();
 }

@@ -20,6 +20,7 @@ struct FrameStats {
   int march_w = 0, march_h = 0;
   core::MarchStats march;   // what the last marched frame sampled and left out
   std::string renderer;     // GL_RENDERER
+  std::string prefetch;     // the prefetcher's resident instants, memory and hit rate (playback)
 };
 
 // What the panels need besides the state, and what they ask of the main loop.
@@ -32,6 +33,8 @@ struct PanelContext {
   std::string scene_message;    // result of the last load/save
   double auto_exposure = 4.0;   // what the automatic exposure chose, shown while it is on
   std::string budget_text;      // the frame budget's candidate and its source, when the budget is on
+  std::string instant_text;     // the scene's instant, and how the medium there was made
+  std::string time_warning;     // why `advected` fell back to `linear` (no winds), shown on screen
 };
 
 void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats);

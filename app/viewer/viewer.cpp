@@ -12,7 +12,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <climits>
 #include <cstdio>
+#include <memory>
 
 #include "importer.hpp"
 #include "io/output_file.hpp"
@@ -29,6 +31,8 @@
 #include "scene/scene_json.hpp"
 #include "scene_source.hpp"
 #include "kernel/volume_cache.hpp"
+#include "scene/instant.hpp"
+#include "viewer/playback.hpp"
 #include "render/frame_renderer.hpp"
 #include "scene/framing.hpp"
 #include "scene/quality.hpp"
@@ -148,8 +152,22 @@ int cmd_view(const std::vector<std::string>& args) {
       } else if (a == "--frames") {
         o.frames = parse_int("--frames", next(), 1, 100000);
       } else if (a == "--time") {
-        o.time_step = parse_int("--time", next(), 0, 1000000);
+        const std::string v = next();
+        if (core::parse_iso_utc(v)) o.time_utc = v;
+        else o.time_step = parse_int("--time", v, 0, 1000000);
         o.time_given = true;
+      } else if (a == "--play") {
+        const std::string v = next();
+        try {
+          std::size_t used = 0;
+          o.play_h_per_s = std::stod(v, &used);
+          if (used != v.size()) o.play_h_per_s = -1.0;
+        } catch (const std::exception&) {
+          o.play_h_per_s = -1.0;
+        }
+        if (!(o.play_h_per_s > 0.0 && o.play_h_per_s <= 1000.0)) {
+          throw ViewerInputError("cloudviewer view: --play: found '" + v + "', expected forecast hours per second of wall time, > 0 and <= 1000");
+        }
       } else if (a == "--screenshot") {
         o.screenshot = next();
       } else if (a == "--scale") {
@@ -177,6 +195,8 @@ int cmd_view(const std::vector<std::string>& args) {
         if (!(o.frame_budget_ms >= 0.0 && o.frame_budget_ms <= 1e7)) {
           throw ViewerInputError("cloudviewer view: --frame-budget: found '" + v + "', expected a frame time in ms 0..1e7 (0: off)");
         }
+      } else if (a == "--realtime") {
+        o.realtime = true;
       } else if (a == "--hide-ui") {
         o.hide_ui = true;
       } else if (!a.empty() && a[0] == '-') {
@@ -229,7 +249,42 @@ int run_viewer(const ViewerOptions& o) {
     return kExitBadInput;
   }
   s.import_report = s.volume.report.to_text();
-  if (!o.scene || o.time_given) s.scene.time_step = o.time_step;
+  if (!o.scene || o.time_given) s.scene.time_step = o.time_step, s.scene.time.valid_utc = o.time_utc;
+  // The timeline: from the scene's instant; a file with one step is a still (with a note).
+  bool timeline = core::times_known(s.volume.times) && s.volume.times.size() > 1;
+  if (timeline) {
+    try {
+      core::check_time_axis(s.volume.times, s.scene.data.path);
+    } catch (const core::TimeError& e) {  // steps by index still work; instants between them do not
+      std::fprintf(stderr, "%s; the timeline is off\n", e.what());
+      timeline = false;
+    }
+  }
+  if (s.volume.times.size() == 1) std::printf("%s has one time step (%s): it shows as a still\n", o.input.c_str(), s.volume.times[0].iso_utc.c_str());
+  try {
+    s.play.t_s = double(core::scene_instant(s.scene, s.volume, s.scene.data.path).unix_s);
+  } catch (const core::TimeError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  }
+  s.play.reset(s.volume.times);
+  if (o.play_h_per_s > 0.0) {
+    if (!timeline) {
+      std::fprintf(stderr, "cloudviewer view: --play: %s has %s, expected at least two steps with UTC valid times\n", o.input.c_str(),
+                   s.volume.times.size() == 1 ? "one time step" : "no UTC valid times");
+      return kExitBadInput;
+    }
+    s.play.playing = true;
+    s.play.speed_h_per_s = o.play_h_per_s;
+    s.scene.time.valid_utc = core::format_iso_utc(s.play.shown());
+  }
+  // Instants are prepared off the render thread, from the prefetcher's own copy of the data.
+  constexpr std::size_t kResidentInstants = 6;
+  std::unique_ptr<Prefetcher> prefetch;
+  if (timeline) prefetch = std::make_unique<Prefetcher>(s.scene, kResidentInstants);
+  s.timeline = timeline;
+  std::int64_t shown_instant = INT64_MIN;  // the instant whose medium is on the GPU
+  bool have_volume = false;
   s.scene.width = o.width;
   s.scene.height = o.height;
   // As `render` does: the quality preset's settings, the view step from the grid's vertical spacing.
@@ -322,7 +377,79 @@ int run_viewer(const ViewerOptions& o) {
     s.scene.camera->width = mw;
     s.scene.camera->height = mh;
     s.scene.time_step = std::clamp(s.scene.time_step, 0, static_cast<int>(s.volume.times.size()) - 1);
-    renderer.use_volume(volumes.get(s.scene.data.path, s.volume, static_cast<std::size_t>(s.scene.time_step)));
+    // Playback: the playhead moves (one grid instant per frame with --frames, else by wall time) and
+    // the scene's instant follows it; the medium comes from the prefetcher, and while the next
+    // instant is not ready the playhead waits on the one shown.
+    const bool on_timeline = prefetch && !s.scene.time.valid_utc.empty();
+    if (prefetch && s.play.playing) {
+      if (s.scene.time.valid_utc.empty()) s.play.t_s = double(s.volume.times[static_cast<std::size_t>(s.scene.time_step)].unix_s);
+      if (frame > 0 && have_volume) {
+        if (o.frames > 0 && !o.realtime) s.play.advance_one();
+        else s.play.advance(dt);
+      }
+      s.scene.time.valid_utc = core::format_iso_utc(s.play.shown());
+    }
+    if (prefetch && (on_timeline || s.play.playing)) {
+      const std::int64_t want_t = *core::parse_iso_utc(s.scene.time.valid_utc);
+      std::vector<std::int64_t> wanted = {want_t};
+      if (s.play.playing) {
+        const std::vector<std::int64_t> next = s.play.upcoming(static_cast<int>(kResidentInstants) - 1);
+        wanted.insert(wanted.end(), next.begin(), next.end());
+      }
+      prefetch->want(wanted, s.scene.time.interpolation);
+      core::TimeInterpolationReport interp;
+      const bool first_ask = want_t != shown_instant;
+      auto v = first_ask ? prefetch->get(want_t, (o.frames > 0 && !o.realtime) || !have_volume, &interp) : nullptr;
+      if (v) {
+        renderer.use_volume(v);
+        shown_instant = want_t;
+        // The step slider shows the step at or before the instant.
+        s.scene.time_step = static_cast<int>(core::instant_at_time(s.volume.times, s.scene.time.valid_utc, s.scene.data.path).step0);
+        have_volume = true;
+        ctx.time_warning = interp.warning;
+        if (o.frames > 0 && s.play.playing) std::printf("frame %d: instant %s\n", frame, s.scene.time.valid_utc.c_str());
+      } else if (first_ask) {
+        if (!prefetch->error().empty()) std::fprintf(stderr, "%s\n", prefetch->error().c_str());
+        // Not ready: show the instant on the GPU, and hold the playhead there.
+        if (have_volume) {
+          s.scene.time.valid_utc = core::format_iso_utc(shown_instant);
+          if (s.play.playing) s.play.t_s = double(shown_instant);
+        }
+      }
+      const PrefetchStats ps = prefetch->stats();
+      char text[200];
+      std::snprintf(text, sizeof text, "prefetch: %zu/%zu instants resident, %.1f MB, hits %zu, misses %zu (%.0f %%), last %.0f ms",
+                    ps.resident, ps.max_resident, double(ps.resident_bytes) / 1e6, ps.hits, ps.misses,
+                    ps.hits + ps.misses ? 100.0 * double(ps.hits) / double(ps.hits + ps.misses) : 0.0, ps.last_prepare_ms);
+      stats.prefetch = text;
+    } else {  // the scene's instant: between steps the medium is interpolated once per instant (core::PreparedVolumeCache)
+      core::Instant at;
+      try {
+        at = core::scene_instant(s.scene, s.volume, s.scene.data.path);
+      } catch (const core::TimeError& e) {
+        std::fprintf(stderr, "%s; the time step is used instead\n", e.what());
+        s.scene.time.valid_utc.clear();
+        at = core::instant_at_step(s.volume.times, static_cast<std::size_t>(s.scene.time_step), s.scene.data.path);
+      }
+      core::TimeInterpolationReport interp;
+      renderer.use_volume(volumes.get(s.scene.data.path, s.volume, at, s.scene.time.interpolation, &interp));
+      ctx.time_warning = interp.warning;
+      ctx.instant_text = at.iso_utc + (at.between() ? std::string(" (") + core::time_interpolation_name(interp.used) + " between steps)" : "");
+      have_volume = true;
+      shown_instant = INT64_MIN;
+    }
+    if (core::times_known(s.volume.times)) {  // the valid time shown, and the local solar time at the view centre
+      const std::int64_t t = shown_instant != INT64_MIN ? shown_instant
+                             : !s.scene.time.valid_utc.empty() ? *core::parse_iso_utc(s.scene.time.valid_utc)
+                                                               : s.volume.times[static_cast<std::size_t>(s.scene.time_step)].unix_s;
+      const double lon = view_centre_lon_deg(*s.scene.camera, g.earth_radius_m);
+      const double h = local_solar_time_h(lon, t);
+      char text[160];
+      std::snprintf(text, sizeof text, "%s; local solar time %02d:%02d at the view centre (%.1f E)%s", core::format_iso_utc(t).c_str(),
+                    static_cast<int>(h), static_cast<int>(std::fmod(h * 60.0, 60.0)), lon,
+                    s.scene.sun.mode == core::SunMode::LocalNoon ? "; sun: local noon (teaching)" : "");
+      ctx.instant_text = text;
+    }
     if (presenter.width() != mw || presenter.height() != mh) presenter.resize(mw, mh);
     // The frame as `render` resolves it (camera at the march size, sun, settings).
     core::FrameSpec spec;
@@ -386,6 +513,7 @@ int run_viewer(const ViewerOptions& o) {
                   o.screenshot.c_str(), fbw, fbh, accumulated, std::chrono::duration<double>(clock::now() - start).count(),
                   stats.march_ms, stats.renderer.c_str());
       if (budget.on()) std::printf("frame budget %g ms: ended on %s\n", s.scene.render.budget_ms, budget.status().c_str());
+      if (!stats.prefetch.empty()) std::printf("%s\n", stats.prefetch.c_str());
     }
     win->swap_buffers();
     ++fps_frames;

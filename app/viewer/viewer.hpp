@@ -16,6 +16,9 @@ struct ViewerOptions {
   bool time_given = false, scale_given = false;
   int width = 1280, height = 720;  // window size, screen pixels
   int time_step = 0;
+  std::string time_utc;     // --time ISO: an instant (between steps: interpolated)
+  double play_h_per_s = 0.0;  // --play H: start playing at H forecast hours per second (0: paused)
+  bool realtime = false;      // --realtime: with --frames, playback follows wall time and does not wait (measures the prefetch)
   int frames = 0;           // 0: interactive until the window closes
   std::string screenshot;   // PNG of the window's framebuffer after the last frame
   bool hide_ui = false;     // start with the panels hidden (F1 toggles them)

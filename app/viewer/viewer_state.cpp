@@ -33,7 +33,8 @@ bool same_camera(const std::optional<core::Camera>& a, const std::optional<core:
 }  // namespace
 
 bool same_march(const core::Scene& a, const core::Scene& b) {
-  return a.data.path == b.data.path && a.time_step == b.time_step && same_camera(a.camera, b.camera) && a.width == b.width &&
+  return a.data.path == b.data.path && a.time_step == b.time_step && a.time.valid_utc == b.time.valid_utc &&
+         a.time.interpolation == b.time.interpolation && same_camera(a.camera, b.camera) && a.width == b.width &&
          a.height == b.height && a.sun.mode == b.sun.mode && a.sun.datetime_utc == b.sun.datetime_utc &&
          a.sun.subsolar_lat_deg == b.sun.subsolar_lat_deg && a.sun.subsolar_lon_deg == b.sun.subsolar_lon_deg &&
          a.sun.irradiance == b.sun.irradiance && core::same_image(a.render.march, b.render.march) &&

@@ -12,6 +12,7 @@
 #include "settings/march_settings.hpp"
 #include "scene/scene.hpp"
 #include "volume/cloud_volume.hpp"
+#include "viewer/playback.hpp"
 
 namespace cv::viewer {
 
@@ -25,6 +26,8 @@ struct ViewerState {
   core::CloudVolume volume;
   std::string import_report;  // the importer's report as text, for the data panel
   bool fly_mode = false;      // the camera panel's mode; mouse and keys follow it
+  Playhead play;              // the timeline: where in the file's times, playing or not
+  bool timeline = false;      // the file has two or more ascending UTC valid times: play, scrub
 };
 
 

@@ -5,8 +5,41 @@
 
 namespace cv::core {
 
+std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string& source, CloudVolume& volume, const Instant& at,
+                                                               TimeInterpolation mode, TimeInterpolationReport* report) {
+  if (!at.between()) {
+    if (report) *report = TimeInterpolationReport{};
+    return get(source, volume, at.step0);
+  }
+  const auto it = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) {
+    return e.source == source && e.step == at.step0 && e.step1 == at.step1 && e.fraction == at.fraction && e.mode == mode;
+  });
+  if (it != entries_.end()) {
+    Entry e = *it;
+    entries_.erase(it);
+    entries_.push_back(e);
+    if (report) *report = e.report, report->cost_ms = 0.0;
+    return e.volume;
+  }
+  // Each step's medium and winds taken before the next step is loaded (which may evict it).
+  const GridMeanExtinction e0 = grid_mean_extinction(volume.grid, volume.step(at.step0));
+  const StepWinds w0 = step_winds(volume.step(at.step0));
+  const GridMeanExtinction e1 = grid_mean_extinction(volume.grid, volume.step(at.step1));
+  const StepWinds w1 = step_winds(volume.step(at.step1));
+  Entry e;
+  e.source = source, e.step = at.step0, e.step1 = at.step1, e.fraction = at.fraction, e.mode = mode;
+  GridMeanExtinction mixed = interpolate_extinction(volume.grid, e0, e1, w0, w1, at.gap_s, at.fraction, mode, &e.report);
+  e.volume = std::make_shared<const PreparedVolume>(prepare_volume(volume.grid, std::move(mixed)));
+  ++prepared_;
+  entries_.push_back(e);
+  if (entries_.size() > kResident) entries_.erase(entries_.begin());
+  if (report) *report = e.report;
+  return e.volume;
+}
+
 std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string& source, CloudVolume& volume, std::size_t step) {
-  const auto it = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.source == source && e.step == step; });
+  const auto it = std::find_if(entries_.begin(), entries_.end(),
+                               [&](const Entry& e) { return e.source == source && e.step == step && e.step1 == step; });
   if (it != entries_.end()) {
     Entry e = *it;
     entries_.erase(it);
@@ -15,7 +48,9 @@ std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string
   }
   auto v = std::make_shared<const PreparedVolume>(prepare_volume(volume.grid, volume.step(step)));
   ++prepared_;
-  entries_.push_back({source, step, v});
+  Entry e;
+  e.source = source, e.step = e.step1 = step, e.volume = v;
+  entries_.push_back(e);
   if (entries_.size() > kResident) entries_.erase(entries_.begin());
   return v;
 }

@@ -9,7 +9,9 @@
 #include <vector>
 
 #include "kernel/prepared_volume.hpp"
+#include "scene/instant.hpp"
 #include "volume/cloud_volume.hpp"
+#include "volume/time_interpolation.hpp"
 
 namespace cv::core {
 
@@ -19,6 +21,12 @@ class PreparedVolumeCache {
   // The prepared time step `step` of `volume`, whose data are named by `source` (a file path):
   // from the cache, or prepared now (evicting the least recently used beyond kResident).
   std::shared_ptr<const PreparedVolume> get(const std::string& source, CloudVolume& volume, std::size_t step);
+  // The medium at an instant: the step itself at a step, else the two neighbouring steps'
+  // extinction interpolated (interpolate_extinction) and prepared, once per instant and mode.
+  // `report` receives what the interpolation did (its cost, or 0 when it came from the cache).
+  // `volume` must keep at least two steps decoded (CloudVolume::set_loader's cache_steps).
+  std::shared_ptr<const PreparedVolume> get(const std::string& source, CloudVolume& volume, const Instant& at,
+                                            TimeInterpolation mode, TimeInterpolationReport* report = nullptr);
   // How many preparations get has run: a test of the cache, and what the viewer's overlay reports.
   std::size_t prepared() const { return prepared_; }
 
@@ -26,6 +34,11 @@ class PreparedVolumeCache {
   struct Entry {
     std::string source;
     std::size_t step = 0;
+    // Between steps: the later step, the fraction and the mode asked for (step1 == step: a step).
+    std::size_t step1 = 0;
+    double fraction = 0.0;
+    TimeInterpolation mode = TimeInterpolation::Auto;
+    TimeInterpolationReport report;
     std::shared_ptr<const PreparedVolume> volume;
   };
   std::vector<Entry> entries_;  // most recently used last

@@ -9,6 +9,7 @@
 #include "frame/camera.hpp"
 #include "frame/sun.hpp"
 #include "settings/march_settings.hpp"
+#include "scene/instant.hpp"
 #include "scene/scene.hpp"
 #include "volume/cloud_volume.hpp"
 
@@ -23,13 +24,18 @@ struct FrameSpec {
   double exposure = 4.0;
   bool auto_exposure = false;  // exposure from the marched image (render::auto_exposure), not the number
   bool valid_time_known = false;  // the data's time step has a UTC valid time (else the sun is at noon over the camera)
+  Instant instant;                // where the scene's time falls among the file's steps
 };
+
+// The scene's instant in `volume`: time.valid_utc when set, else time_step (TimeError otherwise,
+// naming `source`, the file).
+Instant scene_instant(const Scene& scene, const CloudVolume& volume, const std::string& source);
 
 // The march size of an output of width x height at a resolution scale (clamped to 0.01..1):
 // each side rounded, at least 1 pixel.
 void march_size(int width, int height, double resolution_scale, int& march_w, int& march_h);
 
-// Resolves scene.time_step of `volume` (which must hold it: std::out_of_range otherwise). The camera
+// Resolves the scene's instant in `volume` (scene_instant: TimeError when the file does not hold it). The camera
 // frames the volume from the south when the scene has none; the sun follows scene.sun (from the
 // valid time unless set). The ground texture stays as the scene names it (the render layer finds it).
 FrameSpec resolve_frame(const Scene& scene, const CloudVolume& volume);

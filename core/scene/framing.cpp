@@ -59,6 +59,26 @@ std::optional<std::int64_t> parse_iso_utc(const std::string& text) {
   return days * 86400 + h * 3600 + mi * 60 + s;
 }
 
+const char* sun_mode_name(SunMode m) {
+  switch (m) {
+    case SunMode::ValidTime: return "valid_time";
+    case SunMode::DateTime: return "datetime";
+    case SunMode::Manual: return "manual";
+    case SunMode::LocalNoon: return "local_noon";
+  }
+  return "valid_time";
+}
+
+bool parse_sun_mode(const std::string& text, SunMode& out) {
+  for (SunMode m : {SunMode::ValidTime, SunMode::DateTime, SunMode::Manual, SunMode::LocalNoon}) {
+    if (text == sun_mode_name(m)) {
+      out = m;
+      return true;
+    }
+  }
+  return false;
+}
+
 Sun resolve_sun(const SunSpec& spec, const std::optional<std::int64_t>& valid_time_unix_s, double fallback_lon_deg) {
   Sun s;
   s.irradiance = glm::dvec3(spec.irradiance);
@@ -75,6 +95,10 @@ Sun resolve_sun(const SunSpec& spec, const std::optional<std::int64_t>& valid_ti
     case SunMode::ValidTime:
       when = valid_time_unix_s;
       break;
+    case SunMode::LocalNoon:  // the season's declination, the hour always noon over the camera
+      s.subsolar_lat_deg = valid_time_unix_s ? geo::subsolar_point(*valid_time_unix_s).lat_deg : 0.0;
+      s.subsolar_lon_deg = fallback_lon_deg;
+      return s;
   }
   if (when) {
     const geo::SubsolarPoint sp = geo::subsolar_point(*when);

@@ -20,7 +20,12 @@ Camera auto_camera(const VolumeGrid& grid, int width, int height);
 // fraction is dropped), or nothing when the text is not such a date-time.
 std::optional<std::int64_t> parse_iso_utc(const std::string& text);
 
-// The sun a scene asks for. `valid_time` is the data's valid time (nothing when unknown, e.g. a
+// sun.mode in scene files: "valid_time", "datetime", "manual", "local_noon" (parse: false otherwise).
+const char* sun_mode_name(SunMode m);
+bool parse_sun_mode(const std::string& text, SunMode& out);
+
+// The sun a scene asks for. A LocalNoon sun stands over `fallback_lon_deg` (the camera's longitude)
+// at the declination of the valid time (0 without one). `valid_time` is the data's valid time (nothing when unknown, e.g. a
 // file without a time axis); then a ValidTime sun stands at noon over `fallback_lon_deg`.
 // Throws std::invalid_argument when a DateTime sun has no parseable date-time.
 Sun resolve_sun(const SunSpec& spec, const std::optional<std::int64_t>& valid_time_unix_s, double fallback_lon_deg);

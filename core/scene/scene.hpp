@@ -10,6 +10,7 @@
 
 #include "frame/camera.hpp"
 #include "settings/march_settings.hpp"
+#include "volume/time_interpolation.hpp"
 
 namespace cv::core {
 
@@ -22,9 +23,10 @@ struct DataSource {
   double dz_m = 0.0;  // vertical spacing of the resampled grid; 0: the importer's default
 };
 
-// How the sun is placed: where it stood at the data's valid time, at a given UTC date/time, or by
-// hand through its subsolar point.
-enum class SunMode { ValidTime, DateTime, Manual };
+// How the sun is placed: where it stood at the data's valid time (the scene's instant), at a given
+// UTC date/time, by hand through its subsolar point, or for teaching at local noon over the camera's
+// longitude (the declination of the instant kept), so an animation never goes dark.
+enum class SunMode { ValidTime, DateTime, Manual, LocalNoon };
 struct SunSpec {
   SunMode mode = SunMode::ValidTime;
   std::string datetime_utc;  // ISO 8601, for SunMode::DateTime
@@ -65,10 +67,18 @@ struct RenderSettings {
   double budget_ms = 0.0;
 };
 
+// The scene's instant: a UTC valid time anywhere within the file's times (between two steps the
+// medium is interpolated), or, when valid_utc is empty, the time step `Scene::time_step`.
+struct TimeSpec {
+  std::string valid_utc;  // ISO 8601, YYYY-MM-DDThh:mm:ssZ; empty: Scene::time_step
+  TimeInterpolation interpolation = TimeInterpolation::Auto;  // auto: advected where the file has winds, else linear
+};
+
 struct Scene {
   static constexpr int kVersion = 1;
   DataSource data;
   int time_step = 0;
+  TimeSpec time;
   // No camera: frame the volume from the south and above (auto_camera in the renderer).
   std::optional<Camera> camera;
   int width = 960, height = 540;

@@ -172,12 +172,9 @@ void read_camera(const Reader& r, Camera& c) {
 
 void read_sun(const Reader& r, SunSpec& s) {
   r.only({"mode", "datetime_utc", "subsolar_lat_deg", "subsolar_lon_deg", "irradiance"});
-  std::string mode = s.mode == SunMode::Manual ? "manual" : s.mode == SunMode::DateTime ? "datetime" : "valid_time";
+  std::string mode = sun_mode_name(s.mode);
   r.string("mode", mode);
-  if (mode == "valid_time") s.mode = SunMode::ValidTime;
-  else if (mode == "datetime") s.mode = SunMode::DateTime;
-  else if (mode == "manual") s.mode = SunMode::Manual;
-  else r.fail("mode", shown(json(mode)), "\"valid_time\", \"datetime\" or \"manual\"");
+  if (!parse_sun_mode(mode, s.mode)) r.fail("mode", shown(json(mode)), "\"valid_time\", \"datetime\", \"manual\" or \"local_noon\"");
   r.string("datetime_utc", s.datetime_utc);
   if ((s.mode == SunMode::DateTime || !s.datetime_utc.empty()) && !parse_iso_utc(s.datetime_utc)) {
     r.fail("datetime_utc", shown(json(s.datetime_utc)), "a UTC date-time YYYY-MM-DDThh:mm:ssZ");
@@ -189,6 +186,19 @@ void read_sun(const Reader& r, SunSpec& s) {
 
 // render.march, row by row from the table (settings/march_settings.def): its keys, its ranges
 // and its wording, so a new row is read without a line here.
+void read_time(const Reader& r, TimeSpec& t) {
+  r.only({"valid_utc", "interpolation"});
+  r.string("valid_utc", t.valid_utc);
+  if (!t.valid_utc.empty() && !parse_iso_utc(t.valid_utc)) {
+    r.fail("valid_utc", shown(json(t.valid_utc)), "a UTC date-time YYYY-MM-DDThh:mm:ssZ (or \"\": time_step)");
+  }
+  std::string interp = time_interpolation_name(t.interpolation);
+  r.string("interpolation", interp);
+  if (!parse_time_interpolation(interp, t.interpolation)) {
+    r.fail("interpolation", shown(json(interp)), "\"auto\", \"nearest\", \"linear\" or \"advected\"");
+  }
+}
+
 void read_march(const Reader& r, MarchSettings& m) {
   std::vector<const char*> keys;
   for (const SettingRow& row : kMarchSettingRows) keys.push_back(row.key);
@@ -300,7 +310,7 @@ Scene scene_from_json(const std::string& text, const std::string& source) {
   }
   if (!root.is_object()) throw SceneError(source + ": found " + shown(root) + " at the top, expected a JSON object { ... }");
   const Reader r(source, root, "");
-  r.only({"version", "data", "time_step", "camera", "width", "height", "sun", "render", "overlays"});
+  r.only({"version", "data", "time_step", "time", "camera", "width", "height", "sun", "render", "overlays"});
   const json* version = r.find("version");
   if (!version) r.fail("version", "nothing", "\"version\": " + std::to_string(Scene::kVersion));
   if (!version->is_number_integer() || version->get<long long>() < 1) r.fail("version", shown(*version), "an integer >= 1");
@@ -312,6 +322,7 @@ Scene scene_from_json(const std::string& text, const std::string& source) {
   apply_quality(scene.render.quality, scene.render);  // a scene without render keys renders at "default"
   if (const auto d = r.child("data")) read_data(*d, scene.data);
   r.integer("time_step", scene.time_step, 0, 1 << 30);
+  if (const auto t = r.child("time")) read_time(*t, scene.time);
   if (const auto c = r.child("camera")) {
     scene.camera = Camera{};
     read_camera(*c, *scene.camera);
@@ -340,6 +351,7 @@ std::string scene_to_json(const Scene& s) {
   data["levels_hpa"] = s.data.levels_hpa ? ojson(*s.data.levels_hpa) : ojson(nullptr);
   root["data"] = data;
   root["time_step"] = s.time_step;
+  root["time"] = {{"valid_utc", s.time.valid_utc}, {"interpolation", time_interpolation_name(s.time.interpolation)}};
   root["width"] = s.width;
   root["height"] = s.height;
   if (s.camera) {
@@ -349,8 +361,7 @@ std::string scene_to_json(const Scene& s) {
   } else {
     root["camera"] = nullptr;  // automatic framing
   }
-  const char* mode = s.sun.mode == SunMode::Manual ? "manual" : s.sun.mode == SunMode::DateTime ? "datetime" : "valid_time";
-  root["sun"] = {{"mode", mode},
+  root["sun"] = {{"mode", sun_mode_name(s.sun.mode)},
                  {"datetime_utc", s.sun.datetime_utc},
                  {"subsolar_lat_deg", s.sun.subsolar_lat_deg},
                  {"subsolar_lon_deg", s.sun.subsolar_lon_deg},

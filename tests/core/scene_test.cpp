@@ -31,6 +31,8 @@ Scene full_scene() {
   s.data.horizontal_stride = 3;
   s.data.dz_m = 250.0;
   s.time_step = 4;
+  s.time.valid_utc = "2024-01-15T04:30:00Z";
+  s.time.interpolation = TimeInterpolation::Linear;
   Camera c;
   c.lat_deg = -33.123456789012345, c.lon_deg = 151.2, c.alt_m = 3.6e6 / 3.0;
   c.heading_deg = 12.5, c.pitch_deg = -41.0 / 3.0, c.fov_deg = 47.0;
@@ -59,6 +61,8 @@ void expect_equal(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.data.horizontal_stride, b.data.horizontal_stride);
   EXPECT_EQ(a.data.dz_m, b.data.dz_m);
   EXPECT_EQ(a.time_step, b.time_step);
+  EXPECT_EQ(a.time.valid_utc, b.time.valid_utc);
+  EXPECT_EQ(a.time.interpolation, b.time.interpolation);
   ASSERT_EQ(a.camera.has_value(), b.camera.has_value());
   if (a.camera) {
     EXPECT_EQ(a.camera->lat_deg, b.camera->lat_deg);
@@ -189,7 +193,7 @@ TEST(SceneJson, UnknownKeysAreNamedSoTyposAreCaught) {
             "scene.json: render.march.max_sun_step_m: found -1, expected a sun step length in metres 0..1e7 (0: the grid's "
             "horizontal cell)");
   EXPECT_EQ(error_of(R"({"version": 1, "camra": {}})"),
-            "scene.json: camra: unknown key, expected one of version, data, time_step, camera, width, height, sun, render, "
+            "scene.json: camra: unknown key, expected one of version, data, time_step, time, camera, width, height, sun, render, "
             "overlays");
 }
 

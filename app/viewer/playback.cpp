@@ -1,0 +1,214 @@
+// The viewer's playhead and prefetcher.
+#include "viewer/playback.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "geo/geodesy.hpp"
+#include "geo/solar.hpp"
+#include "scene/instant.hpp"
+#include "scene_source.hpp"
+#include "volume/grid_mean.hpp"
+
+namespace cv::viewer {
+
+void Playhead::reset(const std::vector<core::ValidTime>& times) {
+  first_s = times.empty() ? 0.0 : double(times.front().unix_s);
+  last_s = times.empty() ? 0.0 : double(times.back().unix_s);
+  const double gap = times.size() > 1 ? double(times[1].unix_s - times[0].unix_s) : 3600.0;
+  quantum_s = std::max(1.0, gap / std::max(1, frames_per_step));
+  t_s = std::clamp(t_s, first_s, last_s);
+  if (still()) playing = false;
+}
+
+std::int64_t Playhead::shown() const {
+  const double k = std::round((t_s - first_s) / quantum_s);
+  return static_cast<std::int64_t>(std::llround(std::min(last_s, first_s + k * quantum_s)));
+}
+
+void Playhead::advance(double wall_s) {
+  if (!playing || still()) return;
+  t_s += wall_s * speed_h_per_s * 3600.0;
+  if (t_s > last_s) {
+    if (loop) t_s = first_s + std::fmod(t_s - first_s, last_s - first_s + quantum_s);
+    else t_s = last_s, playing = false;
+  }
+  if (t_s > last_s) t_s = last_s;
+}
+
+void Playhead::advance_one() {
+  if (!playing || still()) return;
+  const double next = double(shown()) + quantum_s;
+  if (next > last_s + 0.5) {
+    if (loop) t_s = first_s;
+    else t_s = last_s, playing = false;
+  } else {
+    t_s = next;
+  }
+}
+
+void Playhead::step(const std::vector<core::ValidTime>& times, int dir) {
+  if (times.empty()) return;
+  const double now = double(shown());
+  if (dir > 0) {
+    for (const auto& v : times)
+      if (double(v.unix_s) > now + 0.5) {
+        t_s = double(v.unix_s);
+        return;
+      }
+    t_s = loop ? first_s : last_s;
+  } else {
+    for (auto it = times.rbegin(); it != times.rend(); ++it)
+      if (double(it->unix_s) < now - 0.5) {
+        t_s = double(it->unix_s);
+        return;
+      }
+    t_s = loop ? last_s : first_s;
+  }
+}
+
+std::vector<std::int64_t> Playhead::upcoming(int n) const {
+  std::vector<std::int64_t> out;
+  double t = double(shown());
+  for (int i = 0; i < n && !still(); ++i) {
+    t += quantum_s;
+    if (t > last_s + 0.5) {
+      if (!loop) break;
+      t = first_s;
+    }
+    out.push_back(static_cast<std::int64_t>(std::llround(t)));
+  }
+  return out;
+}
+
+double view_centre_lon_deg(const core::Camera& cam, double r0_m) {
+  const glm::dvec3 o = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0_m);
+  const glm::dvec3 d = glm::normalize(core::camera_frame(cam).forward);
+  const double b = glm::dot(o, d), c = glm::dot(o, o) - r0_m * r0_m;
+  const double disc = b * b - c;
+  if (disc < 0.0 || -b - std::sqrt(disc) < 0.0) return cam.lon_deg;
+  return geo::ecef_to_sphere(o + (-b - std::sqrt(disc)) * d, r0_m).lon_deg;
+}
+
+double local_solar_time_h(double lon_deg, std::int64_t unix_s) {
+  const double h = 12.0 + (lon_deg - geo::subsolar_point(unix_s).lon_deg) / 15.0;
+  return h - 24.0 * std::floor(h / 24.0);
+}
+
+std::size_t prepared_bytes(const core::PreparedVolume& v) {
+  return (v.extinction.liquid_per_m.size() + v.extinction.ice_per_m.size() + v.columns.tau.size()) * sizeof(float) +
+         v.pyramid_packed.size() * sizeof(glm::vec2);
+}
+
+Prefetcher::Prefetcher(const core::Scene& scene, std::size_t max_resident)
+    : scene_(scene), volume_(importers::load_scene_volume(scene, 2)), max_resident_(std::max<std::size_t>(1, max_resident)) {
+  stats_.max_resident = max_resident_;
+  worker_ = std::thread([this] { run(); });
+}
+
+Prefetcher::~Prefetcher() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  changed_.notify_all();
+  worker_.join();
+}
+
+void Prefetcher::want(const std::vector<std::int64_t>& instants, core::TimeInterpolation mode) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (mode != mode_) ready_.clear();  // prepared for another mode: not what is shown now
+  mode_ = mode;
+  wanted_.assign(instants.begin(), instants.begin() + static_cast<std::ptrdiff_t>(std::min(instants.size(), max_resident_)));
+  changed_.notify_all();
+}
+
+std::shared_ptr<const core::PreparedVolume> Prefetcher::get(std::int64_t t, bool wait, core::TimeInterpolationReport* report) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (wait) changed_.wait(lock, [&] { return ready_.count(t) || !error_.empty() || stop_; });
+  const auto it = ready_.find(t);
+  if (it == ready_.end()) {
+    ++stats_.misses;
+    return nullptr;
+  }
+  ++stats_.hits;
+  if (report) *report = it->second.report;
+  return it->second.volume;
+}
+
+PrefetchStats Prefetcher::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  PrefetchStats s = stats_;
+  s.resident = ready_.size();
+  s.resident_bytes = 0;
+  for (const auto& [t, r] : ready_) s.resident_bytes += prepared_bytes(*r.volume);
+  return s;
+}
+
+std::string Prefetcher::error() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return error_;
+}
+
+void Prefetcher::run() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stop_) {
+    // The most urgent wanted instant not ready yet.
+    std::int64_t todo = 0;
+    bool found = false;
+    for (std::int64_t t : wanted_)
+      if (!ready_.count(t)) {
+        todo = t, found = true;
+        break;
+      }
+    if (!found) {
+      changed_.wait(lock);
+      continue;
+    }
+    const core::TimeInterpolation mode = mode_;
+    lock.unlock();
+    Ready r;
+    std::string error;
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      const core::Instant at = core::instant_at_time(volume_.times, core::format_iso_utc(todo), scene_.data.path);
+      core::GridMeanExtinction e0 = core::grid_mean_extinction(volume_.grid, volume_.step(at.step0));
+      if (at.between()) {
+        const core::StepWinds w0 = core::step_winds(volume_.step(at.step0));
+        const core::GridMeanExtinction e1 = core::grid_mean_extinction(volume_.grid, volume_.step(at.step1));
+        const core::StepWinds w1 = core::step_winds(volume_.step(at.step1));
+        e0 = core::interpolate_extinction(volume_.grid, e0, e1, w0, w1, at.gap_s, at.fraction, mode, &r.report);
+      }
+      r.volume = std::make_shared<const core::PreparedVolume>(core::prepare_volume(volume_.grid, std::move(e0)));
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    lock.lock();
+    if (!error.empty()) {
+      error_ = error;
+      wanted_.erase(std::remove(wanted_.begin(), wanted_.end(), todo), wanted_.end());
+      changed_.notify_all();
+      continue;
+    }
+    if (mode != mode_) continue;  // the mode changed meanwhile
+    // Room: evict what is no longer wanted (oldest instants first), never beyond the bound.
+    while (ready_.size() >= max_resident_) {
+      auto victim = ready_.end();
+      for (auto it = ready_.begin(); it != ready_.end(); ++it)
+        if (std::find(wanted_.begin(), wanted_.end(), it->first) == wanted_.end()) {
+          victim = it;
+          break;
+        }
+      if (victim == ready_.end()) victim = ready_.begin();
+      ready_.erase(victim);
+    }
+    ready_[todo] = std::move(r);
+    ++stats_.prepared;
+    stats_.last_prepare_ms = ms;
+    changed_.notify_all();
+  }
+}
+
+}  // namespace cv::viewer

@@ -1,0 +1,104 @@
+// Playing a forecast in the viewer: the playhead (play/pause, loop, speed in forecast hours per
+// second, step forward and back, scrubbing) on a grid of instants, and a prefetcher that prepares
+// the instants playback will need on its own thread, from its own copy of the data, with a bound on
+// how many stay resident.
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "frame/camera.hpp"
+#include "kernel/prepared_volume.hpp"
+#include "scene/scene.hpp"
+#include "volume/cloud_volume.hpp"
+#include "volume/time_interpolation.hpp"
+
+namespace cv::viewer {
+
+// The playhead over a file's times [first_s, last_s]. Instants shown are on a grid of quantum_s
+// (the file's first gap / frames_per_step), so prefetching knows them in advance.
+struct Playhead {
+  double first_s = 0.0, last_s = 0.0;
+  double quantum_s = 3600.0;
+  double t_s = 0.0;               // where the playhead is (continuous)
+  bool playing = false, loop = true;
+  double speed_h_per_s = 1.0;     // forecast hours per second of wall time
+  int frames_per_step = 8;
+
+  // Sets the span and the grid from the file's times (one step: a still, never playing).
+  void reset(const std::vector<core::ValidTime>& times);
+  // The instant shown: t_s on the grid.
+  std::int64_t shown() const;
+  // Moves on by `wall_s` of wall time (when playing): stops at the end, or goes back to the start on loop.
+  void advance(double wall_s);
+  // Moves on by one instant of the grid (the --frames mode: one per frame, independent of wall time).
+  void advance_one();
+  // To the previous / next step of the file (dir -1 / +1) from the playhead.
+  void step(const std::vector<core::ValidTime>& times, int dir);
+  // The next `n` instants after the shown one, as playback will need them (wrapping on loop).
+  std::vector<std::int64_t> upcoming(int n) const;
+  bool still() const { return last_s <= first_s; }
+};
+
+struct PrefetchStats {
+  std::size_t resident = 0;        // prepared instants held
+  std::size_t resident_bytes = 0;  // their memory
+  std::size_t max_resident = 0;
+  std::size_t hits = 0, misses = 0;  // instants found ready / not ready when shown
+  std::size_t prepared = 0;          // instants the worker prepared
+  double last_prepare_ms = 0.0;
+};
+
+// The longitude where the camera's centre ray meets the sphere of radius r0_m (the camera's own
+// longitude when it looks past the Earth), and the local apparent solar time there at unix_s, in
+// hours 0..24 (12 + the hour angle from the subsolar point).
+double view_centre_lon_deg(const core::Camera& cam, double r0_m);
+double local_solar_time_h(double lon_deg, std::int64_t unix_s);
+
+// Bytes a prepared instant holds (extinction, pyramid, column depths).
+std::size_t prepared_bytes(const core::PreparedVolume& v);
+
+class Prefetcher {
+ public:
+  // Opens its own copy of the scene's data (the viewer's CloudVolume stays on the render thread).
+  Prefetcher(const core::Scene& scene, std::size_t max_resident);
+  ~Prefetcher();
+  Prefetcher(const Prefetcher&) = delete;
+  Prefetcher& operator=(const Prefetcher&) = delete;
+
+  // The instants wanted, most urgent first; those beyond max_resident are ignored. Resident instants
+  // not wanted are evicted as room is needed.
+  void want(const std::vector<std::int64_t>& instants, core::TimeInterpolation mode);
+  // The prepared instant if ready (counted as a hit), else nullptr (a miss). `wait`: block until ready.
+  std::shared_ptr<const core::PreparedVolume> get(std::int64_t t, bool wait, core::TimeInterpolationReport* report = nullptr);
+  PrefetchStats stats() const;
+  std::string error() const;  // the worker's last error (a time outside the file), or empty
+
+ private:
+  struct Ready {
+    std::shared_ptr<const core::PreparedVolume> volume;
+    core::TimeInterpolationReport report;
+  };
+  void run();
+  core::Scene scene_;
+  core::CloudVolume volume_;
+  std::size_t max_resident_;
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::vector<std::int64_t> wanted_;
+  core::TimeInterpolation mode_ = core::TimeInterpolation::Auto;
+  std::map<std::int64_t, Ready> ready_;
+  PrefetchStats stats_;
+  std::string error_;
+  bool stop_ = false;
+  std::thread worker_;
+};
+
+}  // namespace cv::viewer

@@ -1,0 +1,57 @@
+// The medium between two forecast steps: the renderer's grid-mean extinction at an instant inside a
+// step interval, by the nearest step, a linear blend, or each neighbour carried along the model's
+// winds (semi-Lagrangian) and then blended. Computed once per instant on the CPU, so the GPU march
+// and the CPU reference read the same field (docs/physics.md, "Between forecast steps").
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "volume/grid_mean.hpp"
+
+namespace cv::core {
+
+enum class TimeInterpolation { Auto, Nearest, Linear, Advected };
+// "auto", "nearest", "linear", "advected" (and back); parse returns false for anything else.
+const char* time_interpolation_name(TimeInterpolation m);
+bool parse_time_interpolation(const std::string& text, TimeInterpolation& out);
+
+// One step's winds (m/s; eastward, northward, upward), each a field of the grid or empty where the
+// file has none. NaN (no data) counts as calm.
+struct StepWinds {
+  std::vector<float> u, v, w;
+  bool horizontal() const { return !u.empty() && !v.empty(); }
+};
+StepWinds step_winds(const TimeStepData& data);
+
+struct TimeInterpolationReport {
+  TimeInterpolation used = TimeInterpolation::Nearest;  // after Auto and the fallback are decided
+  std::string warning;       // not empty when `advected` fell back to `linear` (no winds)
+  int substeps = 0;          // trajectory sub-steps per neighbour (advected)
+  double max_courant = 0.0;  // the largest wind over the gap, in grid cells (advected)
+  bool vertical_wind = false;
+  // Per neighbour (earlier, later) and species (liquid, ice): the factor (<= 1) that brought the
+  // carried field's area-weighted optical depth back to its source step's where the warp raised it.
+  double rescale[2][2] = {{1.0, 1.0}, {1.0, 1.0}};
+  double cost_ms = 0.0;      // wall time of the interpolation
+};
+
+// Trajectory sub-steps are bounded: beyond it a sub-step moves more than one cell, which costs
+// trajectory accuracy but not stability (every value is interpolated from the source field).
+constexpr int kMaxAdvectionSubsteps = 64;
+
+// The extinction at `fraction` (0: the earlier step e0, 1: the later e1) of a gap of gap_s seconds.
+// Auto is advected where both steps have horizontal winds, else linear; advected without winds
+// falls back to linear and says so in report.warning. Never negative; finite for any winds and gap.
+GridMeanExtinction interpolate_extinction(const VolumeGrid& grid, const GridMeanExtinction& e0, const GridMeanExtinction& e1,
+                                          const StepWinds& w0, const StepWinds& w1, double gap_s, double fraction,
+                                          TimeInterpolation mode, TimeInterpolationReport* report = nullptr);
+
+// One field carried by the (time-interpolated) winds from step `from` (0 or 1) to `fraction`:
+// trilinear at the departure (from 0) or arrival (from 1) point of each node's trajectory, which
+// runs in sub-steps of the midpoint rule. Exposed for tests; interpolate_extinction uses it.
+std::vector<float> advect_field(const VolumeGrid& grid, const std::vector<float>& field, const StepWinds& w0,
+                                const StepWinds& w1, double gap_s, double fraction, int from, int* substeps = nullptr,
+                                double* max_courant = nullptr);
+
+}  // namespace cv::core

@@ -1,0 +1,247 @@
+// Interpolation between forecast steps (core/volume/time_interpolation): a blob carried by a uniform
+// wind has a known exact position; positivity, the no-inflation rule and stability under any winds;
+// the instant against a file's time axis and the scene's time keys.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "scene/instant.hpp"
+#include "scene/scene_json.hpp"
+#include "volume/time_interpolation.hpp"
+
+namespace cv::core {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// 64 x 9 x 3 nodes of 0.5 degree around the equator, 1 km apart from 1 km up.
+VolumeGrid strip() {
+  VolumeGrid g;
+  g.lon_deg = {0.0, 0.5, 64};
+  g.lat_deg = {-2.0, 0.5, 9};
+  g.alt_m = {1000.0, 1000.0, 3};
+  return g;
+}
+
+// A Gaussian blob of width 3 cells centred at longitude index x0, latitude row 4, every level.
+std::vector<float> blob(const VolumeGrid& g, double x0) {
+  std::vector<float> f(g.points());
+  for (int k = 0; k < g.alt_m.count; ++k)
+    for (int j = 0; j < g.lat_deg.count; ++j)
+      for (int i = 0; i < g.lon_deg.count; ++i) {
+        const double r2 = (i - x0) * (i - x0) + (j - 4.0) * (j - 4.0);
+        f[g.index(i, j, k)] = static_cast<float>(1e-3 * std::exp(-r2 / 9.0));
+      }
+  return f;
+}
+
+StepWinds uniform(const VolumeGrid& g, double u, double v = 0.0, double w = 0.0) {
+  StepWinds s;
+  s.u.assign(g.points(), static_cast<float>(u));
+  s.v.assign(g.points(), static_cast<float>(v));
+  if (w != 0.0) s.w.assign(g.points(), static_cast<float>(w));
+  return s;
+}
+
+// The longitude index of the largest value on the blob's row at the lowest level.
+int peak_x(const VolumeGrid& g, const std::vector<float>& f) {
+  int best = 0;
+  for (int i = 1; i < g.lon_deg.count; ++i)
+    if (f[g.index(i, 4, 0)] > f[g.index(best, 4, 0)]) best = i;
+  return best;
+}
+
+double total(const std::vector<float>& f) {
+  double t = 0.0;
+  for (float v : f) t += v;
+  return t;
+}
+
+// The blob at 16 cells at the earlier step and 16 cells further east at the later one, as a uniform
+// eastward wind carries it over a gap of 3 h.
+struct Carried {
+  VolumeGrid g = strip();
+  double gap_s = 3 * 3600.0;
+  double cells = 16.0;
+  double u = cells * (g.earth_radius_m + g.alt_m.start) * (0.5 * kPi / 180.0) / gap_s;  // m/s
+  GridMeanExtinction e0{blob(g, 16.0), {}}, e1{blob(g, 16.0 + cells), {}};
+  StepWinds w = uniform(g, u);
+};
+
+TEST(TimeInterpolation, AdvectedRecoversAUniformlyCarriedBlobAtHalfTheGapAndLinearDoesNot) {
+  const Carried c;
+  TimeInterpolationReport r;
+  const GridMeanExtinction adv = interpolate_extinction(c.g, c.e0, c.e1, c.w, c.w, c.gap_s, 0.5, TimeInterpolation::Advected, &r);
+  EXPECT_EQ(r.used, TimeInterpolation::Advected);
+  EXPECT_TRUE(r.warning.empty());
+  EXPECT_LE(std::abs(peak_x(c.g, adv.liquid_per_m) - 24), 1) << "the exact position at half the gap is 24";
+  // Its peak keeps the blob's height (a moved blob, not two faded ones).
+  EXPECT_GT(adv.liquid_per_m[c.g.index(24, 4, 0)], 0.9e-3);
+  const GridMeanExtinction lin = interpolate_extinction(c.g, c.e0, c.e1, c.w, c.w, c.gap_s, 0.5, TimeInterpolation::Linear);
+  EXPECT_GT(std::abs(peak_x(c.g, lin.liquid_per_m) - 24), 1) << "a blend peaks where the steps had the blob, not between";
+  EXPECT_LT(lin.liquid_per_m[c.g.index(24, 4, 0)], 0.1e-3);
+}
+
+TEST(TimeInterpolation, AdvectedIsTheDefaultWithWindsAndFallsBackToLinearWithAWarningWithout) {
+  const Carried c;
+  TimeInterpolationReport r;
+  interpolate_extinction(c.g, c.e0, c.e1, c.w, c.w, c.gap_s, 0.25, TimeInterpolation::Auto, &r);
+  EXPECT_EQ(r.used, TimeInterpolation::Advected);
+  const StepWinds none;
+  const GridMeanExtinction fell = interpolate_extinction(c.g, c.e0, c.e1, none, none, c.gap_s, 0.25, TimeInterpolation::Advected, &r);
+  EXPECT_EQ(r.used, TimeInterpolation::Linear);
+  EXPECT_NE(r.warning.find("fell back to linear"), std::string::npos) << r.warning;
+  const GridMeanExtinction lin = interpolate_extinction(c.g, c.e0, c.e1, none, none, c.gap_s, 0.25, TimeInterpolation::Linear);
+  EXPECT_EQ(fell.liquid_per_m, lin.liquid_per_m);
+  interpolate_extinction(c.g, c.e0, c.e1, none, none, c.gap_s, 0.25, TimeInterpolation::Auto, &r);
+  EXPECT_EQ(r.used, TimeInterpolation::Linear);
+  EXPECT_TRUE(r.warning.empty()) << "auto without winds is linear by choice, not a fallback";
+}
+
+TEST(TimeInterpolation, NearestAndTheEndsAreTheStepsThemselves) {
+  const Carried c;
+  for (TimeInterpolation m : {TimeInterpolation::Nearest, TimeInterpolation::Linear, TimeInterpolation::Advected}) {
+    EXPECT_EQ(interpolate_extinction(c.g, c.e0, c.e1, c.w, c.w, c.gap_s, 0.0, m).liquid_per_m, c.e0.liquid_per_m);
+    EXPECT_EQ(interpolate_extinction(c.g, c.e0, c.e1, c.w, c.w, c.gap_s, 1.0, m).liquid_per_m, c.e1.liquid_per_m);
+  }
+  EXPECT_EQ(interpolate_extinction(c.g, c.e0, c.e1, c.w, c.w, c.gap_s, 0.4, TimeInterpolation::Nearest).liquid_per_m, c.e0.liquid_per_m);
+  EXPECT_EQ(interpolate_extinction(c.g, c.e0, c.e1, c.w, c.w, c.gap_s, 0.6, TimeInterpolation::Nearest).liquid_per_m, c.e1.liquid_per_m);
+}
+
+// A convergent wind (eastward, slowing to the east) piles a field up: the carried field may not
+// hold more optical depth than its source, nor any column more than the source's thickest.
+TEST(TimeInterpolation, TheWarpNeitherGoesNegativeNorInflatesTheOpticalDepth) {
+  const VolumeGrid g = strip();
+  std::vector<float> f(g.points());
+  for (std::size_t p = 0; p < f.size(); ++p) f[p] = static_cast<float>(1e-4 * (1.0 + std::sin(0.7 * double(p))));
+  StepWinds w;
+  w.u.resize(g.points()), w.v.assign(g.points(), 0.0f), w.w.resize(g.points());
+  for (int k = 0; k < g.alt_m.count; ++k)
+    for (int j = 0; j < g.lat_deg.count; ++j)
+      for (int i = 0; i < g.lon_deg.count; ++i) {
+        w.u[g.index(i, j, k)] = static_cast<float>(40.0 * std::cos(2.0 * kPi * i / 64.0));
+        w.w[g.index(i, j, k)] = static_cast<float>(0.3 * std::sin(2.0 * kPi * i / 64.0));
+      }
+  const GridMeanExtinction e0{f, f}, e1{f, {}};
+  TimeInterpolationReport r;
+  const GridMeanExtinction adv = interpolate_extinction(g, e0, e1, w, w, 6 * 3600.0, 0.5, TimeInterpolation::Advected, &r);
+  EXPECT_TRUE(r.vertical_wind);
+  const GridMeanExtinction lin = interpolate_extinction(g, e0, e1, w, w, 6 * 3600.0, 0.5, TimeInterpolation::Linear);
+  ASSERT_EQ(adv.liquid_per_m.size(), g.points());
+  ASSERT_EQ(adv.ice_per_m.size(), g.points());
+  for (float v : adv.liquid_per_m) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f);
+  for (float v : adv.ice_per_m) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f);
+  // On this strip near the equator the area weights are all but equal: the plain sums compare.
+  EXPECT_LE(total(adv.liquid_per_m), total(lin.liquid_per_m) * (1.0 + 1e-4));
+  EXPECT_LE(total(adv.ice_per_m), total(lin.ice_per_m) * (1.0 + 1e-4));
+  double src_col = 0.0;
+  const std::size_t cols = g.columns();
+  for (std::size_t c = 0; c < cols; ++c) {
+    double s = 0.0, a = 0.0;
+    for (int k = 0; k < g.alt_m.count; ++k) s += f[k * cols + c];
+    src_col = std::max(src_col, s);
+    (void)a;
+  }
+  for (std::size_t c = 0; c < cols; ++c) {
+    double a = 0.0;
+    for (int k = 0; k < g.alt_m.count; ++k) a += adv.liquid_per_m[k * cols + c];
+    EXPECT_LE(a, src_col * (1.0 + 1e-5)) << "column " << c;
+  }
+}
+
+TEST(TimeInterpolation, AStiffCaseStaysFiniteAndNonNegative) {
+  const VolumeGrid g = strip();
+  const std::vector<float> f = blob(g, 20.0);
+  StepWinds w0 = uniform(g, 3e4, -2e4, 50.0), w1 = uniform(g, -1e5, 7e4, -80.0);
+  w0.u[17] = std::numeric_limits<float>::quiet_NaN();
+  w1.v[5] = std::numeric_limits<float>::infinity();
+  TimeInterpolationReport r;
+  const GridMeanExtinction out = interpolate_extinction(g, {f, {}}, {f, {}}, w0, w1, 30 * 86400.0, 0.3, TimeInterpolation::Advected, &r);
+  EXPECT_EQ(r.substeps, kMaxAdvectionSubsteps);
+  EXPECT_GT(r.max_courant, 1e3);
+  const double peak = *std::max_element(f.begin(), f.end());
+  for (float v : out.liquid_per_m) {
+    ASSERT_TRUE(std::isfinite(v));
+    ASSERT_GE(v, 0.0f);
+    ASSERT_LE(v, peak * (1.0 + 1e-6));
+  }
+}
+
+std::vector<ValidTime> three_hourly(int n) {
+  std::vector<ValidTime> t;
+  for (int i = 0; i < n; ++i) {
+    const std::int64_t s = 1705276800 + i * 10800;  // 2024-01-15T00:00:00Z
+    t.push_back({s, format_iso_utc(s)});
+  }
+  return t;
+}
+
+TEST(Instant, FallsBetweenStepsAndNamesTheRangeWhenOutside) {
+  const auto times = three_hourly(6);
+  EXPECT_EQ(times[1].iso_utc, "2024-01-15T03:00:00Z");
+  const Instant at = instant_at_time(times, "2024-01-15T04:30:00Z", "f.nc");
+  EXPECT_EQ(at.step0, 1u);
+  EXPECT_EQ(at.step1, 2u);
+  EXPECT_DOUBLE_EQ(at.fraction, 0.5);
+  EXPECT_DOUBLE_EQ(at.gap_s, 10800.0);
+  EXPECT_EQ(at.iso_utc, "2024-01-15T04:30:00Z");
+  EXPECT_TRUE(at.between());
+  const Instant on = instant_at_time(times, "2024-01-15T06:00:00Z", "f.nc");
+  EXPECT_FALSE(on.between());
+  EXPECT_EQ(on.step0, 2u);
+  EXPECT_FALSE(instant_at_time(times, "2024-01-15T15:00:00Z", "f.nc").between());  // the last step
+  try {
+    instant_at_time(times, "2024-01-16T00:00:00Z", "f.nc");
+    FAIL() << "no error";
+  } catch (const TimeError& e) {
+    EXPECT_STREQ(e.what(), "f.nc: time 2024-01-16T00:00:00Z is outside the file's times 2024-01-15T00:00:00Z .. "
+                           "2024-01-15T15:00:00Z (6 steps), expected an instant within them");
+  }
+  EXPECT_THROW(instant_at_step(times, 6, "f.nc"), TimeError);
+  EXPECT_THROW(instant_at_time(times, "tomorrow", "f.nc"), TimeError);
+}
+
+TEST(Instant, ADuplicateOrBackwardTimeIsAnErrorNamingTheValues) {
+  auto times = three_hourly(4);
+  times[2] = times[1];
+  try {
+    instant_at_time(times, "2024-01-15T01:00:00Z", "dup.nc");
+    FAIL() << "no error";
+  } catch (const TimeError& e) {
+    EXPECT_STREQ(e.what(), "dup.nc: the valid times are duplicated: step 1 is 2024-01-15T03:00:00Z and step 2 is "
+                           "2024-01-15T03:00:00Z, expected strictly ascending times");
+  }
+  times = three_hourly(4);
+  std::swap(times[0], times[3]);
+  EXPECT_THROW(check_time_axis(times, "back.nc"), TimeError);
+}
+
+TEST(Instant, AOneStepFileHoldsOnlyItsStep) {
+  const auto times = three_hourly(1);
+  EXPECT_FALSE(instant_at_time(times, "2024-01-15T00:00:00Z", "one.nc").between());
+  EXPECT_THROW(instant_at_time(times, "2024-01-15T00:30:00Z", "one.nc"), TimeError);
+  const std::vector<ValidTime> labels = {{0, "0"}, {1, "1"}};  // a file without a time axis
+  EXPECT_THROW(instant_at_time(labels, "2024-01-15T00:00:00Z", "bare.nc"), TimeError);
+  EXPECT_FALSE(instant_at_step(labels, 1, "bare.nc").time_known);
+}
+
+TEST(SceneTime, KeysAreReadCheckedAndWritten) {
+  const Scene s = scene_from_json(R"({"version": 1, "time": {"valid_utc": "2024-01-15T04:30:00Z", "interpolation": "nearest"}})");
+  EXPECT_EQ(s.time.valid_utc, "2024-01-15T04:30:00Z");
+  EXPECT_EQ(s.time.interpolation, TimeInterpolation::Nearest);
+  EXPECT_EQ(scene_from_json(R"({"version": 1})").time.interpolation, TimeInterpolation::Auto);
+  try {
+    scene_from_json(R"({"version": 1, "time": {"interpolation": "cubic"}})", "s.json");
+    FAIL() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_STREQ(e.what(), "s.json: time.interpolation: found \"cubic\", expected \"auto\", \"nearest\", \"linear\" or \"advected\"");
+  }
+  EXPECT_THROW(scene_from_json(R"({"version": 1, "time": {"valid_utc": "noon"}})"), SceneError);
+  EXPECT_THROW(scene_from_json(R"({"version": 1, "time": {"when": 3}})"), SceneError);
+  EXPECT_EQ(scene_from_json(R"({"version": 1, "sun": {"mode": "local_noon"}})").sun.mode, SunMode::LocalNoon);
+}
+
+}  // namespace
+}  // namespace cv::core
