@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "frame/camera.hpp"
 #include "frame/march_stats.hpp"
@@ -12,6 +13,12 @@
 
 namespace cv::viewer {
 
+// One overlay's cost, as the overlay panel shows it.
+struct OverlayTiming {
+  double build_ms = 0.0;  // the last (re)build of its geometry (VTK)
+  double draw_ms = 0.0;   // its draw in the last overlay pass
+};
+
 struct FrameStats {
   double march_ms = 0.0;    // GPU time of the last raymarch dispatch (timer query)
   double present_ms = 0.0;  // GPU time of accumulation + tonemap draw
@@ -20,6 +27,7 @@ struct FrameStats {
   int march_w = 0, march_h = 0;
   core::MarchStats march;   // what the last marched frame sampled and left out
   std::string renderer;     // GL_RENDERER
+  std::vector<OverlayTiming> overlays;  // per scene overlay
 };
 
 // What the panels need besides the state, and what they ask of the main loop.
