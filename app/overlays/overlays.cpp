@@ -3,6 +3,7 @@
 
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -14,11 +15,17 @@
 #include <vtkCleanPolyData.h>
 #include <vtkFloatArray.h>
 #include <vtkFlyingEdges3D.h>
+#include <vtkFlyingEdgesPlaneCutter.h>
+#include <vtkPlane.h>
+#include <vtkProbeFilter.h>
+#include <vtkCharArray.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkRungeKutta45.h>
+#include <vtkStreamTracer.h>
 #include <vtkSmartPointer.h>
 
 #include "geo/geodesy.hpp"
@@ -102,7 +109,38 @@ core::Field volume_field(const core::CloudVolume& volume, const std::string& nam
 void check_overlays(const std::vector<core::OverlaySpec>& specs, const core::CloudVolume& volume) {
   for (std::size_t i = 0; i < specs.size(); ++i) {
     const std::string at = "overlays[" + std::to_string(i) + "]";
-    if (specs[i].type == "isosurface") volume_field(volume, specs[i].text("field"), at + ".field");
+    if (specs[i].type == "isosurface") {
+      volume_field(volume, specs[i].text("field"), at + ".field");
+      if (specs[i].text("color_field") != "none") volume_field(volume, specs[i].text("color_field"), at + ".color_field");
+    }
+    if (specs[i].type == "section") {
+      const core::OverlaySpec& o = specs[i];
+      volume_field(volume, o.text("field"), at + ".field");
+      const std::string& kind = o.text("kind");
+      if (kind != "horizontal" && kind != "vertical") throw OverlayError(at + ".kind: found \"" + kind + "\", expected horizontal or vertical");
+      const core::RegularAxis& z = volume.grid.alt_m;
+      if (kind == "horizontal" && !(o.number("altitude_m") >= z.start && o.number("altitude_m") <= z.last())) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, ".altitude_m: found %g, expected an altitude within the grid's levels, %g..%g m", o.number("altitude_m"),
+                      z.start, z.last());
+        throw OverlayError(at + buf);
+      }
+      if (kind == "vertical" && glm::dot(unit(o.number("from_lat"), o.number("from_lon")), unit(o.number("to_lat"), o.number("to_lon"))) > 1.0 - 1e-15) {
+        throw OverlayError(at + ".to_lat: found the path's two ends at one point, expected a vertical section's path of non-zero length");
+      }
+    }
+    if (specs[i].type == "wind") {
+      if (!volume.has_field[static_cast<std::size_t>(core::Field::WindU)] || !volume.has_field[static_cast<std::size_t>(core::Field::WindV)]) {
+        throw OverlayError(at + ": found a volume without wind_u and wind_v, expected both for wind streamlines (it holds " + hold_list(volume) + ")");
+      }
+      const double a = specs[i].number("altitude_m");
+      const core::RegularAxis& z = volume.grid.alt_m;
+      if (!(a >= z.start && a <= z.last())) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, ".altitude_m: found %g, expected an altitude within the grid's levels, %g..%g m", a, z.start, z.last());
+        throw OverlayError(at + buf);
+      }
+    }
     if (specs[i].type == "coastlines") {
       const std::string& r = specs[i].text("resolution");
       if (r != "auto" && (r.size() != 1 || std::string("clihf").find(r[0]) == std::string::npos)) {
@@ -207,31 +245,81 @@ core::OverlayMesh build_graticule(double step_deg, double r0_m, const glm::vec4&
 
 std::vector<std::array<double, 4>> label_strokes(const std::string& text) {
   // Seven segments for the digits (a top, b upper right, c lower right, d bottom, e lower left,
-  // f upper left, g middle) and strokes of their own for N, E, W and the minus sign.
+  // f upper left, g middle); polylines of their own for the letters (either case draws the
+  // capital) and a few signs. A glyph is 4 wide and 6 high.
   static const double seg[7][4] = {{0, 6, 4, 6}, {4, 6, 4, 3}, {4, 3, 4, 0}, {0, 0, 4, 0}, {0, 0, 0, 3}, {0, 3, 0, 6}, {0, 3, 4, 3}};
   static const char* digits[10] = {"abcdef", "bc", "abged", "abgcd", "fgbc", "afgcd", "afgedc", "abc", "abcdefg", "abcdfg"};
+  // Each glyph: polylines separated by '|', points "x,y" separated by ' '.
+  static const char* letters[26] = {
+      "0,0 2,6 4,0|1,3 3,3",                               // A
+      "0,0 0,6 3,6 4,5 3,3 0,3|3,3 4,1.5 3,0 0,0",        // B
+      "4,6 0,6 0,0 4,0",                                   // C
+      "0,0 0,6 2.5,6 4,4 4,2 2.5,0 0,0",                   // D
+      "4,6 0,6 0,0 4,0|0,3 3,3",                           // E
+      "4,6 0,6 0,0|0,3 3,3",                               // F
+      "4,6 0,6 0,0 4,0 4,3 2,3",                           // G
+      "0,0 0,6|4,0 4,6|0,3 4,3",                           // H
+      "2,0 2,6|1,6 3,6|1,0 3,0",                           // I
+      "4,6 4,0 0,0 0,2",                                   // J
+      "0,0 0,6|4,6 0,3 4,0",                               // K
+      "0,6 0,0 4,0",                                       // L
+      "0,0 0,6 2,3 4,6 4,0",                               // M
+      "0,0 0,6 4,0 4,6",                                   // N
+      "0,0 0,6 4,6 4,0 0,0",                               // O
+      "0,0 0,6 4,6 4,3 0,3",                               // P
+      "0,0 0,6 4,6 4,0 0,0|2,2 4,0",                       // Q
+      "0,0 0,6 4,6 4,3 0,3|1.5,3 4,0",                     // R
+      "4,6 0,6 0,3 4,3 4,0 0,0",                           // S
+      "0,6 4,6|2,6 2,0",                                   // T
+      "0,6 0,0 4,0 4,6",                                   // U
+      "0,6 2,0 4,6",                                       // V
+      "0,6 1,0 2,4 3,0 4,6",                               // W
+      "0,0 4,6|0,6 4,0",                                   // X
+      "0,6 2,3 4,6|2,3 2,0",                               // Y
+      "0,6 4,6 0,0 4,0",                                   // Z
+  };
   std::vector<std::array<double, 4>> out;
   double x = 0.0;
   auto add = [&](double x0, double y0, double x1, double y1) { out.push_back({x + x0, y0, x + x1, y1}); };
+  auto polylines = [&](const char* spec) {
+    double px = 0.0, py = 0.0;
+    bool have = false;
+    for (const char* p = spec; *p;) {
+      if (*p == '|') {
+        have = false;
+        ++p;
+        continue;
+      }
+      if (*p == ' ') {
+        ++p;
+        continue;
+      }
+      char* end = nullptr;
+      const double qx = std::strtod(p, &end);
+      const double qy = std::strtod(end + 1, &end);
+      p = end;
+      if (have) add(px, py, qx, qy);
+      px = qx, py = qy, have = true;
+    }
+  };
   for (char ch : text) {
     if (ch >= '0' && ch <= '9') {
       for (const char* p = digits[ch - '0']; *p; ++p) {
         const double* q = seg[*p - 'a'];
         add(q[0], q[1], q[2], q[3]);
       }
-    } else if (ch == 'S') {
-      for (const char* p = digits[5]; *p; ++p) {
-        const double* q = seg[*p - 'a'];
-        add(q[0], q[1], q[2], q[3]);
-      }
-    } else if (ch == 'N') {
-      add(0, 0, 0, 6), add(0, 6, 4, 0), add(4, 0, 4, 6);
-    } else if (ch == 'E') {
-      add(0, 0, 0, 6), add(0, 6, 4, 6), add(0, 3, 3, 3), add(0, 0, 4, 0);
-    } else if (ch == 'W') {
-      add(0, 6, 1, 0), add(1, 0, 2, 4), add(2, 4, 3, 0), add(3, 0, 4, 6);
+    } else if ((ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z')) {
+      polylines(letters[(ch >= 'a' ? ch - 'a' : ch - 'A')]);
     } else if (ch == '-') {
       add(0, 3, 4, 3);
+    } else if (ch == '+') {
+      add(0, 3, 4, 3), add(2, 1, 2, 5);
+    } else if (ch == '.') {
+      polylines("1.5,0 2.5,0 2.5,1 1.5,1 1.5,0");
+    } else if (ch == '/') {
+      add(0, 0, 4, 6);
+    } else if (ch == '_') {
+      add(0, 0, 4, 0);
     } else if (ch != ' ') {
       continue;
     }
@@ -304,7 +392,45 @@ core::OverlayMesh graticule_labels(double step_deg, const core::Camera& cam, dou
   return out;
 }
 
-core::OverlayMesh build_isosurface(const core::VolumeGrid& grid, const std::vector<float>& field, double value, const glm::vec4& color) {
+glm::vec4 colormap(double t, double brightness) {
+  static const double stops[5][3] = {{0.05, 0.05, 0.45}, {0.0, 0.6, 0.85}, {0.2, 0.8, 0.2}, {0.95, 0.85, 0.1}, {0.85, 0.1, 0.05}};
+  const double x = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0) * 4.0;
+  const int k = std::min(3, static_cast<int>(x));
+  const double f = x - k;
+  glm::vec4 c(1.0f);
+  for (int i = 0; i < 3; ++i) c[i] = static_cast<float>(brightness * ((1.0 - f) * stops[k][i] + f * stops[k + 1][i]));
+  return c;
+}
+
+namespace {
+
+// A field at fractional grid indices, trilinear (as the march's fetch between grid points).
+double trilinear(const core::VolumeGrid& g, const std::vector<float>& f, double x, double y, double z) {
+  const int nx = g.lon_deg.count, ny = g.lat_deg.count, nz = g.alt_m.count;
+  x = std::clamp(x, 0.0, nx - 1.0), y = std::clamp(y, 0.0, ny - 1.0), z = std::clamp(z, 0.0, nz - 1.0);
+  const int i = std::min(static_cast<int>(x), nx - 2 < 0 ? 0 : nx - 2), j = std::min(static_cast<int>(y), ny - 2 < 0 ? 0 : ny - 2),
+            k = std::min(static_cast<int>(z), nz - 2 < 0 ? 0 : nz - 2);
+  const double fx = x - i, fy = y - j, fz = z - k;
+  double sum = 0.0;
+  for (int c = 0; c < 8; ++c) {
+    const int di = c & 1, dj = (c >> 1) & 1, dk = (c >> 2) & 1;
+    const int ii = std::min(i + di, nx - 1), jj = std::min(j + dj, ny - 1), kk = std::min(k + dk, nz - 1);
+    const double wgt = (di ? fx : 1.0 - fx) * (dj ? fy : 1.0 - fy) * (dk ? fz : 1.0 - fz);
+    if (wgt == 0.0) continue;
+    sum += wgt * f[g.index(ii, jj, kk)];
+  }
+  return sum;
+}
+
+glm::dvec3 index_to_ecef(const core::VolumeGrid& g, double x, double y, double z) {
+  return geo::sphere_to_ecef({g.lat_deg.start + y * g.lat_deg.step, g.lon_deg.start + x * g.lon_deg.step, g.alt_m.start + z * g.alt_m.step},
+                             g.earth_radius_m);
+}
+
+}  // namespace
+
+core::OverlayMesh build_isosurface(const core::VolumeGrid& grid, const std::vector<float>& field, double value, const glm::vec4& color,
+                                   const FieldColor& by) {
   core::OverlayMesh out;
   if (field.size() != grid.points() || grid.points() == 0) return out;
   vtkNew<vtkImageData> image;
@@ -337,7 +463,12 @@ core::OverlayMesh build_isosurface(const core::VolumeGrid& grid, const std::vect
     const double lat = grid.lat_deg.start + p[1] * grid.lat_deg.step;
     const double alt = grid.alt_m.start + p[2] * grid.alt_m.step;
     out.positions.push_back(geo::sphere_to_ecef({lat, lon, alt}, grid.earth_radius_m));
-    out.colors.push_back(color);
+    if (by.field && by.field->size() == grid.points()) {
+      const double fv = trilinear(grid, *by.field, p[0], p[1], p[2]);
+      out.colors.push_back(colormap((fv - by.lo) / (by.hi - by.lo != 0.0 ? by.hi - by.lo : 1.0), by.brightness));
+    } else {
+      out.colors.push_back(color);
+    }
   }
   vtkCellArray* polys = pd->GetPolys();
   vtkIdType npts = 0;
@@ -350,6 +481,259 @@ core::OverlayMesh build_isosurface(const core::VolumeGrid& grid, const std::vect
     }
   }
   return out;
+}
+
+namespace {
+
+// The field as a VTK image in grid indices (longitude fastest: VTK's x, y, z).
+vtkSmartPointer<vtkImageData> field_image(const core::VolumeGrid& g, const std::vector<float>& field) {
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(g.lon_deg.count, g.lat_deg.count, g.alt_m.count);
+  image->SetOrigin(0.0, 0.0, 0.0);
+  image->SetSpacing(1.0, 1.0, 1.0);
+  vtkNew<vtkFloatArray> scalars;
+  scalars->SetNumberOfValues(static_cast<vtkIdType>(field.size()));
+  for (std::size_t i = 0; i < field.size(); ++i) scalars->SetValue(static_cast<vtkIdType>(i), field[i]);
+  scalars->SetName("field");
+  image->GetPointData()->SetScalars(scalars);
+  return image;
+}
+
+glm::vec4 mapped(const FieldColor& by, double v) {
+  return colormap((v - by.lo) / (by.hi - by.lo != 0.0 ? by.hi - by.lo : 1.0), by.brightness);
+}
+
+}  // namespace
+
+core::OverlayMesh build_horizontal_section(const core::VolumeGrid& g, const std::vector<float>& field, double altitude_m, const FieldColor& by) {
+  core::OverlayMesh out;
+  if (field.size() != g.points() || g.points() == 0) return out;
+  const auto image = field_image(g, field);
+  vtkNew<vtkPlane> plane;
+  plane->SetOrigin(0.0, 0.0, (altitude_m - g.alt_m.start) / g.alt_m.step);
+  plane->SetNormal(0.0, 0.0, 1.0);
+  vtkNew<vtkFlyingEdgesPlaneCutter> cut;
+  cut->SetInputData(image);
+  cut->SetPlane(plane);
+  cut->ComputeNormalsOff();
+  cut->InterpolateAttributesOn();
+  cut->Update();
+  ++g_vtk_runs;
+  vtkPolyData* pd = cut->GetOutput();
+  vtkPoints* pts = pd->GetPoints();
+  vtkDataArray* values = pd->GetPointData()->GetArray("field");
+  if (!pts || !values) return out;
+  for (vtkIdType i = 0; i < pts->GetNumberOfPoints(); ++i) {
+    double p[3];
+    pts->GetPoint(i, p);
+    out.positions.push_back(index_to_ecef(g, p[0], p[1], p[2]));
+    out.colors.push_back(mapped(by, values->GetTuple1(i)));
+  }
+  vtkIdType npts = 0;
+  const vtkIdType* ids = nullptr;
+  vtkCellArray* polys = pd->GetPolys();
+  for (polys->InitTraversal(); polys->GetNextCell(npts, ids);) {
+    for (vtkIdType k = 1; k + 1 < npts; ++k) {
+      out.triangles.insert(out.triangles.end(), {static_cast<std::uint32_t>(ids[0]), static_cast<std::uint32_t>(ids[k]), static_cast<std::uint32_t>(ids[k + 1])});
+    }
+  }
+  return out;
+}
+
+core::OverlayMesh build_vertical_section(const core::VolumeGrid& g, const std::vector<float>& field, double from_lat, double from_lon,
+                                         double to_lat, double to_lon, const FieldColor& by, int columns) {
+  core::OverlayMesh out;
+  if (field.size() != g.points() || g.points() == 0 || columns < 2) return out;
+  const glm::dvec3 a = unit(from_lat, from_lon), b = unit(to_lat, to_lon);
+  const double angle = std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
+  const double sn = std::sin(angle);
+  const int levels = g.alt_m.count;
+  // The curtain's points in grid indices: `columns` along the path, every level.
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  for (int c = 0; c < columns; ++c) {
+    const double f = static_cast<double>(c) / (columns - 1);
+    const glm::dvec3 p = sn > 1e-12 ? (std::sin((1.0 - f) * angle) * a + std::sin(f * angle) * b) / sn : a;
+    const geo::Geodetic ll = geo::ecef_to_sphere(p, 1.0);
+    double lon = ll.lon_deg;
+    while (lon < g.lon_deg.start) lon += 360.0;  // the grid's own longitudes (it may run past 180)
+    while (lon - 360.0 >= g.lon_deg.start) lon -= 360.0;
+    for (int k = 0; k < levels; ++k) {
+      points->InsertNextPoint((lon - g.lon_deg.start) / g.lon_deg.step, (ll.lat_deg - g.lat_deg.start) / g.lat_deg.step, k);
+    }
+  }
+  vtkNew<vtkPolyData> curtain;
+  curtain->SetPoints(points);
+  vtkNew<vtkProbeFilter> probe;
+  probe->SetInputData(curtain);
+  probe->SetSourceData(field_image(g, field));
+  probe->Update();
+  ++g_vtk_runs;
+  vtkDataSet* sampled = probe->GetOutput();
+  vtkDataArray* values = sampled->GetPointData()->GetArray("field");
+  vtkDataArray* valid = sampled->GetPointData()->GetArray(probe->GetValidPointMaskArrayName());
+  if (!values) return out;
+  for (vtkIdType i = 0; i < sampled->GetNumberOfPoints(); ++i) {
+    double p[3];
+    points->GetPoint(i, p);
+    out.positions.push_back(index_to_ecef(g, p[0], p[1], p[2]));
+    out.colors.push_back(mapped(by, values->GetTuple1(i)));
+  }
+  auto ok = [&](int c, int k) { return !valid || valid->GetTuple1(static_cast<vtkIdType>(c * levels + k)) != 0.0; };
+  for (int c = 0; c + 1 < columns; ++c) {
+    for (int k = 0; k + 1 < levels; ++k) {
+      if (!ok(c, k) || !ok(c + 1, k) || !ok(c, k + 1) || !ok(c + 1, k + 1)) continue;
+      const auto i00 = static_cast<std::uint32_t>(c * levels + k), i10 = static_cast<std::uint32_t>((c + 1) * levels + k);
+      out.triangles.insert(out.triangles.end(), {i00, i10, i10 + 1, i00, i10 + 1, i00 + 1});
+    }
+  }
+  return out;
+}
+
+core::OverlayMesh colour_bar(const core::Camera& cam, double r0_m, const std::string& title, double lo, double hi, double brightness,
+                             double text_px) {
+  core::OverlayMesh out;
+  if (!(text_px > 0.0)) return out;
+  const glm::dvec3 c = core::camera_ecef(cam, r0_m);
+  const core::CameraFrame f = core::camera_frame(cam);
+  const double w = cam.width, h = cam.height, aspect = h / w;
+  // A pixel position (x right, y down) 1 m in front of the camera, on that pixel's ray's plane.
+  auto at = [&](double x, double y) {
+    const double xn = (2.0 * x / w - 1.0) * f.tan_half, yn = (1.0 - 2.0 * y / h) * f.tan_half * aspect;
+    return c + 1.0 * (f.forward + xn * f.right + yn * f.up);
+  };
+  const glm::vec4 white(static_cast<float>(brightness));
+  auto text = [&](const std::string& t, double x, double y_base, double px) {  // left end, baseline (pixels), height
+    const double u = px / 6.0;
+    for (const auto& s : label_strokes(t)) {
+      const auto base = static_cast<std::uint32_t>(out.positions.size());
+      out.positions.push_back(at(x + s[0] * u, y_base - s[1] * u));
+      out.positions.push_back(at(x + s[2] * u, y_base - s[3] * u));
+      out.colors.insert(out.colors.end(), 2, white);
+      out.lines.insert(out.lines.end(), {base, base + 1});
+    }
+  };
+  auto text_w = [&](const std::string& t) { return (6.0 * static_cast<double>(t.size()) - 2.0) * text_px / 6.0; };
+  char buf[5][32];
+  double widest = 0.0;
+  for (int k = 0; k < 5; ++k) {
+    std::snprintf(buf[k], sizeof buf[k], "%.3g", lo + (hi - lo) * k / 4.0);
+    widest = std::max(widest, text_w(buf[k]));
+  }
+  const double bar_w = std::max(4.0, text_px), x1 = w - 6.0 - widest - 4.0, x0 = x1 - bar_w;
+  const double y0 = h * 0.85, y1 = std::max(h * 0.30, 2.0 * text_px + 8.0);  // bottom (lo) and top (hi)
+  const int steps = 16;
+  for (int k = 0; k <= steps; ++k) {
+    const double y = y0 + (y1 - y0) * k / steps;
+    out.positions.push_back(at(x0, y));
+    out.positions.push_back(at(x1, y));
+    out.colors.insert(out.colors.end(), 2, colormap(static_cast<double>(k) / steps, brightness));
+    if (k > 0) {
+      const auto b = static_cast<std::uint32_t>(out.positions.size() - 4);
+      out.triangles.insert(out.triangles.end(), {b, b + 1, b + 3, b, b + 3, b + 2});
+    }
+  }
+  for (int k = 0; k < 5; ++k) {
+    const double y = y0 + (y1 - y0) * k / 4.0;
+    const auto b = static_cast<std::uint32_t>(out.positions.size());
+    out.positions.push_back(at(x1, y));
+    out.positions.push_back(at(x1 + 3.0, y));
+    out.colors.insert(out.colors.end(), 2, white);
+    out.lines.insert(out.lines.end(), {b, b + 1});
+    text(buf[k], x1 + 5.0, y + 0.5 * text_px, text_px);
+  }
+  // The title above the bar, right-aligned; smaller where it would not fit the image's width.
+  const double title_px = std::min(text_px, text_px * (w - 6.0) / std::max(1.0, text_w(title)));
+  text(title, w - 4.0 - text_w(title) * title_px / text_px, y1 - 6.0, title_px);
+  return out;
+}
+
+core::OverlayMesh build_streamlines_from(const core::VolumeGrid& g, const std::vector<float>& u, const std::vector<float>& v,
+                                         const std::vector<float>& w, const std::vector<glm::dvec3>& seeds_ijk, double length_cells,
+                                         double speed_max_m_s, double brightness, std::vector<std::vector<glm::dvec3>>* lines_ijk) {
+  core::OverlayMesh out;
+  const std::size_t n = g.points();
+  if (u.size() != n || v.size() != n || n == 0 || seeds_ijk.empty()) return out;
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(g.lon_deg.count, g.lat_deg.count, g.alt_m.count);
+  image->SetOrigin(0.0, 0.0, 0.0);
+  image->SetSpacing(1.0, 1.0, 1.0);
+  // Velocity in grid cells per second: east over the cell's width at its latitude, north over its
+  // height, up over its depth. No data (NaN) is calm.
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  vtkNew<vtkFloatArray> vel;
+  vel->SetNumberOfComponents(3);
+  vel->SetNumberOfTuples(static_cast<vtkIdType>(n));
+  vel->SetName("velocity");
+  for (int k = 0; k < g.alt_m.count; ++k) {
+    const double r = g.earth_radius_m + g.alt_m.at(k);
+    for (int j = 0; j < g.lat_deg.count; ++j) {
+      const double dx = r * std::cos(g.lat_deg.at(j) * kDeg) * g.lon_deg.step * kDeg, dy = r * g.lat_deg.step * kDeg;
+      for (int i = 0; i < g.lon_deg.count; ++i) {
+        const std::size_t idx = g.index(i, j, k);
+        auto calm = [](float x) { return std::isfinite(x) ? static_cast<double>(x) : 0.0; };
+        const double c[3] = {calm(u[idx]) / dx, calm(v[idx]) / dy, w.size() == n ? calm(w[idx]) / g.alt_m.step : 0.0};
+        vel->SetTuple(static_cast<vtkIdType>(idx), c);
+      }
+    }
+  }
+  image->GetPointData()->SetVectors(vel);
+  vtkNew<vtkPoints> seed_points;
+  seed_points->SetDataTypeToDouble();
+  for (const glm::dvec3& s : seeds_ijk) seed_points->InsertNextPoint(s.x, s.y, s.z);
+  vtkNew<vtkPolyData> seeds;
+  seeds->SetPoints(seed_points);
+  vtkNew<vtkRungeKutta45> rk;
+  vtkNew<vtkStreamTracer> tracer;
+  tracer->SetInputData(image);
+  tracer->SetSourceData(seeds);
+  tracer->SetIntegrator(rk);
+  tracer->SetIntegrationDirectionToForward();
+  tracer->SetMaximumPropagation(length_cells);
+  tracer->SetIntegrationStepUnit(vtkStreamTracer::CELL_LENGTH_UNIT);
+  tracer->SetInitialIntegrationStep(0.05);
+  tracer->SetMinimumIntegrationStep(0.001);
+  tracer->SetMaximumIntegrationStep(0.2);
+  tracer->SetMaximumError(1e-8);
+  tracer->SetMaximumNumberOfSteps(200000);
+  tracer->SetTerminalSpeed(1e-12);
+  tracer->Update();
+  ++g_vtk_runs;
+  vtkPolyData* pd = tracer->GetOutput();
+  vtkPoints* pts = pd->GetPoints();
+  vtkCellArray* lines = pd->GetLines();
+  if (!pts || !lines) return out;
+  vtkIdType npts = 0;
+  const vtkIdType* ids = nullptr;
+  for (lines->InitTraversal(); lines->GetNextCell(npts, ids);) {
+    std::vector<glm::dvec3> ijk;
+    for (vtkIdType k = 0; k < npts; ++k) {
+      double p[3];
+      pts->GetPoint(ids[k], p);
+      ijk.emplace_back(p[0], p[1], p[2]);
+      const double su = trilinear(g, u, p[0], p[1], p[2]), sv = trilinear(g, v, p[0], p[1], p[2]);
+      const double sw = w.size() == n ? trilinear(g, w, p[0], p[1], p[2]) : 0.0;
+      const auto base = static_cast<std::uint32_t>(out.positions.size());
+      out.positions.push_back(index_to_ecef(g, p[0], p[1], p[2]));
+      out.colors.push_back(colormap(std::sqrt(su * su + sv * sv + sw * sw) / speed_max_m_s, brightness));
+      if (k > 0) out.lines.push_back(base - 1), out.lines.push_back(base);
+    }
+    if (lines_ijk) lines_ijk->push_back(std::move(ijk));
+  }
+  return out;
+}
+
+core::OverlayMesh build_streamlines(const core::VolumeGrid& g, const std::vector<float>& u, const std::vector<float>& v,
+                                    const std::vector<float>& w, double altitude_m, int seeds, double length_cells,
+                                    double speed_max_m_s, double brightness) {
+  const double z = (altitude_m - g.alt_m.start) / g.alt_m.step;
+  std::vector<glm::dvec3> lattice;
+  for (int b = 0; b < seeds; ++b) {
+    for (int a = 0; a < seeds; ++a) {
+      lattice.emplace_back((a + 0.5) / seeds * (g.lon_deg.count - 1), (b + 0.5) / seeds * (g.lat_deg.count - 1), z);
+    }
+  }
+  return build_streamlines_from(g, u, v, w, lattice, length_cells, speed_max_m_s, brightness);
 }
 
 std::vector<BuiltOverlay> OverlayBuilder::build(const std::vector<core::OverlaySpec>& specs, core::CloudVolume& volume, std::size_t time_step,
@@ -370,7 +754,7 @@ std::vector<BuiltOverlay> OverlayBuilder::build(const std::vector<core::OverlayS
       built.push_back(b);
       continue;
     }
-    const bool of_field = s.type == "isosurface";
+    const bool of_field = s.type == "isosurface" || s.type == "wind" || s.type == "section";
     const char res = s.type == "coastlines" ? coastline_resolution(s.text("resolution"), cam.alt_m) : 0;
     Entry& e = cache_[i];
     const bool fresh = e.mesh && e.spec == s && e.resolution == res && (!of_field || e.time_step == time_step);
@@ -381,7 +765,27 @@ std::vector<BuiltOverlay> OverlayBuilder::build(const std::vector<core::OverlayS
       if (s.type == "graticule") m = build_graticule(s.number("step_deg"), r0, rgba(s.color("color")));
       if (s.type == "isosurface") {
         const core::Field f = volume_field(volume, s.text("field"), "overlays[" + std::to_string(i) + "].field");
-        m = build_isosurface(volume.grid, volume.step(time_step)[f], s.number("value"), rgba(s.color("color")));
+        const core::TimeStepData& data = volume.step(time_step);
+        FieldColor by;
+        if (s.text("color_field") != "none") {
+          by.field = &data[volume_field(volume, s.text("color_field"), "overlays[" + std::to_string(i) + "].color_field")];
+          by.lo = s.number("color_min"), by.hi = s.number("color_max"), by.brightness = s.number("brightness");
+        }
+        m = build_isosurface(volume.grid, data[f], s.number("value"), rgba(s.color("color")), by);
+      }
+      if (s.type == "section") {
+        const core::TimeStepData& data = volume.step(time_step);
+        const core::Field f = volume_field(volume, s.text("field"), "overlays[" + std::to_string(i) + "].field");
+        const FieldColor by{nullptr, s.number("color_min"), s.number("color_max"), s.number("brightness")};
+        m = s.text("kind") == "vertical"
+                ? build_vertical_section(volume.grid, data[f], s.number("from_lat"), s.number("from_lon"), s.number("to_lat"), s.number("to_lon"), by)
+                : build_horizontal_section(volume.grid, data[f], s.number("altitude_m"), by);
+      }
+      if (s.type == "wind") {
+        const core::TimeStepData& data = volume.step(time_step);
+        m = build_streamlines(volume.grid, data[core::Field::WindU], data[core::Field::WindV], data[core::Field::WindW],
+                              s.number("altitude_m"), static_cast<int>(s.number("seeds")), s.number("length_cells"),
+                              s.number("speed_max_m_s"), s.number("brightness"));
       }
       e = {s, time_step, res, std::make_shared<const core::OverlayMesh>(std::move(m))};
       b.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -392,6 +796,13 @@ std::vector<BuiltOverlay> OverlayBuilder::build(const std::vector<core::OverlayS
       auto with_labels = std::make_shared<core::OverlayMesh>(*e.mesh);
       with_labels->append(graticule_labels(s.number("step_deg"), cam, r0, rgba(s.color("color")), s.number("label_px")));
       b.mesh = std::move(with_labels);
+    }
+    if (s.type == "section" && s.number("legend_px") > 0.0) {  // the legend stands in front of this view
+      auto with_legend = std::make_shared<core::OverlayMesh>(*e.mesh);
+      const core::Field f = volume_field(volume, s.text("field"), "overlays[" + std::to_string(i) + "].field");
+      with_legend->append(colour_bar(cam, r0, std::string(core::field_name(f)) + " " + core::field_units(f), s.number("color_min"),
+                                     s.number("color_max"), s.number("brightness"), s.number("legend_px")));
+      b.mesh = std::move(with_legend);
     }
     built.push_back(b);
   }

@@ -83,18 +83,58 @@ core::OverlayMesh build_coastlines(const std::string& gshhs_dir, char res, doubl
 core::OverlayMesh build_graticule(double step_deg, double r0_m, const glm::vec4& color);
 // The labels of that graticule for one view: each meridian's longitude where it crosses the
 // parallel nearest the view's centre, and each parallel's latitude where it crosses the meridian
-// nearest it ("20W", "60N"), drawn as strokes of a built-in font (digits and N, S, E, W) label_px
+// nearest it ("20W", "60N"), drawn as strokes of a built-in font (label_strokes) label_px
 // high, in the plane facing the camera at the crossing, so they are geometry composited by depth
 // like the rest (no VTK: they change with every view). Crossings hidden by the Earth or outside
 // the image are left out, and so is a label that would overlap one placed before it.
 core::OverlayMesh graticule_labels(double step_deg, const core::Camera& cam, double r0_m, const glm::vec4& color, double label_px);
 // The strokes of `text` in the font: segments in glyph units (a glyph 4 wide and 6 high, 6 apart),
-// as x0, y0, x1, y1 with y up; characters without a glyph are left out.
+// as x0, y0, x1, y1 with y up: digits, letters (drawn as capitals), - + . / _ and space; other
+// characters are left out.
 std::vector<std::array<double, 4>> label_strokes(const std::string& text);
 
 // The isosurface field == value of a 3-D field on the volume's grid (vtkFlyingEdges3D in grid
 // indices, then mapped to the sphere: index -> lon, lat, alt -> Earth-centred). NaN (no data) is
 // treated as far below the value.
-core::OverlayMesh build_isosurface(const core::VolumeGrid& grid, const std::vector<float>& field, double value, const glm::vec4& color);
+// A colour field (the same grid, or empty) colours each vertex through colormap over
+// color_min..color_max instead.
+struct FieldColor {
+  const std::vector<float>* field = nullptr;
+  double lo = 0.0, hi = 1.0, brightness = 1.0;
+};
+core::OverlayMesh build_isosurface(const core::VolumeGrid& grid, const std::vector<float>& field, double value, const glm::vec4& color,
+                                   const FieldColor& by = {});
+
+// Sections coloured by a field through the colour map (by.field is ignored: `field` colours them).
+// Horizontal: the plane at altitude_m through the grid (vtkFlyingEdgesPlaneCutter, the field
+// interpolated onto it). Vertical: a curtain from the ground to the grid's top along the great
+// circle between two points, `columns` samples along it (vtkProbeFilter samples the field; a
+// stretch outside the grid is left out).
+core::OverlayMesh build_horizontal_section(const core::VolumeGrid& grid, const std::vector<float>& field, double altitude_m, const FieldColor& by);
+core::OverlayMesh build_vertical_section(const core::VolumeGrid& grid, const std::vector<float>& field, double from_lat, double from_lon,
+                                         double to_lat, double to_lon, const FieldColor& by, int columns = 128);
+// A colour bar legend for one view: the colour map from lo (bottom) to hi (top) as a bar at the
+// image's right, five ticks with their values, and the title (field and units) above, text_px
+// high; geometry 1 m in front of the camera, so it is drawn and composited as any overlay (no
+// cloud lies in front of it).
+core::OverlayMesh colour_bar(const core::Camera& cam, double r0_m, const std::string& title, double lo, double hi, double brightness,
+                             double text_px);
+
+// The colour map: cool (dark blue) through cyan, green and yellow to warm (red) over t in 0..1
+// (clamped), brightest 1; written here as five control points, linear between them.
+glm::vec4 colormap(double t, double brightness = 1.0);
+
+// Streamlines of the wind (u, v and w, m/s; w may be empty) by vtkStreamTracer (RK45) in grid-index
+// space, each component divided by its cell's size in metres, from a seeds x seeds lattice at
+// altitude_m, each followed length_cells cells forward; coloured by speed over 0..speed_max.
+core::OverlayMesh build_streamlines(const core::VolumeGrid& grid, const std::vector<float>& u, const std::vector<float>& v,
+                                    const std::vector<float>& w, double altitude_m, int seeds, double length_cells,
+                                    double speed_max_m_s, double brightness);
+// The same from explicit seeds, given as fractional grid indices (i, j, k); each streamline's
+// points in grid indices too (for the tests), and the mesh on the sphere.
+core::OverlayMesh build_streamlines_from(const core::VolumeGrid& grid, const std::vector<float>& u, const std::vector<float>& v,
+                                         const std::vector<float>& w, const std::vector<glm::dvec3>& seeds_ijk, double length_cells,
+                                         double speed_max_m_s, double brightness,
+                                         std::vector<std::vector<glm::dvec3>>* lines_ijk = nullptr);
 
 }  // namespace cv::overlays

@@ -49,7 +49,7 @@ struct OverlaySpec {
 // An overlay of `type` with every parameter at its default; std::invalid_argument for an unknown type.
 OverlaySpec default_overlay(const std::string& type);
 
-// What the overlay types are, for messages: "one of coastlines, graticule, isosurface".
+// What the overlay types are, for messages: "one of coastlines, graticule, isosurface, wind".
 std::string overlay_types_expected();
 // What a parameter accepts, for messages: "a number 0.5..90 (degrees)", "[r, g, b], each 0..1000".
 std::string overlay_param_expected(const OverlayParamRow& row);

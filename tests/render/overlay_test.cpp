@@ -337,6 +337,85 @@ TEST(GraticuleLabels, StrokesStandBesideTheirCrossingsInTheImage) {
   EXPECT_GT(n_both, n_lines + 50) << "labels drew " << n_both - n_lines << " pixels";
 }
 
+// A solid-body rotation of the wind about the grid's centre column, written so that in grid
+// indices (where the tracer integrates) it is a rotation at omega: u = -omega (j - j0) dx_j,
+// v = omega (i - i0) dy, dx_j the cell's width at its latitude. A streamline started r cells from
+// the centre and followed 2 pi r cells closes on itself: within 1e-3 of r (RK45 at a 1e-8 error
+// per step; the field is linear in the indices, so the trilinear interpolation is exact).
+TEST(Wind, AStreamlineInAUniformRotationClosesOnItself) {
+  core::VolumeGrid g;
+  g.lon_deg = {-0.5, 0.05, 21};
+  g.lat_deg = {-0.5, 0.05, 21};
+  g.alt_m = {0.0, 500.0, 5};
+  const double kDeg = 3.14159265358979323846 / 180.0, omega = 1e-4, i0 = 10.0, j0 = 10.0;
+  std::vector<float> u(g.points()), v(g.points()), w;
+  for (int k = 0; k < g.alt_m.count; ++k) {
+    const double r = g.earth_radius_m + g.alt_m.at(k);
+    for (int j = 0; j < g.lat_deg.count; ++j) {
+      const double dx = r * std::cos(g.lat_deg.at(j) * kDeg) * g.lon_deg.step * kDeg, dy = r * g.lat_deg.step * kDeg;
+      for (int i = 0; i < g.lon_deg.count; ++i) {
+        u[g.index(i, j, k)] = static_cast<float>(-omega * (j - j0) * dx);
+        v[g.index(i, j, k)] = static_cast<float>(omega * (i - i0) * dy);
+      }
+    }
+  }
+  for (double radius : {3.0, 6.0}) {
+    std::vector<std::vector<glm::dvec3>> lines;
+    const core::OverlayMesh m = overlays::build_streamlines_from(g, u, v, w, {{i0 + radius, j0, 2.0}}, 2.0 * 3.14159265358979323846 * radius,
+                                                                  30.0, 1.0, &lines);
+    ASSERT_EQ(lines.size(), 1u);
+    ASSERT_GT(lines[0].size(), 20u);
+    const glm::dvec3 start = lines[0].front(), end = lines[0].back();
+    double worst_radius = 0.0;
+    for (const glm::dvec3& p : lines[0]) worst_radius = std::max(worst_radius, std::abs(std::hypot(p.x - i0, p.y - j0) - radius));
+    EXPECT_LT(glm::length(end - start), 1e-3 * radius) << "radius " << radius << ": the streamline ends " << glm::length(end - start)
+                                                        << " cells from its start";
+    EXPECT_LT(worst_radius, 1e-3 * radius) << "radius " << radius;
+    EXPECT_EQ(m.lines.size(), 2 * (lines[0].size() - 1));
+  }
+}
+
+// Sections: a horizontal slice through a field that grows with longitude lies at its altitude and
+// carries the field's colours; a vertical curtain between two points stands on their great circle;
+// the legend's bar and text lie 1 m in front of the camera, inside the image.
+TEST(Section, SlicesLieWhereAskedAndCarryTheField) {
+  core::VolumeGrid g;
+  g.lon_deg = {-1.0, 0.1, 21};
+  g.lat_deg = {-1.0, 0.1, 21};
+  g.alt_m = {0.0, 500.0, 9};
+  std::vector<float> f(g.points());
+  for (int k = 0; k < g.alt_m.count; ++k) {
+    for (int j = 0; j < g.lat_deg.count; ++j) {
+      for (int i = 0; i < g.lon_deg.count; ++i) f[g.index(i, j, k)] = static_cast<float>(i) / 20.0f;  // 0..1 west to east
+    }
+  }
+  const overlays::FieldColor by{nullptr, 0.0, 1.0, 1.0};
+  const core::OverlayMesh h = overlays::build_horizontal_section(g, f, 1250.0, by);
+  ASSERT_GT(h.triangles.size(), 100u);
+  for (std::size_t i = 0; i < h.positions.size(); ++i) {
+    const geo::Geodetic p = geo::ecef_to_sphere(h.positions[i], g.earth_radius_m);
+    EXPECT_NEAR(p.alt_m, 1250.0, 1e-6);
+    const glm::vec4 expected = overlays::colormap((p.lon_deg + 1.0) / 2.0);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(h.colors[i][c], expected[c], 1e-5) << i;
+  }
+  const core::OverlayMesh v = overlays::build_vertical_section(g, f, -0.5, -0.5, 0.5, 0.5, by, 32);
+  ASSERT_EQ(v.triangles.size(), 6u * 31u * 8u);
+  const glm::dvec3 n = glm::normalize(glm::cross(geo::sphere_to_ecef({-0.5, -0.5, 0.0}, 1.0), geo::sphere_to_ecef({0.5, 0.5, 0.0}, 1.0)));
+  for (const glm::dvec3& p : v.positions) EXPECT_NEAR(glm::dot(glm::normalize(p), n), 0.0, 1e-12);  // on the great circle's plane
+
+  core::Camera cam;
+  cam.alt_m = 3000.0, cam.pitch_deg = -30.0, cam.width = 160, cam.height = 90;
+  const core::OverlayMesh bar = overlays::colour_bar(cam, g.earth_radius_m, "extinction_liquid 1/m", 0.0, 1e-3, 1.0, 8.0);
+  ASSERT_GT(bar.triangles.size(), 30u);
+  ASSERT_GT(bar.lines.size(), 100u);
+  const glm::dvec3 c = core::camera_ecef(cam, g.earth_radius_m);
+  for (const glm::dvec3& p : bar.positions) {
+    const core::Projected q = core::project_point(cam, p - c);
+    EXPECT_NEAR(glm::dot(p - c, core::camera_frame(cam).forward), 1.0, 1e-6);
+    EXPECT_TRUE(q.x >= 0.0 && q.x <= cam.width && q.y >= 0.0 && q.y <= cam.height) << q.x << ", " << q.y;
+  }
+}
+
 // An analytic sphere in a field (the distance from a point 3 km up, in metres): the isosurface at
 // 2 km lies on that sphere within a tenth of a cell.
 TEST(Isosurface, AnalyticSphereWithinATenthOfACell) {
