@@ -36,6 +36,7 @@
 #include "scene/quality.hpp"
 #include "scene/scene_json.hpp"
 #include "kernel/volume_cache.hpp"
+#include "overlays/overlays.hpp"
 #include "render/frame_renderer.hpp"
 #include "scene_source.hpp"
 #include "volume/volume_io.hpp"
@@ -260,6 +261,12 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
       const auto size = parse_size(v, 1, 16384);
       if (!size) throw UsageError{"cloudviewer render: --size: found '" + v + "', expected WxH with 1..16384 each"};
       scene.width = size->first, scene.height = size->second;
+    } else if (a == "--overlay") {
+      try {
+        scene.overlays.push_back(core::parse_overlay_flag(v));
+      } catch (const std::invalid_argument& e) {
+        throw UsageError{std::string("cloudviewer render: ") + e.what()};
+      }
     } else if (a == "--time") {  // a UTC instant, or a step index (still accepted, and converted)
       if (core::parse_iso_utc(v)) {
         scene.time.valid_utc = v;
@@ -445,7 +452,10 @@ const char* render_usage() {
         "                           clouds and a ground of constant albedo, no air): N samples per pixel at most (1024),\n"
         "                           fewer once the image's mean relative standard error is E\n"
         "         [--exposure E|auto] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N]\n"
-        "         [--no-sky]  clouds on black: no air, globe or ambient sky light\n";
+        "         [--no-sky]  clouds on black: no air, globe or ambient sky light\n"
+        "         [--overlay NAME[:key=value,...]]  an overlay composited with the clouds by depth (repeatable):\n"
+        "                           coastlines, graticule or isosurface, with the keys of docs/scene.md's Overlays\n"
+        "                           table, e.g. --overlay graticule:step_deg=15,color=1,1,1\n";
     for (const core::SettingRow& row : core::kMarchSettingRows) {
       if (!row.flag) continue;
       std::string opt = std::string("[") + row.flag + (row.metavar ? std::string(" ") + row.metavar : "") + "]";
@@ -651,6 +661,11 @@ int cmd_render(const std::vector<std::string>& args) {
     std::printf(": %.1f ms on the CPU, once per instant (each frame of an animation at a new instant pays it)\n", interp.cost_ms);
     if (!interp.warning.empty()) std::printf("warning: %s\n", interp.warning.c_str());
   }
+  try {
+    overlays::check_overlays(scene.overlays, vol);  // before any work: a field the volume lacks is bad input
+  } catch (const overlays::OverlayError& e) {
+    throw UsageError{std::string("cloudviewer render: ") + e.what()};
+  }
 
   // Resolve everything the scene left automatic, so the saved scene reproduces this image exactly.
   core::FrameSpec frame = render::resolve_frame(scene, vol);
@@ -727,6 +742,20 @@ int cmd_render(const std::vector<std::string>& args) {
               mw != cam.width || mh != cam.height ? (" marched at " + std::to_string(mw) + "x" + std::to_string(mh)).c_str() : "",
               rs.quality.c_str(), march.quality.view_step_m, march.quality.sun_steps, model.c_str(), frame.accumulate);
 
+  // The overlays' geometry (VTK), built only when the scene has overlays; drawn before the march.
+  std::vector<overlays::BuiltOverlay> built;
+  if (!scene.overlays.empty() && ra.reference) {
+    std::printf("the path tracer composites no overlays: they are left out with --quality reference\n");
+  } else if (!scene.overlays.empty()) {
+    overlays::OverlayBuilder builder;
+    try {
+      built = builder.build(scene.overlays, vol, static_cast<std::size_t>(scene.time_step), frame.march_camera);
+    } catch (const overlays::OverlayError& e) {
+      throw UsageError{std::string("cloudviewer render: ") + e.what()};
+    }
+    renderer.set_overlays(overlays::OverlayBuilder::draws(built));
+  }
+
   t0 = clock::now();
   double gpu_s = 0.0;
   render::DispatchOptions dispatch;
@@ -799,9 +828,15 @@ int cmd_render(const std::vector<std::string>& args) {
   // next to nothing; on a real GPU this is the march without queueing and read-back).
   if (gpu_s > 0.0) std::snprintf(gpu_text, sizeof gpu_text, "%.3f ms (GL timer query)", gpu_s * 1e3);
   else std::snprintf(gpu_text, sizeof gpu_text, "not reported by the driver");
-  std::printf("timings (%s):\n  load/import %.3f s\n  upload      %.3f s\n  march       %.3f s wall, GPU %s\n"
-              "  composite/tonemap %.3f s\n  write       %.3f s\n",
-              ctx->info().renderer.c_str(), t_load, t_upload, t_march, gpu_text, t_tone, t_write);
+  std::printf("timings (%s):\n  load/import %.3f s\n  upload      %.3f s\n  march       %.3f s wall, GPU %s\n",
+              ctx->info().renderer.c_str(), t_load, t_upload, t_march, gpu_text);
+  for (std::size_t i = 0; i < built.size(); ++i) {
+    const std::size_t v = built[i].mesh ? built[i].mesh->positions.size() : 0;
+    const double draw = i < renderer.overlay_draw_ms().size() ? renderer.overlay_draw_ms()[i] : 0.0;
+    std::printf("  overlay %-11s build %.3f s, draw %.3f s (%zu vertices; the draw is inside the march's wall time)\n",
+                built[i].name.c_str(), built[i].build_ms * 1e-3, draw * 1e-3, v);
+  }
+  std::printf("  composite/tonemap %.3f s\n  write       %.3f s\n", t_tone, t_write);
   std::printf("wrote %s%s\n", ra.out.c_str(),
               ra.pfm.empty() ? "" : (", " + ra.pfm + " (radiance) and " + transmittance_pfm + " (transmittance)").c_str());
   return 0;

@@ -7,7 +7,33 @@
 
 namespace cv::render {
 
-FrameRenderer::FrameRenderer(const ShaderLoader& loader) : gpu_(loader) {}
+FrameRenderer::FrameRenderer(const ShaderLoader& loader) : gpu_(loader), loader_(loader) {}
+
+void FrameRenderer::set_overlays(std::vector<OverlayDraw> overlays) {
+  // Kept in order (overlay_draw_ms follows it); only geometry makes a pass.
+  overlays_.clear();
+  for (OverlayDraw& o : overlays) {
+    if (o.mesh && !o.mesh->empty()) {
+      overlays_ = std::move(overlays);
+      return;
+    }
+  }
+  overlay_ms_.assign(overlays.size(), 0.0);
+}
+
+OpaqueInput FrameRenderer::draw_overlays(const core::Camera& cam) {
+  if (overlays_.empty()) return {};
+  if (!overlay_pass_) overlay_pass_ = std::make_unique<OverlayPass>(loader_);
+  const double r0 = volume_ ? volume_->grid.earth_radius_m : core::VolumeGrid{}.earth_radius_m;
+  overlay_pass_->begin(cam, r0);
+  overlay_ms_.clear();
+  for (const OverlayDraw& o : overlays_) overlay_ms_.push_back(o.mesh ? overlay_pass_->draw(*o.mesh, o.line_width_px) : 0.0);
+  return overlay_pass_->output();
+}
+
+core::OpaqueLayer FrameRenderer::read_overlays() const {
+  return overlay_pass_ ? overlay_pass_->read() : core::OpaqueLayer{};
+}
 
 void FrameRenderer::use_volume(std::shared_ptr<const core::PreparedVolume> volume) {
   if (volume == volume_) return;
@@ -38,7 +64,11 @@ void FrameRenderer::march_into(GLuint out, const core::FrameSpec& f, int index, 
                                const OpaqueInput& opaque) {
   const core::MarchSettings m = frame_settings(f.march, f.accumulate, index);
   ensure_noise(m);
-  gpu_.render_into(out, f.march_camera, f.sun, m, dispatch, opaque);
+  // The overlays, drawn once per accumulation (the camera does not move within one), unless the
+  // caller brings its own opaque input.
+  OpaqueInput in = opaque;
+  if (in.depth == 0 && !overlays_.empty()) in = index == 0 || !overlay_pass_ ? draw_overlays(f.march_camera) : overlay_pass_->output();
+  gpu_.render_into(out, f.march_camera, f.sun, m, dispatch, in);
 }
 
 std::vector<glm::vec4> FrameRenderer::render(const core::FrameSpec& f, const DispatchOptions& dispatch,
@@ -46,10 +76,11 @@ std::vector<glm::vec4> FrameRenderer::render(const core::FrameSpec& f, const Dis
                                              std::vector<glm::vec4>* marched) {
   const int mw = f.march_camera.width, mh = f.march_camera.height;
   std::vector<glm::vec4> mean;
+  const OpaqueInput opaque = draw_overlays(f.march_camera);  // none, and no pass, without overlays
   for (int i = 0; i < f.accumulate; ++i) {
     const core::MarchSettings m = frame_settings(f.march, f.accumulate, i);
     ensure_noise(m);
-    const std::vector<glm::vec4> frame = gpu_.render(f.march_camera, f.sun, m, dispatch);
+    const std::vector<glm::vec4> frame = gpu_.render(f.march_camera, f.sun, m, dispatch, opaque);
     if (i == 0) {
       mean = frame;
     } else {

@@ -10,6 +10,8 @@
 #include <glm/vec4.hpp>
 
 #include "kernel/prepared_volume.hpp"
+#include "geometry/overlay_mesh.hpp"
+#include "render/overlay_pass.hpp"
 #include "render/raymarcher.hpp"
 #include "scene/frame_spec.hpp"
 
@@ -18,6 +20,13 @@ namespace cv::render {
 // core::resolve_frame, the scene's ground texture found as well (resolve_ground_texture: an empty
 // setting is the Natural Earth relief where it is installed).
 core::FrameSpec resolve_frame(const core::Scene& scene, const core::CloudVolume& volume);
+
+// One overlay's geometry for the frame (built by app/overlays), drawn by the overlay pass.
+struct OverlayDraw {
+  std::string name;
+  std::shared_ptr<const core::OverlayMesh> mesh;
+  float line_width_px = 1.0f;
+};
 
 class FrameRenderer {
  public:
@@ -44,12 +53,31 @@ class FrameRenderer {
                                 const std::function<void(int, int)>& on_frame = {},
                                 std::vector<glm::vec4>* marched = nullptr);
 
+  // The overlays drawn before each march (none, or none with geometry: no overlay pass is made or
+  // run). Their
+  // distance and radiance are the march's opaque input: it stops at the geometry and composites it
+  // behind the cloud's transmittance in front.
+  void set_overlays(std::vector<OverlayDraw> overlays);
+  // Each overlay's draw time in the last frame that drew overlays (ms, in set_overlays' order; 0
+  // for one without geometry).
+  const std::vector<double>& overlay_draw_ms() const { return overlay_ms_; }
+  // Whether an overlay pass exists: only once a frame has drawn overlays.
+  bool has_overlay_pass() const { return overlay_pass_ != nullptr; }
+  // The overlay pass's last frame read back (the CPU reference composites the same layer).
+  core::OpaqueLayer read_overlays() const;
+
   GpuRaymarcher& raymarcher() { return gpu_; }
   const core::MarchStats& last_stats() { return gpu_.last_stats(); }
 
  private:
   void ensure_noise(const core::MarchSettings& m);
+  // Draws the overlays from cam's view; the march's opaque input (none without overlays).
+  OpaqueInput draw_overlays(const core::Camera& cam);
   GpuRaymarcher gpu_;
+  const ShaderLoader& loader_;
+  std::vector<OverlayDraw> overlays_;
+  std::vector<double> overlay_ms_;
+  std::unique_ptr<OverlayPass> overlay_pass_;
   std::shared_ptr<const core::PreparedVolume> volume_;
   bool noise_uploaded_ = false;
 };

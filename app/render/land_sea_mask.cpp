@@ -76,10 +76,8 @@ char gshhs_resolution_for(int w) {
   return 'f';
 }
 
-namespace {
-
 // The polygons of one shapefile (without .shp), all of `level`.
-void read_polygons(const std::string& base, int level, std::vector<ShorePolygon>& out) {
+void read_shore_polygons(const std::string& base, int level, std::vector<ShorePolygon>& out) {
   SHPHandle shp = SHPOpen(base.c_str(), "rb");
   if (!shp) throw std::runtime_error(base + ".shp: cannot read the shapefile, expected GSHHS shoreline polygons");
   int count = 0, type = 0;
@@ -107,8 +105,6 @@ void read_polygons(const std::string& base, int level, std::vector<ShorePolygon>
   SHPClose(shp);
 }
 
-}  // namespace
-
 std::optional<WaterFraction> gshhs_water_fraction(int w, int h, const std::string& dir) {
   // Resolutions from coarse to fine; for each level the one that fits, then finer, then coarser.
   const std::string order = "clihf";
@@ -122,7 +118,7 @@ std::optional<WaterFraction> gshhs_water_fraction(int w, int h, const std::strin
     for (char r : preference) {
       const std::string base = dir + "/" + r + "/GSHHS_" + r + "_L" + std::to_string(level);
       if (!std::filesystem::exists(base + ".shp")) continue;
-      read_polygons(base, level, polygons);
+      read_shore_polygons(base, level, polygons);
       used += (used.empty() ? "" : ", ") + std::string(1, r) + " L" + std::to_string(level);
       break;
     }

@@ -28,6 +28,10 @@ struct WaterFraction {
   std::string source;  // what it was made from, e.g. "GSHHS c L1, l L2 (4 x 4 samples per texel)"
 };
 
+// Appends the polygons of one GSHHS shapefile (its path without .shp), all of `level`, to `out`
+// (the overlays' coastlines read them too); throws std::runtime_error naming a file it cannot read.
+void read_shore_polygons(const std::string& base, int level, std::vector<ShorePolygon>& out);
+
 // Rasterises polygons onto a w x h grid, ss x ss samples per texel at their centres: a sample is
 // land when the highest level among the polygons containing it is odd (in land, not in a lake or
 // in an island in one), water otherwise (none, or a lake); a texel's water fraction is its share

@@ -213,6 +213,47 @@ void quality_panel(ViewerState& s, const PanelContext& ctx) {
   if (r.budget_ms > 0.0 && !ctx.budget_text.empty()) ImGui::TextWrapped("budget: %s", ctx.budget_text.c_str());
 }
 
+void overlay_panel(ViewerState& s, const FrameStats& stats) {
+  if (!ImGui::CollapsingHeader("Overlays")) return;
+  // Each overlay: on/off, its parameters from the overlay table, and what it costs.
+  std::size_t remove = s.scene.overlays.size();
+  for (std::size_t i = 0; i < s.scene.overlays.size(); ++i) {
+    core::OverlaySpec& o = s.scene.overlays[i];
+    ImGui::PushID(static_cast<int>(i));
+    ImGui::Checkbox(o.type.c_str(), &o.enabled);
+    ImGui::SameLine();
+    if (ImGui::SmallButton("remove")) remove = i;
+    if (i < stats.overlays.size()) {
+      ImGui::SameLine();
+      ImGui::TextDisabled("build %.1f ms, draw %.2f ms", stats.overlays[i].build_ms, stats.overlays[i].draw_ms);
+    }
+    for (const core::OverlayParamRow& row : core::overlay_param_rows()) {
+      if (o.type != row.overlay) continue;
+      if (row.kind == core::OverlayParamKind::Number) {
+        double v = o.number(row.key);
+        const double lo = std::max(row.lo, -1e6), hi = std::min(row.hi, 1e6);
+        if (drag_double(row.key, &v, std::max(1e-3, 0.01 * std::abs(v)), lo, hi, "%.4g")) o.numbers[row.key] = std::clamp(v, row.lo, row.hi);
+      } else if (row.kind == core::OverlayParamKind::Rgb) {
+        const glm::dvec3 c = o.color(row.key);
+        float f[3] = {static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z)};
+        if (ImGui::ColorEdit3(row.key, f, ImGuiColorEditFlags_Float | ImGuiColorEditFlags_HDR)) {
+          o.colors[row.key] = glm::clamp(glm::dvec3(f[0], f[1], f[2]), row.lo, row.hi);
+        }
+      } else {
+        ImGui::Text("%s: %s", row.key, o.text(row.key).c_str());
+      }
+    }
+    ImGui::PopID();
+  }
+  if (remove < s.scene.overlays.size()) s.scene.overlays.erase(s.scene.overlays.begin() + static_cast<std::ptrdiff_t>(remove));
+  for (const std::string& type : core::overlay_types()) {
+    if (type == "isosurface") continue;  // needs a field and a value: from a scene file or --overlay
+    if (ImGui::SmallButton(("add " + type).c_str())) s.scene.overlays.push_back(core::default_overlay(type));
+    ImGui::SameLine();
+  }
+  ImGui::NewLine();
+}
+
 void scene_panel(ViewerState& s, PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Scene file")) return;
   ImGui::InputText("path", &ctx.scene_path);
@@ -260,6 +301,7 @@ void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats)
     lighting_panel(state);
     features_panel(state);
     quality_panel(state, ctx);
+    overlay_panel(state, stats);
     scene_panel(state, ctx);
     ImGui::TextDisabled("F1 hides the panels; %s", stats.renderer.c_str());
   }

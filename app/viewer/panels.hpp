@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "frame/camera.hpp"
 #include "frame/march_stats.hpp"
@@ -11,6 +12,12 @@
 #include "viewer/viewer_state.hpp"
 
 namespace cv::viewer {
+
+// One overlay's cost, as the overlay panel shows it.
+struct OverlayTiming {
+  double build_ms = 0.0;  // the last (re)build of its geometry (VTK)
+  double draw_ms = 0.0;   // its draw in the last overlay pass
+};
 
 struct FrameStats {
   double march_ms = 0.0;    // GPU time of the last raymarch dispatch (timer query)
@@ -21,6 +28,7 @@ struct FrameStats {
   core::MarchStats march;   // what the last marched frame sampled and left out
   std::string renderer;     // GL_RENDERER
   std::string prefetch;     // the prefetcher's resident instants, memory and hit rate (playback)
+  std::vector<OverlayTiming> overlays;  // per scene overlay
 };
 
 // What the panels need besides the state, and what they ask of the main loop.

@@ -33,6 +33,7 @@
 #include "kernel/volume_cache.hpp"
 #include "scene/instant.hpp"
 #include "viewer/playback.hpp"
+#include "overlays/overlays.hpp"
 #include "render/frame_renderer.hpp"
 #include "scene/framing.hpp"
 #include "scene/quality.hpp"
@@ -248,6 +249,12 @@ int run_viewer(const ViewerOptions& o) {
                  s.volume.times.size());
     return kExitBadInput;
   }
+  try {
+    overlays::check_overlays(s.scene.overlays, s.volume);
+  } catch (const overlays::OverlayError& e) {
+    std::fprintf(stderr, "cloudviewer view: %s\n", e.what());
+    return kExitBadInput;
+  }
   s.import_report = s.volume.report.to_text();
   if (!o.scene || o.time_given) s.scene.time_step = o.time_step, s.scene.time.valid_utc = o.time_utc;
   // The timeline: from the scene's instant; a file with one step is a still (with a note).
@@ -304,6 +311,7 @@ int run_viewer(const ViewerOptions& o) {
   render::FrameRenderer renderer(loader);
   render::Presenter presenter(loader);
   core::PreparedVolumeCache volumes;  // the time steps shown last, prepared once each
+  overlays::OverlayBuilder overlay_builder;  // the overlays' geometry, rebuilt only when its inputs change
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -471,6 +479,19 @@ int run_viewer(const ViewerOptions& o) {
     // exactly as `render` does without --accumulate.
     marched_last = accumulated < s.scene.render.accumulate;
     if (marched_last) {
+      if (accumulated == 0) {  // a new mean: the overlays for this view (VTK only when a scene has some)
+        try {
+          const auto built = overlay_builder.build(s.scene.overlays, s.volume, static_cast<std::size_t>(s.scene.time_step), spec.march_camera);
+          stats.overlays.resize(built.size());
+          for (std::size_t i = 0; i < built.size(); ++i) {
+            if (built[i].rebuilt) stats.overlays[i].build_ms = built[i].build_ms;
+          }
+          renderer.set_overlays(overlays::OverlayBuilder::draws(built));
+        } catch (const overlays::OverlayError& e) {
+          ctx.scene_message = e.what();
+          renderer.set_overlays({});
+        }
+      }
       march_timer.begin();
       renderer.march_into(presenter.frame_texture(), spec, accumulated);
       march_timer.end();
@@ -497,6 +518,9 @@ int run_viewer(const ViewerOptions& o) {
     present_timer.end();
     stats.march_ms = march_timer.ms();
     stats.present_ms = present_timer.ms();
+    for (std::size_t i = 0; i < stats.overlays.size(); ++i) {  // one per scene overlay, in order (0: off)
+      stats.overlays[i].draw_ms = i < renderer.overlay_draw_ms().size() ? renderer.overlay_draw_ms()[i] : 0.0;
+    }
     if (show_ui) stats.march = renderer.last_stats();  // read back only when shown (it waits for the march)
     stats.accumulated = accumulated;
     stats.march_w = mw;

@@ -38,7 +38,7 @@ bool same_march(const core::Scene& a, const core::Scene& b) {
          a.height == b.height && a.sun.mode == b.sun.mode && a.sun.datetime_utc == b.sun.datetime_utc &&
          a.sun.subsolar_lat_deg == b.sun.subsolar_lat_deg && a.sun.subsolar_lon_deg == b.sun.subsolar_lon_deg &&
          a.sun.irradiance == b.sun.irradiance && core::same_image(a.render.march, b.render.march) &&
-         a.render.resolution_scale == b.render.resolution_scale;
+         a.render.resolution_scale == b.render.resolution_scale && a.overlays == b.overlays;
 }
 
 }  // namespace cv::viewer

@@ -11,6 +11,7 @@
 #include "frame/camera.hpp"
 #include "settings/march_settings.hpp"
 #include "volume/time_interpolation.hpp"
+#include "settings/overlay_settings.hpp"
 
 namespace cv::core {
 
@@ -84,7 +85,8 @@ struct Scene {
   int width = 960, height = 540;
   SunSpec sun;
   RenderSettings render;
-  std::vector<std::string> overlays;  // none yet
+  // Overlays drawn with the clouds, composited by depth (settings/overlay_settings.def).
+  std::vector<OverlaySpec> overlays;
 };
 
 }  // namespace cv::core

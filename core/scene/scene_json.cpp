@@ -17,6 +17,7 @@
 
 #include "scene/framing.hpp"
 #include "scene/quality.hpp"
+#include "settings/overlay_settings.hpp"
 #include "settings/quality_knobs.hpp"
 #include "volume/volume_io.hpp"
 
@@ -282,6 +283,55 @@ ojson march_to_json(const MarchSettings& m) {
   return out;
 }
 
+// "overlays": each entry a type name (its defaults) or an object {"type": NAME, key: value, ...}
+// typed by the overlay table (settings/overlay_settings.def).
+void read_overlays(const std::string& source, const json& o, std::vector<OverlaySpec>& out) {
+  const json empty = json::object();
+  const Reader top(source, empty, "");
+  if (!o.is_array()) top.fail("overlays", shown(o), "an array of overlays (names or {\"type\": ...} objects)");
+  for (std::size_t i = 0; i < o.size(); ++i) {
+    const json& item = o[i];
+    const std::string at = "overlays[" + std::to_string(i) + "]";
+    if (item.is_string()) {
+      if (!is_overlay_type(item.get<std::string>())) top.fail(at, shown(item), overlay_types_expected());
+      out.push_back(default_overlay(item.get<std::string>()));
+      continue;
+    }
+    if (!item.is_object()) top.fail(at, shown(item), "an overlay name or an object {\"type\": NAME, ...}");
+    const auto type = item.find("type");
+    if (type == item.end()) top.fail(at + ".type", "nothing", overlay_types_expected());
+    if (!type->is_string() || !is_overlay_type(type->get<std::string>())) top.fail(at + ".type", shown(*type), overlay_types_expected());
+    OverlaySpec spec = default_overlay(type->get<std::string>());
+    std::vector<const char*> known = {"type"};
+    for (const OverlayParamRow& row : overlay_param_rows()) {
+      if (spec.type == row.overlay) known.push_back(row.key);
+    }
+    const Reader r(source, item, at);
+    r.only(known);
+    for (const auto& [key, value] : item.items()) {
+      if (key == "type") continue;
+      const OverlayParamRow& row = *overlay_param(spec.type, key);
+      const std::string expected = overlay_param_expected(row);
+      if (row.kind == OverlayParamKind::Number) {
+        if (!value.is_number() || !(value.get<double>() >= row.lo && value.get<double>() <= row.hi)) r.fail(key, shown(value), expected);
+        spec.numbers[key] = value.get<double>();
+      } else if (row.kind == OverlayParamKind::Text) {
+        if (!value.is_string() || value.get<std::string>().empty()) r.fail(key, shown(value), "a non-empty string: " + std::string(row.doc));
+        spec.texts[key] = value.get<std::string>();
+      } else {
+        if (!value.is_array() || value.size() != 3) r.fail(key, shown(value), expected);
+        glm::dvec3 c;
+        for (int k = 0; k < 3; ++k) {
+          if (!value[k].is_number() || !(value[k].get<double>() >= row.lo && value[k].get<double>() <= row.hi)) r.fail(key, shown(value), expected);
+          c[k] = value[k].get<double>();
+        }
+        spec.colors[key] = c;
+      }
+    }
+    out.push_back(std::move(spec));
+  }
+}
+
 }  // namespace
 
 Scene scene_from_json(const std::string& text, const std::string& source) {
@@ -332,13 +382,7 @@ Scene scene_from_json(const std::string& text, const std::string& source) {
   if (scene.camera) scene.camera->width = scene.width, scene.camera->height = scene.height;
   if (const auto s = r.child("sun")) read_sun(*s, scene.sun);
   if (const auto rs = r.child("render")) read_render(*rs, scene.render);
-  if (const json* o = r.find("overlays")) {
-    if (!o->is_array()) r.fail("overlays", shown(*o), "an array of overlay names (none exist yet)");
-    for (const auto& item : *o) {
-      if (!item.is_string()) r.fail("overlays", shown(*o), "an array of strings");
-      scene.overlays.push_back(item.get<std::string>());
-    }
-  }
+  if (const json* o = r.find("overlays")) read_overlays(source, *o, scene.overlays);
   return scene;
 }
 
@@ -372,7 +416,21 @@ std::string scene_to_json(const Scene& s) {
                     {"exposure", s.render.auto_exposure ? ojson("auto") : ojson(s.render.exposure)},
                     {"budget_ms", s.render.budget_ms},
                     {"march", march_to_json(s.render.march)}};
-  root["overlays"] = s.overlays;
+  ojson overlays = ojson::array();
+  for (const OverlaySpec& o : s.overlays) {
+    ojson entry = {{"type", o.type}};
+    for (const OverlayParamRow& row : overlay_param_rows()) {
+      if (o.type != row.overlay) continue;
+      if (row.kind == OverlayParamKind::Number) entry[row.key] = o.number(row.key);
+      if (row.kind == OverlayParamKind::Text) entry[row.key] = o.text(row.key);
+      if (row.kind == OverlayParamKind::Rgb) {
+        const glm::dvec3 c = o.color(row.key);
+        entry[row.key] = {c.x, c.y, c.z};
+      }
+    }
+    overlays.push_back(entry);
+  }
+  root["overlays"] = overlays;
   return root.dump(2) + "\n";
 }
 

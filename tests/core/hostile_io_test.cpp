@@ -185,12 +185,25 @@ TEST_F(HostileInput, ASceneFileWritesNothingAndRunsNothing) {
   const auto before = listing();
   const fs::path cwd = fs::current_path();
   fs::current_path(dir_);
-  Scene s;
-  EXPECT_NO_THROW(s = load_scene("evil.json"));
+  // An overlay is a name from the overlay table: anything else is refused, and nothing is run.
+  std::string error;
+  try {
+    load_scene("evil.json");
+  } catch (const SceneError& e) {
+    error = e.what();
+  }
   fs::current_path(cwd);
+  EXPECT_EQ(error, "evil.json: overlays[0]: found \"$(touch pwned_overlay)\", expected one of coastlines, graticule, isosurface, wind, section");
   EXPECT_EQ(listing(), before);
   EXPECT_FALSE(fs::exists("pwned_data") || fs::exists("pwned_texture") || fs::exists("pwned_overlay"));
-  EXPECT_EQ(s.overlays.at(0), "$(touch pwned_overlay)");
+  // Without the overlay the same file loads, its strings kept as text.
+  write("evil2.json", R"J({"version": 1, "data": {"path": "../../../tmp/$(touch pwned_data)"},
+    "render": {"march": {"ground_texture": "`touch pwned_texture`; rm -rf ."}}})J");
+  fs::current_path(dir_);
+  Scene s;
+  EXPECT_NO_THROW(s = load_scene("evil2.json"));
+  fs::current_path(cwd);
+  EXPECT_FALSE(fs::exists("pwned_data") || fs::exists("pwned_texture"));
 }
 
 TEST_F(HostileInput, SizesAreMultipliedWithOverflowChecks) {

@@ -50,7 +50,14 @@ Scene full_scene() {
   cv::test::set_every_row_off(s.render.march, defaults.render.march);
   s.render.accumulate = 8, s.render.resolution_scale = 0.5, s.render.exposure = 6.25, s.render.auto_exposure = false;
   s.render.budget_ms = 40.0;
-  s.overlays = {"coastlines"};
+  // Every overlay type, every parameter off its default.
+  s.overlays = {default_overlay("coastlines"), default_overlay("graticule"), default_overlay("isosurface")};
+  s.overlays[0].colors["color"] = {0.25, 0.5, 0.75};
+  s.overlays[0].texts["resolution"] = "l";
+  s.overlays[0].numbers["line_width_px"] = 2.0;
+  s.overlays[1].numbers["step_deg"] = 15.0;
+  s.overlays[2].texts["field"] = "temperature";
+  s.overlays[2].numbers["value"] = 273.15;
   return s;
 }
 
@@ -287,3 +294,53 @@ TEST(Framing, IsoDateTimesAndTheSun) {
 }
 
 }  // namespace
+
+TEST(SceneJson, OverlaysAreTypedEntriesOrPlainNames) {
+  const Scene s = scene_from_json(
+      R"({"version": 1, "overlays": ["coastlines", {"type": "graticule", "step_deg": 5, "color": [1, 0, 0]},
+          {"type": "isosurface", "field": "temperature", "value": 273.15}]})", "scene.json");
+  ASSERT_EQ(s.overlays.size(), 3u);
+  EXPECT_EQ(s.overlays[0], default_overlay("coastlines"));
+  EXPECT_EQ(s.overlays[1].number("step_deg"), 5.0);
+  EXPECT_EQ(s.overlays[1].color("color"), glm::dvec3(1.0, 0.0, 0.0));
+  EXPECT_EQ(s.overlays[1].number("line_width_px"), 1.0);  // a key left out keeps its default
+  EXPECT_EQ(s.overlays[2].text("field"), "temperature");
+  EXPECT_EQ(s.overlays[2].number("value"), 273.15);
+}
+
+TEST(SceneJson, BadOverlaysAreNamedWithWhatWasExpected) {
+  EXPECT_EQ(error_of(R"({"version": 1, "overlays": ["rivers"]})"),
+            "scene.json: overlays[0]: found \"rivers\", expected one of coastlines, graticule, isosurface, wind, section");
+  EXPECT_EQ(error_of(R"({"version": 1, "overlays": [{"step_deg": 5}]})"),
+            "scene.json: overlays[0].type: found nothing, expected one of coastlines, graticule, isosurface, wind, section");
+  EXPECT_EQ(error_of(R"({"version": 1, "overlays": ["coastlines", {"type": "graticule", "step_deg": 0}]})"),
+            "scene.json: overlays[1].step_deg: found 0, expected a number 0.5..90 (degrees)");
+  EXPECT_EQ(error_of(R"({"version": 1, "overlays": [{"type": "graticule", "colour": [1, 1, 1]}]})"),
+            "scene.json: overlays[0].colour: unknown key, expected one of type, color, step_deg, line_width_px, label_px");
+  EXPECT_EQ(error_of(R"({"version": 1, "overlays": [{"type": "coastlines", "color": [1, 1]}]})"),
+            "scene.json: overlays[0].color: found [1,1], expected [r, g, b], each 0..1000");
+  EXPECT_EQ(error_of(R"({"version": 1, "overlays": "coastlines"})"),
+            "scene.json: overlays: found \"coastlines\", expected an array of overlays (names or {\"type\": ...} objects)");
+}
+
+TEST(OverlayFlag, ParsesNameAndTypedParameters) {
+  const OverlaySpec g = parse_overlay_flag("graticule:step_deg=15,color=1,0.5,0");
+  EXPECT_EQ(g.type, "graticule");
+  EXPECT_EQ(g.number("step_deg"), 15.0);
+  EXPECT_EQ(g.color("color"), glm::dvec3(1.0, 0.5, 0.0));
+  EXPECT_EQ(parse_overlay_flag("coastlines"), default_overlay("coastlines"));
+  auto message = [](const std::string& arg) {
+    try {
+      parse_overlay_flag(arg);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message("borders"), "--overlay borders: found \"borders\", expected one of coastlines, graticule, isosurface, wind, section");
+  EXPECT_EQ(message("graticule:step_deg=0"),
+            "--overlay graticule:step_deg=0: found \"0\" for step_deg, expected a number 0.5..90 (degrees)");
+  EXPECT_EQ(message("graticule:spacing=5"),
+            "--overlay graticule:spacing=5: found the key \"spacing\", expected one of color, step_deg, line_width_px, label_px for graticule");
+  EXPECT_EQ(message("graticule:5"), "--overlay graticule:5: found \"5\", expected key=value");
+}

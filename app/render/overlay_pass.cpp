@@ -1,0 +1,148 @@
+// The overlay pass: camera-relative geometry into distance and radiance textures.
+#include "render/overlay_pass.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "render/presenter.hpp"
+
+namespace cv::render {
+namespace {
+constexpr double kNearM = 0.05;   // the projection's clip planes: a metre's depth resolution comes
+constexpr double kFarM = 1.0e8;   // from the linear distance the fragment writes, not from these
+}  // namespace
+
+OverlayPass::OverlayPass(const ShaderLoader& loader)
+    : program_(load_graphics(loader, ShaderLoader::default_shader_dir() / "render" / "overlay.vert",
+                             ShaderLoader::default_shader_dir() / "render" / "overlay.frag")) {
+  glCreateFramebuffers(1, &fbo_);
+  glCreateVertexArrays(1, &vao_);
+  glCreateBuffers(1, &vbo_pos_);
+  glCreateBuffers(1, &vbo_color_);
+  glCreateBuffers(1, &ibo_);
+  glVertexArrayVertexBuffer(vao_, 0, vbo_pos_, 0, sizeof(glm::vec3));
+  glVertexArrayAttribFormat(vao_, 0, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(vao_, 0, 0);
+  glEnableVertexArrayAttrib(vao_, 0);
+  glVertexArrayVertexBuffer(vao_, 1, vbo_color_, 0, sizeof(glm::vec4));
+  glVertexArrayAttribFormat(vao_, 1, 4, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(vao_, 1, 1);
+  glEnableVertexArrayAttrib(vao_, 1);
+  glVertexArrayElementBuffer(vao_, ibo_);
+  check_gl("creating the overlay pass");
+}
+
+OverlayPass::~OverlayPass() {
+  const GLuint textures[] = {distance_, color_, depth_};
+  glDeleteTextures(3, textures);
+  glDeleteFramebuffers(1, &fbo_);
+  const GLuint buffers[] = {vbo_pos_, vbo_color_, ibo_};
+  glDeleteBuffers(3, buffers);
+  glDeleteVertexArrays(1, &vao_);
+}
+
+void OverlayPass::begin(const core::Camera& cam, double r0_m) {
+  if (cam.width != w_ || cam.height != h_) {
+    const GLuint textures[] = {distance_, color_, depth_};
+    glDeleteTextures(3, textures);
+    w_ = cam.width, h_ = cam.height;
+    glCreateTextures(GL_TEXTURE_2D, 1, &distance_);
+    glTextureStorage2D(distance_, 1, GL_R32F, w_, h_);
+    glCreateTextures(GL_TEXTURE_2D, 1, &color_);
+    glTextureStorage2D(color_, 1, GL_RGBA32F, w_, h_);
+    glCreateTextures(GL_TEXTURE_2D, 1, &depth_);
+    glTextureStorage2D(depth_, 1, GL_DEPTH_COMPONENT32F, w_, h_);
+    glNamedFramebufferTexture(fbo_, GL_COLOR_ATTACHMENT0, distance_, 0);
+    glNamedFramebufferTexture(fbo_, GL_COLOR_ATTACHMENT1, color_, 0);
+    glNamedFramebufferTexture(fbo_, GL_DEPTH_ATTACHMENT, depth_, 0);
+    const GLenum draw_buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(fbo_, 2, draw_buffers);
+    if (glCheckNamedFramebufferStatus(fbo_, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      throw GlError("the overlay pass's framebuffer is incomplete");
+    }
+  }
+  cam_ = cam;
+  r0_m_ = r0_m;
+  camera_m_ = core::camera_ecef(cam, r0_m);
+  const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  const float one = 1.0f;
+  glClearNamedFramebufferfv(fbo_, GL_COLOR, 0, zero);
+  glClearNamedFramebufferfv(fbo_, GL_COLOR, 1, zero);
+  glClearNamedFramebufferfv(fbo_, GL_DEPTH, 0, &one);
+  check_gl("starting the overlay pass");
+}
+
+double OverlayPass::draw(const core::OverlayMesh& mesh, float line_width_px) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (mesh.empty() || w_ == 0) return 0.0;
+  // Camera-relative positions, formed in double.
+  std::vector<glm::vec3> rel(mesh.positions.size());
+  for (std::size_t i = 0; i < rel.size(); ++i) rel[i] = glm::vec3(mesh.positions[i] - camera_m_);
+  std::vector<glm::vec4> colors = mesh.colors;
+  colors.resize(rel.size(), glm::vec4(1.0f));
+  glNamedBufferData(vbo_pos_, static_cast<GLsizeiptr>(rel.size() * sizeof(glm::vec3)), rel.data(), GL_STREAM_DRAW);
+  glNamedBufferData(vbo_color_, static_cast<GLsizeiptr>(colors.size() * sizeof(glm::vec4)), colors.data(), GL_STREAM_DRAW);
+  std::vector<std::uint32_t> indices = mesh.triangles;
+  indices.insert(indices.end(), mesh.lines.begin(), mesh.lines.end());
+  glNamedBufferData(ibo_, static_cast<GLsizeiptr>(indices.size() * sizeof(std::uint32_t)), indices.data(), GL_STREAM_DRAW);
+
+  const glm::mat4 view_proj(core::camera_projection_matrix(cam_, kNearM, kFarM) * core::camera_view_matrix(cam_));
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glViewport(0, 0, w_, h_);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glUseProgram(program_.id());
+  glUniformMatrix4fv(glGetUniformLocation(program_.id(), "u_view_proj"), 1, GL_FALSE, glm::value_ptr(view_proj));
+  glUniform3d(glGetUniformLocation(program_.id(), "u_camera"), camera_m_.x, camera_m_.y, camera_m_.z);
+  glUniform1d(glGetUniformLocation(program_.id(), "u_cq"), glm::dot(camera_m_, camera_m_) - r0_m_ * r0_m_);
+  glUniform1f(glGetUniformLocation(program_.id(), "u_far"), static_cast<float>(kFarM));
+  const core::CameraFrame cf = core::camera_frame(cam_);
+  const glm::vec3 fw(cf.forward), rt(cf.right), up(cf.up);
+  glUniform3fv(glGetUniformLocation(program_.id(), "u_forward"), 1, glm::value_ptr(fw));
+  glUniform3fv(glGetUniformLocation(program_.id(), "u_right"), 1, glm::value_ptr(rt));
+  glUniform3fv(glGetUniformLocation(program_.id(), "u_up"), 1, glm::value_ptr(up));
+  glUniform2f(glGetUniformLocation(program_.id(), "u_tan_half"), static_cast<float>(cf.tan_half),
+              static_cast<float>(cf.tan_half * h_ / w_));
+  glUniform2f(glGetUniformLocation(program_.id(), "u_size"), static_cast<float>(w_), static_cast<float>(h_));
+  glBindVertexArray(vao_);
+  const GLint bias = glGetUniformLocation(program_.id(), "u_bias");
+  glUniform1f(bias, 0.0f);
+  if (!mesh.triangles.empty()) glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.triangles.size()), GL_UNSIGNED_INT, nullptr);
+  if (!mesh.lines.empty()) {
+    // Wide lines where the driver draws them (a forward-compatible context refuses widths over 1).
+    GLfloat range[2] = {1.0f, 1.0f};
+    glGetFloatv(GL_ALIASED_LINE_WIDTH_RANGE, range);
+    const float width = std::clamp(line_width_px, 1.0f, range[1]);
+    glUniform1f(bias, static_cast<float>(core::kLineDistanceBias));
+    glLineWidth(width);
+    if (glGetError() != GL_NO_ERROR) glLineWidth(1.0f);
+    glDrawElements(GL_LINES, static_cast<GLsizei>(mesh.lines.size()), GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(mesh.triangles.size() * sizeof(std::uint32_t)));
+    glLineWidth(1.0f);
+  }
+  glBindVertexArray(0);
+  glUseProgram(0);
+  glDisable(GL_DEPTH_TEST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glFinish();
+  check_gl("drawing overlays");
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+core::OpaqueLayer OverlayPass::read() const {
+  core::OpaqueLayer layer;
+  layer.distance_m.resize(static_cast<std::size_t>(w_) * h_);
+  layer.radiance_rgba.resize(4 * layer.distance_m.size());
+  glGetTextureImage(distance_, 0, GL_RED, GL_FLOAT, static_cast<GLsizei>(layer.distance_m.size() * sizeof(float)), layer.distance_m.data());
+  glGetTextureImage(color_, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(layer.radiance_rgba.size() * sizeof(float)), layer.radiance_rgba.data());
+  check_gl("reading the overlay pass back");
+  return layer;
+}
+
+}  // namespace cv::render

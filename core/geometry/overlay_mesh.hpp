@@ -1,0 +1,60 @@
+// Overlay geometry (coastlines, graticule, isosurfaces, ...) as plain data: Earth-centred vertices
+// in double with a colour each, line segments and triangles. Built by the overlays layer
+// (app/overlays, through VTK), drawn by the GPU overlay pass (app/render/overlay_pass) and cast by
+// the CPU reference (cast_overlay below) into the same per-pixel opaque layer the march composites
+// behind the clouds. Nothing here knows GL or VTK.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "frame/camera.hpp"
+#include "reference/raymarcher.hpp"
+
+namespace cv::core {
+
+struct OverlayMesh {
+  std::vector<glm::dvec3> positions;     // Earth-centred, Earth-fixed metres (the renderer's sphere)
+  std::vector<glm::vec4> colors;         // per vertex: radiance (rgb, the march's units) and alpha
+  std::vector<std::uint32_t> lines;      // vertex index pairs
+  std::vector<std::uint32_t> triangles;  // vertex index triples
+  bool empty() const { return lines.empty() && triangles.empty(); }
+  // Appends another mesh's vertices and primitives (indices shifted).
+  void append(const OverlayMesh& other);
+};
+
+// Lines lie on surfaces (coastlines and the graticule on the ground): their distance is pulled
+// toward the camera by this fraction, on the GPU and the CPU alike, so that the float distance
+// and the march's own ground intersection do not decide between a line and the ground it lies on
+// (400 m at 4000 km, 0.2 m at 2 km).
+inline constexpr double kLineDistanceBias = 1e-4;
+
+// Where a camera-relative point lands on the image: pixel coordinates (x right, y down, pixel
+// centres at half-integers as camera_ray's) and the distance along the ray; `in_front` false when
+// the point is behind the camera.
+struct Projected {
+  double x = 0.0, y = 0.0, distance_m = 0.0;
+  bool in_front = false;
+};
+Projected project_point(const Camera& cam, const glm::dvec3& relative_m);
+
+// Whether the sphere of radius r0_m hides the point `relative_m` (camera-relative) from a camera
+// at `camera_m` (Earth-centred): the segment from the camera meets the sphere more than
+// max(1 m, 1e-6 of its length) before the point. Points on the sphere's visible side are not hidden.
+// The GPU overlay pass (shaders/render/overlay.frag) makes the same test in float.
+bool hidden_by_sphere(const glm::dvec3& camera_m, const glm::dvec3& relative_m, double r0_m);
+
+// The mesh's opaque layer as the march reads it (OpaqueLayer: distance along each pixel's ray to
+// the nearest geometry, 0 where none, and its radiance), computed on the CPU: each pixel's ray (camera_ray)
+// is intersected exactly with the triangles (double precision, Moller-Trumbore), and a line covers
+// the pixels whose centres lie within half a pixel of its projected segment (its distance there
+// is that of the segment's point nearest the ray, or of the ground the pixel's ray meets where
+// that is nearer, less kLineDistanceBias of it). The nearest hit wins; geometry hidden by the
+// sphere of radius r0_m is left out. The GPU pass rasterises the same primitives: triangles agree
+// to float precision, lines may differ by a pixel at their ends (GL's diamond-exit rule).
+OpaqueLayer cast_overlay(const OverlayMesh& mesh, const Camera& cam, double r0_m);
+
+}  // namespace cv::core

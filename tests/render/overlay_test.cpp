@@ -1,0 +1,453 @@
+// Overlays composited with the clouds by depth (issue 15): the GPU overlay pass against the CPU
+// cast of the same primitives; an opaque plane inside a uniform cloud on the GPU and the CPU
+// reference against the closed form; a coastline vertex on the pixel the camera's projection
+// gives, from orbit and from 100 m; an isosurface of an analytic sphere field; and no overlay, no
+// VTK call and no pass.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "geo/geodesy.hpp"
+#include "geometry/overlay_mesh.hpp"
+#include "kernel/prepared_volume.hpp"
+#include "overlays/overlays.hpp"
+#include "reference/raymarcher.hpp"
+#include "render/context.hpp"
+#include "render/frame_renderer.hpp"
+#include "render/land_sea_mask.hpp"
+#include "render/overlay_pass.hpp"
+
+namespace {
+using namespace cv;
+
+const double kSigma = static_cast<double>(0.002f);  // 1/m, as the volume stores it
+constexpr int kSize = 9;
+
+// A uniform liquid cloud from the ground to 4 km over a 4 x 4 degree box; the camera inside it at
+// 2 km looks straight up at the sun overhead (as tests/render/depth_io_test.cpp).
+struct UniformCloud {
+  core::VolumeGrid grid;
+  core::TimeStepData data;
+  core::FrameSpec frame;
+  UniformCloud() {
+    grid.lon_deg = {-2.0, 0.25, 17};
+    grid.lat_deg = {-2.0, 0.25, 17};
+    grid.alt_m = {0.0, 250.0, 17};
+    data[core::Field::ExtinctionLiquid].assign(grid.points(), static_cast<float>(kSigma));
+    core::Camera& cam = frame.camera;
+    cam.alt_m = 2000.0, cam.pitch_deg = 90.0, cam.fov_deg = 30.0, cam.width = kSize, cam.height = kSize;
+    frame.march_camera = cam;
+    frame.march.quality.view_step_m = 50.0;
+    frame.march.quality.octaves = 1;
+  }
+};
+
+// A square plane `height_m` above the camera, normal up, two triangles of one colour.
+std::shared_ptr<core::OverlayMesh> plane_above(const core::Camera& cam, double r0, double height_m, glm::vec4 color) {
+  auto m = std::make_shared<core::OverlayMesh>();
+  const glm::dvec3 up = glm::normalize(core::camera_ecef(cam, r0));
+  const geo::EnuFrame f = geo::sphere_enu(cam.lat_deg, cam.lon_deg);
+  const glm::dvec3 c = core::camera_ecef(cam, r0) + height_m * up;
+  const double s = 3000.0;
+  m->positions = {c - s * f.east - s * f.north, c + s * f.east - s * f.north, c + s * f.east + s * f.north, c - s * f.east + s * f.north};
+  m->colors.assign(4, color);
+  m->triangles = {0, 1, 2, 0, 2, 3};
+  return m;
+}
+
+double pixel_up_cosine(const core::Camera& cam, int i, double r0) {
+  return glm::dot(core::camera_ray(cam, i % cam.width, i / cam.width), glm::normalize(core::camera_ecef(cam, r0)));
+}
+
+TEST(OverlayPass, DrawsTheLayerTheCpuCasts) {
+  auto ctx = render::make_headless_context();
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::OverlayPass pass(loader);
+  const UniformCloud u;
+  const double r0 = u.grid.earth_radius_m;
+  const auto mesh = plane_above(u.frame.camera, r0, 600.0, {0.5f, 0.25f, 0.125f, 1.0f});
+  pass.begin(u.frame.camera, r0);
+  pass.draw(*mesh);
+  const core::OpaqueLayer gpu = pass.read(), cpu = core::cast_overlay(*mesh, u.frame.camera, r0);
+  for (int i = 0; i < kSize * kSize; ++i) {
+    const double expected = 600.0 / pixel_up_cosine(u.frame.camera, i, r0);
+    EXPECT_NEAR(cpu.distance_m[i], expected, 1e-3) << i;
+    // float: the camera-relative vertices and the interpolated position, a few ulps of 600 m.
+    EXPECT_NEAR(gpu.distance_m[i], expected, 2e-3) << i;
+    // Both interpolate the vertices' colour (equal here) in float: a few ulps.
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(gpu.radiance_rgba[4 * i + c], cpu.radiance_rgba[4 * i + c], 1e-6) << i;
+  }
+}
+
+// The composite of an opaque plane inside the cloud: each pixel is the cloud in front of the plane
+// (the march stopped at its distance, alpha the transmittance there) plus the plane's radiance
+// times exp(-sigma d), d the distance to the plane along the pixel's ray; on the GPU through the
+// frame renderer's overlay pass and on the CPU reference through the CPU cast.
+TEST(OverlayComposite, OpaquePlaneInsideACloudOnTheGpuAndTheCpuReference) {
+  auto ctx = render::make_headless_context();
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  const UniformCloud u;
+  const double r0 = u.grid.earth_radius_m;
+  const glm::vec4 color(0.5f, 0.25f, 0.125f, 1.0f);
+  const auto mesh = plane_above(u.frame.camera, r0, 600.0, color);
+  const auto volume = std::make_shared<const core::PreparedVolume>(core::prepare_volume(u.grid, u.data));
+
+  render::FrameRenderer renderer(loader);
+  renderer.use_volume(volume);
+  renderer.set_overlays({{"plane", mesh, 1.0f}});
+  const std::vector<glm::vec4> gpu = renderer.render(u.frame);
+  const core::OpaqueLayer drawn = renderer.read_overlays();
+  // The cloud in front alone: the same distances, no radiance given (alpha is then the transmittance).
+  core::OpaqueLayer depth_only = drawn;
+  depth_only.radiance_rgba.clear();
+  render::GpuRaymarcher& march = renderer.raymarcher();
+  GLuint depth_tex = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &depth_tex);
+  glTextureStorage2D(depth_tex, 1, GL_R32F, kSize, kSize);
+  glTextureSubImage2D(depth_tex, 0, 0, 0, kSize, kSize, GL_RED, GL_FLOAT, drawn.distance_m.data());
+  const std::vector<glm::vec4> front = march.render(u.frame.march_camera, u.frame.sun, u.frame.march, {}, {depth_tex, 0});
+  glDeleteTextures(1, &depth_tex);
+
+  const core::OpaqueLayer cast = core::cast_overlay(*mesh, u.frame.camera, r0);
+  const core::ReferenceImage cpu = core::render_reference(*volume, u.frame.camera, u.frame.sun, u.frame.march, nullptr, nullptr, &cast);
+  core::OpaqueLayer cast_depth = cast;
+  cast_depth.radiance_rgba.clear();
+  const core::ReferenceImage cpu_front =
+      core::render_reference(*volume, u.frame.camera, u.frame.sun, u.frame.march, nullptr, nullptr, &cast_depth);
+
+  double l_max = 0.0;
+  for (int i = 0; i < kSize * kSize; ++i) l_max = std::max(l_max, cpu.radiance[i].y);
+  ASSERT_GT(l_max, 0.0);
+  for (int i = 0; i < kSize * kSize; ++i) {
+    // The layers hold float distances and colours: the closed forms take what they hold, and
+    // those are the plane's own to float precision.
+    const double d = 600.0 / pixel_up_cosine(u.frame.camera, i, r0);
+    ASSERT_NEAR(cast.distance_m[i], d, 1e-3) << i;
+    ASSERT_NEAR(drawn.distance_m[i], d, 2e-3) << i;
+    const double t_cpu = std::exp(-kSigma * static_cast<double>(cast.distance_m[i]));
+    const double t_gpu = std::exp(-kSigma * static_cast<double>(drawn.distance_m[i]));
+    // Transmittance in front of the plane: the closed form.
+    EXPECT_NEAR(cpu_front.transmittance[i], t_cpu, 1e-12) << i;
+    EXPECT_NEAR(front[i].w, t_gpu, 5e-6) << i;
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_NEAR(cast.radiance_rgba[4 * i + c], color[c], 1e-6) << i;
+      // CPU reference: cloud in front + colour x exp(-tau), to double precision.
+      EXPECT_NEAR(cpu.radiance[i][c], cpu_front.radiance[i][c] + t_cpu * cast.radiance_rgba[4 * i + c], 1e-12) << i;
+      // GPU: the same composite to float precision, and against the CPU within 1e-4 of the brightest pixel.
+      EXPECT_NEAR(gpu[i][c], front[i][c] + t_gpu * drawn.radiance_rgba[4 * i + c], 1e-5) << i;
+      EXPECT_NEAR(gpu[i][c], cpu.radiance[i][c], 1e-4 * l_max) << i;
+    }
+    EXPECT_EQ(gpu[i].w, 0.0f);  // nothing shows through the opaque plane
+    EXPECT_EQ(cpu.transmittance[i], 0.0);
+  }
+}
+
+TEST(OverlayComposite, NoOverlayMakesNoPassAndNoVtkCall) {
+  auto ctx = render::make_headless_context();
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  const UniformCloud u;
+  const auto volume = std::make_shared<const core::PreparedVolume>(core::prepare_volume(u.grid, u.data));
+  render::FrameRenderer renderer(loader);
+  renderer.use_volume(volume);
+  const std::uint64_t runs = overlays::vtk_pipeline_runs();
+  core::CloudVolume vol;
+  vol.grid = u.grid;
+  overlays::OverlayBuilder builder;
+  const auto built = builder.build({}, vol, 0, u.frame.camera);
+  renderer.set_overlays(overlays::OverlayBuilder::draws(built));
+  const std::vector<glm::vec4> img = renderer.render(u.frame);
+  EXPECT_TRUE(built.empty());
+  EXPECT_EQ(overlays::vtk_pipeline_runs(), runs);
+  EXPECT_FALSE(renderer.has_overlay_pass());
+  EXPECT_TRUE(renderer.overlay_draw_ms().empty());
+  // And the image is the march's own, bit for bit.
+  const std::vector<glm::vec4> plain = renderer.raymarcher().render(u.frame.march_camera, u.frame.sun, u.frame.march);
+  ASSERT_EQ(img.size(), plain.size());
+  for (std::size_t i = 0; i < img.size(); ++i) EXPECT_EQ(img[i], plain[i]) << i;
+}
+
+TEST(OverlayBuilder, RebuildsOnlyWhenItsInputsChange) {
+  core::CloudVolume vol;
+  vol.grid.lon_deg = {-2.0, 0.25, 17};
+  vol.grid.lat_deg = {-2.0, 0.25, 17};
+  vol.grid.alt_m = {0.0, 250.0, 17};
+  core::Camera cam;
+  cam.alt_m = 5.0e6;
+  overlays::OverlayBuilder builder;
+  std::vector<core::OverlaySpec> specs = {core::default_overlay("graticule")};
+  specs[0].numbers["label_px"] = 0.0;  // labels face the view and are made for each; the lines are cached
+  const std::uint64_t r0 = overlays::vtk_pipeline_runs();
+  auto a = builder.build(specs, vol, 0, cam);
+  EXPECT_TRUE(a[0].rebuilt);
+  EXPECT_EQ(overlays::vtk_pipeline_runs(), r0 + 1);
+  auto b = builder.build(specs, vol, 1, cam);  // another time step: the graticule does not depend on it
+  EXPECT_FALSE(b[0].rebuilt);
+  EXPECT_EQ(b[0].mesh, a[0].mesh);
+  EXPECT_EQ(overlays::vtk_pipeline_runs(), r0 + 1);
+  specs[0].numbers["step_deg"] = 30.0;
+  auto c = builder.build(specs, vol, 1, cam);
+  EXPECT_TRUE(c[0].rebuilt);
+  EXPECT_EQ(overlays::vtk_pipeline_runs(), r0 + 2);
+}
+
+TEST(Coastlines, ResolutionFollowsTheView) {
+  EXPECT_EQ(overlays::coastline_resolution("auto", 3.6e7), 'c');
+  EXPECT_EQ(overlays::coastline_resolution("auto", 5.0e5), 'l');
+  EXPECT_EQ(overlays::coastline_resolution("auto", 5.0e4), 'i');
+  EXPECT_EQ(overlays::coastline_resolution("auto", 1.0e4), 'h');
+  EXPECT_EQ(overlays::coastline_resolution("auto", 100.0), 'f');
+  EXPECT_EQ(overlays::coastline_resolution("l", 100.0), 'l');
+}
+
+TEST(Coastlines, MissingDataNamesThePackage) {
+  try {
+    overlays::build_coastlines("/nonexistent/gshhs", 'c', 6371000.0, glm::vec4(1.0f));
+    FAIL() << "no error";
+  } catch (const overlays::OverlayError& e) {
+    EXPECT_NE(std::string(e.what()).find("python-cartopy-data"), std::string::npos) << e.what();
+  }
+}
+
+// A GSHHS vertex of Iceland's shore (the crude level-1 shapefile's point nearest 64.1 N, 21.9 W),
+// its lat/lon read from the file, drawn by the overlay pass from the camera: it lands on the pixel
+// the camera's projection gives (within one pixel), from orbit and from 100 m.
+TEST(Coastlines, AVertexLandsOnThePixelTheProjectionGives) {
+  const std::string base = std::string(render::kGshhsDir) + "/c/GSHHS_c_L1";
+  std::vector<render::ShorePolygon> shores;
+  render::read_shore_polygons(base, 1, shores);
+  double best = 1e9, lat = 0.0, lon = 0.0;
+  for (const auto& p : shores) {
+    for (const auto& ring : p.rings) {
+      for (std::size_t k = 0; k + 1 < ring.size(); k += 2) {
+        const double dd = std::hypot(ring[k + 1] - 64.1, (ring[k] + 21.9) * std::cos(64.1 * 3.14159265358979 / 180.0));
+        if (dd < best) best = dd, lon = ring[k], lat = ring[k + 1];
+      }
+    }
+  }
+  ASSERT_LT(best, 1.0) << "no Icelandic vertex in " << base;
+  const double r0 = 6371000.0;
+  const core::OverlayMesh coast = overlays::build_coastlines(render::kGshhsDir, 'c', r0, glm::vec4(1.0f));
+  const glm::dvec3 v = geo::sphere_to_ecef({lat, lon, 0.0}, r0);
+  std::size_t vi = coast.positions.size();
+  for (std::size_t i = 0; i < coast.positions.size(); ++i) {
+    // The vertex is lifted so its chords stay above the sphere: 8 cm at most for 2 km pieces.
+    if (glm::length(coast.positions[i] - v) < 0.1) vi = i;
+  }
+  ASSERT_LT(vi, coast.positions.size()) << "the vertex " << lat << ", " << lon << " is not in the mesh";
+  // The vertex's own segments only, so no other shore can cover the pixel.
+  core::OverlayMesh near;
+  near.positions = coast.positions;
+  near.colors = coast.colors;
+  for (std::size_t k = 0; k + 1 < coast.lines.size(); k += 2) {
+    if (coast.lines[k] == vi || coast.lines[k + 1] == vi) near.lines.insert(near.lines.end(), {coast.lines[k], coast.lines[k + 1]});
+  }
+  ASSERT_FALSE(near.lines.empty());
+
+  auto ctx = render::make_headless_context();
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::OverlayPass pass(loader);
+  struct View {
+    const char* name;
+    double back_deg, alt_m, pitch_deg;
+  };
+  // From orbit: 400 km up, 3 degrees south, looking north and down; from 100 m: 2 km south, level.
+  for (const View& view : {View{"orbit", 3.0, 4.0e5, -55.0}, View{"100 m", 2000.0 / 111195.0, 100.0, -2.0}}) {
+    core::Camera cam;
+    cam.lat_deg = lat - view.back_deg, cam.lon_deg = lon, cam.alt_m = view.alt_m, cam.pitch_deg = view.pitch_deg;
+    cam.heading_deg = 0.0, cam.fov_deg = 40.0, cam.width = 320, cam.height = 180;
+    const core::Projected q = core::project_point(cam, v - core::camera_ecef(cam, r0));
+    ASSERT_TRUE(q.in_front) << view.name;
+    ASSERT_TRUE(q.x > 0 && q.x < cam.width && q.y > 0 && q.y < cam.height) << view.name << ": " << q.x << ", " << q.y;
+    pass.begin(cam, r0);
+    pass.draw(near);
+    const core::OpaqueLayer layer = pass.read();
+    const int px = static_cast<int>(q.x), py = static_cast<int>(q.y);
+    // A drawn pixel within one pixel of the prediction, at the vertex's distance there: within the
+    // distance one pixel spans along the line (its footprint over the grazing angle, bounded here
+    // by 2 % of the distance from 100 m and 0.5 % from orbit).
+    int found = 0;
+    double nearest = 1e30;
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const float d = layer.distance_m[static_cast<std::size_t>(py + dy) * cam.width + px + dx];
+        if (d > 0.0f) ++found, nearest = std::min(nearest, std::abs(d - q.distance_m));
+      }
+    }
+    EXPECT_GT(found, 0) << view.name << ": nothing drawn within a pixel of " << q.x << ", " << q.y;
+    EXPECT_LT(nearest, (view.alt_m < 1000.0 ? 0.02 : 0.005) * q.distance_m) << view.name;
+    // Nothing drawn far from the vertex's segments: the line is where the projection puts it.
+    const core::OpaqueLayer cpu = core::cast_overlay(near, cam, r0);
+    int gpu_only = 0;
+    for (int y = 0; y < cam.height; ++y) {
+      for (int x = 0; x < cam.width; ++x) {
+        if (layer.distance_m[static_cast<std::size_t>(y) * cam.width + x] == 0.0f) continue;
+        bool cpu_near = false;
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx >= 0 && yy >= 0 && xx < cam.width && yy < cam.height && cpu.distance_m[static_cast<std::size_t>(yy) * cam.width + xx] > 0.0f) cpu_near = true;
+          }
+        }
+        gpu_only += cpu_near ? 0 : 1;
+      }
+    }
+    EXPECT_EQ(gpu_only, 0) << view.name << ": GPU pixels more than a pixel from the CPU's cast of the same lines";
+  }
+}
+
+TEST(GraticuleLabels, StrokesStandBesideTheirCrossingsInTheImage) {
+  EXPECT_EQ(overlays::label_strokes("60N").size(), 6u + 6u + 3u);  // 6: afgedc, 0: abcdef, N: three strokes
+  EXPECT_EQ(overlays::label_strokes("1").size(), 2u);
+  core::Camera cam;
+  cam.lat_deg = -20.0, cam.alt_m = 3.0e6, cam.pitch_deg = -70.0, cam.fov_deg = 50.0, cam.width = 160, cam.height = 90;
+  const double r0 = 6371000.0;
+  const core::OverlayMesh labels = overlays::graticule_labels(10.0, cam, r0, glm::vec4(1.0f), 12.0);
+  ASSERT_GT(labels.lines.size(), 20u);
+  // Every stroke end lands in the image, and the strokes are about 12 px high: their projected
+  // heights (y spans per label) never exceed 13 px.
+  const glm::dvec3 c = core::camera_ecef(cam, r0);
+  for (const glm::dvec3& p : labels.positions) {
+    const core::Projected q = core::project_point(cam, p - c);
+    ASSERT_TRUE(q.in_front);
+    EXPECT_GT(q.x, -1.0);
+    EXPECT_LT(q.y, cam.height + 13.0);
+  }
+  // Drawn by the overlay pass: the labels cover pixels the lines alone do not.
+  auto ctx = render::make_headless_context();
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::OverlayPass pass(loader);
+  const core::OverlayMesh lines = overlays::build_graticule(10.0, r0, glm::vec4(1.0f));
+  core::OverlayMesh both = lines;
+  both.append(labels);
+  auto covered = [&](const core::OverlayMesh& m) {
+    pass.begin(cam, r0);
+    pass.draw(m);
+    int n = 0;
+    for (float d : pass.read().distance_m) n += d > 0.0f ? 1 : 0;
+    return n;
+  };
+  const int n_lines = covered(lines), n_both = covered(both);
+  EXPECT_GT(n_lines, 100);
+  EXPECT_GT(n_both, n_lines + 50) << "labels drew " << n_both - n_lines << " pixels";
+}
+
+// A solid-body rotation of the wind about the grid's centre column, written so that in grid
+// indices (where the tracer integrates) it is a rotation at omega: u = -omega (j - j0) dx_j,
+// v = omega (i - i0) dy, dx_j the cell's width at its latitude. A streamline started r cells from
+// the centre and followed 2 pi r cells closes on itself: within 1e-3 of r (RK45 at a 1e-8 error
+// per step; the field is linear in the indices, so the trilinear interpolation is exact).
+TEST(Wind, AStreamlineInAUniformRotationClosesOnItself) {
+  core::VolumeGrid g;
+  g.lon_deg = {-0.5, 0.05, 21};
+  g.lat_deg = {-0.5, 0.05, 21};
+  g.alt_m = {0.0, 500.0, 5};
+  const double kDeg = 3.14159265358979323846 / 180.0, omega = 1e-4, i0 = 10.0, j0 = 10.0;
+  std::vector<float> u(g.points()), v(g.points()), w;
+  for (int k = 0; k < g.alt_m.count; ++k) {
+    const double r = g.earth_radius_m + g.alt_m.at(k);
+    for (int j = 0; j < g.lat_deg.count; ++j) {
+      const double dx = r * std::cos(g.lat_deg.at(j) * kDeg) * g.lon_deg.step * kDeg, dy = r * g.lat_deg.step * kDeg;
+      for (int i = 0; i < g.lon_deg.count; ++i) {
+        u[g.index(i, j, k)] = static_cast<float>(-omega * (j - j0) * dx);
+        v[g.index(i, j, k)] = static_cast<float>(omega * (i - i0) * dy);
+      }
+    }
+  }
+  for (double radius : {3.0, 6.0}) {
+    std::vector<std::vector<glm::dvec3>> lines;
+    const core::OverlayMesh m = overlays::build_streamlines_from(g, u, v, w, {{i0 + radius, j0, 2.0}}, 2.0 * 3.14159265358979323846 * radius,
+                                                                  30.0, 1.0, &lines);
+    ASSERT_EQ(lines.size(), 1u);
+    ASSERT_GT(lines[0].size(), 20u);
+    const glm::dvec3 start = lines[0].front(), end = lines[0].back();
+    double worst_radius = 0.0;
+    for (const glm::dvec3& p : lines[0]) worst_radius = std::max(worst_radius, std::abs(std::hypot(p.x - i0, p.y - j0) - radius));
+    EXPECT_LT(glm::length(end - start), 1e-3 * radius) << "radius " << radius << ": the streamline ends " << glm::length(end - start)
+                                                        << " cells from its start";
+    EXPECT_LT(worst_radius, 1e-3 * radius) << "radius " << radius;
+    EXPECT_EQ(m.lines.size(), 2 * (lines[0].size() - 1));
+  }
+}
+
+// Sections: a horizontal slice through a field that grows with longitude lies at its altitude and
+// carries the field's colours; a vertical curtain between two points stands on their great circle;
+// the legend's bar and text lie 1 m in front of the camera, inside the image.
+TEST(Section, SlicesLieWhereAskedAndCarryTheField) {
+  core::VolumeGrid g;
+  g.lon_deg = {-1.0, 0.1, 21};
+  g.lat_deg = {-1.0, 0.1, 21};
+  g.alt_m = {0.0, 500.0, 9};
+  std::vector<float> f(g.points());
+  for (int k = 0; k < g.alt_m.count; ++k) {
+    for (int j = 0; j < g.lat_deg.count; ++j) {
+      for (int i = 0; i < g.lon_deg.count; ++i) f[g.index(i, j, k)] = static_cast<float>(i) / 20.0f;  // 0..1 west to east
+    }
+  }
+  const overlays::FieldColor by{nullptr, 0.0, 1.0, 1.0};
+  const core::OverlayMesh h = overlays::build_horizontal_section(g, f, 1250.0, by);
+  ASSERT_GT(h.triangles.size(), 100u);
+  for (std::size_t i = 0; i < h.positions.size(); ++i) {
+    const geo::Geodetic p = geo::ecef_to_sphere(h.positions[i], g.earth_radius_m);
+    EXPECT_NEAR(p.alt_m, 1250.0, 1e-6);
+    const glm::vec4 expected = overlays::colormap((p.lon_deg + 1.0) / 2.0);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(h.colors[i][c], expected[c], 1e-5) << i;
+  }
+  const core::OverlayMesh v = overlays::build_vertical_section(g, f, -0.5, -0.5, 0.5, 0.5, by, 32);
+  ASSERT_EQ(v.triangles.size(), 6u * 31u * 8u);
+  const glm::dvec3 n = glm::normalize(glm::cross(geo::sphere_to_ecef({-0.5, -0.5, 0.0}, 1.0), geo::sphere_to_ecef({0.5, 0.5, 0.0}, 1.0)));
+  for (const glm::dvec3& p : v.positions) EXPECT_NEAR(glm::dot(glm::normalize(p), n), 0.0, 1e-12);  // on the great circle's plane
+
+  core::Camera cam;
+  cam.alt_m = 3000.0, cam.pitch_deg = -30.0, cam.width = 160, cam.height = 90;
+  const core::OverlayMesh bar = overlays::colour_bar(cam, g.earth_radius_m, "extinction_liquid 1/m", 0.0, 1e-3, 1.0, 8.0);
+  ASSERT_GT(bar.triangles.size(), 30u);
+  ASSERT_GT(bar.lines.size(), 100u);
+  const glm::dvec3 c = core::camera_ecef(cam, g.earth_radius_m);
+  for (const glm::dvec3& p : bar.positions) {
+    const core::Projected q = core::project_point(cam, p - c);
+    EXPECT_NEAR(glm::dot(p - c, core::camera_frame(cam).forward), 1.0, 1e-6);
+    EXPECT_TRUE(q.x >= 0.0 && q.x <= cam.width && q.y >= 0.0 && q.y <= cam.height) << q.x << ", " << q.y;
+  }
+}
+
+// An analytic sphere in a field (the distance from a point 3 km up, in metres): the isosurface at
+// 2 km lies on that sphere within a tenth of a cell.
+TEST(Isosurface, AnalyticSphereWithinATenthOfACell) {
+  core::VolumeGrid g;
+  g.lon_deg = {-0.05, 0.0025, 41};  // 278 m cells
+  g.lat_deg = {-0.05, 0.0025, 41};
+  g.alt_m = {0.0, 250.0, 25};
+  const glm::dvec3 centre = geo::sphere_to_ecef({0.0, 0.0, 3000.0}, g.earth_radius_m);
+  std::vector<float> f(g.points());
+  for (int k = 0; k < g.alt_m.count; ++k) {
+    for (int j = 0; j < g.lat_deg.count; ++j) {
+      for (int i = 0; i < g.lon_deg.count; ++i) {
+        const glm::dvec3 p = geo::sphere_to_ecef({g.lat_deg.at(j), g.lon_deg.at(i), g.alt_m.at(k)}, g.earth_radius_m);
+        f[g.index(i, j, k)] = static_cast<float>(glm::length(p - centre));
+      }
+    }
+  }
+  const core::OverlayMesh m = overlays::build_isosurface(g, f, 2000.0, glm::vec4(1.0f));
+  ASSERT_GT(m.triangles.size(), 300u);
+  const double cell = std::min({g.alt_m.step, g.lat_deg.step * 111195.0});
+  double worst = 0.0;
+  for (const glm::dvec3& p : m.positions) worst = std::max(worst, std::abs(glm::length(p - centre) - 2000.0));
+  EXPECT_LT(worst, 0.1 * cell) << "largest radius error " << worst << " m against cells of " << cell << " m";
+  // Closed: every edge of the triangles shared by two of them.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+  for (std::size_t t = 0; t + 2 < m.triangles.size(); t += 3) {
+    for (int e = 0; e < 3; ++e) {
+      std::uint32_t a = m.triangles[t + e], b = m.triangles[t + (e + 1) % 3];
+      ++edges[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  for (const auto& [edge, n] : edges) EXPECT_EQ(n, 2);
+}
+
+}  // namespace
