@@ -733,12 +733,15 @@ int cmd_render(const std::vector<std::string>& args) {
   const int mw = frame.march_camera.width, mh = frame.march_camera.height;
   const std::string model =
       march.medium.ms_two_stream ? std::string("two-stream multiple scattering") : std::to_string(march.quality.octaves) + " octaves";
+  // Between two steps the report names both (the medium is interpolated), else the step.
+  const std::string when = instant.between() ? "between time steps " + std::to_string(instant.step0) + " and " + std::to_string(instant.step1)
+                                             : "time step " + std::to_string(instant.step0);
   if (ra.reference) {
-    std::printf("rendering %s, time step %zu (%s), %dx%d, quality reference: the GPU path tracer, up to %d samples per pixel%s\n",
-                scene.data.path.c_str(), instant.step0, vt.iso_utc.c_str(), cam.width, cam.height, ra.spp,
+    std::printf("rendering %s, %s (%s), %dx%d, quality reference: the GPU path tracer, up to %d samples per pixel%s\n",
+                scene.data.path.c_str(), when.c_str(), vt.iso_utc.c_str(), cam.width, cam.height, ra.spp,
                 ra.target_error > 0.0 ? (", to a relative standard error of " + core::short_number(ra.target_error)).c_str() : "");
-  } else std::printf("rendering %s, time step %zu (%s), %dx%d%s, quality %s: view step %.0f m, %d sun steps, %s, %d frame(s)\n",
-              scene.data.path.c_str(), instant.step0, vt.iso_utc.c_str(), cam.width, cam.height,
+  } else std::printf("rendering %s, %s (%s), %dx%d%s, quality %s: view step %.0f m, %d sun steps, %s, %d frame(s)\n",
+              scene.data.path.c_str(), when.c_str(), vt.iso_utc.c_str(), cam.width, cam.height,
               mw != cam.width || mh != cam.height ? (" marched at " + std::to_string(mw) + "x" + std::to_string(mh)).c_str() : "",
               rs.quality.c_str(), march.quality.view_step_m, march.quality.sun_steps, model.c_str(), frame.accumulate);
 
