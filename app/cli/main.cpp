@@ -306,7 +306,7 @@ int main(int argc, char** argv) {
     return kExitBadInput;
   }
   if (args[0] == "help") {  // `cloudviewer help COMMAND`: as `cloudviewer COMMAND --help`
-    if (args.size() == 1) {
+    if (args.size() == 1 || (args.size() == 2 && (args[1] == "--help" || args[1] == "-h"))) {  // help on help: the usage
       print_usage();
       return 0;
     }

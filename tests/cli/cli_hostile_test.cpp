@@ -72,7 +72,7 @@ class CliHostile : public ::testing::Test {
 };
 
 TEST_F(CliHostile, HelpOnEveryCommandAndHelpCommand) {
-  for (const char* c : {"info", "import", "gpu-info", "phase", "render", "bench", "view"}) {
+  for (const char* c : {"info", "import", "gpu-info", "phase", "render", "bench", "time-error", "view"}) {
     const Result a = cloudviewer(std::string(c) + " --help", "env -u DISPLAY ");
     EXPECT_EQ(a.rc, 0) << c << ": " << a.out;
     EXPECT_NE(a.out.find(std::string("usage: cloudviewer ") + c), std::string::npos) << a.out;
@@ -80,7 +80,11 @@ TEST_F(CliHostile, HelpOnEveryCommandAndHelpCommand) {
     EXPECT_EQ(b.rc, 0) << c;
     EXPECT_EQ(a.out, b.out) << c;
   }
-  EXPECT_EQ(cloudviewer("help").rc, 0);
+  const Result usage = cloudviewer("help");
+  EXPECT_EQ(usage.rc, 0);
+  const Result help_on_help = cloudviewer("help --help");  // every command answers --help, help too
+  EXPECT_EQ(help_on_help.rc, 0) << help_on_help.out;
+  EXPECT_EQ(help_on_help.out, usage.out);
   expect_refused(cloudviewer("help frobnicate"), "cloudviewer help: found 'frobnicate', expected one command");
 }
 
