@@ -292,7 +292,15 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   for (std::size_t k = header.find("\"iso_utc\":"); k != std::string::npos; k = header.find("\"iso_utc\":", k + 1)) {
     ValidTime t;
     t.iso_utc = json_quoted(header, header.find('"', k + 10), "iso_utc", path);
-    t.unix_s = static_cast<std::int64_t>(json_number(header, "unix_s", k, path));
+    // Converted to an integer only once known to be one within range: a double beyond int64's
+    // range converted is undefined behaviour (the fuzzer found 'unix_s': 1e300).
+    const double unix_s = json_number(header, "unix_s", k, path);
+    if (!(std::fabs(unix_s) <= 1e12) || unix_s != std::floor(unix_s)) {
+      char found[32];
+      std::snprintf(found, sizeof found, "%.17g", unix_s);
+      throw VolumeFileError(path + ": header key 'unix_s': found " + found + ", expected whole seconds within +-1e12 of 1970");
+    }
+    t.unix_s = static_cast<std::int64_t>(unix_s);
     v.times.push_back(t);
   }
   const bool half = header.find("\"encoding\": \"float16\"") != std::string::npos;

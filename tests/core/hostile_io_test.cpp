@@ -83,6 +83,10 @@ std::string header_with(const std::string& lon_step, const std::string& radius =
          counts + "}, \"earth_radius_m\": " + radius + "}, \"liquid_r_eff_um\": 10, \"times\": [{\"iso_utc\": \"2024-01-01T00:00:00Z\", "
          "\"unix_s\": 1704067200}], \"fields\": " + fields + ", \"maps\": []}\n";
 }
+std::string with_unix_s(const std::string& unix_s) {
+  std::string h = header_with("1");
+  return h.replace(h.find("1704067200"), 10, unix_s);
+}
 // 8 points of one field and 7 maps of 4 columns, as float32.
 constexpr std::size_t kPayload = (8 + 7 * 4) * 4;
 
@@ -97,6 +101,10 @@ TEST_F(HostileInput, CvvolHeaderValuesAreCheckedAndNamed) {
       {header_with("1", "-6371000"), "earth_radius_m: found -6.371e+06"},
       {header_with("1", "NaN"), "header key 'earth_radius_m': found 'NaN"},
       {header_with("abc"), "header key 'step': found 'abc"},  // was std::stod's "stod", exit 1
+      // A time beyond int64's range was converted to an integer: undefined behaviour (fuzzer).
+      {with_unix_s("1e300"), "header key 'unix_s': found 1.0000000000000001e+300, expected whole seconds within +-1e12 of 1970"},
+      {with_unix_s("-1e19"), "header key 'unix_s': found -1e+19"},
+      {with_unix_s("0.5"), "header key 'unix_s': found 0.5"},
   };
   for (const auto& [header, expected] : cases) {
     write("bad.cvvol", cvvol_bytes(header, kPayload));
