@@ -834,7 +834,7 @@ int cmd_render(const std::vector<std::string>& args) {
   std::printf("timings (%s):\n  load/import %.3f s\n  upload      %.3f s\n  march       %.3f s wall, GPU %s\n",
               ctx->info().renderer.c_str(), t_load, t_upload, t_march, gpu_text);
   for (std::size_t i = 0; i < built.size(); ++i) {
-    const std::size_t v = built[i].mesh ? built[i].mesh->positions.size() : 0;
+    const std::size_t v = (built[i].mesh ? built[i].mesh->positions.size() : 0) + (built[i].view_mesh ? built[i].view_mesh->positions.size() : 0);
     const double draw = i < renderer.overlay_draw_ms().size() ? renderer.overlay_draw_ms()[i] : 0.0;
     std::printf("  overlay %-11s build %.3f s, draw %.3f s (%zu vertices; the draw is inside the march's wall time)\n",
                 built[i].name.c_str(), built[i].build_ms * 1e-3, draw * 1e-3, v);

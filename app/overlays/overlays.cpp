@@ -793,16 +793,14 @@ std::vector<BuiltOverlay> OverlayBuilder::build(const std::vector<core::OverlayS
     }
     b.mesh = e.mesh;
     if (s.type == "graticule" && s.number("label_px") > 0.0) {  // the labels face this view: made for it
-      auto with_labels = std::make_shared<core::OverlayMesh>(*e.mesh);
-      with_labels->append(graticule_labels(s.number("step_deg"), cam, r0, rgba(s.color("color")), s.number("label_px")));
-      b.mesh = std::move(with_labels);
+      b.view_mesh = std::make_shared<const core::OverlayMesh>(
+          graticule_labels(s.number("step_deg"), cam, r0, rgba(s.color("color")), s.number("label_px")));
     }
     if (s.type == "section" && s.number("legend_px") > 0.0) {  // the legend stands in front of this view
-      auto with_legend = std::make_shared<core::OverlayMesh>(*e.mesh);
       const core::Field f = volume_field(volume, s.text("field"), "overlays[" + std::to_string(i) + "].field");
-      with_legend->append(colour_bar(cam, r0, std::string(core::field_name(f)) + " " + core::field_units(f), s.number("color_min"),
-                                     s.number("color_max"), s.number("brightness"), s.number("legend_px")));
-      b.mesh = std::move(with_legend);
+      b.view_mesh = std::make_shared<const core::OverlayMesh>(colour_bar(cam, r0, std::string(core::field_name(f)) + " " + core::field_units(f),
+                                                                         s.number("color_min"), s.number("color_max"),
+                                                                         s.number("brightness"), s.number("legend_px")));
     }
     built.push_back(b);
   }
@@ -811,7 +809,7 @@ std::vector<BuiltOverlay> OverlayBuilder::build(const std::vector<core::OverlayS
 
 std::vector<render::OverlayDraw> OverlayBuilder::draws(const std::vector<BuiltOverlay>& built) {
   std::vector<render::OverlayDraw> d;
-  for (const BuiltOverlay& b : built) d.push_back({b.name, b.mesh, b.line_width_px});  // one per overlay, in order
+  for (const BuiltOverlay& b : built) d.push_back({b.name, b.mesh, b.view_mesh, b.line_width_px});  // one per overlay, in order
   return d;
 }
 

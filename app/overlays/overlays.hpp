@@ -41,7 +41,10 @@ char coastline_resolution(const std::string& setting, double camera_alt_m);
 // The built overlay: its geometry, how long the build took, and whether this call rebuilt it.
 struct BuiltOverlay {
   std::string name;
-  std::shared_ptr<const core::OverlayMesh> mesh;
+  std::shared_ptr<const core::OverlayMesh> mesh;  // kept between frames (and on the GPU)
+  // What faces this view (graticule labels, a section's colour bar): made for each frame, drawn
+  // after `mesh`, so the kept geometry is neither copied nor uploaded again.
+  std::shared_ptr<const core::OverlayMesh> view_mesh;
   float line_width_px = 1.0f;
   double build_ms = 0.0;
   bool rebuilt = false;

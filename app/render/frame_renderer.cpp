@@ -13,7 +13,7 @@ void FrameRenderer::set_overlays(std::vector<OverlayDraw> overlays) {
   // Kept in order (overlay_draw_ms follows it); only geometry makes a pass.
   overlays_.clear();
   for (OverlayDraw& o : overlays) {
-    if (o.mesh && !o.mesh->empty()) {
+    if ((o.mesh && !o.mesh->empty()) || (o.view_mesh && !o.view_mesh->empty())) {
       overlays_ = std::move(overlays);
       return;
     }
@@ -27,7 +27,10 @@ OpaqueInput FrameRenderer::draw_overlays(const core::Camera& cam) {
   const double r0 = volume_ ? volume_->grid.earth_radius_m : core::VolumeGrid{}.earth_radius_m;
   overlay_pass_->begin(cam, r0);
   overlay_ms_.clear();
-  for (const OverlayDraw& o : overlays_) overlay_ms_.push_back(o.mesh ? overlay_pass_->draw(*o.mesh, o.line_width_px) : 0.0);
+  for (const OverlayDraw& o : overlays_) {
+    overlay_ms_.push_back(overlay_pass_->draw(o.mesh, o.line_width_px) +
+                          (o.view_mesh ? overlay_pass_->draw(*o.view_mesh, o.line_width_px) : 0.0));
+  }
   return overlay_pass_->output();
 }
 

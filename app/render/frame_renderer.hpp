@@ -24,7 +24,8 @@ core::FrameSpec resolve_frame(const core::Scene& scene, const core::CloudVolume&
 // One overlay's geometry for the frame (built by app/overlays), drawn by the overlay pass.
 struct OverlayDraw {
   std::string name;
-  std::shared_ptr<const core::OverlayMesh> mesh;
+  std::shared_ptr<const core::OverlayMesh> mesh;       // kept on the GPU while drawn each frame
+  std::shared_ptr<const core::OverlayMesh> view_mesh;  // made for this view: uploaded with each draw
   float line_width_px = 1.0f;
 };
 

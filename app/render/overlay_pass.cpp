@@ -20,19 +20,6 @@ OverlayPass::OverlayPass(const ShaderLoader& loader)
     : program_(load_graphics(loader, ShaderLoader::default_shader_dir() / "render" / "overlay.vert",
                              ShaderLoader::default_shader_dir() / "render" / "overlay.frag")) {
   glCreateFramebuffers(1, &fbo_);
-  glCreateVertexArrays(1, &vao_);
-  glCreateBuffers(1, &vbo_pos_);
-  glCreateBuffers(1, &vbo_color_);
-  glCreateBuffers(1, &ibo_);
-  glVertexArrayVertexBuffer(vao_, 0, vbo_pos_, 0, sizeof(glm::vec3));
-  glVertexArrayAttribFormat(vao_, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(vao_, 0, 0);
-  glEnableVertexArrayAttrib(vao_, 0);
-  glVertexArrayVertexBuffer(vao_, 1, vbo_color_, 0, sizeof(glm::vec4));
-  glVertexArrayAttribFormat(vao_, 1, 4, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(vao_, 1, 1);
-  glEnableVertexArrayAttrib(vao_, 1);
-  glVertexArrayElementBuffer(vao_, ibo_);
   check_gl("creating the overlay pass");
 }
 
@@ -40,9 +27,46 @@ OverlayPass::~OverlayPass() {
   const GLuint textures[] = {distance_, color_, depth_};
   glDeleteTextures(3, textures);
   glDeleteFramebuffers(1, &fbo_);
-  const GLuint buffers[] = {vbo_pos_, vbo_color_, ibo_};
+  free_buffers(transient_);
+  for (Kept& k : kept_) free_buffers(k.buffers);
+}
+
+OverlayPass::Buffers OverlayPass::make_buffers(const core::OverlayMesh& mesh) {
+  Buffers b;
+  glCreateVertexArrays(1, &b.vao);
+  glCreateBuffers(1, &b.pos);
+  glCreateBuffers(1, &b.color);
+  glCreateBuffers(1, &b.index);
+  // Positions as doubles (64-bit attributes, glVertexArrayAttribLFormat): the vertex shader takes
+  // the camera off in double.
+  glNamedBufferStorage(b.pos, static_cast<GLsizeiptr>(mesh.positions.size() * sizeof(glm::dvec3)), mesh.positions.data(), 0);
+  std::vector<glm::vec4> colors = mesh.colors;
+  colors.resize(mesh.positions.size(), glm::vec4(1.0f));
+  glNamedBufferStorage(b.color, static_cast<GLsizeiptr>(colors.size() * sizeof(glm::vec4)), colors.data(), 0);
+  std::vector<std::uint32_t> indices = mesh.triangles;
+  indices.insert(indices.end(), mesh.lines.begin(), mesh.lines.end());
+  glNamedBufferStorage(b.index, static_cast<GLsizeiptr>(indices.size() * sizeof(std::uint32_t)), indices.data(), 0);
+  glVertexArrayVertexBuffer(b.vao, 0, b.pos, 0, sizeof(glm::dvec3));
+  glVertexArrayAttribLFormat(b.vao, 0, 3, GL_DOUBLE, 0);
+  glVertexArrayAttribBinding(b.vao, 0, 0);
+  glEnableVertexArrayAttrib(b.vao, 0);
+  glVertexArrayVertexBuffer(b.vao, 1, b.color, 0, sizeof(glm::vec4));
+  glVertexArrayAttribFormat(b.vao, 1, 4, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(b.vao, 1, 1);
+  glEnableVertexArrayAttrib(b.vao, 1);
+  glVertexArrayElementBuffer(b.vao, b.index);
+  b.triangles = mesh.triangles.size();
+  b.lines = mesh.lines.size();
+  ++uploads_;
+  check_gl("uploading overlay geometry");
+  return b;
+}
+
+void OverlayPass::free_buffers(Buffers& b) {
+  const GLuint buffers[] = {b.pos, b.color, b.index};
   glDeleteBuffers(3, buffers);
-  glDeleteVertexArrays(1, &vao_);
+  glDeleteVertexArrays(1, &b.vao);
+  b = Buffers{};
 }
 
 void OverlayPass::begin(const core::Camera& cam, double r0_m) {
@@ -65,6 +89,12 @@ void OverlayPass::begin(const core::Camera& cam, double r0_m) {
       throw GlError("the overlay pass's framebuffer is incomplete");
     }
   }
+  // Kept meshes not drawn in the last frame are released (and their meshes with them).
+  std::erase_if(kept_, [](Kept& k) {
+    if (!k.drawn) free_buffers(k.buffers);
+    return !k.drawn;
+  });
+  for (Kept& k : kept_) k.drawn = false;
   cam_ = cam;
   r0_m_ = r0_m;
   camera_m_ = core::camera_ecef(cam, r0_m);
@@ -79,17 +109,21 @@ void OverlayPass::begin(const core::Camera& cam, double r0_m) {
 double OverlayPass::draw(const core::OverlayMesh& mesh, float line_width_px) {
   const auto t0 = std::chrono::steady_clock::now();
   if (mesh.empty() || w_ == 0) return 0.0;
-  // Camera-relative positions, formed in double.
-  std::vector<glm::vec3> rel(mesh.positions.size());
-  for (std::size_t i = 0; i < rel.size(); ++i) rel[i] = glm::vec3(mesh.positions[i] - camera_m_);
-  std::vector<glm::vec4> colors = mesh.colors;
-  colors.resize(rel.size(), glm::vec4(1.0f));
-  glNamedBufferData(vbo_pos_, static_cast<GLsizeiptr>(rel.size() * sizeof(glm::vec3)), rel.data(), GL_STREAM_DRAW);
-  glNamedBufferData(vbo_color_, static_cast<GLsizeiptr>(colors.size() * sizeof(glm::vec4)), colors.data(), GL_STREAM_DRAW);
-  std::vector<std::uint32_t> indices = mesh.triangles;
-  indices.insert(indices.end(), mesh.lines.begin(), mesh.lines.end());
-  glNamedBufferData(ibo_, static_cast<GLsizeiptr>(indices.size() * sizeof(std::uint32_t)), indices.data(), GL_STREAM_DRAW);
+  free_buffers(transient_);
+  transient_ = make_buffers(mesh);
+  return draw_buffers(transient_, line_width_px, t0);
+}
 
+double OverlayPass::draw(const std::shared_ptr<const core::OverlayMesh>& mesh, float line_width_px) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!mesh || mesh->empty() || w_ == 0) return 0.0;
+  auto it = std::find_if(kept_.begin(), kept_.end(), [&](const Kept& k) { return k.mesh == mesh; });
+  if (it == kept_.end()) it = kept_.insert(kept_.end(), Kept{mesh, make_buffers(*mesh), false});
+  it->drawn = true;
+  return draw_buffers(it->buffers, line_width_px, t0);
+}
+
+double OverlayPass::draw_buffers(const Buffers& b, float line_width_px, std::chrono::steady_clock::time_point t0) {
   const glm::mat4 view_proj(core::camera_projection_matrix(cam_, kNearM, kFarM) * core::camera_view_matrix(cam_));
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
   glViewport(0, 0, w_, h_);
@@ -110,11 +144,11 @@ double OverlayPass::draw(const core::OverlayMesh& mesh, float line_width_px) {
   glUniform2f(glGetUniformLocation(program_.id(), "u_tan_half"), static_cast<float>(cf.tan_half),
               static_cast<float>(cf.tan_half * h_ / w_));
   glUniform2f(glGetUniformLocation(program_.id(), "u_size"), static_cast<float>(w_), static_cast<float>(h_));
-  glBindVertexArray(vao_);
+  glBindVertexArray(b.vao);
   const GLint bias = glGetUniformLocation(program_.id(), "u_bias");
   glUniform1f(bias, 0.0f);
-  if (!mesh.triangles.empty()) glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.triangles.size()), GL_UNSIGNED_INT, nullptr);
-  if (!mesh.lines.empty()) {
+  if (b.triangles > 0) glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(b.triangles), GL_UNSIGNED_INT, nullptr);
+  if (b.lines > 0) {
     // Wide lines where the driver draws them (a forward-compatible context refuses widths over 1).
     GLfloat range[2] = {1.0f, 1.0f};
     glGetFloatv(GL_ALIASED_LINE_WIDTH_RANGE, range);
@@ -122,8 +156,8 @@ double OverlayPass::draw(const core::OverlayMesh& mesh, float line_width_px) {
     glUniform1f(bias, static_cast<float>(core::kLineDistanceBias));
     glLineWidth(width);
     if (glGetError() != GL_NO_ERROR) glLineWidth(1.0f);
-    glDrawElements(GL_LINES, static_cast<GLsizei>(mesh.lines.size()), GL_UNSIGNED_INT,
-                   reinterpret_cast<const void*>(mesh.triangles.size() * sizeof(std::uint32_t)));
+    glDrawElements(GL_LINES, static_cast<GLsizei>(b.lines), GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(b.triangles * sizeof(std::uint32_t)));
     glLineWidth(1.0f);
   }
   glBindVertexArray(0);

@@ -1,10 +1,15 @@
 // The overlay pass: draws overlay geometry (core::OverlayMesh, built by app/overlays) with our
 // own OpenGL into the two textures the march reads as its opaque input (render::OpaqueInput): the
 // distance along each pixel's ray to the nearest geometry and the geometry's radiance. Vertices go
-// to the GPU camera-relative (double on the CPU, then float), so they keep their digits at orbit and
-// at the ground alike. No VTK here: only its geometry, as plain data.
+// to the GPU in double, Earth-centred, and the vertex shader makes them camera-relative in double
+// before it rounds them to float, so they keep their digits at orbit and at the ground alike; a
+// mesh held by a shared_ptr stays on the GPU for as long as it is drawn each frame, so a moving
+// camera uploads nothing. No VTK here: only its geometry, as plain data.
 #pragma once
 
+#include <chrono>
+#include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "frame/camera.hpp"
@@ -22,11 +27,18 @@ class OverlayPass {
   OverlayPass(const OverlayPass&) = delete;
   OverlayPass& operator=(const OverlayPass&) = delete;
 
-  // Starts a frame of cam's size: distance 0 (none) and radiance 0 everywhere.
+  // Starts a frame of cam's size: distance 0 (none) and radiance 0 everywhere. Meshes kept on the
+  // GPU (draw of a shared_ptr) that were not drawn since the previous begin are released.
   void begin(const core::Camera& cam, double r0_m);
   // Draws a mesh (lines line_width_px wide where the driver allows; 1 otherwise); returns the
-  // wall time of the draw in ms (it waits for the GPU to finish).
+  // wall time of the draw in ms (it waits for the GPU to finish). A mesh given by reference is
+  // uploaded for this draw alone (labels and colour bars that follow the camera); one given by
+  // shared_ptr is uploaded once and kept while it is drawn every frame (the pass holds a reference,
+  // so the mesh cannot change or be replaced under the same address while it is kept).
   double draw(const core::OverlayMesh& mesh, float line_width_px = 1.0f);
+  double draw(const std::shared_ptr<const core::OverlayMesh>& mesh, float line_width_px = 1.0f);
+  // How many vertex uploads the pass has made since it was made (for tests and the bench).
+  std::uint64_t uploads() const { return uploads_; }
   // The textures for the march (valid until the next begin).
   OpaqueInput output() const { return {distance_, color_}; }
 
@@ -34,9 +46,25 @@ class OverlayPass {
   core::OpaqueLayer read() const;
 
  private:
+  // One mesh's buffers: Earth-centred positions in double, colours, triangle then line indices.
+  struct Buffers {
+    GLuint vao = 0, pos = 0, color = 0, index = 0;
+    std::size_t triangles = 0, lines = 0;
+  };
+  Buffers make_buffers(const core::OverlayMesh& mesh);
+  static void free_buffers(Buffers& b);
+  double draw_buffers(const Buffers& b, float line_width_px, std::chrono::steady_clock::time_point t0);
+  struct Kept {
+    std::shared_ptr<const core::OverlayMesh> mesh;
+    Buffers buffers;
+    bool drawn = false;  // since the last begin
+  };
+
   GlProgram program_;
   GLuint fbo_ = 0, distance_ = 0, color_ = 0, depth_ = 0;
-  GLuint vao_ = 0, vbo_pos_ = 0, vbo_color_ = 0, ibo_ = 0;
+  Buffers transient_;
+  std::vector<Kept> kept_;
+  std::uint64_t uploads_ = 0;
   int w_ = 0, h_ = 0;
   core::Camera cam_;
   double r0_m_ = 0.0;

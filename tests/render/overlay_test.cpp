@@ -85,6 +85,44 @@ TEST(OverlayPass, DrawsTheLayerTheCpuCasts) {
   }
 }
 
+// A mesh held by a shared_ptr is uploaded once and kept while it is drawn each frame: a moving
+// camera draws exactly the layer a fresh upload of the same mesh draws (the shader takes the camera
+// off in double), and a mesh left out of a frame is released.
+TEST(OverlayPass, KeptMeshesAreUploadedOnceAndDrawLikeFreshOnes) {
+  auto ctx = render::make_headless_context();
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::OverlayPass kept(loader), fresh(loader);
+  const UniformCloud u;
+  const double r0 = u.grid.earth_radius_m;
+  const std::shared_ptr<const core::OverlayMesh> mesh = plane_above(u.frame.camera, r0, 600.0, {0.5f, 0.25f, 0.125f, 1.0f});
+  int drawn = 0;
+  for (int frame = 0; frame < 4; ++frame) {
+    core::Camera cam = u.frame.camera;
+    cam.lon_deg += 0.001 * frame, cam.heading_deg += 2.0 * frame, cam.alt_m += 25.0 * frame;
+    kept.begin(cam, r0);
+    kept.draw(mesh);
+    fresh.begin(cam, r0);
+    fresh.draw(*mesh);
+    const core::OpaqueLayer a = kept.read(), b = fresh.read();
+    ASSERT_EQ(a.distance_m.size(), b.distance_m.size());
+    for (std::size_t i = 0; i < a.distance_m.size(); ++i) {
+      ASSERT_EQ(a.distance_m[i], b.distance_m[i]) << "frame " << frame << ", pixel " << i;
+      drawn += a.distance_m[i] > 0.0f ? 1 : 0;
+    }
+    EXPECT_EQ(a.radiance_rgba, b.radiance_rgba) << "frame " << frame;
+  }
+  EXPECT_GT(drawn, 0);
+  EXPECT_EQ(kept.uploads(), 1u);   // once, for four frames from four cameras
+  EXPECT_EQ(fresh.uploads(), 4u);  // once per draw
+  EXPECT_EQ(mesh.use_count(), 2);  // the pass holds it while it is drawn
+  kept.begin(u.frame.camera, r0);  // a frame that does not draw it
+  EXPECT_EQ(mesh.use_count(), 2);
+  kept.begin(u.frame.camera, r0);  // and the next one: released
+  EXPECT_EQ(mesh.use_count(), 1);
+  kept.draw(mesh);
+  EXPECT_EQ(kept.uploads(), 2u);
+}
+
 // The composite of an opaque plane inside the cloud: each pixel is the cloud in front of the plane
 // (the march stopped at its distance, alpha the transmittance there) plus the plane's radiance
 // times exp(-sigma d), d the distance to the plane along the pixel's ray; on the GPU through the
@@ -100,7 +138,7 @@ TEST(OverlayComposite, OpaquePlaneInsideACloudOnTheGpuAndTheCpuReference) {
 
   render::FrameRenderer renderer(loader);
   renderer.use_volume(volume);
-  renderer.set_overlays({{"plane", mesh, 1.0f}});
+  renderer.set_overlays({{"plane", mesh, nullptr, 1.0f}});
   const std::vector<glm::vec4> gpu = renderer.render(u.frame);
   const core::OpaqueLayer drawn = renderer.read_overlays();
   // The cloud in front alone: the same distances, no radiance given (alpha is then the transmittance).
