@@ -787,6 +787,10 @@ std::vector<BuiltOverlay> OverlayBuilder::build(const std::vector<core::OverlayS
                               s.number("altitude_m"), static_cast<int>(s.number("seeds")), s.number("length_cells"),
                               s.number("speed_max_m_s"), s.number("brightness"));
       }
+      if (s.type == "isosurface" || s.type == "section") {  // translucent below 1 (core::kOpaqueAlpha)
+        m.colors.resize(m.positions.size(), glm::vec4(1.0f));
+        for (glm::vec4& c : m.colors) c.a = static_cast<float>(s.number("opacity"));
+      }
       e = {s, time_step, res, std::make_shared<const core::OverlayMesh>(std::move(m))};
       b.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       b.rebuilt = true;

@@ -12,6 +12,7 @@
 
 namespace cv::render {
 namespace {
+constexpr GLuint kPrevUnit = 14, kOpaqueUnit = 15;  // overlay.frag's u_prev and u_front_opaque
 constexpr double kNearM = 0.05;   // the projection's clip planes: a metre's depth resolution comes
 constexpr double kFarM = 1.0e8;   // from the linear distance the fragment writes, not from these
 }  // namespace
@@ -27,8 +28,11 @@ OverlayPass::~OverlayPass() {
   const GLuint textures[] = {distance_, color_, depth_};
   glDeleteTextures(3, textures);
   glDeleteFramebuffers(1, &fbo_);
-  free_buffers(transient_);
+  for (Buffers& b : transient_) free_buffers(b);
   for (Kept& k : kept_) free_buffers(k.buffers);
+  const GLuint peel[] = {peel_distance_[0], peel_distance_[1], peel_color_[0], peel_color_[1], peel_depth_, layer_distance_, layer_color_};
+  glDeleteTextures(7, peel);
+  glDeleteFramebuffers(1, &peel_fbo_);
 }
 
 OverlayPass::Buffers OverlayPass::make_buffers(const core::OverlayMesh& mesh) {
@@ -57,6 +61,7 @@ OverlayPass::Buffers OverlayPass::make_buffers(const core::OverlayMesh& mesh) {
   glVertexArrayElementBuffer(b.vao, b.index);
   b.triangles = mesh.triangles.size();
   b.lines = mesh.lines.size();
+  for (std::size_t k = 0; k < mesh.triangles.size() && !b.translucent; ++k) b.translucent = colors[mesh.triangles[k]].a < core::kOpaqueAlpha;
   ++uploads_;
   check_gl("uploading overlay geometry");
   return b;
@@ -95,6 +100,11 @@ void OverlayPass::begin(const core::Camera& cam, double r0_m) {
     return !k.drawn;
   });
   for (Kept& k : kept_) k.drawn = false;
+  for (Buffers& b : transient_) free_buffers(b);
+  transient_.clear();
+  translucent_.clear();
+  peeled_ = true;
+  peel_ms_ = 0.0;
   cam_ = cam;
   r0_m_ = r0_m;
   camera_m_ = core::camera_ecef(cam, r0_m);
@@ -109,9 +119,8 @@ void OverlayPass::begin(const core::Camera& cam, double r0_m) {
 double OverlayPass::draw(const core::OverlayMesh& mesh, float line_width_px) {
   const auto t0 = std::chrono::steady_clock::now();
   if (mesh.empty() || w_ == 0) return 0.0;
-  free_buffers(transient_);
-  transient_ = make_buffers(mesh);
-  return draw_buffers(transient_, line_width_px, t0);
+  transient_.push_back(make_buffers(mesh));  // kept until the next begin, for peeling
+  return draw_buffers(transient_.back(), line_width_px, t0);
 }
 
 double OverlayPass::draw(const std::shared_ptr<const core::OverlayMesh>& mesh, float line_width_px) {
@@ -123,9 +132,9 @@ double OverlayPass::draw(const std::shared_ptr<const core::OverlayMesh>& mesh, f
   return draw_buffers(it->buffers, line_width_px, t0);
 }
 
-double OverlayPass::draw_buffers(const Buffers& b, float line_width_px, std::chrono::steady_clock::time_point t0) {
+void OverlayPass::use_program(int peel) {
   const glm::mat4 view_proj(core::camera_projection_matrix(cam_, kNearM, kFarM) * core::camera_view_matrix(cam_));
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glBindFramebuffer(GL_FRAMEBUFFER, peel < 0 ? fbo_ : peel_fbo_);
   glViewport(0, 0, w_, h_);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -144,9 +153,23 @@ double OverlayPass::draw_buffers(const Buffers& b, float line_width_px, std::chr
   glUniform2f(glGetUniformLocation(program_.id(), "u_tan_half"), static_cast<float>(cf.tan_half),
               static_cast<float>(cf.tan_half * h_ / w_));
   glUniform2f(glGetUniformLocation(program_.id(), "u_size"), static_cast<float>(w_), static_cast<float>(h_));
+  glUniform1i(glGetUniformLocation(program_.id(), "u_peel"), peel < 0 ? 0 : 1);
+  glUniform1i(glGetUniformLocation(program_.id(), "u_has_prev"), peel > 0 ? 1 : 0);
+  glUniform1f(glGetUniformLocation(program_.id(), "u_bias"), 0.0f);
+  if (peel >= 0) {
+    glBindTextureUnit(kPrevUnit, peel > 0 ? peel_distance_[(peel - 1) % 2] : 0);
+    glBindTextureUnit(kOpaqueUnit, distance_);
+  }
+}
+
+double OverlayPass::draw_buffers(const Buffers& b, float line_width_px, std::chrono::steady_clock::time_point t0) {
+  if (b.translucent) {
+    translucent_.push_back(b);
+    peeled_ = false;
+  }
+  use_program(-1);
   glBindVertexArray(b.vao);
   const GLint bias = glGetUniformLocation(program_.id(), "u_bias");
-  glUniform1f(bias, 0.0f);
   if (b.triangles > 0) glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(b.triangles), GL_UNSIGNED_INT, nullptr);
   if (b.lines > 0) {
     // Wide lines where the driver draws them (a forward-compatible context refuses widths over 1).
@@ -169,12 +192,88 @@ double OverlayPass::draw_buffers(const Buffers& b, float line_width_px, std::chr
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-core::OpaqueLayer OverlayPass::read() const {
+void OverlayPass::peel() {
+  if (peeled_) return;
+  peeled_ = true;
+  const auto t0 = std::chrono::steady_clock::now();
+  const int n = core::kTranslucentLayers;
+  if (peel_w_ != w_ || peel_h_ != h_) {  // made on the first frame that has translucent geometry
+    const GLuint old[] = {peel_distance_[0], peel_distance_[1], peel_color_[0], peel_color_[1], peel_depth_, layer_distance_, layer_color_};
+    glDeleteTextures(7, old);
+    if (!peel_fbo_) glCreateFramebuffers(1, &peel_fbo_);
+    glCreateTextures(GL_TEXTURE_2D, 2, peel_distance_);
+    glCreateTextures(GL_TEXTURE_2D, 2, peel_color_);
+    for (int i = 0; i < 2; ++i) {
+      glTextureStorage2D(peel_distance_[i], 1, GL_R32F, w_, h_);
+      glTextureStorage2D(peel_color_[i], 1, GL_RGBA32F, w_, h_);
+    }
+    glCreateTextures(GL_TEXTURE_2D, 1, &peel_depth_);
+    glTextureStorage2D(peel_depth_, 1, GL_DEPTH_COMPONENT32F, w_, h_);
+    glCreateTextures(GL_TEXTURE_2D, 1, &layer_distance_);
+    glTextureStorage2D(layer_distance_, 1, GL_R32F, n * w_, h_);
+    glCreateTextures(GL_TEXTURE_2D, 1, &layer_color_);
+    glTextureStorage2D(layer_color_, 1, GL_RGBA32F, n * w_, h_);
+    glNamedFramebufferTexture(peel_fbo_, GL_DEPTH_ATTACHMENT, peel_depth_, 0);
+    const GLenum draw_buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(peel_fbo_, 2, draw_buffers);
+    peel_w_ = w_, peel_h_ = h_;
+  }
+  const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  const float one = 1.0f;
+  // Layer k: the nearest translucent fragment strictly behind layer k - 1 and in front of the
+  // opaque geometry (overlay.frag), by the depth test; then copied to its place side by side.
+  for (int k = 0; k < n; ++k) {
+    const int target = k % 2;
+    glNamedFramebufferTexture(peel_fbo_, GL_COLOR_ATTACHMENT0, peel_distance_[target], 0);
+    glNamedFramebufferTexture(peel_fbo_, GL_COLOR_ATTACHMENT1, peel_color_[target], 0);
+    if (glCheckNamedFramebufferStatus(peel_fbo_, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      throw GlError("the overlay pass's peeling framebuffer is incomplete");
+    }
+    glClearNamedFramebufferfv(peel_fbo_, GL_COLOR, 0, zero);
+    glClearNamedFramebufferfv(peel_fbo_, GL_COLOR, 1, zero);
+    glClearNamedFramebufferfv(peel_fbo_, GL_DEPTH, 0, &one);
+    use_program(k);
+    for (const Buffers& b : translucent_) {
+      glBindVertexArray(b.vao);
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(b.triangles), GL_UNSIGNED_INT, nullptr);
+    }
+    glBindVertexArray(0);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glCopyImageSubData(peel_distance_[target], GL_TEXTURE_2D, 0, 0, 0, 0, layer_distance_, GL_TEXTURE_2D, 0, k * w_, 0, 0, w_, h_, 1);
+    glCopyImageSubData(peel_color_[target], GL_TEXTURE_2D, 0, 0, 0, 0, layer_color_, GL_TEXTURE_2D, 0, k * w_, 0, 0, w_, h_, 1);
+  }
+  glBindTextureUnit(kPrevUnit, 0);
+  glBindTextureUnit(kOpaqueUnit, 0);
+  glUseProgram(0);
+  glDisable(GL_DEPTH_TEST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glFinish();
+  check_gl("peeling translucent overlays");
+  peel_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+OpaqueInput OverlayPass::output() {
+  peel();
+  if (translucent_.empty()) return {distance_, color_};
+  return {distance_, color_, layer_distance_, layer_color_, core::kTranslucentLayers};
+}
+
+core::OpaqueLayer OverlayPass::read() {
+  peel();
   core::OpaqueLayer layer;
   layer.distance_m.resize(static_cast<std::size_t>(w_) * h_);
   layer.radiance_rgba.resize(4 * layer.distance_m.size());
   glGetTextureImage(distance_, 0, GL_RED, GL_FLOAT, static_cast<GLsizei>(layer.distance_m.size() * sizeof(float)), layer.distance_m.data());
   glGetTextureImage(color_, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(layer.radiance_rgba.size() * sizeof(float)), layer.radiance_rgba.data());
+  if (!translucent_.empty()) {
+    layer.layers = core::kTranslucentLayers;
+    layer.layer_distance_m.resize(static_cast<std::size_t>(layer.layers) * layer.distance_m.size());
+    layer.layer_rgba.resize(4 * layer.layer_distance_m.size());
+    glGetTextureImage(layer_distance_, 0, GL_RED, GL_FLOAT, static_cast<GLsizei>(layer.layer_distance_m.size() * sizeof(float)),
+                      layer.layer_distance_m.data());
+    glGetTextureImage(layer_color_, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(layer.layer_rgba.size() * sizeof(float)),
+                      layer.layer_rgba.data());
+  }
   check_gl("reading the overlay pass back");
   return layer;
 }

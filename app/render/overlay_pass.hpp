@@ -39,21 +39,29 @@ class OverlayPass {
   double draw(const std::shared_ptr<const core::OverlayMesh>& mesh, float line_width_px = 1.0f);
   // How many vertex uploads the pass has made since it was made (for tests and the bench).
   std::uint64_t uploads() const { return uploads_; }
-  // The textures for the march (valid until the next begin).
-  OpaqueInput output() const { return {distance_, color_}; }
+  // The textures for the march (valid until the next begin). Translucent triangles drawn since
+  // begin (alpha below 1) are peeled here into core::kTranslucentLayers layers, nearest first, each
+  // nearer than the opaque geometry; none drawn, no peeling and no layer textures.
+  OpaqueInput output();
 
-  // The frame read back (rows top to bottom), as core::OpaqueLayer.
-  core::OpaqueLayer read() const;
+  // The frame read back (rows top to bottom), as core::OpaqueLayer (with its translucent layers).
+  core::OpaqueLayer read();
+  // The wall time of the last peeling (ms; 0 without translucent geometry).
+  double peel_ms() const { return peel_ms_; }
 
  private:
   // One mesh's buffers: Earth-centred positions in double, colours, triangle then line indices.
   struct Buffers {
     GLuint vao = 0, pos = 0, color = 0, index = 0;
     std::size_t triangles = 0, lines = 0;
+    bool translucent = false;  // some triangle vertex has alpha below 1
   };
   Buffers make_buffers(const core::OverlayMesh& mesh);
   static void free_buffers(Buffers& b);
+  // Sets the program's per-frame uniforms; peel: -1 for the opaque pass, else the layer peeled.
+  void use_program(int peel);
   double draw_buffers(const Buffers& b, float line_width_px, std::chrono::steady_clock::time_point t0);
+  void peel();
   struct Kept {
     std::shared_ptr<const core::OverlayMesh> mesh;
     Buffers buffers;
@@ -62,7 +70,14 @@ class OverlayPass {
 
   GlProgram program_;
   GLuint fbo_ = 0, distance_ = 0, color_ = 0, depth_ = 0;
-  Buffers transient_;
+  std::vector<Buffers> transient_;    // meshes given by reference this frame, freed at begin
+  std::vector<Buffers> translucent_;  // this frame's meshes with translucent triangles (not owned)
+  bool peeled_ = true;
+  double peel_ms_ = 0.0;
+  // Peeling: two layers in turn (distance, colour) with their depth, and the layers side by side.
+  GLuint peel_fbo_ = 0, peel_distance_[2] = {0, 0}, peel_color_[2] = {0, 0}, peel_depth_ = 0;
+  GLuint layer_distance_ = 0, layer_color_ = 0;
+  int peel_w_ = 0, peel_h_ = 0;
   std::vector<Kept> kept_;
   std::uint64_t uploads_ = 0;
   int w_ = 0, h_ = 0;

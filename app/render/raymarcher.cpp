@@ -179,6 +179,7 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
       core::march_params(v, cam, sun, s, textured ? glm::ivec2(ground_w_, ground_h_) : glm::ivec2(0));
   params.u_has_depth = opaque.depth != 0;
   params.u_has_opaque_color = opaque.depth != 0 && opaque.color != 0;
+  params.u_tl_count = opaque.layer_distance != 0 && opaque.layer_color != 0 ? opaque.layers : 0;
   if (s.medium.ms_two_stream) {  // the two-stream source, for this time step and sun
     const core::MsSourceKey key = core::ms_source_key(s, params.u_to_sun);
     if (!ms_[0] || ms_volume_ != &v || !(key == ms_key_)) {
@@ -219,6 +220,8 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_STATS, stats_buffer_);
   glBindTextureUnit(CV_TEX_DEPTH, opaque.depth);
   glBindTextureUnit(CV_TEX_OPAQUE, opaque.color);
+  glBindTextureUnit(CV_TEX_TL_DISTANCE, opaque.layer_distance);
+  glBindTextureUnit(CV_TEX_TL_COLOR, opaque.layer_color);
   glBindTextureUnit(CV_TEX_LIQUID, textures_[0]);
   glBindTextureUnit(CV_TEX_ICE, textures_[1]);
   glBindTextureUnit(CV_TEX_GROUND, ground_);
@@ -236,7 +239,9 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
   if (noise && !(s.medium.noise_scale_m > 0.0)) throw GlError("noise_scale_m must be > 0");
   if (!(s.quality.view_step_m > 0.0)) throw GlError("view_step_m must be > 0");
-  const GLuint p = program_for(kernel::MarchVariant::of(s)).id();
+  kernel::MarchVariant variant = kernel::MarchVariant::of(s);
+  variant.translucent = opaque.layers > 0 && opaque.layer_distance != 0 && opaque.layer_color != 0;
+  const GLuint p = program_for(variant).id();
   const kernel::MarchParams params = bind_inputs(cam, sun, s, opaque);
   const core::PreparedVolume& v = *volume_;
   const core::VolumeGrid& grid = v.grid;

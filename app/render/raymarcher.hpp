@@ -42,6 +42,11 @@ struct DispatchOptions {
 struct OpaqueInput {
   GLuint depth = 0;
   GLuint color = 0;
+  // Translucent fragments (core::OpaqueLayer's layers): `layers` per pixel side by side in
+  // R32F (distance) and RGBA32F (radiance, alpha) textures layers x width wide; 0: none.
+  GLuint layer_distance = 0;
+  GLuint layer_color = 0;
+  int layers = 0;
 };
 
 // Mesa's llvmpipe lets the loops of one shader invocation run 65 535 iterations in all

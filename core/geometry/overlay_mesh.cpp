@@ -72,6 +72,9 @@ OpaqueLayer cast_overlay(const OverlayMesh& mesh, const Camera& cam, double r0_m
     for (int x = 0; x < w; ++x) rays[static_cast<std::size_t>(y) * w + x] = camera_ray(cam, x, y);
   }
   auto color_of = [&](std::uint32_t v) { return v < mesh.colors.size() ? mesh.colors[v] : glm::vec4(1.0f); };
+  // Translucent triangle fragments (alpha below 1), every one per pixel; sorted and cut below.
+  std::vector<std::vector<Hit>> translucent(hits.size());
+  bool any_translucent = false;
   // Triangles: exact ray intersection over the pixels of the projected bounding box (all pixels when
   // a vertex is behind the camera).
   for (std::size_t k = 0; k + 2 < mesh.triangles.size(); k += 3) {
@@ -102,7 +105,12 @@ OpaqueLayer cast_overlay(const OverlayMesh& mesh, const Camera& cam, double r0_m
         // Colour interpolated barycentrically, as the GPU's perspective-correct varyings.
         const glm::vec4 col = static_cast<float>(1.0 - u - v) * color_of(i0) + static_cast<float>(u) * color_of(i1) +
                               static_cast<float>(v) * color_of(i2);
-        keep(hits, pi, t, col);
+        if (col.a < kOpaqueAlpha) {
+          translucent[pi].push_back({static_cast<float>(t), col});
+          any_translucent = true;
+        } else {
+          keep(hits, pi, t, col);
+        }
       }
     }
   }
@@ -151,6 +159,30 @@ OpaqueLayer cast_overlay(const OverlayMesh& mesh, const Camera& cam, double r0_m
   for (std::size_t i = 0; i < hits.size(); ++i) {
     out.distance_m[i] = hits[i].distance;
     for (int ch = 0; ch < 4; ++ch) out.radiance_rgba[4 * i + ch] = hits[i].distance > 0.0f ? hits[i].color[ch] : 0.0f;
+  }
+  if (any_translucent) {
+    // The nearest kTranslucentLayers fragments in front of the opaque geometry, nearest first (as
+    // the GPU pass's depth peeling finds them).
+    const int n = kTranslucentLayers;
+    out.layers = n;
+    out.layer_distance_m.assign(static_cast<std::size_t>(n) * hits.size(), 0.0f);
+    out.layer_rgba.assign(4 * out.layer_distance_m.size(), 0.0f);
+    for (std::size_t i = 0; i < hits.size(); ++i) {
+      std::vector<Hit>& f = translucent[i];
+      const float opaque = hits[i].distance;
+      std::erase_if(f, [&](const Hit& h) { return opaque > 0.0f && !(h.distance < opaque); });
+      std::sort(f.begin(), f.end(), [](const Hit& a, const Hit& b) { return a.distance < b.distance; });
+      // One fragment per surface: a pixel on the edge two triangles share is hit by both here (at
+      // distances a rounding apart), where the GPU's rasteriser gives it to one of them.
+      f.erase(std::unique(f.begin(), f.end(), [](const Hit& a, const Hit& b) { return b.distance - a.distance <= 1e-6f * b.distance; }),
+              f.end());
+      const std::size_t x = i % static_cast<std::size_t>(w), y = i / static_cast<std::size_t>(w);
+      for (std::size_t k = 0; k < std::min(f.size(), static_cast<std::size_t>(n)); ++k) {
+        const std::size_t at = (y * static_cast<std::size_t>(n) + k) * static_cast<std::size_t>(w) + x;
+        out.layer_distance_m[at] = f[k].distance;
+        for (int ch = 0; ch < 4; ++ch) out.layer_rgba[4 * at + ch] = f[k].color[ch];
+      }
+    }
   }
   return out;
 }

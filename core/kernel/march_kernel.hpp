@@ -49,10 +49,11 @@ using namespace cv::physics::f64;
 
 struct MarchKernel : MarchParams {
   sampler3D u_liquid, u_ice, u_noise_low, u_noise_high, u_ms_i0, u_ms_i1;
-  sampler2D u_column_tau, u_jitter_mask, u_ground, u_depth, u_opaque;
+  sampler2D u_column_tau, u_jitter_mask, u_ground, u_depth, u_opaque, u_tl_distance, u_tl_color;
   const glm::vec2* u_min_max = nullptr;
   // The program switches (compile-time constants on the GPU).
-  bool kSkipEmpty = true, kAdaptive = false, kAtmosphere = false, kGlobe = false, kNoise = false, kTwoStream = false;
+  bool kSkipEmpty = true, kAdaptive = false, kAtmosphere = false, kGlobe = false, kNoise = false, kTwoStream = false,
+       kTranslucent = false;
 
 #include "kernel/march.glsl"
 

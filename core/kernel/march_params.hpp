@@ -122,10 +122,11 @@ struct MarchVariant {
   bool atmosphere = false;  // the air: sun colour, sky in-scatter, ambient light
   bool globe = false;       // the ground where a ray meets it
   bool two_stream = false;  // multiple scattering from the two-stream source, not the octave sum
+  bool translucent = false; // translucent geometry composited among the samples (set by the caller: not a setting)
   static MarchVariant of(const core::MarchSettings& s);
   // A small integer naming the variant (a bit per switch), for caches of compiled programs.
   unsigned key() const;
-  static constexpr unsigned kCount = 64;
+  static constexpr unsigned kCount = 128;
   std::vector<std::pair<std::string, std::string>> defines() const;
 };
 

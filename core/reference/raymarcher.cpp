@@ -54,6 +54,11 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
     k.u_depth = {opaque->distance_m.data(), {cam.width, cam.height}, 1};
     k.u_has_opaque_color = !opaque->radiance_rgba.empty();
     if (k.u_has_opaque_color) k.u_opaque = {opaque->radiance_rgba.data(), {cam.width, cam.height}, 4};
+    if (opaque->layers > 0) {
+      k.u_tl_count = opaque->layers;
+      k.u_tl_distance = {opaque->layer_distance_m.data(), {opaque->layers * cam.width, cam.height}, 1};
+      k.u_tl_color = {opaque->layer_rgba.data(), {opaque->layers * cam.width, cam.height}, 4};
+    }
   }
   k.kSkipEmpty = s.features.skip_empty;
   k.kAdaptive = s.features.adaptive_steps;
@@ -61,6 +66,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   k.kGlobe = s.features.globe;
   k.kNoise = eroded;
   k.kTwoStream = s.medium.ms_two_stream;
+  k.kTranslucent = k.u_tl_count > 0;
 
   ReferenceImage img;
   img.width = cam.width;

@@ -32,9 +32,20 @@ struct ReferenceImage {
 // Opaque geometry for the march to stop at, per pixel (rows top to bottom): the distance (m) from
 // the camera along the pixel's ray (0: none there) and, optionally, the geometry's radiance (see
 // render::OpaqueInput: composited behind the clouds when given, else alpha is the transmittance).
+// Translucent geometry (triangles whose alpha is below 1) is not opaque: `layers` fragments per
+// pixel, nearest first and all nearer than the opaque geometry there, which the march composites in
+// depth order with its cloud samples (shaders/kernel/march.glsl, tl_composite). Row y holds the
+// layers side by side: fragment k of pixel x at y * layers * width + k * width + x.
+inline constexpr int kTranslucentLayers = 4;  // the most fragments per pixel kept (the nearest)
+// A fragment is translucent when its alpha is below this (interpolating three alphas of 1 can
+// round a few ulps below 1; overlay.frag holds the same number).
+inline constexpr float kOpaqueAlpha = 0.9999f;
 struct OpaqueLayer {
   std::vector<float> distance_m;
   std::vector<float> radiance_rgba;  // 4 floats per pixel, or empty
+  int layers = 0;                    // translucent fragments per pixel held (0: none)
+  std::vector<float> layer_distance_m;  // layers per pixel, m from the camera (0: none)
+  std::vector<float> layer_rgba;        // 4 floats each: radiance and alpha (not premultiplied)
 };
 
 struct PreparedVolume;  // kernel/prepared_volume.hpp

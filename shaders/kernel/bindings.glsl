@@ -12,6 +12,8 @@
 #define CV_TEX_OPAQUE 9
 #define CV_TEX_MS_I0 10
 #define CV_TEX_MS_I1 11
+#define CV_TEX_TL_DISTANCE 12
+#define CV_TEX_TL_COLOR 13
 #define CV_IMAGE_OUT 0
 #define CV_IMAGE_STATE_L 6
 #define CV_IMAGE_STATE_DEPTH 7

@@ -20,6 +20,11 @@ layout(binding = CV_TEX_NOISE_LOW) uniform sampler3D u_noise_low;    // Perlin-W
 layout(binding = CV_TEX_NOISE_HIGH) uniform sampler3D u_noise_high;  // Worley fBm, periodic, [0, 1]
 layout(binding = CV_TEX_DEPTH) uniform sampler2D u_depth;    // distance (m) from the camera to opaque geometry
 layout(binding = CV_TEX_OPAQUE) uniform sampler2D u_opaque;  // that geometry's radiance
+// Translucent geometry (shaders/render/overlay.frag, peeled): u_tl_count fragments per pixel, nearest
+// first, side by side (fragment k of pixel (x, y) at (x + k * width, y)): the distance (m, 0: none)
+// and the radiance with its alpha (not premultiplied).
+layout(binding = CV_TEX_TL_DISTANCE) uniform sampler2D u_tl_distance;
+layout(binding = CV_TEX_TL_COLOR) uniform sampler2D u_tl_color;
 layout(binding = CV_TEX_MS_I0) uniform sampler3D u_ms_i0;  // two-stream diffuse radiance per unit irradiance
 layout(binding = CV_TEX_MS_I1) uniform sampler3D u_ms_i1;  // its first moment (upward)
 // The extinction pyramid: (min, max) per brick, levels one after the other, x fastest.
@@ -49,9 +54,13 @@ uint g_stats[CV_STAT_COUNT] = uint[CV_STAT_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u
 #ifndef CV_TWO_STREAM
 #define CV_TWO_STREAM 0
 #endif
+#ifndef CV_TRANSLUCENT
+#define CV_TRANSLUCENT 0
+#endif
 const bool kSkipEmpty = CV_SKIP_EMPTY != 0;
 const bool kAdaptive = CV_ADAPTIVE != 0;
 const bool kAtmosphere = CV_ATMOSPHERE != 0;
 const bool kGlobe = CV_GLOBE != 0;
 const bool kNoise = CV_NOISE != 0;
 const bool kTwoStream = CV_TWO_STREAM != 0;  // the two-stream source; else the octave sum
+const bool kTranslucent = CV_TRANSLUCENT != 0;  // translucent geometry composited among the samples

@@ -6,10 +6,11 @@
 //
 // What the including side declares before this file: the parameters (u_*), the textures u_liquid,
 // u_ice (sampler3D, grid-mean extinction 1/m), u_ms_i0, u_ms_i1 (sampler3D, the two-stream source), u_column_tau, u_jitter_mask, u_ground, u_depth (the
-// distance to opaque geometry per pixel, m), u_opaque (that geometry's radiance) (sampler2D),
+// distance to opaque geometry per pixel, m), u_opaque (that geometry's radiance), u_tl_distance and
+// u_tl_color (translucent fragments, u_tl_count per pixel side by side, nearest first) (sampler2D),
 // u_noise_low, u_noise_high (sampler3D), the pyramid u_min_max (vec2 per brick, levels one after
 // the other), the counters g_stats[CV_STAT_COUNT] (uint, indices in march_stats.glsl) and the switches kSkipEmpty, kAdaptive,
-// kAtmosphere, kGlobe, kNoise and kTwoStream (compile-time constants on the GPU, where llvmpipe runs both sides
+// kAtmosphere, kGlobe, kNoise, kTwoStream and kTranslucent (compile-time constants on the GPU, where llvmpipe runs both sides
 // of a branch under masks; plain members in C++).
 //
 // Loops are shaped for Mesa's llvmpipe: all loops of one invocation share a budget of 65 535
@@ -242,6 +243,7 @@ struct MarchState {
   bool ended;
   int next_step;
   real t_half;  // distance from the camera where the view transmittance fell to 0.5 (3e38: never)
+  int tl_next;  // the next translucent fragment to composite (kTranslucent)
 };
 
 // One view sample at p (altitude alt_p, distance t along the ray) standing for a step of ds that
@@ -343,6 +345,21 @@ CV_FN real opaque_distance(ivec2 px) {
   return t > real(0.0) ? t : real(3.0e38);
 }
 
+// Translucent fragment k of pixel px (kTranslucent): its distance from the camera (3e38: none).
+CV_FN real tl_distance(ivec2 px, int k) {
+  real t = real(texelFetch(u_tl_distance, ivec2(px.x + k * u_size.x, px.y), 0).r);
+  return t > real(0.0) ? t : real(3.0e38);
+}
+
+// Composites the next translucent fragment where the march stands: its radiance times its alpha
+// behind what the march gathered, and the view transmittance times 1 - alpha.
+CV_FN void tl_composite(ivec2 px, CV_INOUT(MarchState) s) {
+  real4 c = real4(texelFetch(u_tl_color, ivec2(px.x + s.tl_next * u_size.x, px.y), 0));
+  s.radiance += s.t_view * c.w * real3(c.x, c.y, c.z);
+  s.t_view *= real(1.0) - c.w;
+  s.tl_next += 1;
+}
+
 CV_FN real3 pixel_direction(ivec2 px) {
   real x = (real(2.0) * (real(px.x) + real(0.5)) / real(u_size.x) - real(1.0)) * u_tan_half;
   real y = (real(1.0) - real(2.0) * (real(px.y) + real(0.5)) / real(u_size.y)) * u_tan_half * real(u_size.y) / real(u_size.x);
@@ -393,6 +410,7 @@ CV_FN MarchState march_start() {
   s.ended = false;
   s.next_step = 0;
   s.t_half = real(3.0e38);
+  s.tl_next = 0;
   return s;
 }
 
@@ -458,7 +476,24 @@ CV_FN void march_advance(MarchRay r, ivec2 px, int step_begin, int step_count, C
       }
       real ds = dt / real(substeps);
       real t = t_start + (real(i) + (real(j) + offset) / real(substeps)) * dt;
-      march_sample(r.origin + t * r.d, ray_altitude(u_r0, r.h, r.mu_up, t), t, ds, r.t_offset + t - offset * ds, r.d, mu, mie, s);
+      real t_in = t - offset * ds;  // where the sample's step begins, from origin
+      if (kTranslucent) {
+        // Translucent geometry within the step (or before it, in space the march jumped): the step
+        // is divided at each fragment, which is composited in its place, so the cloud in front of
+        // it and behind it are each taken where they stand.
+        while (s.tl_next < u_tl_count) {
+          real td = tl_distance(px, s.tl_next) - r.t_offset;
+          if (!(td < t_in + ds)) break;
+          real front = td - t_in;
+          if (front > real(0.0)) {
+            march_sample(r.origin + t * r.d, ray_altitude(u_r0, r.h, r.mu_up, t), t, front, r.t_offset + t_in, r.d, mu, mie, s);
+            t_in = td;
+            ds -= front;
+          }
+          tl_composite(px, s);
+        }
+      }
+      march_sample(r.origin + t * r.d, ray_altitude(u_r0, r.h, r.mu_up, t), t, ds, r.t_offset + t_in, r.d, mu, mie, s);
       if (++j == substeps) {
         j = 0;
         ++i;
@@ -574,6 +609,10 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, bool has_cloud,
 // has neither air nor globe, else the air and the ground composited around it, the cloud standing
 // for the air at the mean depth of the light it takes out; opaque geometry behind as over_opaque.
 CV_FN real4 march_finish(MarchRay r, ivec2 px, MarchState s) {
+  // Translucent geometry behind the last sample (or on a ray that crossed no cloud).
+  if (kTranslucent) {
+    while (s.tl_next < u_tl_count && tl_distance(px, s.tl_next) < real(3.0e38)) tl_composite(px, s);
+  }
   real3 opaque_l = u_has_opaque_color ? real3(texelFetch(u_opaque, px, 0)) : real3(0.0);
   if (!(kAtmosphere || kGlobe)) return over_opaque(s.radiance, s.t_view, r.t_opaque < real(3.0e38), opaque_l);
   real3 p_cloud = r.origin + (s.depth_w > real(0.0) ? s.depth_t / s.depth_w : real(0.0)) * r.d;

@@ -43,6 +43,7 @@ CV_PARAM(int, u_frame)               // -1: step middles; else the accumulation 
 CV_PARAM(int, u_sky_steps)           // steps of a sky in-scatter integral
 CV_PARAM(int, u_atmo_sun_steps)      // steps of an atmospheric transmittance toward the sun
 CV_PARAM(int, u_levels)              // pyramid levels, 0: no pyramid
+CV_PARAM(int, u_tl_count)            // translucent fragments per pixel in u_tl_distance, u_tl_color (0: none)
 CV_PARAM(bool, u_wraps)
 CV_PARAM(bool, u_global_lat)
 CV_PARAM(bool, u_cloudless)          // no cloud anywhere: nothing to march

@@ -2,7 +2,10 @@
 // holds, shaders/kernel/march.glsl) and the geometry's radiance. The depth test runs on that
 // distance over the far plane (linear: a metre's resolution out to 1e8 m in a 32-bit float depth,
 // where the projection's own depth would lose tens of percent at orbit). Geometry behind the
-// Earth's sphere is discarded as core::hidden_by_sphere does on the CPU, in double.
+// Earth's sphere is discarded as core::hidden_by_sphere does on the CPU, in double. Triangle
+// fragments with alpha below 1 are translucent: left out of the opaque pass (u_peel 0) and peeled
+// one layer at a time (u_peel 1): the nearest strictly behind the layer before (u_prev) and in
+// front of the opaque geometry (u_front_opaque), as core::cast_overlay keeps them.
 in vec3 v_rel;
 in vec4 v_color;
 uniform dvec3 u_camera;  // the camera, Earth-centred (m)
@@ -15,6 +18,10 @@ uniform float u_bias;    // lines: core::kLineDistanceBias, pulled toward the ca
 uniform vec3 u_forward, u_right, u_up;
 uniform vec2 u_tan_half;  // x, and y scaled by the aspect
 uniform vec2 u_size;      // pixels
+uniform int u_peel;       // 0: the opaque pass; 1: a translucent layer
+uniform bool u_has_prev;  // peeling a layer after the first
+layout(binding = 14) uniform sampler2D u_prev;          // the layer before's distance (m, 0: none)
+layout(binding = 15) uniform sampler2D u_front_opaque;  // the opaque pass's distance (m, 0: none)
 layout(location = 0) out float o_distance;
 layout(location = 1) out vec4 o_color;
 
@@ -43,6 +50,19 @@ void main() {
     }
   }
   float shown = float(t * (1.0 - double(u_bias)));
+  bool translucent = u_bias == 0.0 && v_color.a < 0.9999;  // core::kOpaqueAlpha
+  if (u_peel == 0) {
+    if (translucent) discard;
+  } else {
+    if (!translucent) discard;
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    float opaque = texelFetch(u_front_opaque, px, 0).r;
+    if (opaque > 0.0 && !(shown < opaque)) discard;
+    if (u_has_prev) {
+      float prev = texelFetch(u_prev, px, 0).r;  // 0: the layer before is empty, and so is this one
+      if (!(prev > 0.0) || !(shown > prev)) discard;
+    }
+  }
   o_distance = shown;
   o_color = v_color;
   gl_FragDepth = clamp(shown / u_far, 0.0, 1.0);

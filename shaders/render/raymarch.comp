@@ -16,7 +16,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 // The dispatch's own state.
 layout(rgba32f, binding = CV_IMAGE_OUT) writeonly uniform image2D u_out;
 layout(rgba32f, binding = CV_IMAGE_STATE_L) uniform image2D u_state_l;          // radiance so far, view transmittance
-// depth_w, depth_t, t_half, and the next step (n) while the march goes on or -(n + 1) once it has ended
+// depth_w, depth_t, t_half, and the next step (n) while the march goes on or -(n + 1) once it has ended;
+// with translucent geometry n is next_step * 8 + the next translucent fragment
 layout(rgba32f, binding = CV_IMAGE_STATE_DEPTH) uniform image2D u_state_depth;
 layout(r32f, binding = CV_IMAGE_CLOUD_DEPTH) writeonly uniform image2D u_cloud_depth;  // pass 1 writes it there
 uniform int u_pass;        // 0: march a range of steps; 1: air and ground, then u_out
@@ -53,12 +54,15 @@ void main() {
   s.depth_t = state_depth.y;
   s.t_half = state_depth.z;
   s.ended = ended;
-  s.next_step = ended ? -1 - int(state_depth.w) : int(state_depth.w);
+  int code = ended ? -1 - int(state_depth.w) : int(state_depth.w);
+  s.next_step = kTranslucent ? code >> 3 : code;
+  s.tl_next = kTranslucent ? code & 7 : 0;
   if (u_pass == 0) {
     march_advance(r, px, u_step_begin, u_step_count, s);
     flush_stats();
     imageStore(u_state_l, px, vec4(s.radiance, s.t_view));
-    imageStore(u_state_depth, px, vec4(s.depth_w, s.depth_t, s.t_half, float(s.ended ? -1 - s.next_step : s.next_step)));
+    int out_code = kTranslucent ? s.next_step * 8 + s.tl_next : s.next_step;
+    imageStore(u_state_depth, px, vec4(s.depth_w, s.depth_t, s.t_half, float(s.ended ? -1 - out_code : out_code)));
     return;
   }
   imageStore(u_out, px, march_finish(r, px, s));

@@ -186,6 +186,114 @@ TEST(OverlayComposite, OpaquePlaneInsideACloudOnTheGpuAndTheCpuReference) {
   }
 }
 
+// Translucent planes inside the uniform cloud, rendered on the GPU (the frame renderer's overlay
+// pass, peeled) and on the CPU reference (the CPU cast), each as one image with the planes.
+struct TranslucentRender {
+  std::vector<glm::vec4> gpu;
+  core::ReferenceImage cpu;
+  core::OpaqueLayer drawn, cast;
+};
+TranslucentRender render_with(const UniformCloud& u, const std::vector<std::shared_ptr<core::OverlayMesh>>& planes) {
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  const auto volume = std::make_shared<const core::PreparedVolume>(core::prepare_volume(u.grid, u.data));
+  render::FrameRenderer renderer(loader);
+  renderer.use_volume(volume);
+  std::vector<render::OverlayDraw> draws;
+  core::OverlayMesh all;
+  for (const auto& p : planes) draws.push_back({"plane", p, nullptr, 1.0f}), all.append(*p);
+  renderer.set_overlays(draws);
+  TranslucentRender r;
+  r.gpu = renderer.render(u.frame);
+  r.drawn = renderer.read_overlays();
+  r.cast = core::cast_overlay(all, u.frame.camera, u.grid.earth_radius_m);
+  r.cpu = core::render_reference(*volume, u.frame.camera, u.frame.sun, u.frame.march, nullptr, nullptr, &r.cast);
+  return r;
+}
+
+// Without sunlight the cloud gathers no light of its own: a translucent plane (alpha a, radiance C)
+// d from the camera gives exactly exp(-sigma d) a C, and the view transmittance is (1 - a) times
+// the plane-free one. Two planes drawn far first come out nearest first: exp(-sigma d1) a1 C1 +
+// exp(-sigma d2) (1 - a1) a2 C2, which the other order would not give.
+TEST(OverlayComposite, TranslucentPlanesInsideACloudInDepthOrder) {
+  auto ctx = render::make_headless_context();
+  UniformCloud u;
+  u.frame.sun.irradiance = glm::dvec3(0.0);
+  const double r0 = u.grid.earth_radius_m;
+  const glm::vec4 near_c(0.8f, 0.1f, 0.05f, 0.5f), far_c(0.05f, 0.6f, 0.3f, 0.25f);
+  const auto near_p = plane_above(u.frame.camera, r0, 400.0, near_c), far_p = plane_above(u.frame.camera, r0, 800.0, far_c);
+  const TranslucentRender none = render_with(u, {});
+  const TranslucentRender one = render_with(u, {near_p});
+  const TranslucentRender two = render_with(u, {far_p, near_p});
+  ASSERT_EQ(one.cast.layers, core::kTranslucentLayers);
+  ASSERT_EQ(one.drawn.layers, core::kTranslucentLayers);
+  const std::size_t n = static_cast<std::size_t>(kSize) * kSize;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t x = i % kSize, y = i / kSize;
+    auto at = [&](int k) { return (y * core::kTranslucentLayers + static_cast<std::size_t>(k)) * kSize + x; };
+    const double cosine = pixel_up_cosine(u.frame.camera, static_cast<int>(i), r0);
+    // No opaque geometry; the layers nearest first, the third empty.
+    EXPECT_EQ(two.drawn.distance_m[i], 0.0f) << i;
+    EXPECT_EQ(two.cast.distance_m[i], 0.0f) << i;
+    for (const core::OpaqueLayer* l : {&two.drawn, &two.cast}) {
+      EXPECT_NEAR(l->layer_distance_m[at(0)], 400.0 / cosine, 2e-3) << i;
+      EXPECT_NEAR(l->layer_distance_m[at(1)], 800.0 / cosine, 2e-3) << i;
+      EXPECT_EQ(l->layer_distance_m[at(2)], 0.0f) << i;
+    }
+    for (int side = 0; side < 2; ++side) {  // 0: GPU, 1: CPU
+      const core::OpaqueLayer& l1 = side ? one.cast : one.drawn;
+      const core::OpaqueLayer& l2 = side ? two.cast : two.drawn;
+      const double tol = side ? 1e-12 : 2e-6;  // double; float (exp of a float distance)
+      // The closed forms take what the layers hold (float distances, and colours interpolated in
+      // float), which are the planes' own to float precision.
+      const double d1 = l2.layer_distance_m[at(0)], d2 = l2.layer_distance_m[at(1)];
+      const double t1 = std::exp(-kSigma * d1), t2 = std::exp(-kSigma * d2);
+      const float* c1 = &l2.layer_rgba[4 * at(0)];
+      const float* c2 = &l2.layer_rgba[4 * at(1)];
+      const float* c0 = &l1.layer_rgba[4 * at(0)];
+      for (int c = 0; c < 4; ++c) {
+        EXPECT_NEAR(c1[c], near_c[c], 1e-6) << i;
+        EXPECT_NEAR(c2[c], far_c[c], 1e-6) << i;
+      }
+      for (int c = 0; c < 3; ++c) {
+        const double single = std::exp(-kSigma * l1.layer_distance_m[at(0)]) * c0[3] * c0[c];
+        const double pair = t1 * c1[3] * c1[c] + t2 * (1.0 - c1[3]) * c2[3] * c2[c];
+        const double got1 = side ? one.cpu.radiance[i][c] : one.gpu[i][c];
+        const double got2 = side ? two.cpu.radiance[i][c] : two.gpu[i][c];
+        EXPECT_NEAR(got1, single, tol) << (side ? "CPU" : "GPU") << " pixel " << i << " channel " << c;
+        EXPECT_NEAR(got2, pair, tol) << (side ? "CPU" : "GPU") << " pixel " << i << " channel " << c;
+      }
+      const double t_none = side ? none.cpu.transmittance[i] : none.gpu[i].w;
+      const double t_two = side ? two.cpu.transmittance[i] : two.gpu[i].w;
+      ASSERT_GT(t_none, 0.0);
+      EXPECT_NEAR(t_two / t_none, (1.0 - c1[3]) * (1.0 - c2[3]), side ? 1e-12 : 1e-5) << i;
+    }
+  }
+}
+
+// A plane of alpha 0 is translucent geometry that shows nothing: in a sunlit cloud the march
+// divides the steps it crosses and the image must not change (the two parts of a step sum to the
+// whole), to rounding.
+TEST(OverlayComposite, AnInvisibleTranslucentPlaneLeavesTheLitCloudAsItWas) {
+  auto ctx = render::make_headless_context();
+  const UniformCloud u;
+  const double r0 = u.grid.earth_radius_m;
+  const TranslucentRender none = render_with(u, {});
+  const TranslucentRender clear = render_with(u, {plane_above(u.frame.camera, r0, 437.0, {1.0f, 1.0f, 1.0f, 0.0f})});
+  ASSERT_EQ(clear.cast.layers, core::kTranslucentLayers);
+  double l_max = 0.0;
+  for (const glm::dvec3& l : none.cpu.radiance) l_max = std::max(l_max, l.y);
+  ASSERT_GT(l_max, 0.0);
+  for (std::size_t i = 0; i < none.gpu.size(); ++i) {
+    ASSERT_GT(clear.cast.layer_distance_m[(i / kSize * core::kTranslucentLayers) * kSize + i % kSize], 0.0f) << i;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(clear.cpu.radiance[i][c], none.cpu.radiance[i][c], 1e-12 * l_max) << i;
+      EXPECT_NEAR(clear.gpu[i][c], none.gpu[i][c], 1e-5 * l_max) << i;
+    }
+    EXPECT_NEAR(clear.cpu.transmittance[i], none.cpu.transmittance[i], 1e-12) << i;
+    EXPECT_NEAR(clear.gpu[i].w, none.gpu[i].w, 1e-6) << i;
+  }
+}
+
 TEST(OverlayComposite, NoOverlayMakesNoPassAndNoVtkCall) {
   auto ctx = render::make_headless_context();
   render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
