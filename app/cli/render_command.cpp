@@ -454,7 +454,7 @@ const char* render_usage() {
         "         [--exposure E|auto] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N]\n"
         "         [--no-sky]  clouds on black: no air, globe or ambient sky light\n"
         "         [--overlay NAME[:key=value,...]]  an overlay composited with the clouds by depth (repeatable):\n"
-        "                           coastlines, graticule or isosurface, with the keys of docs/scene.md's Overlays\n"
+        "                           coastlines, borders, rivers, graticule, isosurface, wind or section, with the keys of docs/scene.md's Overlays\n"
         "                           table, e.g. --overlay graticule:step_deg=15,color=1,1,1\n";
     for (const core::SettingRow& row : core::kMarchSettingRows) {
       if (!row.flag) continue;

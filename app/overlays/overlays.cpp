@@ -141,7 +141,14 @@ void check_overlays(const std::vector<core::OverlaySpec>& specs, const core::Clo
         throw OverlayError(at + buf);
       }
     }
-    if (specs[i].type == "coastlines") {
+    if (specs[i].type == "borders" || specs[i].type == "rivers") {
+      const std::string& c = specs[i].text("class");
+      const bool borders = specs[i].type == "borders";
+      if (borders ? (c != "national" && c != "states" && c != "marine" && c != "all") : (c != "major" && c != "permanent" && c != "all")) {
+        throw OverlayError(at + ".class: found \"" + c + "\", expected " + (borders ? "national, states, marine or all" : "major, permanent or all"));
+      }
+    }
+    if (specs[i].type == "coastlines" || specs[i].type == "borders" || specs[i].type == "rivers") {
       const std::string& r = specs[i].text("resolution");
       if (r != "auto" && (r.size() != 1 || std::string("clihf").find(r[0]) == std::string::npos)) {
         throw OverlayError(at + ".resolution: found \"" + r + "\", expected auto, c, l, i, h or f");
@@ -159,57 +166,69 @@ char coastline_resolution(const std::string& setting, double alt_m) {
   return 'f';
 }
 
-core::OverlayMesh build_coastlines(const std::string& dir, char res, double r0_m, const glm::vec4& color, double max_segment_m) {
-  // For each level the requested resolution, else the nearest installed (finer first).
-  const std::string order = "clihf";
-  const std::size_t fit = std::min(order.find(res), order.size() - 1);
-  std::string preference(1, order[fit]);
-  for (std::size_t k = fit + 1; k < order.size(); ++k) preference += order[k];
-  for (std::size_t k = fit; k-- > 0;) preference += order[k];
-  std::vector<render::ShorePolygon> polygons;
-  bool land = false;
-  for (int level = 1; level <= 2; ++level) {
-    for (char r : preference) {
-      const std::string base = dir + "/" + r + "/GSHHS_" + r + "_L" + std::to_string(level);
-      if (!std::filesystem::exists(base + ".shp")) continue;
-      render::read_shore_polygons(base, level, polygons);
-      land = land || level == 1;
-      break;
-    }
-  }
-  if (!land) {
-    throw OverlayError("overlays: coastlines: no GSHHS shorelines (GSHHS_<res>_L1.shp) under " + dir +
-                       ", expected the files of the Debian package python-cartopy-data (apt-get install python-cartopy-data)");
-  }
-  // The rings as closed polylines in (lon, lat); vtkCleanPolyData merges the repeated closing
-  // vertex and any duplicate points, and drops degenerate segments.
+core::OverlayMesh build_coastlines(const std::string& dir, char res, double r0_m, const glm::vec4& color, double max_segment_m,
+                                   const GeoBox& box) {
+  return build_gshhg(GshhgFeature::Shore, res, "", box, r0_m, color, dir, max_segment_m);
+}
+
+core::OverlayMesh build_gshhg(GshhgFeature feature, char res, const std::string& select, const GeoBox& box, double r0_m,
+                              const glm::vec4& color, const std::string& dir, double max_segment_m) {
+  const std::vector<std::vector<glm::dvec2>> lines = read_gshhg_lines(feature, res, select, box, dir);
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();  // degrees in float would move a vertex by up to half a metre
   vtkNew<vtkCellArray> cells;
-  for (const render::ShorePolygon& p : polygons) {
-    for (const auto& ring : p.rings) {
-      const vtkIdType n = static_cast<vtkIdType>(ring.size() / 2);
-      const vtkIdType first = points->GetNumberOfPoints();
-      cells->InsertNextCell(n + 1);
-      for (vtkIdType k = 0; k < n; ++k) {
-        points->InsertNextPoint(ring[2 * k], ring[2 * k + 1], 0.0);
-        cells->InsertCellPoint(first + k);
-      }
-      cells->InsertCellPoint(first);
+  // GSHHG's lines are straight in longitude and latitude (the border along 49 N is the parallel):
+  // each piece is divided every 0.05 degrees there, so the great-circle chords that follow stay
+  // within a metre of it (a 4 degree piece along 49 N drawn as one great circle bulges 4 km north).
+  constexpr double kStepDeg = 0.05;
+  for (const auto& line : lines) {
+    std::vector<glm::dvec2> dense{line.front()};
+    for (std::size_t k = 1; k < line.size(); ++k) {
+      const glm::dvec2 a = line[k - 1], b = line[k];
+      const int n = std::max(1, static_cast<int>(std::ceil(std::max(std::abs(b.x - a.x), std::abs(b.y - a.y)) / kStepDeg)));
+      for (int j = 1; j <= n; ++j) dense.push_back(a + (b - a) * (static_cast<double>(j) / n));
     }
+    cells->InsertNextCell(static_cast<vtkIdType>(dense.size()));
+    for (const glm::dvec2& p : dense) cells->InsertCellPoint(points->InsertNextPoint(p.x, p.y, 0.0));
   }
+  core::OverlayMesh out;
+  if (lines.empty()) return out;  // nothing of the feature in the box
   vtkNew<vtkPolyData> pd;
   pd->SetPoints(points);
   pd->SetLines(cells);
+  // GMT cuts the lines at its bins' edges: the repeated points there are merged.
   vtkNew<vtkCleanPolyData> clean;
   clean->SetInputData(pd);
   clean->PointMergingOn();
   clean->SetTolerance(0.0);
   clean->Update();
   ++g_vtk_runs;
-  core::OverlayMesh out;
   polylines_to_sphere(clean->GetOutput(), r0_m, max_segment_m, color, out);
   return out;
+}
+
+GeoBox overlay_box(const core::VolumeGrid& grid, char res, const core::Camera& cam) {
+  GeoBox box;
+  if (res != 'h' && res != 'f') return box;
+  // Around the camera, on a lattice so a moving camera rebuilds only when it crosses a cell.
+  const double half = res == 'h' ? 15.0 : 4.0, step = res == 'h' ? 5.0 : 1.0;
+  const double clat = std::clamp(std::round(cam.lat_deg / step) * step, -90.0, 90.0), clon = std::round(cam.lon_deg / step) * step;
+  const double lon_half = std::min(180.0, half / std::max(std::cos(clat * 3.14159265358979323846 / 180.0), 0.1));
+  box.global = false;
+  box.lat_min = std::max(-90.0, clat - half), box.lat_max = std::min(90.0, clat + half);
+  box.lon_min = clon - lon_half, box.lon_max = clon + lon_half;
+  // A regional volume: no further than its own extent and a margin of 2 degrees.
+  if (grid.lon_deg.step * grid.lon_deg.count < 359.0) {
+    const double lon0 = std::min(grid.lon_deg.start, grid.lon_deg.last()) - 2.0, lon1 = std::max(grid.lon_deg.start, grid.lon_deg.last()) + 2.0;
+    const double lat0 = std::min(grid.lat_deg.start, grid.lat_deg.last()) - 2.0, lat1 = std::max(grid.lat_deg.start, grid.lat_deg.last()) + 2.0;
+    const double shift = std::round(((lon0 + lon1) / 2.0 - clon) / 360.0) * 360.0;  // the grid's longitudes near the camera's
+    const GeoBox cut{false, std::max(box.lon_min, lon0 - shift), std::min(box.lon_max, lon1 - shift), std::max(box.lat_min, lat0),
+                     std::min(box.lat_max, lat1)};
+    if (cut.lon_min < cut.lon_max && cut.lat_min < cut.lat_max) return cut;
+    return GeoBox{false, lon0, lon1, std::max(-90.0, lat0), std::min(90.0, lat1)};
+  }
+  if (lon_half >= 180.0) box.global = true;
+  return box;
 }
 
 core::OverlayMesh build_graticule(double step_deg, double r0_m, const glm::vec4& color) {
@@ -755,14 +774,26 @@ std::vector<BuiltOverlay> OverlayBuilder::build(const std::vector<core::OverlayS
       continue;
     }
     const bool of_field = s.type == "isosurface" || s.type == "wind" || s.type == "section";
-    const char res = s.type == "coastlines" ? coastline_resolution(s.text("resolution"), cam.alt_m) : 0;
+    const bool gshhg = s.type == "coastlines" || s.type == "borders" || s.type == "rivers";
+    const char res = gshhg ? coastline_resolution(s.text("resolution"), cam.alt_m) : 0;
+    const GeoBox box = gshhg ? overlay_box(volume.grid, res, cam) : GeoBox{};
     Entry& e = cache_[i];
-    const bool fresh = e.mesh && e.spec == s && e.resolution == res && (!of_field || e.time_step == time_step);
+    const bool same_box = e.box.global == box.global && e.box.lon_min == box.lon_min && e.box.lon_max == box.lon_max &&
+                          e.box.lat_min == box.lat_min && e.box.lat_max == box.lat_max;
+    const bool fresh = e.mesh && e.spec == s && e.resolution == res && same_box && (!of_field || e.time_step == time_step);
     if (!fresh) {
       const auto t0 = std::chrono::steady_clock::now();
       core::OverlayMesh m;
-      if (s.type == "coastlines") m = build_coastlines(gshhs_dir_, res, r0, rgba(s.color("color")));
+      if (s.type == "coastlines") m = build_coastlines(gshhg_dir_, res, r0, rgba(s.color("color")), 2000.0, box);
       if (s.type == "graticule") m = build_graticule(s.number("step_deg"), r0, rgba(s.color("color")));
+      if (s.type == "borders" || s.type == "rivers") {
+        // GMT's classes: borders 1 national, 2 states of the Americas, 3 marine, a all; rivers 1
+        // permanent major, r all permanent, a all with canals.
+        const std::string& c = s.text("class");
+        const std::string select = c == "national" || c == "major" ? "1" : c == "states" ? "2" : c == "marine" ? "3" : c == "permanent" ? "r" : "a";
+        m = build_gshhg(s.type == "borders" ? GshhgFeature::Border : GshhgFeature::River, res, select, box, r0, rgba(s.color("color")),
+                        gshhg_dir_);
+      }
       if (s.type == "isosurface") {
         const core::Field f = volume_field(volume, s.text("field"), "overlays[" + std::to_string(i) + "].field");
         const core::TimeStepData& data = volume.step(time_step);
@@ -791,7 +822,7 @@ std::vector<BuiltOverlay> OverlayBuilder::build(const std::vector<core::OverlayS
         m.colors.resize(m.positions.size(), glm::vec4(1.0f));
         for (glm::vec4& c : m.colors) c.a = static_cast<float>(s.number("opacity"));
       }
-      e = {s, time_step, res, std::make_shared<const core::OverlayMesh>(std::move(m))};
+      e = {s, time_step, res, box, std::make_shared<const core::OverlayMesh>(std::move(m))};
       b.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       b.rebuilt = true;
     }

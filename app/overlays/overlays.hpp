@@ -13,6 +13,7 @@
 
 #include "frame/camera.hpp"
 #include "geometry/overlay_mesh.hpp"
+#include "overlays/gshhg.hpp"
 #include "render/frame_renderer.hpp"
 #include "render/land_sea_mask.hpp"
 #include "settings/overlay_settings.hpp"
@@ -55,7 +56,7 @@ struct BuiltOverlay {
 // resolution) changes.
 class OverlayBuilder {
  public:
-  explicit OverlayBuilder(std::string gshhs_dir = render::kGshhsDir) : gshhs_dir_(std::move(gshhs_dir)) {}
+  explicit OverlayBuilder(std::string gshhg_dir = kGshhgDir) : gshhg_dir_(std::move(gshhg_dir)) {}
   std::vector<BuiltOverlay> build(const std::vector<core::OverlaySpec>& specs, core::CloudVolume& volume, std::size_t time_step,
                                   const core::Camera& cam);
   // For the frame renderer.
@@ -66,9 +67,10 @@ class OverlayBuilder {
     core::OverlaySpec spec;
     std::size_t time_step = 0;
     char resolution = 0;
+    GeoBox box;  // what borders and rivers were read for
     std::shared_ptr<const core::OverlayMesh> mesh;
   };
-  std::string gshhs_dir_;
+  std::string gshhg_dir_;
   std::vector<Entry> cache_;
 };
 
@@ -76,12 +78,22 @@ class OverlayBuilder {
 std::uint64_t vtk_pipeline_runs();
 
 // The builders, each running VTK filters (the tests call them directly).
-// Coastlines: the GSHHS level-1 (and level-2 lake) shorelines of resolution `res` (the nearest
-// installed when that one is not) on the sphere of radius r0_m, each segment divided so that no
-// piece is longer than max_segment_m (a long chord would cut under the sphere). OverlayError
-// naming python-cartopy-data when no shoreline file is installed.
-core::OverlayMesh build_coastlines(const std::string& gshhs_dir, char res, double r0_m, const glm::vec4& color,
-                                   double max_segment_m = 2000.0);
+// Coastlines: GSHHG's level-1 shorelines and level-2 lake shores (through the GMT library, as
+// borders and rivers) of resolution `res` (the nearest installed when that one is not) inside
+// `box`, on the sphere of radius r0_m, each segment divided so that no piece is longer than
+// max_segment_m (a long chord would cut under the sphere). OverlayError naming gmt-gshhg-low (or
+// -high, -full) when the files are not installed.
+core::OverlayMesh build_coastlines(const std::string& gshhg_dir, char res, double r0_m, const glm::vec4& color,
+                                   double max_segment_m = 2000.0, const GeoBox& box = {});
+// GSHHG borders or rivers (read_gshhg_lines, through the GMT library) of resolution `res` inside
+// `box`, on the sphere as the coastlines are (segments no longer than max_segment_m).
+core::OverlayMesh build_gshhg(GshhgFeature feature, char res, const std::string& select, const GeoBox& box, double r0_m,
+                              const glm::vec4& color, const std::string& dir = kGshhgDir, double max_segment_m = 2000.0);
+// The box shorelines, borders and rivers are read for: the whole Earth at resolutions c, l and i;
+// at h and f a box around the camera (15 and 4 degrees of latitude each way, its centre on a 5 and
+// 1 degree lattice so a moving camera rebuilds only when it crosses a cell), cut to a regional
+// volume's extent and a margin of 2 degrees.
+GeoBox overlay_box(const core::VolumeGrid& grid, char res, const core::Camera& cam);
 // Meridians and parallels every step_deg on the sphere, divided every fraction of a degree.
 core::OverlayMesh build_graticule(double step_deg, double r0_m, const glm::vec4& color);
 // The labels of that graticule for one view: each meridian's longitude where it crosses the

@@ -353,32 +353,29 @@ TEST(Coastlines, ResolutionFollowsTheView) {
 
 TEST(Coastlines, MissingDataNamesThePackage) {
   try {
-    overlays::build_coastlines("/nonexistent/gshhs", 'c', 6371000.0, glm::vec4(1.0f));
+    overlays::build_coastlines("/nonexistent/gshhg", 'c', 6371000.0, glm::vec4(1.0f));
     FAIL() << "no error";
   } catch (const overlays::OverlayError& e) {
-    EXPECT_NE(std::string(e.what()).find("python-cartopy-data"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()),
+              "overlays: coastlines: no GSHHG files (binned_GSHHS_c.nc) under /nonexistent/gshhg, expected the files of the Debian "
+              "package gmt-gshhg-low (apt-get install gmt-gshhg-low gmt-common)");
   }
 }
 
-// A GSHHS vertex of Iceland's shore (the crude level-1 shapefile's point nearest 64.1 N, 21.9 W),
-// its lat/lon read from the file, drawn by the overlay pass from the camera: it lands on the pixel
-// the camera's projection gives (within one pixel), from orbit and from 100 m.
+// A GSHHG vertex of Iceland's shore (the crude shoreline's point nearest 64.1 N, 21.9 W), its
+// lat/lon as the GMT library reads it, drawn by the overlay pass from the camera: it lands on the
+// pixel the camera's projection gives (within one pixel), from orbit and from 100 m.
 TEST(Coastlines, AVertexLandsOnThePixelTheProjectionGives) {
-  const std::string base = std::string(render::kGshhsDir) + "/c/GSHHS_c_L1";
-  std::vector<render::ShorePolygon> shores;
-  render::read_shore_polygons(base, 1, shores);
   double best = 1e9, lat = 0.0, lon = 0.0;
-  for (const auto& p : shores) {
-    for (const auto& ring : p.rings) {
-      for (std::size_t k = 0; k + 1 < ring.size(); k += 2) {
-        const double dd = std::hypot(ring[k + 1] - 64.1, (ring[k] + 21.9) * std::cos(64.1 * 3.14159265358979 / 180.0));
-        if (dd < best) best = dd, lon = ring[k], lat = ring[k + 1];
-      }
+  for (const auto& line : overlays::read_gshhg_lines(overlays::GshhgFeature::Shore, 'c', "", {})) {
+    for (const glm::dvec2& p : line) {
+      const double dd = std::hypot(p.y - 64.1, (p.x + 21.9) * std::cos(64.1 * 3.14159265358979 / 180.0));
+      if (dd < best) best = dd, lon = p.x, lat = p.y;
     }
   }
-  ASSERT_LT(best, 1.0) << "no Icelandic vertex in " << base;
+  ASSERT_LT(best, 1.0) << "no Icelandic vertex in the crude GSHHG shorelines";
   const double r0 = 6371000.0;
-  const core::OverlayMesh coast = overlays::build_coastlines(render::kGshhsDir, 'c', r0, glm::vec4(1.0f));
+  const core::OverlayMesh coast = overlays::build_coastlines(overlays::kGshhgDir, 'c', r0, glm::vec4(1.0f));
   const glm::dvec3 v = geo::sphere_to_ecef({lat, lon, 0.0}, r0);
   std::size_t vi = coast.positions.size();
   for (std::size_t i = 0; i < coast.positions.size(); ++i) {
@@ -594,6 +591,93 @@ TEST(Isosurface, AnalyticSphereWithinATenthOfACell) {
     }
   }
   for (const auto& [edge, n] : edges) EXPECT_EQ(n, 2);
+}
+
+// Borders and rivers from GSHHG through GMT (Debian's gmt-gshhg-low): the US-Canada border runs
+// along 49 N from the Lake of the Woods to the Strait of Georgia, the Nile's branches meet at
+// Khartoum (15.6 N, 32.5 E), every vertex lies on the sphere, a regional box keeps what is inside
+// it, and missing files are named with their package.
+std::vector<geo::Geodetic> vertices_of(const core::OverlayMesh& m, double r0) {
+  std::vector<geo::Geodetic> out;
+  for (const glm::dvec3& p : m.positions) out.push_back(geo::ecef_to_sphere(p, r0));
+  return out;
+}
+
+TEST(OverlayGshhg, BordersAndRiversLieWhereTheMapsPutThem) {
+  const double r0 = 6371000.0;
+  const core::OverlayMesh borders = overlays::build_gshhg(overlays::GshhgFeature::Border, 'l', "1", {}, r0, glm::vec4(1.0f));
+  ASSERT_FALSE(borders.lines.empty());
+  int on_49 = 0;
+  double worst = 0.0;
+  for (const geo::Geodetic& g : vertices_of(borders, r0)) {
+    EXPECT_LT(std::abs(g.alt_m), 100.0);  // on the sphere (lifted a little so chords stay above it)
+    if (g.lon_deg > -120.0 && g.lon_deg < -96.0 && g.lat_deg > 46.0 && g.lat_deg < 52.0) {
+      ++on_49;
+      worst = std::max(worst, std::abs(g.lat_deg - 49.0));
+    }
+  }
+  EXPECT_GT(on_49, 10);
+  EXPECT_LT(worst, 0.01) << "a national border vertex between 120 W and 96 W off the 49th parallel";
+
+  const core::OverlayMesh rivers = overlays::build_gshhg(overlays::GshhgFeature::River, 'l', "1", {}, r0, glm::vec4(1.0f));
+  double nearest = 1e30;
+  for (const geo::Geodetic& g : vertices_of(rivers, r0)) nearest = std::min(nearest, std::hypot(g.lat_deg - 15.6, g.lon_deg - 32.53));
+  EXPECT_LT(nearest, 0.15) << "no major river vertex near Khartoum";
+
+  overlays::GeoBox box;
+  box.global = false, box.lon_min = 30.0, box.lon_max = 34.0, box.lat_min = 13.0, box.lat_max = 18.0;
+  const core::OverlayMesh inside = overlays::build_gshhg(overlays::GshhgFeature::River, 'l', "1", box, r0, glm::vec4(1.0f));
+  ASSERT_FALSE(inside.lines.empty());
+  for (const geo::Geodetic& g : vertices_of(inside, r0)) {
+    // Within 1e-5 degrees (a metre): the great-circle pieces between two vertices on the box's edge
+    // (0.05 degrees apart at most) bulge from it by that much.
+    EXPECT_TRUE(g.lon_deg >= 30.0 - 1e-5 && g.lon_deg <= 34.0 + 1e-5 && g.lat_deg >= 13.0 - 1e-5 && g.lat_deg <= 18.0 + 1e-5)
+        << g.lat_deg << ", " << g.lon_deg;
+  }
+  EXPECT_LT(inside.positions.size(), rivers.positions.size() / 10);
+
+  try {
+    overlays::build_gshhg(overlays::GshhgFeature::Border, 'h', "1", {}, r0, glm::vec4(1.0f), "/nonexistent");
+    ADD_FAILURE() << "no error without the files";
+  } catch (const overlays::OverlayError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "overlays: borders: no GSHHG files (binned_border_h.nc) under /nonexistent, expected the files of the Debian package "
+              "gmt-gshhg-high (apt-get install gmt-gshhg-high gmt-common)");
+  }
+}
+
+// A scene's borders and rivers through the builder: the class is checked, and the geometry is
+// kept until the resolution the view asks for changes.
+TEST(OverlayGshhg, TheBuilderChecksTheClassAndKeepsTheGeometry) {
+  core::CloudVolume vol;
+  vol.grid.lon_deg = {-2.0, 0.25, 17};
+  vol.grid.lat_deg = {-2.0, 0.25, 17};
+  vol.grid.alt_m = {0.0, 250.0, 17};
+  std::vector<core::OverlaySpec> specs = {core::default_overlay("borders"), core::default_overlay("rivers")};
+  specs[1].texts["class"] = "lakes";
+  try {
+    overlays::check_overlays(specs, vol);
+    ADD_FAILURE() << "no error for class lakes";
+  } catch (const overlays::OverlayError& e) {
+    EXPECT_EQ(std::string(e.what()), "overlays[1].class: found \"lakes\", expected major, permanent or all");
+  }
+  specs[1].texts["class"] = "major";
+  overlays::check_overlays(specs, vol);
+  overlays::OverlayBuilder builder;
+  core::Camera cam;
+  cam.alt_m = 5.0e6;  // crude
+  const auto a = builder.build(specs, vol, 0, cam);
+  ASSERT_EQ(a.size(), 2u);
+  EXPECT_TRUE(a[0].rebuilt && a[1].rebuilt);
+  EXPECT_FALSE(a[0].mesh->lines.empty());
+  EXPECT_FALSE(a[1].mesh->lines.empty());
+  const auto b = builder.build(specs, vol, 0, cam);
+  EXPECT_FALSE(b[0].rebuilt || b[1].rebuilt);
+  EXPECT_EQ(b[0].mesh, a[0].mesh);
+  cam.alt_m = 1.0e6;  // low
+  const auto c = builder.build(specs, vol, 0, cam);
+  EXPECT_TRUE(c[0].rebuilt);
+  EXPECT_GT(c[0].mesh->positions.size(), a[0].mesh->positions.size());
 }
 
 }  // namespace
