@@ -22,6 +22,7 @@
 #include "render/context.hpp"
 #include "render/shader_loader.hpp"
 #include "cli_common.hpp"
+#include "record_command.hpp"
 #include "render_command.hpp"
 #include "bench_command.hpp"
 #include "time_error_command.hpp"
@@ -54,6 +55,7 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
       {"gpu-info", "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"},
       {"phase", "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"},
       {"render", cv::cli::render_usage()},
+      {"record", cv::cli::record_usage()},
       {"bench", cv::cli::bench_usage()},
       {"time-error", cv::cli::time_error_usage()},
       {"view",
@@ -311,7 +313,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (args.size() == 2 && print_command_usage(args[1])) return 0;
-    std::fprintf(stderr, "cloudviewer help: found '%s', expected one command: info, import, gpu-info, phase, render, bench, time-error or view\n",
+    std::fprintf(stderr, "cloudviewer help: found '%s', expected one command: info, import, gpu-info, phase, render, record, bench, time-error or view\n",
                  args.size() == 2 ? args[1].c_str() : "several arguments");
     return kExitBadInput;
   }
@@ -332,10 +334,11 @@ int main(int argc, char** argv) {
     if (cmd == "import") return cmd_import(args);
     if (cmd == "phase") return cmd_phase(args);
     if (cmd == "render") return cv::cli::cmd_render(args);
+    if (cmd == "record") return cv::cli::cmd_record(args);
     if (cmd == "bench") return cv::cli::cmd_bench(args);
     if (cmd == "time-error") return cv::cli::cmd_time_error(args);
     if (cmd == "view") return cv::viewer::cmd_view(args);
-    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase, render, bench, time-error or view"};
+    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase, render, record, bench, time-error or view"};
   } catch (const UsageError& e) {
     std::fprintf(stderr, "%s\n", e.message.c_str());
     return kExitBadInput;

@@ -62,7 +62,7 @@ void FrameRenderer::ensure_noise(const core::MarchSettings& m) {
 
 void FrameRenderer::march_into(GLuint out, const core::FrameSpec& f, int index, const DispatchOptions& dispatch,
                                const OpaqueInput& opaque) {
-  const core::MarchSettings m = frame_settings(f.march, f.accumulate, index);
+  const core::MarchSettings m = frame_settings(f.march, f.accumulate, f.jitter_base + index);
   ensure_noise(m);
   // The overlays, drawn once per accumulation (the camera does not move within one), unless the
   // caller brings its own opaque input.
@@ -78,7 +78,7 @@ std::vector<glm::vec4> FrameRenderer::render(const core::FrameSpec& f, const Dis
   std::vector<glm::vec4> mean;
   const OpaqueInput opaque = draw_overlays(f.march_camera);  // none, and no pass, without overlays
   for (int i = 0; i < f.accumulate; ++i) {
-    const core::MarchSettings m = frame_settings(f.march, f.accumulate, i);
+    const core::MarchSettings m = frame_settings(f.march, f.accumulate, f.jitter_base + i);
     ensure_noise(m);
     const std::vector<glm::vec4> frame = gpu_.render(f.march_camera, f.sun, m, dispatch, opaque);
     if (i == 0) {
