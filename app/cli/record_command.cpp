@@ -345,13 +345,12 @@ int cmd_record(const std::vector<std::string>& args) {
   // Frame k's linear image, through the one frame renderer: the scene at the path's time for k,
   // its jitter indices k * accumulate onwards.
   auto render_frame = [&](int k, std::vector<glm::vec4>* marched, core::FrameSpec& frame) {
-    const core::Scene at = core::scene_at_path_time(scene, path, core::path_frame_time_s(path, k, r.fps));
-    const core::Instant instant = core::scene_instant(at, vol, scene.data.path);
+    core::Scene at;
+    frame = render::resolve_path_frame(scene, path, vol, k, r.fps, &at);
+    const core::Instant& instant = frame.instant;
     core::TimeInterpolationReport rep;
     renderer.use_volume(volumes.get(scene.data.path, vol, instant, at.time.interpolation, &rep));
     if (!rep.warning.empty() && rep.warning != warned) std::printf("warning: %s\n", (warned = rep.warning).c_str());
-    frame = render::resolve_frame(at, vol);
-    frame.jitter_base = k * frame.accumulate;
     if (!at.overlays.empty()) {
       try {
         renderer.set_overlays(overlays::OverlayBuilder::draws(builder.build(at.overlays, vol, instant.step0, frame.march_camera)));

@@ -53,6 +53,15 @@ core::FrameSpec resolve_frame(const core::Scene& scene, const core::CloudVolume&
   return f;
 }
 
+core::FrameSpec resolve_path_frame(const core::Scene& scene, const core::PathEvaluator& path, const core::CloudVolume& volume,
+                                   int k, double fps, core::Scene* at) {
+  const core::Scene s = core::scene_at_path_time(scene, path, core::path_frame_time_s(path, k, fps));
+  core::FrameSpec f = render::resolve_frame(s, volume);
+  f.jitter_base = k * f.accumulate;
+  if (at) *at = s;
+  return f;
+}
+
 void FrameRenderer::ensure_noise(const core::MarchSettings& m) {
   if (m.medium.noise_amount > 0.0 && !noise_uploaded_) {  // generated, compiled and bound only when used
     gpu_.upload_noise(core::make_erosion_noise());
