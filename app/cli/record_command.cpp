@@ -47,6 +47,7 @@ struct RecordArgs {
   double fps = 30.0;
   std::optional<std::pair<int, int>> frames;  // --frames A:B, inclusive
   bool assemble = false;
+  bool count = false;  // --count: print the number of frames and stop
   int crf = 18;
 };
 
@@ -63,6 +64,8 @@ RecordArgs parse_record_args(const std::vector<std::string>& args, core::Scene& 
     const std::string& a = args[i];
     if (a == "--assemble") {
       r.assemble = true;
+    } else if (a == "--count") {
+      r.count = true;
     } else if (!a.empty() && a[0] == '-') {
       if (i + 1 >= args.size()) throw UsageError{"cloudviewer record: " + a + ": expected a value after it"};
       options.emplace_back(a, args[++i]);
@@ -266,7 +269,8 @@ const char* record_usage() {
          "                           taken from frame 0 for every frame, so the video does not flicker\n"
          "         [--frames A:B]            render only frames A..B (inclusive, from 0), no video: for batch\n"
          "                           schedulers (scripts/slurm/record.sbatch)\n"
-         "         [--assemble]              no rendering: the MP4 from the frames on disk, naming any missing\n";
+         "         [--assemble]              no rendering: the MP4 from the frames on disk, naming any missing\n"
+         "         [--count]                 print the path's number of frames at --fps and stop\n";
 }
 
 int cmd_record(const std::vector<std::string>& args) {
@@ -275,6 +279,10 @@ int cmd_record(const std::vector<std::string>& args) {
   RecordArgs r = parse_record_args(args, scene);
   const core::PathEvaluator path(*scene.path);  // checked when the scene was read
   const int count = core::path_frame_count(path, r.fps);
+  if (r.count) {  // for batch scripts that split the frames (scripts/slurm/record.sbatch)
+    std::printf("%d\n", count);
+    return 0;
+  }
   if (r.frames && r.frames->second >= count) {
     throw UsageError{"cloudviewer record: --frames: found " + std::to_string(r.frames->first) + ":" + std::to_string(r.frames->second) +
                      ", expected frames within 0:" + std::to_string(count - 1) + " (the path has " + std::to_string(count) + " frames at " +
