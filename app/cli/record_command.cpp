@@ -48,6 +48,12 @@ struct RecordArgs {
   std::optional<std::pair<int, int>> frames;  // --frames A:B, inclusive
   bool assemble = false;
   bool count = false;  // --count: print the number of frames and stop
+  // --quality reference: the GPU path tracer per frame, up to spp samples per pixel or until the
+  // image's mean relative standard error is target_error (0: all spp); its seed from the frame number.
+  bool reference = false;
+  int spp = 64;
+  double target_error = 0.0;
+  bool spp_given = false;
   int crf = 18;
 };
 
@@ -95,8 +101,21 @@ RecordArgs parse_record_args(const std::vector<std::string>& args, core::Scene& 
       }
       scene.width = size->first, scene.height = size->second;
     } else if (a == "--quality") {
-      if (!core::find_quality(v)) throw UsageError{"cloudviewer record: --quality: found '" + v + "', expected one of " + core::quality_names()};
-      core::apply_quality(v, scene.render);
+      if (v == "reference") {
+        r.reference = true;
+      } else if (!core::find_quality(v)) {
+        throw UsageError{"cloudviewer record: --quality: found '" + v + "', expected one of " + core::quality_names() + " or reference"};
+      } else {
+        core::apply_quality(v, scene.render);
+      }
+    } else if (a == "--spp") {
+      r.spp = parse_whole(a, v, 1, 1000000, "samples per pixel 1..1e6");
+      r.spp_given = true;
+    } else if (a == "--target-error") {
+      r.target_error = parse_number(a, v);
+      if (!(r.target_error > 0.0 && r.target_error < 1.0)) {
+        throw UsageError{"cloudviewer record: --target-error: found '" + v + "', expected a relative standard error between 0 and 1"};
+      }
     } else if (a == "--accumulate") {
       scene.render.accumulate = parse_whole(a, v, 1, 4096, "jittered frames per video frame 1..4096");
       scene.render.quality = "custom";
@@ -121,6 +140,9 @@ RecordArgs parse_record_args(const std::vector<std::string>& args, core::Scene& 
     }
   }
   if (r.out.empty()) throw UsageError{"cloudviewer record: expected -o OUT.mp4"};
+  if (!r.reference && (r.spp_given || r.target_error > 0.0)) {
+    throw UsageError{"cloudviewer record: --spp and --target-error: found them without a path tracer, expected --quality reference"};
+  }
   if (r.assemble && r.frames) throw UsageError{"cloudviewer record: --assemble: found it with --frames, expected one or the other"};
   if (!scene.path) {
     throw UsageError{r.scene_path + ": path: found nothing, expected a camera path {\"keyframes\": [...]} (docs/scene.md, Camera paths)"};
@@ -267,6 +289,9 @@ const char* record_usage() {
          "                           already whole are skipped, so a stopped run resumes; the same scene and frame\n"
          "                           give the same bytes (each frame's jitter from its number); auto exposure is\n"
          "                           taken from frame 0 for every frame, so the video does not flicker\n"
+         "         [--quality reference [--spp N] [--target-error E]]  each frame by the GPU path tracer (clouds and\n"
+         "                           the ground, no air): N samples per pixel at most (64), fewer once the image's mean\n"
+         "                           relative standard error is E; the frame number seeds it\n"
          "         [--frames A:B]            render only frames A..B (inclusive, from 0), no video: for batch\n"
          "                           schedulers (scripts/slurm/record.sbatch)\n"
          "         [--assemble]              no rendering: the MP4 from the frames on disk, naming any missing\n"
@@ -366,7 +391,24 @@ int cmd_record(const std::vector<std::string>& args) {
         throw UsageError{std::string("cloudviewer record: ") + e.what()};
       }
     }
-    return renderer.render(frame, {}, {}, marched);
+    if (!r.reference) return renderer.render(frame, {}, {}, marched);
+    // The path tracer at the output size, without the air (it does not model it), in batches of 8
+    // samples until spp or the target error; the same frame number gives the same samples.
+    frame.march_camera = frame.camera;
+    frame.march.features.atmosphere = false;
+    core::MonteCarloImage img;
+    render::PathTraceSettings pt;
+    pt.samples_per_readback = 8;
+    pt.seed = static_cast<std::uint32_t>(k) + 1u;
+    while (img.spp < static_cast<std::uint64_t>(r.spp)) {
+      const int batch = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(r.spp) - img.spp, 8));
+      renderer.raymarcher().trace_paths(img, frame.camera, frame.sun, frame.march, batch, pt);
+      if (r.target_error > 0.0 && img.spp >= 8 && img.mean_relative_standard_error() <= r.target_error) break;
+    }
+    std::vector<glm::vec4> out(img.lum_sum.size());
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = glm::vec4(glm::vec3(img.mean(i)), 0.0f);
+    if (marched) *marched = out;
+    return out;
   };
 
   std::optional<double> exposure;
@@ -378,9 +420,17 @@ int cmd_record(const std::vector<std::string>& args) {
     exposure = render::auto_exposure(marched);
     std::printf("exposure %.6g (auto, from frame 0, for every frame)\n", *exposure);
   }
-  std::printf("recording %s: %d frames (%.3g s at %.6g fps), %d..%d here, %dx%d, quality %s, %d jittered frame(s) each, into %s\n",
-              r.scene_path.c_str(), count, path.duration_s(), r.fps, first, last, scene.width, scene.height, scene.render.quality.c_str(),
-              std::max(1, scene.render.accumulate), folder.c_str());
+  if (r.reference) {
+    std::printf("recording %s: %d frames (%.3g s at %.6g fps), %d..%d here, %dx%d, quality reference: the GPU path tracer, up to %d "
+                "samples per pixel%s (clouds and the ground, no air), into %s\n",
+                r.scene_path.c_str(), count, path.duration_s(), r.fps, first, last, scene.width, scene.height, r.spp,
+                r.target_error > 0.0 ? (" or a relative standard error of " + core::short_number(r.target_error)).c_str() : "",
+                folder.c_str());
+  } else {
+    std::printf("recording %s: %d frames (%.3g s at %.6g fps), %d..%d here, %dx%d, quality %s, %d jittered frame(s) each, into %s\n",
+                r.scene_path.c_str(), count, path.duration_s(), r.fps, first, last, scene.width, scene.height, scene.render.quality.c_str(),
+                std::max(1, scene.render.accumulate), folder.c_str());
+  }
   std::fflush(stdout);
   const bool tty = ::isatty(::fileno(stdout)) != 0;
   int rendered = 0, skipped = 0;

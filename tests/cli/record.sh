@@ -100,4 +100,13 @@ echo "$out" | grep -q "skipped $n already whole" || fail "the resumed run did no
 cmp -s "$work/a/v.mp4" "$work/d/v.mp4" || fail "the resumed video differs from the uninterrupted run's"
 ls -A "$work/d" "$work/d/v_frames" | grep -q '^\.' && fail "temporaries left behind"
 echo "killed after $n frames and resumed to the same video"
+# The path tracer per frame (--quality reference), seeded by the frame number: the same bytes twice.
+mkdir -p "$work/e" "$work/f"
+for d in e f; do
+  "$cv" record "$work/fly.json" -o "$work/$d/v.mp4" --fps 10 --frames 3:3 --quality reference --spp 8 > "$work/$d.log" 2>&1 ||
+    { cat "$work/$d.log"; fail "--quality reference failed"; }
+done
+grep -q "quality reference: the GPU path tracer, up to 8 samples per pixel" "$work/e.log" || fail "no path tracer line: $(cat "$work/e.log")"
+cmp -s "$work/e/v_frames/frame_00003.png" "$work/f/v_frames/frame_00003.png" || fail "the path-traced frame differs between runs"
+expect2 spp_without_reference "--spp and --target-error: found them without a path tracer" "$cv" record "$work/fly.json" -o "$work/bad.mp4" --spp 4
 echo "record end to end passed"
