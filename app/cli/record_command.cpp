@@ -20,6 +20,7 @@
 #include <glm/glm.hpp>
 
 #include "cli_common.hpp"
+#include "io/input_file.hpp"
 #include "io/output_file.hpp"
 #include "kernel/volume_cache.hpp"
 #include "overlays/overlays.hpp"
@@ -167,6 +168,33 @@ fs::path frame_file(const fs::path& folder, int k) {
   return folder / name;
 }
 
+// What decides the frames' pixels, written beside them as OUT_frames/record.json: a rerun (or
+// another array task) with other settings would mix two videos' frames, so it is refused.
+std::string frames_manifest(const RecordArgs& r, const core::Scene& scene) {
+  core::Scene s = scene;
+  s.data.path = fs::absolute(scene.data.path).lexically_normal().string();
+  char extra[256];
+  std::snprintf(extra, sizeof extra, "{\"fps\": %.17g, \"reference\": %s, \"spp\": %d, \"target_error\": %.17g}\n", r.fps,
+                r.reference ? "true" : "false", r.spp, r.target_error);
+  return std::string("{\"record\": ") + extra + ", \"scene\": " + core::scene_to_json(s) + "}\n";
+}
+
+void check_manifest(const fs::path& folder, const std::string& manifest) {
+  const fs::path file = folder / "record.json";
+  std::error_code ec;
+  if (!fs::exists(file, ec)) return;
+  std::string text;
+  try {
+    text = core::read_regular_file(file.string(), "the frames' record of their settings", 64u << 20);
+  } catch (const core::InputError& e) {
+    throw UsageError{std::string("cloudviewer record: ") + e.what()};
+  }
+  if (text != manifest) {
+    throw UsageError{"cloudviewer record: " + file.string() + ": found frames rendered with other settings (scene, size, quality, fps or "
+                     "data), expected this scene's: remove " + folder.string() + " or choose another -o"};
+  }
+}
+
 // The output folder and the frames' folder can be written, before anything is rendered.
 void check_outputs(const RecordArgs& r, const core::Scene& scene) {
   core::check_output_extension(r.out, "-o", {".mp4"});
@@ -288,7 +316,8 @@ const char* record_usage() {
          "                           through its end), then an H.264 yuv420p MP4 through the ffmpeg program; frames\n"
          "                           already whole are skipped, so a stopped run resumes; the same scene and frame\n"
          "                           give the same bytes (each frame's jitter from its number); auto exposure is\n"
-         "                           taken from frame 0 for every frame, so the video does not flicker\n"
+         "                           taken from frame 0 for every frame, so the video does not flicker;\n"
+         "                           OUT_frames/record.json holds the settings: frames of other ones are refused\n"
          "         [--quality reference [--spp N] [--target-error E]]  each frame by the GPU path tracer (clouds and\n"
          "                           the ground, no air): N samples per pixel at most (64), fewer once the image's mean\n"
          "                           relative standard error is E; the frame number seeds it\n"
@@ -317,6 +346,8 @@ int cmd_record(const std::vector<std::string>& args) {
   const bool encode = !r.frames;
   const std::string ffmpeg = encode ? find_ffmpeg() : "";
   const fs::path folder = frames_folder(r.out);
+  const std::string manifest = frames_manifest(r, scene);
+  check_manifest(folder, manifest);
 
   if (r.assemble) {
     std::vector<int> missing;
@@ -366,6 +397,9 @@ int cmd_record(const std::vector<std::string>& args) {
   std::error_code ec;
   fs::create_directories(folder, ec);
   if (!fs::is_directory(folder)) throw UsageError{"cloudviewer record: -o: cannot create the frames' folder " + folder.string()};
+  if (!fs::exists(folder / "record.json", ec)) {
+    core::write_file_atomically((folder / "record.json").string(), [&](std::FILE* f) { std::fwrite(manifest.data(), 1, manifest.size(), f); });
+  }
 
   const int first = r.frames ? r.frames->first : 0, last = r.frames ? r.frames->second : count - 1;
   auto ctx = render::make_headless_context();

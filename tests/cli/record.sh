@@ -58,7 +58,10 @@ mkdir -p "$work/a" "$work/b" "$work/c" "$work/d"
 "$cv" record "$work/fly.json" -o "$work/a/v.mp4" --fps 10 > "$work/a.log" 2>&1 || { cat "$work/a.log"; fail "record failed"; }
 grep -q "frame 21 of 21 (frame_00020.png), .* frames/min, ETA" "$work/a.log" || fail "no progress line"
 [ -s "$work/a/v.mp4" ] || fail "no video"
-[ "$(ls "$work/a/v_frames" | wc -l)" -eq 21 ] || fail "expected 21 frames"
+[ "$(ls "$work"/a/v_frames/*.png | wc -l)" -eq 21 ] || fail "expected 21 frames"
+# Frames of other settings are never mixed in: a rerun at another size into the same folder is refused.
+expect2 other_settings "v_frames/record.json: found frames rendered with other settings" \
+  "$cv" record "$work/fly.json" -o "$work/a/v.mp4" --fps 10 --size 34x18
 ffprobe -v error -select_streams v:0 -show_entries stream=codec_name,pix_fmt,nb_frames -of csv=p=0 "$work/a/v.mp4" | grep -q "^h264,yuv420p,21$" ||
   fail "the video is not 21 frames of H.264 yuv420p: $(ffprobe -v error -select_streams v:0 -show_entries stream=codec_name,pix_fmt,nb_frames -of csv=p=0 "$work/a/v.mp4")"
 # The weather runs and the camera moves: consecutive frames differ.
@@ -90,9 +93,9 @@ cmp -s "$work/a/v_frames/frame_00005.png" "$work/c/v_frames/frame_00005.png" || 
 "$cv" record "$work/fly.json" -o "$work/d/v.mp4" --fps 10 > "$work/d.log" 2>&1 &
 pid=$!
 i=0
-while [ "$(ls "$work/d/v_frames" 2>/dev/null | wc -l)" -lt 4 ] && [ $i -lt 600 ]; do sleep 0.1; i=$((i + 1)); done
+while [ "$(ls "$work"/d/v_frames/*.png 2>/dev/null | wc -l)" -lt 4 ] && [ $i -lt 600 ]; do sleep 0.1; i=$((i + 1)); done
 kill -9 $pid; wait $pid 2>/dev/null
-n=$(ls "$work/d/v_frames" | wc -l)
+n=$(ls "$work"/d/v_frames/*.png | wc -l)
 [ "$n" -lt 21 ] || fail "the run finished before it was killed"
 [ ! -e "$work/d/v.mp4" ] || fail "a killed run left a video"
 out=$("$cv" record "$work/fly.json" -o "$work/d/v.mp4" --fps 10 2>&1) || fail "resume failed: $out"

@@ -35,7 +35,7 @@ for log in "$work"/array/cv-record-*.log; do grep -q "record" "$log" 2>/dev/null
 for f in "$work"/one/v_frames/*.png; do
   cmp -s "$f" "$work/array/v_frames/$(basename "$f")" || fail "$(basename "$f") differs between the array and one process"
 done
-[ "$(ls "$work/array/v_frames" | wc -l)" -eq 10 ] || fail "expected 10 frames from the array"
+[ "$(ls "$work"/array/v_frames/*.png | wc -l)" -eq 10 ] || fail "expected 10 frames from the array"
 cmp -s "$work/one/v.mp4" "$work/array/v.mp4" || fail "the array's MP4 differs from one process's"
 awk -v a="$t0" -v b="$t1" -v c="$t2" 'BEGIN { printf "one process %.1f s, Slurm array of 4 (submit to assembled) %.1f s\n", b - a, c - b }'
 "$src/scripts/slurm-local" stop "$cluster"
