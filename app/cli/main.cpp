@@ -22,7 +22,9 @@
 #include "render/context.hpp"
 #include "render/shader_loader.hpp"
 #include "cli_common.hpp"
+#include "record_command.hpp"
 #include "render_command.hpp"
+#include "vdb/vdb_export.hpp"
 #include "bench_command.hpp"
 #include "time_error_command.hpp"
 #include "scene/scene_json.hpp"
@@ -44,9 +46,11 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
       {"import",
        "  import FILE -o OUT [--region W,E,S,N] [--times FIRST:LAST[:STRIDE] | --times START..END]\n"
        "         [--levels MIN_HPA:MAX_HPA]\n"
-       "         [--stride N] [--dz M] [--reff-liquid UM] [--reff-ice UM] [--vti]\n"
+       "         [--stride N] [--dz M] [--reff-liquid UM] [--reff-ice UM] [--vti] [--vdb]\n"
        "         [--diagnose-cloud [--rh-critical RH]] [--float32] [--all-levels]\n"
        "                           import into OUT.cvvol (+ OUT.report.json, and OUT_tNNN.vti with --vti);\n"
+       "                           --vdb: OUT_tNNN.vdb, OpenVDB fog volumes of grid-mean liquid and ice extinction\n"
+       "                           (1/m) and cloud fraction in metres in a tangent frame at the region's centre\n"
        "                           fields are stored as half floats (--float32: full floats); levels above\n"
        "                           the highest cloud are left out (--all-levels keeps them);\n"
        "                           --diagnose-cloud: a file with temperature and humidity but no cloud field\n"
@@ -54,6 +58,7 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
       {"gpu-info", "  gpu-info                 open a headless OpenGL 4.5 context and compile every shader\n"},
       {"phase", "  phase --diameter D_UM    approximate Mie phase parameters for a droplet diameter\n"},
       {"render", cv::cli::render_usage()},
+      {"record", cv::cli::record_usage()},
       {"bench", cv::cli::bench_usage()},
       {"time-error", cv::cli::time_error_usage()},
       {"view",
@@ -169,6 +174,7 @@ int cmd_import(const std::vector<std::string>& args) {
   cv::importers::ImportOptions o;
   std::string input, out;
   bool vti = false;
+  bool vdb = false;  // OpenVDB grids per step (app/vdb), for graphics teams
   // Fields as half floats unless asked (docs/importers.md states the error bound).
   cv::core::CvvolEncoding encoding = cv::core::CvvolEncoding::Float16;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -179,6 +185,7 @@ int cmd_import(const std::vector<std::string>& args) {
     };
     if (a == "-o") out = next();
     else if (a == "--vti") vti = true;
+    else if (a == "--vdb") vdb = true;
     else if (a == "--region") {
       const auto r = parse_list("--region", next(), ',', 4, 4, "W,E,S,N in degrees");
       if (r[2] > r[3] || r[2] < -90 || r[3] > 90) throw UsageError{"cloudviewer import: --region: expected S <= N within -90..90"};
@@ -252,6 +259,7 @@ int cmd_import(const std::vector<std::string>& args) {
   // Every output checked before the import starts: its folder, and none of them the input.
   std::vector<std::string> outputs = {out + ".cvvol", out + ".report.json"};
   if (vti) outputs.push_back(out + "_t000.vti");
+  if (vdb) outputs.push_back(out + "_t000.vdb");
   for (const std::string& p : outputs) {
     cv::core::check_output_path(p, "-o");
     cv::core::check_output_not_input(p, "-o", input, "the input");
@@ -261,10 +269,13 @@ int cmd_import(const std::vector<std::string>& args) {
   for (const auto& w : vol.report.warnings) {
     if (w.rfind("DIAGNOSED CLOUD", 0) == 0) std::fprintf(stderr, "cloudviewer import: %s\n", w.c_str());
   }
-  for (std::size_t t = 0; vti && t < vol.times.size(); ++t) {
-    char name[32];
-    std::snprintf(name, sizeof name, "_t%03zu.vti", t);
-    cv::core::check_output_not_input(out + name, "-o", input, "the input");
+  for (std::size_t t = 0; t < vol.times.size(); ++t) {
+    for (const char* ext : {".vti", ".vdb"}) {
+      if ((std::string(ext) == ".vti" && !vti) || (std::string(ext) == ".vdb" && !vdb)) continue;
+      char name[32];
+      std::snprintf(name, sizeof name, "_t%03zu%s", t, ext);
+      cv::core::check_output_not_input(out + name, "-o", input, "the input");
+    }
   }
   std::printf("grid: %d x %d x %d (lon %.4g..%.4g, lat %.4g..%.4g, alt %.0f..%.0f m), %zu time step(s)\n",
               vol.grid.lon_deg.count, vol.grid.lat_deg.count, vol.grid.alt_m.count, vol.grid.lon_deg.start,
@@ -280,6 +291,13 @@ int cmd_import(const std::vector<std::string>& args) {
       std::snprintf(name, sizeof name, "_t%03zu.vti", t);
       cv::core::write_vti(group, out + name, vol.grid, vol.step(t), vol.has_field);
     }
+    if (vdb) {
+      char name[32];
+      std::snprintf(name, sizeof name, "_t%03zu.vdb", t);
+      const cv::vdb::VdbSummary v = cv::vdb::write_vdb(group, out + name, vol.grid, vol.step(t), vol.has_field, vol.times[t].iso_utc);
+      std::printf("  %s%s: %zu, %zu and %zu active voxels (liquid, ice extinction, cloud fraction) in %.2f s\n", out.c_str(), name,
+                  v.active_voxels[0], v.active_voxels[1], v.active_voxels[2], v.seconds);
+    }
   }, encoding);
   group.write(out + ".report.json", [&](std::FILE* f) {
     const std::string j = vol.report.to_json();
@@ -287,7 +305,7 @@ int cmd_import(const std::vector<std::string>& args) {
   });
   group.commit();
   std::printf("%s", vol.report.to_text().c_str());
-  std::printf("wrote %s.cvvol and %s.report.json%s\n", out.c_str(), out.c_str(), vti ? " and .vti files" : "");
+  std::printf("wrote %s.cvvol and %s.report.json%s%s\n", out.c_str(), out.c_str(), vti ? " and .vti files" : "", vdb ? " and .vdb files" : "");
   return 0;
 }
 
@@ -311,7 +329,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (args.size() == 2 && print_command_usage(args[1])) return 0;
-    std::fprintf(stderr, "cloudviewer help: found '%s', expected one command: info, import, gpu-info, phase, render, bench, time-error or view\n",
+    std::fprintf(stderr, "cloudviewer help: found '%s', expected one command: info, import, gpu-info, phase, render, record, bench, time-error or view\n",
                  args.size() == 2 ? args[1].c_str() : "several arguments");
     return kExitBadInput;
   }
@@ -332,10 +350,11 @@ int main(int argc, char** argv) {
     if (cmd == "import") return cmd_import(args);
     if (cmd == "phase") return cmd_phase(args);
     if (cmd == "render") return cv::cli::cmd_render(args);
+    if (cmd == "record") return cv::cli::cmd_record(args);
     if (cmd == "bench") return cv::cli::cmd_bench(args);
     if (cmd == "time-error") return cv::cli::cmd_time_error(args);
     if (cmd == "view") return cv::viewer::cmd_view(args);
-    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase, render, bench, time-error or view"};
+    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase, render, record, bench, time-error or view"};
   } catch (const UsageError& e) {
     std::fprintf(stderr, "%s\n", e.message.c_str());
     return kExitBadInput;

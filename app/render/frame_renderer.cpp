@@ -56,6 +56,15 @@ core::FrameSpec resolve_frame(const core::Scene& scene, const core::CloudVolume&
   return f;
 }
 
+core::FrameSpec resolve_path_frame(const core::Scene& scene, const core::PathEvaluator& path, const core::CloudVolume& volume,
+                                   int k, double fps, core::Scene* at) {
+  const core::Scene s = core::scene_at_path_time(scene, path, core::path_frame_time_s(path, k, fps));
+  core::FrameSpec f = render::resolve_frame(s, volume);
+  f.jitter_base = k * f.accumulate;
+  if (at) *at = s;
+  return f;
+}
+
 void FrameRenderer::ensure_noise(const core::MarchSettings& m) {
   if (m.medium.noise_amount > 0.0 && !noise_uploaded_) {  // generated, compiled and bound only when used
     gpu_.upload_noise(core::make_erosion_noise());
@@ -65,7 +74,7 @@ void FrameRenderer::ensure_noise(const core::MarchSettings& m) {
 
 void FrameRenderer::march_into(GLuint out, const core::FrameSpec& f, int index, const DispatchOptions& dispatch,
                                const OpaqueInput& opaque) {
-  const core::MarchSettings m = frame_settings(f.march, f.accumulate, index);
+  const core::MarchSettings m = frame_settings(f.march, f.accumulate, f.jitter_base + index);
   ensure_noise(m);
   // The overlays, drawn once per accumulation (the camera does not move within one), unless the
   // caller brings its own opaque input.
@@ -81,7 +90,7 @@ std::vector<glm::vec4> FrameRenderer::render(const core::FrameSpec& f, const Dis
   std::vector<glm::vec4> mean;
   const OpaqueInput opaque = draw_overlays(f.march_camera);  // none, and no pass, without overlays
   for (int i = 0; i < f.accumulate; ++i) {
-    const core::MarchSettings m = frame_settings(f.march, f.accumulate, i);
+    const core::MarchSettings m = frame_settings(f.march, f.accumulate, f.jitter_base + i);
     ensure_noise(m);
     const std::vector<glm::vec4> frame = gpu_.render(f.march_camera, f.sun, m, dispatch, opaque);
     if (i == 0) {

@@ -13,6 +13,7 @@
 #include "geometry/overlay_mesh.hpp"
 #include "render/overlay_pass.hpp"
 #include "render/raymarcher.hpp"
+#include "scene/camera_path.hpp"
 #include "scene/frame_spec.hpp"
 
 namespace cv::render {
@@ -20,6 +21,12 @@ namespace cv::render {
 // core::resolve_frame, the scene's ground texture found as well (resolve_ground_texture: an empty
 // setting is the Natural Earth relief where it is installed).
 core::FrameSpec resolve_frame(const core::Scene& scene, const core::CloudVolume& volume);
+
+// Video frame k of a camera path at fps (`record`): the scene at the path's time for frame k
+// (core::scene_at_path_time, returned in `at` when given), resolved as above, with its jitter
+// indices from k * accumulate on, so every frame's seeds come from its number.
+core::FrameSpec resolve_path_frame(const core::Scene& scene, const core::PathEvaluator& path, const core::CloudVolume& volume,
+                                   int k, double fps, core::Scene* at = nullptr);
 
 // One overlay's geometry for the frame (built by app/overlays), drawn by the overlay pass.
 struct OverlayDraw {

@@ -1,6 +1,7 @@
 // Tonemapping and image files.
 #include "render/image_output.hpp"
 
+#include <stb_image.h>
 #include <stb_image_write.h>
 
 #include <glm/glm.hpp>
@@ -148,6 +149,14 @@ void check_finite_pixels(const std::vector<glm::vec4>& pixels, int width, const 
   throw std::runtime_error(what + ": " + std::to_string(bad) + " of " + std::to_string(pixels.size()) +
                            " pixels came out not finite (the first at x " + std::to_string(first_bad % w) + ", y " +
                            std::to_string(first_bad / w) + "), expected finite radiance; nothing written");
+}
+
+bool png_decodes_at_size(const std::string& path, int width, int height) {
+  int w = 0, h = 0, channels = 0;
+  unsigned char* data = stbi_load(path.c_str(), &w, &h, &channels, 3);
+  if (!data) return false;
+  stbi_image_free(data);
+  return w == width && h == height;
 }
 
 }  // namespace cv::render

@@ -42,6 +42,9 @@ void write_png(const std::string& path, int width, int height, const std::vector
 // The same files' contents into an open stream (an OutputFile or a member of an OutputGroup);
 // core::WriteError when the stream fails.
 void encode_png(std::FILE* f, int width, int height, const std::vector<unsigned char>& rgb8);
+// Whether `path` is a PNG that decodes whole at width x height (a frame a stopped run finished:
+// frames are written atomically, so this catches files damaged or written by something else).
+bool png_decodes_at_size(const std::string& path, int width, int height);
 void encode_pfm(std::FILE* f, int width, int height, const std::vector<glm::vec4>& pixels);
 void encode_pfm_transmittance(std::FILE* f, int width, int height, const std::vector<glm::vec4>& pixels);
 // Portable float map ("PF", 3 channels): the linear radiance alone, nothing composited behind it

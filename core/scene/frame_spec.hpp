@@ -21,6 +21,10 @@ struct FrameSpec {
   Sun sun;
   MarchSettings march;
   int accumulate = 1;  // jittered frames averaged (1: one frame at step middles)
+  // The jitter index of the accumulation's first frame (frames jitter_base .. jitter_base +
+  // accumulate - 1): a video's frame k takes k * accumulate, so each frame's seeds come from its
+  // number and the pattern does not repeat from frame to frame.
+  int jitter_base = 0;
   double exposure = 4.0;
   bool auto_exposure = false;  // exposure from the marched image (render::auto_exposure), not the number
   bool valid_time_known = false;  // the data's time step has a UTC valid time (else the sun is at noon over the camera)

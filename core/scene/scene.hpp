@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "frame/camera.hpp"
+#include "scene/camera_path.hpp"
 #include "settings/march_settings.hpp"
 #include "volume/time_interpolation.hpp"
 #include "settings/overlay_settings.hpp"
@@ -82,6 +83,9 @@ struct Scene {
   TimeSpec time;
   // No camera: frame the volume from the south and above (auto_camera in the renderer).
   std::optional<Camera> camera;
+  // A flyover's camera path (`cloudviewer record`): keyframes tied to weather time. `render` and
+  // the viewer use `camera`; record samples the path per video frame.
+  std::optional<CameraPath> path;
   int width = 960, height = 540;
   SunSpec sun;
   RenderSettings render;

@@ -134,6 +134,7 @@ class Reader {
   }
 
   std::string where(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  const std::string& source() const { return source_; }
 
  private:
   const std::string& source_;
@@ -169,6 +170,49 @@ void read_camera(const Reader& r, Camera& c) {
   r.number("heading_deg", c.heading_deg, -kHuge, kHuge, "a heading in degrees clockwise from north");
   r.number("pitch_deg", c.pitch_deg, -90.0, 90.0, "a pitch in degrees -90..90");
   r.number("fov_deg", c.fov_deg, 1e-6, 179.999, "a horizontal field of view in degrees, more than 0 and less than 180");
+}
+
+// "path": {"keyframes": [{"t_s", "lat_deg", ...}, ...], "weather_hours_per_s", "speed", "ease"},
+// read key by key as the camera is, then checked as a whole (PathEvaluator) with the key named.
+void read_path(const Reader& r, CameraPath& p) {
+  r.only({"keyframes", "weather_hours_per_s", "speed", "ease"});
+  const json* keys = r.find("keyframes");
+  if (!keys) r.fail("keyframes", "nothing", "a list of at least 2 keyframes [{\"t_s\": ..., \"lat_deg\": ..., ...}, ...]");
+  if (!keys->is_array()) r.fail("keyframes", shown(*keys), "a list of at least 2 keyframes [{\"t_s\": ..., ...}, ...]");
+  for (std::size_t i = 0; i < keys->size(); ++i) {
+    const std::string at = r.where("keyframes[" + std::to_string(i) + "]");
+    const json& item = (*keys)[i];
+    if (!item.is_object()) r.fail("keyframes[" + std::to_string(i) + "]", shown(item), "a keyframe object {\"t_s\": ..., ...}");
+    const Reader k(r.source(), item, at);
+    k.only({"t_s", "lat_deg", "lon_deg", "alt_m", "heading_deg", "pitch_deg", "fov_deg", "valid_utc"});
+    for (const char* required : {"t_s", "lat_deg", "lon_deg", "alt_m"}) {
+      if (!k.find(required)) k.fail(required, "nothing", "a number (t_s, lat_deg, lon_deg and alt_m are required)");
+    }
+    PathKeyframe f;
+    k.number("t_s", f.t_s, -1e9, 1e9, "a path time in seconds -1e9..1e9");
+    k.number("lat_deg", f.lat_deg, -90.0, 90.0, "a latitude in degrees -90..90");
+    k.number("lon_deg", f.lon_deg, -kHuge, kHuge, "a longitude in degrees");
+    k.number("alt_m", f.alt_m, 0.0, 4e8, "an altitude in metres 0..4e8 (not below the ground)");
+    k.number("heading_deg", f.heading_deg, -kHuge, kHuge, "a heading in degrees clockwise from north");
+    k.number("pitch_deg", f.pitch_deg, -90.0, 90.0, "a pitch in degrees -90..90");
+    k.number("fov_deg", f.fov_deg, 1e-6, 179.999, "a horizontal field of view in degrees, more than 0 and less than 180");
+    k.string("valid_utc", f.valid_utc);
+    p.keyframes.push_back(f);
+  }
+  r.number("weather_hours_per_s", p.weather_hours_per_s, -1e6, 1e6, "hours of weather per path second, -1e6..1e6 (0: none)");
+  std::string speed = p.speed == PathSpeed::Constant ? "constant" : "keyframes";
+  r.string("speed", speed);
+  if (speed != "keyframes" && speed != "constant") r.fail("speed", shown(json(speed)), "\"keyframes\" or \"constant\"");
+  p.speed = speed == "constant" ? PathSpeed::Constant : PathSpeed::Keyframes;
+  std::string ease = p.ease ? "in_out" : "none";
+  r.string("ease", ease);
+  if (ease != "none" && ease != "in_out") r.fail("ease", shown(json(ease)), "\"none\" or \"in_out\"");
+  p.ease = ease == "in_out";
+  try {
+    const PathEvaluator check(p);
+  } catch (const PathError& e) {
+    throw SceneError(r.source() + ": " + r.where(e.key) + ": found " + e.found + ", expected " + e.expected);
+  }
 }
 
 void read_sun(const Reader& r, SunSpec& s) {
@@ -360,7 +404,7 @@ Scene scene_from_json(const std::string& text, const std::string& source) {
   }
   if (!root.is_object()) throw SceneError(source + ": found " + shown(root) + " at the top, expected a JSON object { ... }");
   const Reader r(source, root, "");
-  r.only({"version", "data", "time_step", "time", "camera", "width", "height", "sun", "render", "overlays"});
+  r.only({"version", "data", "time_step", "time", "camera", "path", "width", "height", "sun", "render", "overlays"});
   const json* version = r.find("version");
   if (!version) r.fail("version", "nothing", "\"version\": " + std::to_string(Scene::kVersion));
   if (!version->is_number_integer() || version->get<long long>() < 1) r.fail("version", shown(*version), "an integer >= 1");
@@ -376,6 +420,10 @@ Scene scene_from_json(const std::string& text, const std::string& source) {
   if (const auto c = r.child("camera")) {
     scene.camera = Camera{};
     read_camera(*c, *scene.camera);
+  }
+  if (const auto p = r.child("path")) {
+    scene.path = CameraPath{};
+    read_path(*p, *scene.path);
   }
   r.integer("width", scene.width, 1, 16384);
   r.integer("height", scene.height, 1, 16384);
@@ -404,6 +452,19 @@ std::string scene_to_json(const Scene& s) {
                       {"heading_deg", c.heading_deg}, {"pitch_deg", c.pitch_deg}, {"fov_deg", c.fov_deg}};
   } else {
     root["camera"] = nullptr;  // automatic framing
+  }
+  if (s.path) {
+    ojson keys = ojson::array();
+    for (const PathKeyframe& k : s.path->keyframes) {
+      keys.push_back({{"t_s", k.t_s},         {"lat_deg", k.lat_deg},     {"lon_deg", k.lon_deg}, {"alt_m", k.alt_m},
+                      {"heading_deg", k.heading_deg}, {"pitch_deg", k.pitch_deg}, {"fov_deg", k.fov_deg}, {"valid_utc", k.valid_utc}});
+    }
+    root["path"] = {{"keyframes", keys},
+                    {"weather_hours_per_s", s.path->weather_hours_per_s},
+                    {"speed", s.path->speed == PathSpeed::Constant ? "constant" : "keyframes"},
+                    {"ease", s.path->ease ? "in_out" : "none"}};
+  } else {
+    root["path"] = nullptr;  // no flyover
   }
   root["sun"] = {{"mode", sun_mode_name(s.sun.mode)},
                  {"datetime_utc", s.sun.datetime_utc},

@@ -200,7 +200,7 @@ TEST(SceneJson, UnknownKeysAreNamedSoTyposAreCaught) {
             "scene.json: render.march.max_sun_step_m: found -1, expected a sun step length in metres 0..1e7 (0: the grid's "
             "horizontal cell)");
   EXPECT_EQ(error_of(R"({"version": 1, "camra": {}})"),
-            "scene.json: camra: unknown key, expected one of version, data, time_step, time, camera, width, height, sun, render, "
+            "scene.json: camra: unknown key, expected one of version, data, time_step, time, camera, path, width, height, sun, render, "
             "overlays");
 }
 
