@@ -254,6 +254,63 @@ void overlay_panel(ViewerState& s, const FrameStats& stats) {
   ImGui::NewLine();
 }
 
+// The camera path (issue 16): keyframes at the current view and time, their order and path times,
+// the preview, and the record command. The path is saved and loaded with the scene file.
+void path_panel(ViewerState& s, PanelContext& ctx) {
+  if (!ImGui::CollapsingHeader("Camera path")) return;
+  KeyframeEditor& ed = s.keys;
+  if (ImGui::Button("add keyframe here")) {
+    const core::Camera cam = s.scene.camera ? *s.scene.camera : ctx.home;
+    std::string utc = s.scene.time.valid_utc;
+    if (utc.empty() && core::times_known(s.volume.times)) utc = s.volume.times[static_cast<std::size_t>(s.scene.time_step)].iso_utc;
+    add_keyframe(s.scene, ed, cam, utc);
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("delete")) delete_keyframe(s.scene, ed);
+  ImGui::SameLine();
+  if (ImGui::ArrowButton("earlier", ImGuiDir_Up)) move_keyframe(s.scene, ed, -1);
+  ImGui::SameLine();
+  if (ImGui::ArrowButton("later", ImGuiDir_Down)) move_keyframe(s.scene, ed, +1);
+  if (s.scene.path) {
+    for (std::size_t i = 0; i < s.scene.path->keyframes.size(); ++i) {
+      const core::PathKeyframe& k = s.scene.path->keyframes[i];
+      char label[200];
+      std::snprintf(label, sizeof label, "%zu: %.2f s  %.2f, %.2f  %.0f m  %s", i, k.t_s, k.lat_deg, k.lon_deg, k.alt_m,
+                    k.valid_utc.empty() ? "" : k.valid_utc.c_str());
+      if (ImGui::Selectable(label, ed.selected == static_cast<int>(i))) ed.selected = static_cast<int>(i);
+    }
+    if (ed.selected >= 0 && ed.selected < static_cast<int>(s.scene.path->keyframes.size())) {
+      double t = s.scene.path->keyframes[static_cast<std::size_t>(ed.selected)].t_s;
+      if (ImGui::InputDouble("path time (s)", &t, 0.5, 2.0, "%.2f", ImGuiInputTextFlags_EnterReturnsTrue)) set_keyframe_time(s.scene, ed, t);
+      if (ImGui::Button("go to keyframe")) {
+        const core::PathKeyframe& k = s.scene.path->keyframes[static_cast<std::size_t>(ed.selected)];
+        core::Camera c = s.scene.camera ? *s.scene.camera : ctx.home;
+        c.lat_deg = k.lat_deg, c.lon_deg = k.lon_deg, c.alt_m = k.alt_m, c.heading_deg = k.heading_deg, c.pitch_deg = k.pitch_deg,
+        c.fov_deg = k.fov_deg;
+        s.scene.camera = c;
+        if (!k.valid_utc.empty()) s.scene.time.valid_utc = k.valid_utc;
+      }
+    }
+    bool constant = s.scene.path->speed == core::PathSpeed::Constant;
+    if (ImGui::Checkbox("constant speed", &constant)) s.scene.path->speed = constant ? core::PathSpeed::Constant : core::PathSpeed::Keyframes;
+    ImGui::SameLine();
+    ImGui::Checkbox("ease in/out", &s.scene.path->ease);
+    drag_double("weather h per s (0: keyframes' times)", &s.scene.path->weather_hours_per_s, 0.01, 0.0, 1000.0, "%.3f");
+  }
+  const std::string problem = path_problem(s.scene);
+  if (problem.empty()) {
+    ImGui::Checkbox("preview", &ed.previewing);
+    ImGui::SameLine();
+    ImGui::Checkbox("draw the path", &ed.draw_path);
+    if (ed.previewing) ImGui::Text("path time %.2f s", ed.preview_t_s);
+    ImGui::TextWrapped("save the scene file, then: %s", record_command(ctx.scene_path, s.scene).c_str());
+  } else {
+    ed.previewing = false;
+    ImGui::TextDisabled("%s", problem.c_str());
+  }
+  if (!ed.message.empty()) ImGui::TextWrapped("%s", ed.message.c_str());
+}
+
 void scene_panel(ViewerState& s, PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Scene file")) return;
   ImGui::InputText("path", &ctx.scene_path);
@@ -302,6 +359,7 @@ void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats)
     features_panel(state);
     quality_panel(state, ctx);
     overlay_panel(state, stats);
+    path_panel(state, ctx);
     scene_panel(state, ctx);
     ImGui::TextDisabled("F1 hides the panels; %s", stats.renderer.c_str());
   }

@@ -370,6 +370,13 @@ int run_viewer(const ViewerOptions& o) {
     f1_was_down = f1;
     navigate(win->window(), s, dt);
     if (show_ui) draw_panels(s, ctx, stats);
+    // The camera path's preview: the camera and the weather time follow the path at wall time.
+    if (s.keys.previewing) {
+      if (const std::optional<core::Scene> at = preview_step(s.scene, s.keys, dt)) {
+        s.scene.camera = at->camera;
+        s.scene.time.valid_utc = at->time.valid_utc;
+      }
+    }
 
     // The frame budget steps along its candidates from the last frame's time (after the panels, so
     // that switching it on in the panel takes effect this frame).
@@ -486,7 +493,12 @@ int run_viewer(const ViewerOptions& o) {
           for (std::size_t i = 0; i < built.size(); ++i) {
             if (built[i].rebuilt) stats.overlays[i].build_ms = built[i].build_ms;
           }
-          renderer.set_overlays(overlays::OverlayBuilder::draws(built));
+          std::vector<render::OverlayDraw> draws = overlays::OverlayBuilder::draws(built);
+          if (s.keys.draw_path && s.scene.path) {  // the camera path on the globe, after the scene's overlays
+            auto track = std::make_shared<const core::OverlayMesh>(path_mesh(s.scene, g.earth_radius_m));
+            if (!track->empty()) draws.push_back({"camera path", track, nullptr, 2.0f});
+          }
+          renderer.set_overlays(std::move(draws));
         } catch (const overlays::OverlayError& e) {
           ctx.scene_message = e.what();
           renderer.set_overlays({});

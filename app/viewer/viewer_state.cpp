@@ -30,6 +30,23 @@ bool same_camera(const std::optional<core::Camera>& a, const std::optional<core:
   return a->lat_deg == b->lat_deg && a->lon_deg == b->lon_deg && a->alt_m == b->alt_m && a->heading_deg == b->heading_deg &&
          a->pitch_deg == b->pitch_deg && a->fov_deg == b->fov_deg && a->width == b->width && a->height == b->height;
 }
+// The camera path is drawn on the globe (the keyframe panel): a changed path is a changed image.
+bool same_path(const std::optional<core::CameraPath>& a, const std::optional<core::CameraPath>& b) {
+  if (a.has_value() != b.has_value()) return false;
+  if (!a) return true;
+  if (a->keyframes.size() != b->keyframes.size() || a->weather_hours_per_s != b->weather_hours_per_s || a->speed != b->speed ||
+      a->ease != b->ease) {
+    return false;
+  }
+  for (std::size_t i = 0; i < a->keyframes.size(); ++i) {
+    const core::PathKeyframe &x = a->keyframes[i], &y = b->keyframes[i];
+    if (x.t_s != y.t_s || x.lat_deg != y.lat_deg || x.lon_deg != y.lon_deg || x.alt_m != y.alt_m || x.heading_deg != y.heading_deg ||
+        x.pitch_deg != y.pitch_deg || x.fov_deg != y.fov_deg || x.valid_utc != y.valid_utc) {
+      return false;
+    }
+  }
+  return true;
+}
 }  // namespace
 
 bool same_march(const core::Scene& a, const core::Scene& b) {
@@ -38,7 +55,7 @@ bool same_march(const core::Scene& a, const core::Scene& b) {
          a.height == b.height && a.sun.mode == b.sun.mode && a.sun.datetime_utc == b.sun.datetime_utc &&
          a.sun.subsolar_lat_deg == b.sun.subsolar_lat_deg && a.sun.subsolar_lon_deg == b.sun.subsolar_lon_deg &&
          a.sun.irradiance == b.sun.irradiance && core::same_image(a.render.march, b.render.march) &&
-         a.render.resolution_scale == b.render.resolution_scale && a.overlays == b.overlays;
+         a.render.resolution_scale == b.render.resolution_scale && a.overlays == b.overlays && same_path(a.path, b.path);
 }
 
 }  // namespace cv::viewer

@@ -12,6 +12,7 @@
 #include "settings/march_settings.hpp"
 #include "scene/scene.hpp"
 #include "volume/cloud_volume.hpp"
+#include "viewer/keyframes.hpp"
 #include "viewer/playback.hpp"
 
 namespace cv::viewer {
@@ -28,6 +29,7 @@ struct ViewerState {
   bool fly_mode = false;      // the camera panel's mode; mouse and keys follow it
   Playhead play;              // the timeline: where in the file's times, playing or not
   bool timeline = false;      // the file has two or more ascending UTC valid times: play, scrub
+  KeyframeEditor keys;        // the camera-path panel (keyframes.hpp)
 };
 
 
