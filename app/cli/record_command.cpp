@@ -34,6 +34,7 @@
 #include "scene/quality.hpp"
 #include "scene/scene_json.hpp"
 #include "scene_source.hpp"
+#include "vdb/vdb_export.hpp"
 
 namespace cv::cli {
 namespace {
@@ -56,6 +57,7 @@ struct RecordArgs {
   double target_error = 0.0;
   bool spp_given = false;
   int crf = 18;
+  bool vdb = false;  // --vdb: each frame's medium as OpenVDB grids beside its PNG
 };
 
 int parse_whole(const std::string& option, const std::string& text, int lo, int hi, const std::string& expected) {
@@ -69,7 +71,9 @@ RecordArgs parse_record_args(const std::vector<std::string>& args, core::Scene& 
   std::vector<std::pair<std::string, std::string>> options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "--assemble") {
+    if (a == "--vdb") {
+      r.vdb = true;
+    } else if (a == "--assemble") {
       r.assemble = true;
     } else if (a == "--count") {
       r.count = true;
@@ -324,7 +328,11 @@ const char* record_usage() {
          "         [--frames A:B]            render only frames A..B (inclusive, from 0), no video: for batch\n"
          "                           schedulers (scripts/slurm/record.sbatch)\n"
          "         [--assemble]              no rendering: the MP4 from the frames on disk, naming any missing\n"
-         "         [--count]                 print the path's number of frames at --fps and stop\n";
+         "         [--count]                 print the path's number of frames at --fps and stop\n"
+         "         [--vdb]                   also each frame's medium at its weather instant (interpolated between\n"
+         "                           forecast steps as the frame shows it) as OUT_frames/frame_00000.vdb, ...: OpenVDB\n"
+         "                           grid-mean liquid and ice extinction (and cloud fraction at a forecast step) in\n"
+         "                           metres in a tangent frame at the region's centre, as import --vdb writes them\n";
 }
 
 int cmd_record(const std::vector<std::string>& args) {
@@ -470,11 +478,32 @@ int cmd_record(const std::vector<std::string>& args) {
   int rendered = 0, skipped = 0;
   double verify_s = 0.0, render_s = 0.0;
   const auto t_loop = clock::now();
+  double vdb_s = 0.0;
+  int vdb_written = 0;
   for (int k = first; k <= last; ++k) {
     const fs::path file = frame_file(folder, k);
     const auto t_verify = clock::now();
     const bool whole = render::png_decodes_at_size(file.string(), scene.width, scene.height);
     verify_s += seconds_since(t_verify);
+    if (r.vdb) {
+      // The medium the frame shows, at its instant, written atomically (a rerun writes the missing).
+      fs::path vdb_file = file;
+      vdb_file.replace_extension(".vdb");
+      std::error_code vec;
+      if (!fs::exists(vdb_file, vec)) {
+        const auto t_vdb = clock::now();
+        core::Scene at;
+        const core::FrameSpec f = render::resolve_path_frame(scene, path, vol, k, r.fps, &at);
+        const auto prepared = volumes.get(scene.data.path, vol, f.instant, at.time.interpolation);
+        const bool fraction = !f.instant.between() && vol.has_field[static_cast<int>(core::Field::CloudFraction)];
+        core::OutputGroup group;
+        vdb::write_vdb(group, vdb_file.string(), prepared->grid, prepared->extinction,
+                       fraction ? &vol.step(f.instant.step0)[core::Field::CloudFraction] : nullptr, f.instant.iso_utc);
+        group.commit();
+        vdb_s += seconds_since(t_vdb);
+        ++vdb_written;
+      }
+    }
     if (whole) {
       ++skipped;
       continue;
@@ -500,6 +529,7 @@ int cmd_record(const std::vector<std::string>& args) {
   const double loop_s = seconds_since(t_loop);
   std::printf("rendered %d frame(s), skipped %d already whole, in %.1f s (%.1f frames/min; checking frames on disk %.3f s)\n", rendered,
               skipped, loop_s, rendered > 0 ? 60.0 * rendered / std::max(1e-9, render_s) : 0.0, verify_s);
+  if (r.vdb) std::printf("wrote %d OpenVDB file(s) beside the frames in %.2f s\n", vdb_written, vdb_s);
   if (!encode) {
     std::printf("frames %d..%d of %d in %s; build the video with: cloudviewer record %s -o %s --assemble\n", first, last, count, folder.c_str(),
                 r.scene_path.c_str(), r.out.c_str());

@@ -57,13 +57,17 @@ TangentFrame tangent_frame(const core::VolumeGrid& g) {
 
 VdbSummary write_vdb(core::OutputGroup& group, const std::string& path, const core::VolumeGrid& g, const core::TimeStepData& step,
                      const std::array<bool, core::kFieldCount>& has_field, const std::string& valid_utc) {
+  const bool has_fraction = has_field[static_cast<int>(core::Field::CloudFraction)];
+  return write_vdb(group, path, g, core::grid_mean_extinction(g, step), has_fraction ? &step[core::Field::CloudFraction] : nullptr, valid_utc);
+}
+
+VdbSummary write_vdb(core::OutputGroup& group, const std::string& path, const core::VolumeGrid& g, const core::GridMeanExtinction& mean,
+                     const std::vector<float>* cloud_fraction, const std::string& valid_utc) {
   static std::once_flag init;
   std::call_once(init, [] { openvdb::initialize(); });
   const auto t0 = std::chrono::steady_clock::now();
   const TangentFrame frame = tangent_frame(g);
-  const core::GridMeanExtinction mean = core::grid_mean_extinction(g, step);
-  const bool has_fraction = has_field[static_cast<int>(core::Field::CloudFraction)];
-  const std::vector<float>* fields[3] = {&mean.liquid_per_m, &mean.ice_per_m, has_fraction ? &step[core::Field::CloudFraction] : nullptr};
+  const std::vector<float>* fields[3] = {&mean.liquid_per_m, &mean.ice_per_m, cloud_fraction};
   const char* names[3] = {"extinction_liquid", "extinction_ice", "cloud_fraction"};
   const char* units[3] = {"1/m (grid-box mean: in-cloud extinction x cloud fraction)", "1/m (grid-box mean: in-cloud extinction x cloud fraction)",
                           "1 (fraction 0..1)"};

@@ -10,6 +10,7 @@
 #include <glm/vec3.hpp>
 
 #include "volume/cloud_volume.hpp"
+#include "volume/grid_mean.hpp"
 
 namespace cv::vdb {
 
@@ -36,5 +37,10 @@ struct VdbSummary {
 // origin_lon_deg, earth_radius_m, valid_utc.
 VdbSummary write_vdb(core::OutputGroup& group, const std::string& path, const core::VolumeGrid& grid, const core::TimeStepData& step,
                      const std::array<bool, core::kFieldCount>& has_field, const std::string& valid_utc);
+// The same from the renderer's own medium: grid-mean extinction (for an instant between forecast
+// steps, what core::interpolate_extinction made of the two neighbours), and the cloud fraction
+// where one is given (nullptr: no cloud_fraction grid; interpolation carries extinction only).
+VdbSummary write_vdb(core::OutputGroup& group, const std::string& path, const core::VolumeGrid& grid, const core::GridMeanExtinction& mean,
+                     const std::vector<float>* cloud_fraction, const std::string& valid_utc);
 
 }  // namespace cv::vdb

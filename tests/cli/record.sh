@@ -112,4 +112,14 @@ done
 grep -q "quality reference: the GPU path tracer, up to 8 samples per pixel" "$work/e.log" || fail "no path tracer line: $(cat "$work/e.log")"
 cmp -s "$work/e/v_frames/frame_00003.png" "$work/f/v_frames/frame_00003.png" || fail "the path-traced frame differs between runs"
 expect2 spp_without_reference "--spp and --target-error: found them without a path tracer" "$cv" record "$work/fly.json" -o "$work/bad.mp4" --spp 4
+# OpenVDB per frame (--vdb): each frame's medium beside its PNG at the frame's weather instant
+# (frame 1 at 03:06 UTC lies between forecast steps: the interpolated medium); a rerun writes none.
+mkdir -p "$work/g"
+out=$("$cv" record "$work/fly.json" -o "$work/g/v.mp4" --fps 10 --frames 0:2 --vdb 2>&1) || fail "--vdb failed: $out"
+echo "$out" | grep -q "wrote 3 OpenVDB file(s)" || fail "--vdb did not write 3 files: $out"
+for k in 0 1 2; do [ -s "$work/g/v_frames/frame_0000$k.vdb" ] || fail "no OpenVDB file for frame $k"; done
+cmp -s "$work/g/v_frames/frame_00000.vdb" "$work/g/v_frames/frame_00001.vdb" && fail "frames 0 and 1 wrote the same medium"
+cmp -s "$work/a/v_frames/frame_00001.png" "$work/g/v_frames/frame_00001.png" || fail "--vdb changed a frame's pixels"
+out=$("$cv" record "$work/fly.json" -o "$work/g/v.mp4" --fps 10 --frames 0:2 --vdb 2>&1) || fail "--vdb rerun failed: $out"
+echo "$out" | grep -q "wrote 0 OpenVDB file(s)" || fail "the rerun wrote OpenVDB files again: $out"
 echo "record end to end passed"

@@ -12,6 +12,7 @@
 #include "geo/geodesy.hpp"
 #include "io/output_file.hpp"
 #include "vdb/vdb_export.hpp"
+#include "volume/time_interpolation.hpp"
 
 namespace {
 using namespace cv;
@@ -113,6 +114,49 @@ TEST(VdbExport, ReadBackMatchesTheVolumeAtEveryActiveVoxel) {
     const openvdb::Coord c = grid->transform().worldToIndexNodeCentered(openvdb::Vec3d(0.0, 0.0, 5000.0));
     EXPECT_TRUE(grid->tree().isValueOn(c) || f == 1) << "the centre's voxel is inactive";
   }
+  file.close();
+  std::filesystem::remove_all(dir);
+}
+
+// From the renderer's medium at an instant between two steps (record --vdb): the grid-mean
+// extinction as core::interpolate_extinction blends it (linear, halfway), and no cloud_fraction
+// grid, which the interpolation does not carry. Every active voxel holds the blend at its place.
+TEST(VdbExport, AnInstantBetweenStepsWritesTheBlendedMedium) {
+  const Synthetic a;
+  Synthetic b;
+  for (float& v : b.step[core::Field::ExtinctionLiquid]) v = std::isnan(v) ? v : 2.0f * v;  // the later step: twice the water
+  const core::GridMeanExtinction ea = core::grid_mean_extinction(a.g, a.step), eb = core::grid_mean_extinction(b.g, b.step);
+  const core::GridMeanExtinction mid =
+      core::interpolate_extinction(a.g, ea, eb, {}, {}, 3600.0, 0.5, core::TimeInterpolation::Linear);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("cv_vdb_mid_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "frame_00001.vdb").string();
+  core::OutputGroup group;
+  vdb::write_vdb(group, path, a.g, mid, nullptr, "2024-01-15T03:30:00Z");
+  group.commit();
+  openvdb::initialize();
+  openvdb::io::File file(path);
+  file.open();
+  EXPECT_FALSE(file.hasGrid("cloud_fraction"));
+  const auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid("extinction_liquid"));
+  ASSERT_TRUE(grid);
+  EXPECT_EQ(grid->metaValue<std::string>("valid_utc"), "2024-01-15T03:30:00Z");
+  const double lat0 = grid->metaValue<double>("origin_lat_deg"), lon0 = grid->metaValue<double>("origin_lon_deg");
+  const double r0 = grid->metaValue<double>("earth_radius_m");
+  const glm::dvec3 origin = geo::sphere_to_ecef({lat0, lon0, 0.0}, r0);
+  const geo::EnuFrame e = geo::sphere_enu(lat0, lon0);
+  std::size_t active = 0;
+  double worst = 0.0;
+  for (auto it = grid->cbeginValueOn(); it; ++it) {
+    const openvdb::Vec3d w = grid->transform().indexToWorld(it.getCoord());
+    const geo::Geodetic p = geo::ecef_to_sphere(origin + w.x() * e.east + w.y() * e.north + w.z() * e.up, r0);
+    const double want = 1.5 * a.at(0, p.lat_deg, p.lon_deg, p.alt_m);  // halfway between 1x and 2x
+    ASSERT_FALSE(std::isnan(want));
+    worst = std::max(worst, std::abs(*it - want) / want);
+    ++active;
+  }
+  EXPECT_GT(active, 1000u);
+  EXPECT_LT(worst, 1e-5);
   file.close();
   std::filesystem::remove_all(dir);
 }
