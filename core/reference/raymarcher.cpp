@@ -68,6 +68,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   img.radiance.assign(static_cast<std::size_t>(cam.width) * cam.height, glm::dvec3(0.0));
   img.transmittance.assign(img.radiance.size(), 1.0);
   img.cloud_depth_m.assign(img.radiance.size(), 3.0e38);
+  img.first_cloud_m.assign(img.radiance.size(), 3.0e38);
   img.stats.sun_down = k.u_sun_down;
   // Rows in stripes over the cores, each with its own copy of the kernel (its counters); the image
   // does not depend on the thread count.
@@ -88,6 +89,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
         img.radiance[idx] = glm::dvec3(out);
         img.transmittance[idx] = out.w;
         img.cloud_depth_m[idx] = state.t_half;
+        img.first_cloud_m[idx] = state.t_first;
         for (int i = 0; i < CV_STAT_COUNT; ++i) c[i] += kt.g_stats[i], kt.g_stats[i] = 0;
       }
     }

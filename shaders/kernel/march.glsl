@@ -242,6 +242,9 @@ struct MarchState {
   bool ended;
   int next_step;
   real t_half;  // distance from the camera where the view transmittance fell to 0.5 (3e38: never)
+  // Where the first step holding cloud began, from the camera (3e38: none). Read by the CPU's
+  // probes (core/analysis); the GPU driver keeps no copy of it between its dispatches.
+  real t_first;
 };
 
 // One view sample at p (altitude alt_p, distance t along the ray) standing for a step of ds that
@@ -255,6 +258,7 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
   g_stats[CV_STAT_VIEW_SAMPLES] += 1u;
   real sigma = sl + si;
   if (sigma <= real(0.0)) return;
+  s.t_first = min(s.t_first, t_entry);
   real3 up_p = normalize(p);
   real mu_sun = dot(u_to_sun, up_p);
   real nu_sun = length(cross(u_to_sun, up_p));
@@ -393,6 +397,7 @@ CV_FN MarchState march_start() {
   s.ended = false;
   s.next_step = 0;
   s.t_half = real(3.0e38);
+  s.t_first = real(3.0e38);
   return s;
 }
 
