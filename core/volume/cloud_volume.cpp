@@ -35,6 +35,16 @@ std::size_t TimeStepData::bytes() const {
 }
 
 
+bool named_layer_band(const std::string& name, LayerBand& out, const MapOptions& o) {
+  const LayerBand none;
+  if (name == "all") out = none;
+  else if (name == "low") out = {none.bottom_m, o.low_top_m};
+  else if (name == "mid") out = {o.low_top_m, o.mid_top_m};
+  else if (name == "high") out = {o.mid_top_m, none.top_m};
+  else return false;
+  return true;
+}
+
 void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& options) {
   const std::size_t ncol = grid.columns();
   const auto& cf = data[Field::CloudFraction];

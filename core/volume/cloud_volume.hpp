@@ -106,6 +106,14 @@ struct MaxRandomOverlap {
   double cover() const { return clear > 1.0 ? 0.0 : clear < 0.0 ? 1.0 : 1.0 - clear; }
 };
 
+// The layer masks' named bands (render.march.layer_bottom_m/top_m, `--layer`): heights above the
+// ground of the derived maps' low, mid and high cover (MapOptions' 2 km and 6 km), and "all".
+// False for any other name.
+struct LayerBand {
+  double bottom_m = -100000.0, top_m = 1e7;  // the settings' "no end" values
+};
+bool named_layer_band(const std::string& name, LayerBand& out, const MapOptions& o = {});
+
 // Whether a level counts as cloudy in the derived maps (and the probes): its fraction and its
 // in-cloud extinction both reach the thresholds.
 inline bool map_cloudy(double fraction, double extinction_per_m, const MapOptions& o) {

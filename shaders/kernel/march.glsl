@@ -112,6 +112,31 @@ CV_FN real cell_max(real3 p, real alt_m) {
   return m;
 }
 
+// The ground's altitude (m) under grid index f: bilinear with column_tau's rules, from u_column_tau.g.
+CV_FN real column_ground(real3 f) {
+  ivec2 n = ivec2(u_grid_count);
+  real wx;
+  real wy;
+  int x0 = volume_fetch_index(f.x, n.x, wx);
+  int y0 = volume_fetch_index(f.y, n.y, wy);
+  int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
+  int y1 = y0 + 1;
+  real c00 = x0 < 0 || x0 >= n.x || y0 < 0 || y0 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x0, y0), 0).g);
+  real c10 = x1 < 0 || x1 >= n.x || y0 < 0 || y0 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x1, y0), 0).g);
+  real c01 = x0 < 0 || x0 >= n.x || y1 < 0 || y1 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x0, y1), 0).g);
+  real c11 = x1 < 0 || x1 >= n.x || y1 < 0 || y1 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x1, y1), 0).g);
+  return mix(mix(c00, c10, wx), mix(c01, c11, wx), wy);
+}
+
+// The layer mask (march_settings.def, layer_bottom_m): whether the point at grid index f and
+// altitude alt_m is in the band shown. Every point falls in exactly one of adjacent bands
+// [a, b), [b, c): their images' media add up to the whole.
+CV_FN bool layer_shown(real3 f, real alt_m) {
+  if (!u_mask_band) return true;
+  real h = u_mask_sea_level ? alt_m : alt_m - column_ground(f);
+  return h >= u_mask_bottom && h < u_mask_top;
+}
+
 // The medium (liquid and ice extinction, 1/m) at Earth-centred point p, whose latitude and longitude
 // g (radians, ecef_to_sphere) and altitude alt_m are given. Eroded by the noise where it is on.
 CV_FN void medium_in(real3 p, real3 g, real alt_m, CV_OUT(real) sl, CV_OUT(real) si) {
@@ -119,8 +144,9 @@ CV_FN void medium_in(real3 p, real3 g, real alt_m, CV_OUT(real) sl, CV_OUT(real)
   si = real(0.0);
   real3 f;
   if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
-  sl = fetch(u_liquid, f);
-  si = fetch(u_ice, f);
+  if (!layer_shown(f, alt_m)) return;
+  sl = u_hide_liquid ? real(0.0) : fetch(u_liquid, f);
+  si = u_hide_ice ? real(0.0) : fetch(u_ice, f);
   if (kNoise && sl + si > real(0.0)) erode_at(p, sl, si);
 }
 

@@ -16,6 +16,7 @@
 #include "kernel/prepared_volume.hpp"
 #include "nc_file.hpp"
 #include "support/nc_builder.hpp"
+#include "reference/raymarcher.hpp"
 #include "support/real_data.hpp"
 
 namespace {
@@ -307,6 +308,128 @@ TEST(AnalysisReal, Era5ProbeIsTheFilesValuesAfterTheConversions) {
   }
   EXPECT_GE(checked, 3);
   EXPECT_GE(cloudy, 1);
+}
+
+// Layer masks in the march kernel (march_settings.def, layer_bottom_m), on the real WRF file over
+// the Tibetan Plateau (terrain 4.5-5.5 km), where bands above sea level would put low cloud in "mid".
+class LayerMask : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = cv::test::real_file("wrf_d01_allvars_cropped.nc");
+    if (path_.empty()) GTEST_SKIP() << "wrf_d01_allvars_cropped.nc not found beside the checkout";
+    vol_ = importers::import_file(path_);
+    ASSERT_TRUE(vol_.has_ground);
+    prep_ = core::prepare_volume(vol_.grid, vol_.step(1));
+  }
+  // The kernel over the prepared volume with the march settings `s`.
+  kernel::f64::MarchKernel kernel(const core::MarchSettings& s) const {
+    kernel::f64::MarchKernel k;
+    static_cast<kernel::MarchParams&>(k) = core::march_params(prep_, core::Camera{}, core::Sun{}, s);
+    const auto& g = prep_.grid;
+    const glm::ivec3 n(g.lon_deg.count, g.lat_deg.count, g.alt_m.count);
+    k.u_liquid = {prep_.extinction.liquid_per_m.data(), n};
+    k.u_ice = {prep_.extinction.ice_per_m.data(), n};
+    k.u_column_tau = {prep_.column_maps.data(), {prep_.columns.nx, prep_.columns.ny}, 2};
+    return k;
+  }
+  static core::MarchSettings band(const std::string& name, bool sea_level = false) {
+    core::MarchSettings s;
+    core::LayerBand b;
+    EXPECT_TRUE(core::named_layer_band(name, b));
+    s.medium.layer_bottom_m = b.bottom_m;
+    s.medium.layer_top_m = b.top_m;
+    s.medium.layer_sea_level = sea_level;
+    return s;
+  }
+  std::string path_;
+  core::CloudVolume vol_;
+  core::PreparedVolume prep_;
+};
+
+TEST_F(LayerMask, LowMidHighPartitionTheCloudAboveTheGround) {
+  const auto& g = prep_.grid;
+  auto all = kernel(core::MarchSettings{});
+  auto low = kernel(band("low")), mid = kernel(band("mid")), high = kernel(band("high"));
+  auto mid_sea = kernel(band("mid", true));
+  int cloudy = 0, low_cloudy = 0, low_but_mid_above_sea = 0;
+  // Points between the nodes (and on them) across the whole grid.
+  for (double fx = 0.0; fx <= g.lon_deg.count - 1; fx += 0.37) {
+    for (double fy = 0.0; fy <= g.lat_deg.count - 1; fy += 0.41) {
+      for (double fz = 0.0; fz <= g.alt_m.count - 1; fz += 0.23) {
+        const double lat = g.lat_deg.start + fy * g.lat_deg.step, lon = g.lon_deg.start + fx * g.lon_deg.step;
+        const double alt = g.alt_m.start + fz * g.alt_m.step;
+        const glm::dvec3 geo(lat * M_PI / 180.0, lon * M_PI / 180.0, alt);
+        double l0, i0, l[3], ic[3];
+        all.medium_in(glm::dvec3(0.0), geo, alt, l0, i0);
+        low.medium_in(glm::dvec3(0.0), geo, alt, l[0], ic[0]);
+        mid.medium_in(glm::dvec3(0.0), geo, alt, l[1], ic[1]);
+        high.medium_in(glm::dvec3(0.0), geo, alt, l[2], ic[2]);
+        if (!(l0 + i0 > 0.0)) {
+          for (int b = 0; b < 3; ++b) EXPECT_EQ(l[b] + ic[b], 0.0);
+          continue;
+        }
+        ++cloudy;
+        // Exactly one band holds the point, with the whole medium.
+        int holding = 0;
+        for (int b = 0; b < 3; ++b) {
+          if (l[b] + ic[b] > 0.0) {
+            ++holding;
+            EXPECT_EQ(l[b], l0);
+            EXPECT_EQ(ic[b], i0);
+          }
+        }
+        EXPECT_EQ(holding, 1) << lat << " " << lon << " " << alt;
+        if (l[0] + ic[0] > 0.0) {
+          ++low_cloudy;
+          double ls, is;
+          mid_sea.medium_in(glm::dvec3(0.0), geo, alt, ls, is);
+          low_but_mid_above_sea += ls + is > 0.0;
+        }
+      }
+    }
+  }
+  EXPECT_GT(cloudy, 100);
+  EXPECT_GT(low_cloudy, 0);
+  // Over 4.5-5.5 km of terrain the low cloud lies 4.5-7.5 km above sea level: bands from sea level
+  // would call some of it mid.
+  EXPECT_GT(low_but_mid_above_sea, 0);
+}
+
+TEST_F(LayerMask, BandsAddUpPixelByPixelAndPhasesSplitTheCloud) {
+  // The view optical depths of the three bands add up to the whole cloud's at every pixel: the
+  // same samples, each point in one band.
+  const auto& g = prep_.grid;
+  core::Camera cam;
+  cam.lat_deg = g.lat_deg.start - 1.0;
+  cam.lon_deg = 0.5 * (g.lon_deg.start + g.lon_deg.last());
+  cam.alt_m = 9000.0;
+  cam.pitch_deg = -8.0;
+  cam.fov_deg = 50.0;
+  cam.width = 24;
+  cam.height = 14;
+  auto settings = [](core::MarchSettings s) {
+    s.quality.view_step_m = 500.0;
+    s.quality.min_transmittance = 0.0;
+    return s;
+  };
+  const auto tau = [&](const core::MarchSettings& s) {
+    const core::ReferenceImage img = core::render_reference(prep_, cam, core::Sun{}, settings(s));
+    std::vector<double> t;
+    for (double x : img.transmittance) t.push_back(-std::log(x));
+    return t;
+  };
+  core::MarchSettings liquid_only, ice_only;
+  liquid_only.medium.hide_ice = true;
+  ice_only.medium.hide_liquid = true;
+  const auto all = tau(core::MarchSettings{}), low = tau(band("low")), mid = tau(band("mid")), high = tau(band("high"));
+  const auto liquid = tau(liquid_only), ice = tau(ice_only);
+  double most = 0.0;
+  for (std::size_t p = 0; p < all.size(); ++p) {
+    most = std::max(most, all[p]);
+    EXPECT_NEAR(low[p] + mid[p] + high[p], all[p], 1e-9 * all[p] + 1e-12) << p;
+    EXPECT_NEAR(liquid[p] + ice[p], all[p], 1e-9 * all[p] + 1e-12) << p;
+  }
+  EXPECT_GT(most, 0.1);  // the camera sees cloud
 }
 
 }  // namespace
