@@ -10,8 +10,10 @@ namespace cv::cli {
 const char* probe_usage();
 const char* section_usage();
 const char* series_usage();
+const char* compare_usage();
 int cmd_probe(const std::vector<std::string>& args);
 int cmd_section(const std::vector<std::string>& args);
 int cmd_series(const std::vector<std::string>& args);
+int cmd_compare(const std::vector<std::string>& args);
 
 }  // namespace cv::cli

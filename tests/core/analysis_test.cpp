@@ -9,12 +9,14 @@
 #include <string>
 
 #include "analysis/column_probe.hpp"
+#include "analysis/compare.hpp"
 #include "analysis/section.hpp"
 #include "geo/geodesy.hpp"
 #include "importer.hpp"
 #include "kernel/march_kernel.hpp"
 #include "kernel/prepared_volume.hpp"
 #include "nc_file.hpp"
+#include "support/cf_writer.hpp"
 #include "support/nc_builder.hpp"
 #include "reference/raymarcher.hpp"
 #include "support/real_data.hpp"
@@ -430,6 +432,119 @@ TEST_F(LayerMask, BandsAddUpPixelByPixelAndPhasesSplitTheCloud) {
     EXPECT_NEAR(liquid[p] + ice[p], all[p], 1e-9 * all[p] + 1e-12) << p;
   }
   EXPECT_GT(most, 0.1);  // the camera sees cloud
+}
+
+// Two clouds at 700 hPa on a 2-degree grid (columns 1-2 x rows 1-2, and columns 6-7 x rows 3-4);
+// `second` false leaves the second out. The fields as write_synth names them.
+void write_two_clouds(const std::string& path, bool second, double lon0 = 0.0) {
+  using cv::test::CfAxis;
+  using cv::test::CfVar;
+  std::vector<double> lons, lats{40, 42, 44, 46, 48, 50};
+  for (int i = 0; i < 10; ++i) lons.push_back(lon0 + 2.0 * i);
+  const std::vector<double> hpa{1000, 850, 700, 500};
+  const std::vector<CfAxis> axes = {{"time", {0.0}, {{"units", "hours since 2024-01-15 00:00:00"}, {"calendar", "gregorian"}}},
+                                    {"level", hpa, {{"units", "hPa"}}},
+                                    {"latitude", lats, {{"units", "degrees_north"}}},
+                                    {"longitude", lons, {{"units", "degrees_east"}}}};
+  const std::vector<std::string> dims{"time", "level", "latitude", "longitude"};
+  auto in_cloud = [second](const std::vector<int>& x) {
+    const int k = x[1], j = x[2], i = x[3];
+    if (k != 2) return false;
+    return (i >= 1 && i <= 2 && j >= 1 && j <= 2) || (second && i >= 6 && i <= 7 && j >= 3 && j <= 4);
+  };
+  const std::vector<CfVar> vars = {
+      {"z", dims, {{"units", "m**2 s**-2"}, {"standard_name", "geopotential"}}, {},
+       [&](const std::vector<int>& x) { return 9.80665 * cv::test::isa_height_m(hpa[static_cast<std::size_t>(x[1])] * 100.0); }},
+      {"t", dims, {{"units", "K"}, {"standard_name", "air_temperature"}}, {}, [](const std::vector<int>&) { return 260.0; }},
+      {"q", dims, {{"units", "kg kg**-1"}, {"standard_name", "specific_humidity"}}, {}, [](const std::vector<int>&) { return 1e-3; }},
+      {"cc", dims, {{"units", "(0 - 1)"}}, {}, [&](const std::vector<int>& x) { return in_cloud(x) ? 0.6 : 0.0; }},
+      {"clwc", dims, {{"units", "kg kg**-1"}}, {}, [&](const std::vector<int>& x) { return in_cloud(x) ? 2e-4 : 0.0; }},
+  };
+  cv::test::write_cf(path, axes, vars);
+}
+
+class Compare : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = cv::test::temp_dir(::testing::UnitTest::GetInstance()->current_test_info()->name()); }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  core::CloudVolume import(bool second, double lon0 = 0.0) {
+    const std::string p = (dir_ / (std::string(second ? "two" : "one") + std::to_string(int(lon0)) + ".nc")).string();
+    write_two_clouds(p, second, lon0);
+    importers::ImportOptions o;
+    o.dz_m = level_alt(850) - level_alt(1000);
+    return importers::import_file(p, o);
+  }
+  std::filesystem::path dir_;
+};
+
+TEST_F(Compare, AFileAgainstItselfIsZeroEverywhereAndAllBoth) {
+  core::CloudVolume a = import(true);
+  const core::Overlap o = core::grid_overlap(a.grid, a.grid);
+  ASSERT_FALSE(o.empty);
+  const core::VolumeGrid g = core::common_grid(a.grid, a.grid, o);
+  EXPECT_EQ(g.lon_deg.count, a.grid.lon_deg.count);
+  EXPECT_EQ(g.lat_deg.count, a.grid.lat_deg.count);
+  EXPECT_EQ(g.alt_m.count, a.grid.alt_m.count);
+  const core::Comparison c = core::compare_steps(a.grid, a.step(0), a.grid, a.step(0), g);
+  int both = 0;
+  for (std::size_t i = 0; i < c.columns.size(); ++i) {
+    EXPECT_TRUE(c.columns[i] == core::Presence::Both || c.columns[i] == core::Presence::None) << i;
+    both += c.columns[i] == core::Presence::Both;
+    EXPECT_EQ(c.d_cover[i], 0.0f);
+    EXPECT_EQ(c.d_optical_depth[i], 0.0f);
+    if (c.columns[i] == core::Presence::Both) {
+      EXPECT_EQ(c.d_base_m[i], 0.0f);
+      EXPECT_EQ(c.d_top_m[i], 0.0f);
+    }
+  }
+  EXPECT_EQ(both, 8);  // the two clouds' 2 x 2 columns each
+  int points_both = 0;
+  for (core::Presence p : c.points) {
+    EXPECT_TRUE(p == core::Presence::Both || p == core::Presence::None);
+    points_both += p == core::Presence::Both;
+  }
+  EXPECT_GT(points_both, 0);
+}
+
+TEST_F(Compare, ACloudRemovedFromTheCopyIsExactlyTheAOnlyCloud) {
+  core::CloudVolume a = import(true), b = import(false);
+  const core::VolumeGrid g = core::common_grid(a.grid, b.grid, core::grid_overlap(a.grid, b.grid));
+  const core::Comparison c = core::compare_steps(a.grid, a.step(0), b.grid, b.step(0), g);
+  for (int j = 0; j < g.lat_deg.count; ++j) {
+    for (int i = 0; i < g.lon_deg.count; ++i) {
+      const bool first = i >= 1 && i <= 2 && j >= 1 && j <= 2, second = i >= 6 && i <= 7 && j >= 3 && j <= 4;
+      const std::size_t col = g.column(i, j);
+      const core::Presence want = first ? core::Presence::Both : second ? core::Presence::OnlyA : core::Presence::None;
+      EXPECT_EQ(static_cast<int>(c.columns[col]), static_cast<int>(want)) << i << " " << j;
+      if (second) EXPECT_FLOAT_EQ(c.d_cover[col], -c.a.maps.cloud_cover[col]);
+      else EXPECT_EQ(c.d_cover[col], 0.0f);
+    }
+  }
+  for (std::size_t p = 0; p < c.points.size(); ++p) EXPECT_NE(static_cast<int>(c.points[p]), static_cast<int>(core::Presence::OnlyB));
+}
+
+TEST_F(Compare, TheCommonGridIsTheCoarserOverTheOverlapAndDisjointGridsHaveNone) {
+  core::CloudVolume a = import(true);
+  core::VolumeGrid coarse = a.grid;
+  coarse.lon_deg.step = 5.0;
+  coarse.lon_deg.count = 3;  // 0..10 E
+  coarse.lat_deg.start = 44.0;
+  const core::Overlap o = core::grid_overlap(a.grid, coarse);
+  ASSERT_FALSE(o.empty);
+  EXPECT_DOUBLE_EQ(o.lon_lo, 0.0);
+  EXPECT_DOUBLE_EQ(o.lon_hi, 10.0);
+  EXPECT_DOUBLE_EQ(o.lat_lo, 44.0);
+  const core::VolumeGrid g = core::common_grid(a.grid, coarse, o);
+  EXPECT_DOUBLE_EQ(g.lon_deg.step, 5.0);
+  EXPECT_EQ(g.lon_deg.count, 3);
+  EXPECT_DOUBLE_EQ(g.lat_deg.step, 2.0);
+  EXPECT_NE(core::common_grid_text(g, a.grid, coarse).find("the coarser of A's 2/2 deg"), std::string::npos)
+      << core::common_grid_text(g, a.grid, coarse);
+  core::CloudVolume far = import(true, 100.0);
+  EXPECT_TRUE(core::grid_overlap(a.grid, far.grid).empty);
+  // The same region in the other longitude convention overlaps.
+  core::CloudVolume west = import(true, -360.0);
+  EXPECT_FALSE(core::grid_overlap(a.grid, west.grid).empty);
 }
 
 }  // namespace
