@@ -27,6 +27,7 @@
 #include "vdb/vdb_export.hpp"
 #include "bench_command.hpp"
 #include "time_error_command.hpp"
+#include "analysis_commands.hpp"
 #include "scene/scene_json.hpp"
 #include "viewer/viewer.hpp"
 
@@ -61,6 +62,10 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
       {"record", cv::cli::record_usage()},
       {"bench", cv::cli::bench_usage()},
       {"time-error", cv::cli::time_error_usage()},
+      {"probe", cv::cli::probe_usage()},
+      {"section", cv::cli::section_usage()},
+      {"series", cv::cli::series_usage()},
+      {"compare", cv::cli::compare_usage()},
       {"view",
        "  view INPUT [--size WxH] [--time ISO|N] [--play H] [--scale S] [--hide-ui] [--frame-budget MS]\n"
        "             [--frames N --screenshot OUT.png]\n"
@@ -329,7 +334,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (args.size() == 2 && print_command_usage(args[1])) return 0;
-    std::fprintf(stderr, "cloudviewer help: found '%s', expected one command: info, import, gpu-info, phase, render, record, bench, time-error or view\n",
+    std::fprintf(stderr, "cloudviewer help: found '%s', expected one command: info, import, gpu-info, phase, render, record, bench, time-error, probe, section, series, compare or view\n",
                  args.size() == 2 ? args[1].c_str() : "several arguments");
     return kExitBadInput;
   }
@@ -353,8 +358,12 @@ int main(int argc, char** argv) {
     if (cmd == "record") return cv::cli::cmd_record(args);
     if (cmd == "bench") return cv::cli::cmd_bench(args);
     if (cmd == "time-error") return cv::cli::cmd_time_error(args);
+    if (cmd == "probe") return cv::cli::cmd_probe(args);
+    if (cmd == "section") return cv::cli::cmd_section(args);
+    if (cmd == "series") return cv::cli::cmd_series(args);
+    if (cmd == "compare") return cv::cli::cmd_compare(args);
     if (cmd == "view") return cv::viewer::cmd_view(args);
-    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase, render, record, bench, time-error or view"};
+    throw UsageError{"cloudviewer: unknown command '" + cmd + "', expected info, import, gpu-info, phase, render, record, bench, time-error, probe, section, series, compare or view"};
   } catch (const UsageError& e) {
     std::fprintf(stderr, "%s\n", e.message.c_str());
     return kExitBadInput;

@@ -359,6 +359,14 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
       r.budget_given = true;
     } else if (a == "--front") {
       r.front = v;
+    } else if (a == "--layer") {  // a named band of the layer mask (core::named_layer_band)
+      core::LayerBand band;
+      if (!core::named_layer_band(v, band)) {
+        throw UsageError{"cloudviewer render: --layer: found '" + v + "', expected low, mid, high or all (heights above the ground)"};
+      }
+      m.medium.layer_bottom_m = band.bottom_m;
+      m.medium.layer_top_m = band.top_m;
+      m.medium.layer_sea_level = false;
     } else if (a == "--no-sky") {
       m.features.atmosphere = m.features.globe = false;
       m.medium.ambient = 0.0;
@@ -453,6 +461,8 @@ const char* render_usage() {
         "                           fewer once the image's mean relative standard error is E\n"
         "         [--exposure E|auto] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N]\n"
         "         [--no-sky]  clouds on black: no air, globe or ambient sky light\n"
+        "         [--layer low|mid|high|all]  the layer mask's band: below 2 km, 2-6 km, from 6 km above the ground, or\n"
+        "                           everything (sets layer_bottom_m and layer_top_m, below; docs/scene.md)\n"
         "         [--overlay NAME[:key=value,...]]  an overlay composited with the clouds by depth (repeatable):\n"
         "                           coastlines, borders, rivers, graticule, isosurface, wind or section, with the keys of docs/scene.md's Overlays\n"
         "                           table, e.g. --overlay graticule:step_deg=15,color=1,1,1\n";

@@ -136,8 +136,9 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
   const core::ColumnDepth& columns = volume->columns;
   if (column_tau_) glDeleteTextures(1, &column_tau_);
   glCreateTextures(GL_TEXTURE_2D, 1, &column_tau_);
-  glTextureStorage2D(column_tau_, 1, GL_R32F, columns.nx, columns.ny);
-  glTextureSubImage2D(column_tau_, 0, 0, 0, columns.nx, columns.ny, GL_RED, GL_FLOAT, columns.tau.data());
+  // Two channels: the optical depth and the ground's altitude (the layer masks).
+  glTextureStorage2D(column_tau_, 1, GL_RG32F, columns.nx, columns.ny);
+  glTextureSubImage2D(column_tau_, 0, 0, 0, columns.nx, columns.ny, GL_RG, GL_FLOAT, volume->column_maps.data());
   check_gl("uploading the column optical depths");
   // The two-stream source belongs to a time step: built again, at this size, when a march needs it.
   if (ms_[0]) glDeleteTextures(2, ms_);

@@ -5,6 +5,7 @@
 
 #include <GeographicLib/Geocentric.hpp>
 #include <GeographicLib/Geodesic.hpp>
+#include <GeographicLib/GeodesicLine.hpp>
 
 #include "physics/physics.hpp"
 
@@ -51,6 +52,28 @@ double wgs84_geodesic_distance_m(double lat1_deg, double lon1_deg, double lat2_d
   double s12 = 0.0;
   GeographicLib::Geodesic::WGS84().Inverse(lat1_deg, lon1_deg, lat2_deg, lon2_deg, s12);
   return s12;
+}
+
+double great_circle_distance_m(double lat1_deg, double lon1_deg, double lat2_deg, double lon2_deg, double radius_m) {
+  double s12 = 0.0;
+  GeographicLib::Geodesic(radius_m, 0.0).Inverse(lat1_deg, lon1_deg, lat2_deg, lon2_deg, s12);
+  return s12;
+}
+
+std::vector<PathPoint> great_circle_points(double lat1_deg, double lon1_deg, double lat2_deg, double lon2_deg, int count,
+                                           double radius_m) {
+  const GeographicLib::Geodesic sphere(radius_m, 0.0);
+  const GeographicLib::GeodesicLine line = sphere.InverseLine(lat1_deg, lon1_deg, lat2_deg, lon2_deg);
+  std::vector<PathPoint> out;
+  const int n = count < 2 ? 2 : count;
+  out.reserve(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    PathPoint p;
+    p.distance_m = line.Distance() * i / (n - 1);
+    line.Position(p.distance_m, p.lat_deg, p.lon_deg);
+    out.push_back(p);
+  }
+  return out;
 }
 
 double wrap_lon_deg(double lon_deg) {

@@ -2,6 +2,8 @@
 // core) and the WGS84 ellipsoid (through GeographicLib) where the difference matters.
 #pragma once
 
+#include <vector>
+
 #include <glm/vec3.hpp>
 
 namespace cv::geo {
@@ -35,6 +37,16 @@ EnuFrame wgs84_enu(double lat_deg, double lon_deg);
 
 // Length of the shortest path on the WGS84 ellipsoid between two points, metres.
 double wgs84_geodesic_distance_m(double lat1_deg, double lon1_deg, double lat2_deg, double lon2_deg);
+
+// The great circle on the sphere of radius radius_m (GeographicLib's geodesic with flattening 0)
+// from point 1 to point 2: its length (m), and `count` points evenly along it, ends included
+// (count >= 2), each with its distance from point 1 in alt_m's place.
+double great_circle_distance_m(double lat1_deg, double lon1_deg, double lat2_deg, double lon2_deg, double radius_m = kEarthRadiusM);
+struct PathPoint {
+  double lat_deg = 0.0, lon_deg = 0.0, distance_m = 0.0;
+};
+std::vector<PathPoint> great_circle_points(double lat1_deg, double lon1_deg, double lat2_deg, double lon2_deg, int count,
+                                           double radius_m = kEarthRadiusM);
 
 // Longitude wrapped into [-180, 180).
 double wrap_lon_deg(double lon_deg);

@@ -19,7 +19,7 @@ struct sampler3D {
   const float* texels = nullptr;
   glm::ivec3 size{0};
 };
-// A 2-D texture of floats with 1, 3 or 4 channels, x fastest, row 0 first (R32F, RGB32F or RGBA32F).
+// A 2-D texture of floats with 1 to 4 channels, x fastest, row 0 first (R32F, RG32F, RGB32F or RGBA32F).
 struct sampler2D {
   const float* texels = nullptr;
   glm::ivec2 size{0};
@@ -33,6 +33,7 @@ inline glm::dvec4 texelFetch(const sampler3D& t, glm::ivec3 p, int) {
 inline glm::dvec4 texelFetch(const sampler2D& t, glm::ivec2 p, int) {
   const std::size_t i = (static_cast<std::size_t>(p.y) * t.size.x + p.x) * t.channels;
   if (t.channels == 1) return glm::dvec4(t.texels[i], 0.0, 0.0, 1.0);
+  if (t.channels == 2) return glm::dvec4(t.texels[i], t.texels[i + 1], 0.0, 1.0);
   if (t.channels == 3) return glm::dvec4(t.texels[i], t.texels[i + 1], t.texels[i + 2], 1.0);
   return glm::dvec4(t.texels[i], t.texels[i + 1], t.texels[i + 2], t.texels[i + 3]);
 }

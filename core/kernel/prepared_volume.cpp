@@ -1,6 +1,8 @@
 // Preparing a time step for the march, and the kernel's per-frame parameters.
 #include "kernel/prepared_volume.hpp"
 
+#include <cmath>
+
 #include <algorithm>
 #include <utility>
 
@@ -27,6 +29,12 @@ PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinct
   v.wraps = grid.wraps_lon();
   v.global_lat = VolumeSampler(grid, e.liquid_per_m).global_lat();
   v.columns = column_depth(grid, e.liquid_per_m, e.ice_per_m);
+  v.column_maps.assign(2 * v.columns.tau.size(), 0.0f);
+  for (std::size_t c = 0; c < v.columns.tau.size(); ++c) {
+    v.column_maps[2 * c] = v.columns.tau[c];
+    const float ground = c < e.ground_m.size() ? e.ground_m[c] : 0.0f;
+    v.column_maps[2 * c + 1] = std::isfinite(ground) ? ground : 0.0f;  // unknown terrain: sea level
+  }
   v.pyramid = ExtinctionPyramid(grid, e.liquid_per_m, e.ice_per_m);
   int offset = 0;
   const auto& levels = v.pyramid.levels();
@@ -71,6 +79,7 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
   p.u_global_lat = v.global_lat;
   p.u_layer = {v.layer.bottom_m, v.layer.top_m};
   p.u_cloudless = v.layer.empty;
+  p.u_mask_band = s.medium.layer_bottom_m > -100000.0 || s.medium.layer_top_m < 1e7;
   p.u_sigma_max = v.sigma_max_per_m;
   p.u_sun_step_max = sun_step_limit_m(grid, v.layer, s);
   p.u_octave_abc = {s.medium.octave_a, s.medium.octave_b, s.medium.octave_c};

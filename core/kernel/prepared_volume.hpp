@@ -26,6 +26,9 @@ struct PreparedVolume {
   double sigma_max_per_m = 0.0;   // largest extinction (liquid + ice): sizes the sun marches' steps
   bool wraps = false, global_lat = false;
   ColumnDepth columns;            // vertical optical depth per column (the octave gate)
+  // Per column, (optical depth, ground altitude m, 0 without terrain) interleaved: the kernel's
+  // two-channel u_column_tau (the octave gate reads .r, the layer masks .g).
+  std::vector<float> column_maps;
   ExtinctionPyramid pyramid;
   std::vector<glm::vec2> pyramid_packed;  // every level's (min, max), finest first, as the GPU reads them
   std::array<int, ExtinctionPyramid::kMaxLevels> level_offset{};  // first brick of each level in pyramid_packed

@@ -34,7 +34,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   const glm::ivec3 n(g.lon_deg.count, g.lat_deg.count, g.alt_m.count);
   k.u_liquid = {v.extinction.liquid_per_m.data(), n};
   k.u_ice = {v.extinction.ice_per_m.data(), n};
-  k.u_column_tau = {v.columns.tau.data(), {v.columns.nx, v.columns.ny}, 1};
+  k.u_column_tau = {v.column_maps.data(), {v.columns.nx, v.columns.ny}, 2};
   MsSource ms;  // the two-stream source, built as the GPU's (core/kernel/ms_source)
   if (s.medium.ms_two_stream) {
     ms = build_ms_source(v, ms_source_key(s, k.u_to_sun));
@@ -74,6 +74,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   img.radiance.assign(static_cast<std::size_t>(cam.width) * cam.height, glm::dvec3(0.0));
   img.transmittance.assign(img.radiance.size(), 1.0);
   img.cloud_depth_m.assign(img.radiance.size(), 3.0e38);
+  img.first_cloud_m.assign(img.radiance.size(), 3.0e38);
   img.stats.sun_down = k.u_sun_down;
   // Rows in stripes over the cores, each with its own copy of the kernel (its counters); the image
   // does not depend on the thread count.
@@ -94,6 +95,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
         img.radiance[idx] = glm::dvec3(out);
         img.transmittance[idx] = out.w;
         img.cloud_depth_m[idx] = state.t_half;
+        img.first_cloud_m[idx] = state.t_first;
         for (int i = 0; i < CV_STAT_COUNT; ++i) c[i] += kt.g_stats[i], kt.g_stats[i] = 0;
       }
     }

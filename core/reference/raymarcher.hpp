@@ -26,6 +26,8 @@ struct ReferenceImage {
   std::vector<double> transmittance;   // of the view ray through the clouds (and air); 0 on the globe
   // The distance (m) from the camera at which the view transmittance fell to 0.5 (3e38: never).
   std::vector<double> cloud_depth_m;
+  // The distance (m) from the camera to the first view step that held cloud (3e38: none).
+  std::vector<double> first_cloud_m;
   MarchStats stats;
 };
 

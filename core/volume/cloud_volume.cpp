@@ -34,22 +34,16 @@ std::size_t TimeStepData::bytes() const {
   return b;
 }
 
-namespace {
-// Maximum-random overlap (Geleyn & Hollingsworth 1979): adjacent cloudy layers overlap maximally,
-// layers separated by clear air randomly. Walks the column from the top with the layer's fractions.
-struct Overlap {
-  double clear = 1.0;  // probability of a clear line of sight so far
-  double prev = 0.0;   // fraction of the layer above
-  void add(double c) {
-    c = std::clamp(c, 0.0, 1.0);
-    if (prev < 1.0) clear *= (1.0 - std::max(c, prev)) / (1.0 - prev);
-    else clear = c >= 1.0 ? 0.0 : clear;  // an overcast layer above already hides everything
-    prev = c;
-  }
-  void gap() { prev = 0.0; }
-  double cover() const { return std::clamp(1.0 - clear, 0.0, 1.0); }
-};
-}  // namespace
+
+bool named_layer_band(const std::string& name, LayerBand& out, const MapOptions& o) {
+  const LayerBand none;
+  if (name == "all") out = none;
+  else if (name == "low") out = {none.bottom_m, o.low_top_m};
+  else if (name == "mid") out = {o.low_top_m, o.mid_top_m};
+  else if (name == "high") out = {o.mid_top_m, none.top_m};
+  else return false;
+  return true;
+}
 
 void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& options) {
   const std::size_t ncol = grid.columns();
@@ -68,7 +62,7 @@ void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& o
   // same as walking it alone from the top.
   const int nx = grid.lon_deg.count;
   struct ColumnState {
-    Overlap all, low, mid, high;
+    MaxRandomOverlap all, low, mid, high;
     double tau = 0.0, base = std::numeric_limits<double>::quiet_NaN(), top = std::numeric_limits<double>::quiet_NaN();
     double ground = 0.0;
     bool any_data = false;
@@ -95,10 +89,10 @@ void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& o
         st.any_data = true;
         // Without a cloud-fraction field, a point with water counts as fully cloudy.
         const double frac = cf.empty() || std::isnan(cf[p]) ? (ext > 0.0 ? 1.0 : 0.0) : cf[p];
-        const bool cloudy = frac >= options.min_cloud_fraction && ext >= options.min_extinction_per_m;
+        const bool cloudy = map_cloudy(frac, ext, options);
         const double c = cloudy ? frac : 0.0;
         const double above = alt - st.ground;
-        Overlap& layer = above < options.low_top_m ? st.low : above < options.mid_top_m ? st.mid : st.high;
+        MaxRandomOverlap& layer = above < options.low_top_m ? st.low : above < options.mid_top_m ? st.mid : st.high;
         if (cloudy) {
           st.all.add(c);
           layer.add(c);

@@ -90,6 +90,36 @@ struct TimeStepData {
   std::size_t bytes() const;
 };
 
+// Maximum-random overlap (Geleyn & Hollingsworth 1979): adjacent cloudy layers overlap maximally,
+// layers separated by clear air randomly. Fed a column's layers from the top with their fractions
+// (derive_maps, and the probes of core/analysis on a sampled column).
+struct MaxRandomOverlap {
+  double clear = 1.0;  // probability of a clear line of sight so far
+  double prev = 0.0;   // fraction of the layer above
+  void add(double c) {
+    c = c < 0.0 ? 0.0 : c > 1.0 ? 1.0 : c;
+    if (prev < 1.0) clear *= (1.0 - (c > prev ? c : prev)) / (1.0 - prev);
+    else clear = c >= 1.0 ? 0.0 : clear;  // an overcast layer above already hides everything
+    prev = c;
+  }
+  void gap() { prev = 0.0; }
+  double cover() const { return clear > 1.0 ? 0.0 : clear < 0.0 ? 1.0 : 1.0 - clear; }
+};
+
+// The layer masks' named bands (render.march.layer_bottom_m/top_m, `--layer`): heights above the
+// ground of the derived maps' low, mid and high cover (MapOptions' 2 km and 6 km), and "all".
+// False for any other name.
+struct LayerBand {
+  double bottom_m = -100000.0, top_m = 1e7;  // the settings' "no end" values
+};
+bool named_layer_band(const std::string& name, LayerBand& out, const MapOptions& o = {});
+
+// Whether a level counts as cloudy in the derived maps (and the probes): its fraction and its
+// in-cloud extinction both reach the thresholds.
+inline bool map_cloudy(double fraction, double extinction_per_m, const MapOptions& o) {
+  return fraction >= o.min_cloud_fraction && extinction_per_m >= o.min_extinction_per_m;
+}
+
 // Fills data.maps from data's fields.
 void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& options = {});
 

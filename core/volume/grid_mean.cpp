@@ -32,6 +32,7 @@ GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepDa
   };
   product(data[Field::ExtinctionLiquid], m.liquid_per_m);
   product(data[Field::ExtinctionIce], m.ice_per_m);
+  if (data.ground_m.size() == grid.columns()) m.ground_m = data.ground_m;
   return m;
 }
 

@@ -15,6 +15,9 @@ namespace cv::core {
 // these products, never the factors separately.
 struct GridMeanExtinction {
   std::vector<float> liquid_per_m, ice_per_m;
+  // The ground's altitude per column (m; the step's TimeStepData::ground_m), empty without terrain:
+  // layer masks measure heights above it (march_settings.def, layer_bottom_m).
+  std::vector<float> ground_m{};
 };
 // Extinctions from this up are not data but fill values left in a field (netCDF's default float
 // fill is 9.96921e36): the densest fog is ~0.1 /m, and float sums of sigma x phase (up to 1.6e5 /sr

@@ -36,12 +36,14 @@ double VolumeSampler::sample(double lat_deg, double lon_deg, double alt_m, doubl
     const double v = field_[grid_.index(x, y, z)];
     return std::isnan(v) ? nodata : v;
   };
-  const double c00 = at(x0, y0, z0) + wx * (at(x1, y0, z0) - at(x0, y0, z0));
-  const double c10 = at(x0, y1, z0) + wx * (at(x1, y1, z0) - at(x0, y1, z0));
-  const double c01 = at(x0, y0, z1) + wx * (at(x1, y0, z1) - at(x0, y0, z1));
-  const double c11 = at(x0, y1, z1) + wx * (at(x1, y1, z1) - at(x0, y1, z1));
-  const double c0 = c00 + wy * (c10 - c00), c1 = c01 + wy * (c11 - c01);
-  return c0 + wz * (c1 - c0);
+  // A corner of weight 0 takes no part (so a gap beside a node does not hide the node's own value
+  // when nodata is NaN); at weight 1 the far corner alone.
+  auto lerp = [](double a, double b, double w) { return w == 0.0 ? a : w == 1.0 ? b : a + w * (b - a); };
+  const double c00 = lerp(at(x0, y0, z0), at(x1, y0, z0), wx);
+  const double c10 = lerp(at(x0, y1, z0), at(x1, y1, z0), wx);
+  const double c01 = lerp(at(x0, y0, z1), at(x1, y0, z1), wx);
+  const double c11 = lerp(at(x0, y1, z1), at(x1, y1, z1), wx);
+  return lerp(lerp(c00, c10, wy), lerp(c01, c11, wy), wz);
 }
 
 }  // namespace cv::core

@@ -284,6 +284,7 @@ GridMeanExtinction interpolate_extinction(const VolumeGrid& grid, const GridMean
     }
   }
   r.cost_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  out.ground_m = e0.ground_m.empty() ? e1.ground_m : e0.ground_m;  // the terrain does not move
   return out;
 }
 

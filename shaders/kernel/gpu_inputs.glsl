@@ -13,7 +13,7 @@ layout(std140, binding = CV_UBO_MARCH) uniform MarchParams {
 // The prepared volume and the other textures, fetched texel by texel (interpolated in the kernel).
 layout(binding = CV_TEX_LIQUID) uniform sampler3D u_liquid;  // grid-mean extinction, 1/m (cf x in-cloud)
 layout(binding = CV_TEX_ICE) uniform sampler3D u_ice;
-layout(binding = CV_TEX_COLUMN_TAU) uniform sampler2D u_column_tau;  // vertical optical depth per column
+layout(binding = CV_TEX_COLUMN_TAU) uniform sampler2D u_column_tau;  // per column: vertical optical depth (r), ground altitude m (g)
 layout(binding = CV_TEX_JITTER_MASK) uniform sampler2D u_jitter_mask;  // blue-noise rank / n^2, tiled
 layout(binding = CV_TEX_GROUND) uniform sampler2D u_ground;  // linear albedo, equirectangular
 layout(binding = CV_TEX_NOISE_LOW) uniform sampler3D u_noise_low;    // Perlin-Worley, periodic, [0, 1]

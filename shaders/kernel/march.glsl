@@ -113,6 +113,31 @@ CV_FN real cell_max(real3 p, real alt_m) {
   return m;
 }
 
+// The ground's altitude (m) under grid index f: bilinear with column_tau's rules, from u_column_tau.g.
+CV_FN real column_ground(real3 f) {
+  ivec2 n = ivec2(u_grid_count);
+  real wx;
+  real wy;
+  int x0 = volume_fetch_index(f.x, n.x, wx);
+  int y0 = volume_fetch_index(f.y, n.y, wy);
+  int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
+  int y1 = y0 + 1;
+  real c00 = x0 < 0 || x0 >= n.x || y0 < 0 || y0 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x0, y0), 0).g);
+  real c10 = x1 < 0 || x1 >= n.x || y0 < 0 || y0 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x1, y0), 0).g);
+  real c01 = x0 < 0 || x0 >= n.x || y1 < 0 || y1 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x0, y1), 0).g);
+  real c11 = x1 < 0 || x1 >= n.x || y1 < 0 || y1 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x1, y1), 0).g);
+  return mix(mix(c00, c10, wx), mix(c01, c11, wx), wy);
+}
+
+// The layer mask (march_settings.def, layer_bottom_m): whether the point at grid index f and
+// altitude alt_m is in the band shown. Every point falls in exactly one of adjacent bands
+// [a, b), [b, c): their images' media add up to the whole.
+CV_FN bool layer_shown(real3 f, real alt_m) {
+  if (!u_mask_band) return true;
+  real h = u_mask_sea_level ? alt_m : alt_m - column_ground(f);
+  return h >= u_mask_bottom && h < u_mask_top;
+}
+
 // The medium (liquid and ice extinction, 1/m) at Earth-centred point p, whose latitude and longitude
 // g (radians, ecef_to_sphere) and altitude alt_m are given. Eroded by the noise where it is on.
 CV_FN void medium_in(real3 p, real3 g, real alt_m, CV_OUT(real) sl, CV_OUT(real) si) {
@@ -120,8 +145,9 @@ CV_FN void medium_in(real3 p, real3 g, real alt_m, CV_OUT(real) sl, CV_OUT(real)
   si = real(0.0);
   real3 f;
   if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
-  sl = fetch(u_liquid, f);
-  si = fetch(u_ice, f);
+  if (!layer_shown(f, alt_m)) return;
+  sl = u_hide_liquid ? real(0.0) : fetch(u_liquid, f);
+  si = u_hide_ice ? real(0.0) : fetch(u_ice, f);
   if (kNoise && sl + si > real(0.0)) erode_at(p, sl, si);
 }
 
@@ -244,6 +270,9 @@ struct MarchState {
   int next_step;
   real t_half;  // distance from the camera where the view transmittance fell to 0.5 (3e38: never)
   int tl_next;  // the next translucent fragment to composite (kTranslucent)
+  // Where the first step holding cloud began, from the camera (3e38: none). Read by the CPU's
+  // probes (core/analysis); the GPU driver keeps no copy of it between its dispatches.
+  real t_first;
 };
 
 // One view sample at p (altitude alt_p, distance t along the ray) standing for a step of ds that
@@ -257,6 +286,7 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
   g_stats[CV_STAT_VIEW_SAMPLES] += 1u;
   real sigma = sl + si;
   if (sigma <= real(0.0)) return;
+  s.t_first = min(s.t_first, t_entry);
   real3 up_p = normalize(p);
   real mu_sun = dot(u_to_sun, up_p);
   real nu_sun = length(cross(u_to_sun, up_p));
@@ -411,6 +441,7 @@ CV_FN MarchState march_start() {
   s.next_step = 0;
   s.t_half = real(3.0e38);
   s.tl_next = 0;
+  s.t_first = real(3.0e38);
   return s;
 }
 

@@ -53,6 +53,12 @@ CV_PARAM(bool, u_liquid_phase_hg)    // Henyey-Greenstein with the Mie fit's mea
 CV_PARAM(bool, u_blue_noise)         // the jitter from the blue-noise mask, else the hash
 CV_PARAM(bool, u_has_depth)          // u_depth holds the distance to opaque geometry per pixel
 CV_PARAM(bool, u_has_opaque_color)   // u_opaque holds that geometry's radiance, composited behind
+CV_PARAM(real, u_mask_bottom)        // layer mask: the lowest height shown, m (march_settings.def layer_bottom_m)
+CV_PARAM(real, u_mask_top)           // layer mask: heights from here up are hidden, m
+CV_PARAM(bool, u_mask_sea_level)     // heights above sea level, else above the ground (u_column_tau.g)
+CV_PARAM(bool, u_mask_band)          // the band hides something (not the whole column)
+CV_PARAM(bool, u_hide_liquid)
+CV_PARAM(bool, u_hide_ice)
 CV_PARAM(ivec4, u_level_nodes)       // grid nodes per brick side, finest level first
 CV_PARAM(ivec4, u_level_offset)      // first brick of each level in u_min_max
 CV_PARAM_ARRAY(ivec4, u_bricks, 4)   // bricks per axis (xyz), finest level first

@@ -72,7 +72,7 @@ class CliHostile : public ::testing::Test {
 };
 
 TEST_F(CliHostile, HelpOnEveryCommandAndHelpCommand) {
-  for (const char* c : {"info", "import", "gpu-info", "phase", "render", "bench", "time-error", "view"}) {
+  for (const char* c : {"info", "import", "gpu-info", "phase", "render", "bench", "time-error", "probe", "section", "series", "compare", "view"}) {
     const Result a = cloudviewer(std::string(c) + " --help", "env -u DISPLAY ");
     EXPECT_EQ(a.rc, 0) << c << ": " << a.out;
     EXPECT_NE(a.out.find(std::string("usage: cloudviewer ") + c), std::string::npos) << a.out;

@@ -339,4 +339,41 @@ TEST(Raymarch, LiquidPhaseChoiceMatchesTheReference) {
   EXPECT_LT(worst, 1e-3);
   EXPECT_GT(change, 1e-2);
 }
+// The layer masks (issue 17) in the shader as in the CPU kernel: the ice hidden, then a band of
+// heights, each the CPU reference's image and each unlike the whole cloud's.
+TEST(Raymarch, LayerMasksMatchTheReference) {
+  BubbleOnGpu g;
+  auto& [ctx, loader, gpu, sc, medium] = g;
+  const core::Camera cam = bubble_camera(32, 18);
+  const core::Sun sun = low_eastern_sun();
+  core::MarchSettings s;
+  s.quality.view_step_m = 200.0;
+  s.quality.sun_steps = 16;
+  const auto whole = core::render_reference(sc.grid, medium, cam, sun, s);
+  double max_l = 0.0;
+  for (const auto& l : whole.radiance) max_l = std::max(max_l, l.x);
+  ASSERT_GT(max_l, 0.0);
+  auto check = [&](const core::MarchSettings& m, const char* what) {
+    const auto cpu = core::render_reference(sc.grid, medium, cam, sun, m);
+    const auto img = gpu.render(cam, sun, m);
+    double worst = 0.0, worst_t = 0.0, change = 0.0;
+    for (std::size_t i = 0; i < img.size(); ++i) {
+      worst = std::max(worst, std::abs(img[i].x - cpu.radiance[i].x) / max_l);
+      worst_t = std::max(worst_t, std::abs(img[i].w - cpu.transmittance[i]));
+      change = std::max(change, std::abs(cpu.transmittance[i] - whole.transmittance[i]));
+    }
+    std::printf("%s: GPU vs CPU worst %.3g (transmittance %.3g); the mask moves transmittance by up to %.3g\n", what, worst, worst_t, change);
+    EXPECT_LT(worst, 1e-3) << what;
+    EXPECT_LT(worst_t, 1e-3) << what;
+    EXPECT_GT(change, 1e-2) << what;
+  };
+  core::MarchSettings no_ice = s;
+  no_ice.medium.hide_ice = true;
+  check(no_ice, "ice hidden");
+  core::MarchSettings band = s;
+  band.medium.layer_bottom_m = 2000.0;
+  band.medium.layer_top_m = 6000.0;
+  check(band, "band 2-6 km");
+}
+
 }  // namespace

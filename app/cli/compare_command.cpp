@@ -1,0 +1,208 @@
+// `cloudviewer compare A B`: two sources side by side on their own grids and on an explicit common
+// grid (core/analysis/compare), with where cloud is in A only, B only or both and the B - A maps.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <stdexcept>
+
+#include "analysis/compare.hpp"
+#include "analysis_commands.hpp"
+#include "analysis_common.hpp"
+#include "render/image_output.hpp"
+
+namespace cv::cli {
+
+using namespace analysis;
+
+const char* compare_usage() {
+  return "  compare A B -o OUT.png [--times T | TA,TB] [--csv OUT.csv]\n"
+         "                           two sources side by side, each on its own grid (cloud cover, labelled with the source\n"
+         "                           and valid time), and on a common grid, stated in the image and printed: the coarser\n"
+         "                           spacing of the two on each axis over the region and altitudes both hold; there, the\n"
+         "                           columns with cloud in A only, B only or both, and maps of B - A of cover, optical\n"
+         "                           depth, cloud base and top with a diverging colour map; --times: one of each file's\n"
+         "                           valid times or steps (default: the first valid time both hold); --csv: per column\n";
+}
+
+namespace {
+
+// A 2-D map of a grid's columns into an area of the canvas over (lat_lo..lat_hi, lon_lo..lon_hi):
+// each pixel takes the nearest column.
+void draw_map(Canvas& cv, const Area& a, const core::VolumeGrid& g, double lat_lo, double lat_hi, double lon_lo, double lon_hi,
+              const std::function<Rgb(std::size_t column)>& colour) {
+  for (int y = 0; y < a.h(); ++y) {
+    const double lat = lat_hi - (y + 0.5) / a.h() * (lat_hi - lat_lo);
+    for (int x = 0; x < a.w(); ++x) {
+      const double lon = lon_lo + (x + 0.5) / a.w() * (lon_hi - lon_lo);
+      const double east = std::fmod(std::fmod(lon - g.lon_deg.start, 360.0) + 360.0, 360.0);
+      int i = static_cast<int>(std::lround(east / g.lon_deg.step));
+      if (g.wraps_lon()) i %= g.lon_deg.count;
+      const int j = static_cast<int>(std::lround((lat - g.lat_deg.start) / g.lat_deg.step));
+      if (i < 0 || i >= g.lon_deg.count || j < 0 || j >= g.lat_deg.count) {
+        cv.set(a.x0 + x, a.y0 + y, kNoData);
+        continue;
+      }
+      cv.set(a.x0 + x, a.y0 + y, colour(g.column(i, j)));
+    }
+  }
+  cv.box(a.x0 - 1, a.y0 - 1, a.x1 + 1, a.y1 + 1, kInk);
+}
+
+std::size_t resolve_in(const core::CloudVolume& vol, const std::string& file, const std::string& t) {
+  Common c{"compare", file, t};
+  return resolve_step(vol, c);
+}
+
+}  // namespace
+
+int cmd_compare(const std::vector<std::string>& args) {
+  std::vector<std::string> files;
+  std::string out, csv, times;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (!a.empty() && a[0] == '-') {
+      if (i + 1 >= args.size()) throw UsageError{"cloudviewer compare: " + a + ": expected a value after it"};
+      const std::string& v = args[++i];
+      if (a == "-o") out = v;
+      else if (a == "--csv") csv = v;
+      else if (a == "--times") times = v;
+      else throw UsageError{"cloudviewer compare: unknown option '" + a + "'"};
+    } else {
+      files.push_back(a);
+    }
+  }
+  if (files.size() != 2 || out.empty()) throw UsageError{"cloudviewer compare: expected two files A B and -o OUT.png"};
+  check_outputs("compare", out, csv, files[0]);
+  check_outputs("compare", out, csv, files[1]);
+  core::CloudVolume va = load(files[0]), vb = load(files[1]);
+  // The steps compared.
+  std::size_t sa = 0, sb = 0;
+  if (!times.empty()) {
+    const std::size_t comma = times.find(',');
+    sa = resolve_in(va, files[0], comma == std::string::npos ? times : times.substr(0, comma));
+    sb = resolve_in(vb, files[1], comma == std::string::npos ? times : times.substr(comma + 1));
+  } else if (core::times_known(va.times) && core::times_known(vb.times)) {
+    bool found = false;
+    for (std::size_t i = 0; i < va.times.size() && !found; ++i)
+      for (std::size_t j = 0; j < vb.times.size() && !found; ++j)
+        if (va.times[i].unix_s == vb.times[j].unix_s) sa = i, sb = j, found = true;
+    if (!found) {
+      throw UsageError{"cloudviewer compare: A and B share no valid time: " + files[0] + " holds " + core::time_range_text(va.times) + ", " +
+                       files[1] + " holds " + core::time_range_text(vb.times) + "; expected a common one, or --times TA,TB"};
+    }
+  }
+  const core::Overlap o = core::grid_overlap(va.grid, vb.grid);
+  if (o.empty) {
+    throw UsageError{"cloudviewer compare: A and B share no region: " + files[0] + " holds " + core::grid_extent_text(va.grid) + " (altitude " +
+                     num(va.grid.alt_m.start, "%.0f") + ".." + num(va.grid.alt_m.last(), "%.0f") + " m), " + files[1] + " holds " +
+                     core::grid_extent_text(vb.grid) + " (altitude " + num(vb.grid.alt_m.start, "%.0f") + ".." + num(vb.grid.alt_m.last(), "%.0f") +
+                     " m); expected an overlap"};
+  }
+  const core::TimeStepData& da = va.step(sa);
+  const core::TimeStepData& db = vb.step(sb);
+  const auto t0 = std::chrono::steady_clock::now();
+  const core::VolumeGrid common = core::common_grid(va.grid, vb.grid, o);
+  const core::Comparison cmp = core::compare_steps(va.grid, da, vb.grid, db, common);
+  const double build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const std::string grid_line = core::common_grid_text(common, va.grid, vb.grid);
+  std::size_t count[4] = {0, 0, 0, 0};
+  for (core::Presence p : cmp.columns) ++count[static_cast<int>(p)];
+  std::printf("A: %s at %s; B: %s at %s\n%s\ncolumns with cloud: A only %zu, B only %zu, both %zu, neither %zu; difference grid built in %.1f ms\n",
+              files[0].c_str(), va.times[sa].iso_utc.c_str(), files[1].c_str(), vb.times[sb].iso_utc.c_str(), grid_line.c_str(), count[1],
+              count[2], count[3], count[0], build_ms);
+  // The picture: the two sources on their own grids and the presence map above, the differences below.
+  const int pw = 220, ph = 150, gap = 70, left = 20, top = 50;
+  const int width = left + 4 * (pw + gap), height = top + 2 * (ph + gap) + 60;
+  Canvas cv(width, height, kPaper);
+  auto area = [&](int col, int row) { return Area{left + col * (pw + gap), top + row * (ph + gap), left + col * (pw + gap) + pw - 1, top + row * (ph + gap) + ph - 1}; };
+  auto own = [&](int col, core::CloudVolume& v, std::size_t step, const std::string& label) {
+    const core::TimeStepData& d = v.step(step);
+    const auto& g = v.grid;
+    const Area a = area(col, 0);
+    const double lon_hi = g.wraps_lon() ? g.lon_deg.start + 360.0 : g.lon_deg.last();
+    draw_map(cv, a, g, g.lat_deg.start, g.lat_deg.last(), g.lon_deg.start, lon_hi, [&](std::size_t c) {
+      const float x = d.maps.cloud_cover[c];
+      return std::isfinite(x) ? sequential_colour(x) : kNoData;
+    });
+    cv.text(a.x0, a.y0 - 22, 9, label, kInk);
+    cv.text(a.x0, a.y0 - 8, 9, "cover " + v.times[step].iso_utc, kInk);
+  };
+  own(0, va, sa, "A " + std::filesystem::path(files[0]).filename().string());
+  own(1, vb, sb, "B " + std::filesystem::path(files[1]).filename().string());
+  colour_bar(cv, area(1, 0).x1 + 8, area(1, 0).y0 + 12, area(1, 0).x1 + 18, area(1, 0).y1, 0.0, 1.0, "cover", sequential_colour);
+  const Rgb only_a{230, 120, 20}, only_b{30, 110, 220}, both{90, 90, 90}, neither{245, 245, 245};
+  const Area pa = area(2, 0);
+  draw_map(cv, pa, common, common.lat_deg.start, common.lat_deg.last(), common.lon_deg.start,
+           common.wraps_lon() ? common.lon_deg.start + 360.0 : common.lon_deg.last(), [&](std::size_t c) {
+             switch (cmp.columns[c]) {
+               case core::Presence::OnlyA: return only_a;
+               case core::Presence::OnlyB: return only_b;
+               case core::Presence::Both: return both;
+               default: return neither;
+             }
+           });
+  cv.text(pa.x0, pa.y0 - 22, 9, "cloud on the common grid", kInk);
+  const Area la = area(3, 0);
+  const std::pair<Rgb, std::string> keys[] = {{only_a, "A only"}, {only_b, "B only"}, {both, "both"}, {neither, "neither"}};
+  for (int k = 0; k < 4; ++k) {
+    for (int y = 0; y < 10; ++y)
+      for (int x = 0; x < 14; ++x) cv.set(la.x0 + x, la.y0 + k * 18 + y, keys[k].first);
+    cv.box(la.x0, la.y0 + k * 18, la.x0 + 13, la.y0 + k * 18 + 9, kInk);
+    cv.text(la.x0 + 20, la.y0 + k * 18 + 9, 9, keys[k].second, kInk);
+  }
+  char gl[160];
+  std::snprintf(gl, sizeof gl, "common grid %dx%dx%d", common.lon_deg.count, common.lat_deg.count, common.alt_m.count);
+  cv.text(la.x0, la.y0 + 90, 9, gl, kInk);
+  std::snprintf(gl, sizeof gl, "step %.3g deg %.3g deg %.0f m", common.lon_deg.step, common.lat_deg.step, common.alt_m.step);
+  cv.text(la.x0, la.y0 + 104, 9, gl, kInk);
+  cv.text(la.x0, la.y0 + 118, 9, "the coarser of A and B", kInk);
+  struct Diff {
+    const char* name;
+    const std::vector<float>* d;
+    double scale;
+  };
+  const Diff diffs[4] = {{"B-A cover", &cmp.d_cover, 1.0}, {"B-A optical depth", &cmp.d_optical_depth, 1.0},
+                         {"B-A base km", &cmp.d_base_m, 1e-3}, {"B-A top km", &cmp.d_top_m, 1e-3}};
+  for (int k = 0; k < 4; ++k) {
+    double most = 0.0;
+    for (float x : *diffs[k].d)
+      if (std::isfinite(x)) most = std::max(most, std::abs(double(x)) * diffs[k].scale);
+    const double r = most > 0.0 ? most : 1.0;  // all zero: a bar of +-1, the map all white
+    const Area a = area(k, 1);
+    draw_map(cv, a, common, common.lat_deg.start, common.lat_deg.last(), common.lon_deg.start,
+             common.wraps_lon() ? common.lon_deg.start + 360.0 : common.lon_deg.last(), [&](std::size_t c) {
+               const float x = (*diffs[k].d)[c];
+               return std::isfinite(x) ? diverging_colour(0.5 + 0.5 * x * diffs[k].scale / r) : kNoData;
+             });
+    cv.text(a.x0, a.y0 - 8, 9, diffs[k].name, kInk);
+    colour_bar(cv, a.x1 + 8, a.y0 + 12, a.x1 + 18, a.y1, -r, r, "", diverging_colour);
+  }
+  cv.text(left, height - 14, 9, "grey: no data or no cloud in one of them", kInk);
+  core::OutputGroup group;
+  group.write(out, [&](std::FILE* f) { render::encode_png(f, width, height, cv.rgb()); });
+  if (!csv.empty()) {
+    group.write(csv, [&](std::FILE* f) {
+      put(f, "# A " + files[0] + " at " + va.times[sa].iso_utc + ", B " + files[1] + " at " + vb.times[sb].iso_utc + "; " + grid_line + "\n");
+      put(f, "lon_deg,lat_deg,presence,cover_a,cover_b,d_cover,optical_depth_a,optical_depth_b,d_optical_depth,base_a_m,base_b_m,d_base_m,top_a_m,top_b_m,d_top_m\n");
+      static const char* names[4] = {"neither", "a_only", "b_only", "both"};
+      const core::Maps2D &ma = cmp.a.maps, &mb = cmp.b.maps;
+      for (int j = 0; j < common.lat_deg.count; ++j)
+        for (int i = 0; i < common.lon_deg.count; ++i) {
+          const std::size_t c = common.column(i, j);
+          put(f, num(common.lon_deg.at(i)) + "," + num(common.lat_deg.at(j)) + "," + names[static_cast<int>(cmp.columns[c])] + "," +
+                     num(ma.cloud_cover[c]) + "," + num(mb.cloud_cover[c]) + "," + num(cmp.d_cover[c]) + "," + num(ma.optical_depth[c]) + "," +
+                     num(mb.optical_depth[c]) + "," + num(cmp.d_optical_depth[c]) + "," + num(ma.cloud_base_m[c], "%.1f") + "," +
+                     num(mb.cloud_base_m[c], "%.1f") + "," + num(cmp.d_base_m[c], "%.1f") + "," + num(ma.cloud_top_m[c], "%.1f") + "," +
+                     num(mb.cloud_top_m[c], "%.1f") + "," + num(cmp.d_top_m[c], "%.1f") + "\n");
+        }
+    });
+  }
+  group.commit();
+  std::printf("wrote %s%s%s\n", out.c_str(), csv.empty() ? "" : " and ", csv.c_str());
+  return 0;
+}
+
+}  // namespace cv::cli
