@@ -205,6 +205,10 @@ void for_each_march_setting_pair(A& a, B& b, F&& f) {
 // The row whose scene-file key is `key`, or nullptr.
 const SettingRow* find_march_setting(const std::string& key);
 
+// Whether a height band masks the medium: layer_bottom_m or layer_top_m moved from their defaults
+// (the whole column). The march's band test is compiled in only then (kernel::MarchVariant).
+inline bool layer_band_set(const MarchSettings& s) { return s.medium.layer_bottom_m > -100000.0 || s.medium.layer_top_m < 1e7; }
+
 // Whether the two march the same image: every row but those marked image = false (`frame`).
 bool same_image(const MarchSettings& a, const MarchSettings& b);
 

@@ -133,7 +133,9 @@ CV_FN real column_ground(real3 f) {
 // altitude alt_m is in the band shown. Every point falls in exactly one of adjacent bands
 // [a, b), [b, c): their images' media add up to the whole.
 CV_FN bool layer_shown(real3 f, real alt_m) {
-  if (!u_mask_band) return true;
+  // A compile-time switch (kLayerMask, set with u_mask_band): llvmpipe would run column_ground's
+  // fetches at every sample under a uniform branch.
+  if (!kLayerMask || !u_mask_band) return true;
   real h = u_mask_sea_level ? alt_m : alt_m - column_ground(f);
   return h >= u_mask_bottom && h < u_mask_top;
 }
