@@ -71,12 +71,10 @@ CV_FN void erode_at(real3 p, CV_INOUT(real) sl, CV_INOUT(real) si) {
   si = erode_extinction(si, e, feature_m);
 }
 
-// The column's vertical optical depth at p, bilinear with the 3-D fetch's horizontal rules (wrap,
-// pole clamp, regional border 0), from the prepared volume's column map.
-CV_FN real column_tau(real3 p) {
-  real3 g = ecef_to_sphere(p, u_r0);
-  real3 f;
-  if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, u_grid_start.z, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return real(0.0);
+// The column map at grid index f: the column's vertical optical depth (x) and the ground's
+// altitude in metres (y), bilinear with the 3-D fetch's horizontal rules (wrap, pole clamp,
+// regional border 0), from the prepared volume's column map (u_column_tau, two channels).
+CV_FN real2 column_map(real3 f) {
   ivec2 n = ivec2(u_grid_count);
   real wx;
   real wy;
@@ -84,11 +82,23 @@ CV_FN real column_tau(real3 p) {
   int y0 = volume_fetch_index(f.y, n.y, wy);
   int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
   int y1 = y0 + 1;
-  real c00 = x0 < 0 || x0 >= n.x || y0 < 0 || y0 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x0, y0), 0).r);
-  real c10 = x1 < 0 || x1 >= n.x || y0 < 0 || y0 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x1, y0), 0).r);
-  real c01 = x0 < 0 || x0 >= n.x || y1 < 0 || y1 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x0, y1), 0).r);
-  real c11 = x1 < 0 || x1 >= n.x || y1 < 0 || y1 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x1, y1), 0).r);
+  real4 t00 = x0 < 0 || x0 >= n.x || y0 < 0 || y0 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec2(x0, y0), 0));
+  real4 t10 = x1 < 0 || x1 >= n.x || y0 < 0 || y0 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec2(x1, y0), 0));
+  real4 t01 = x0 < 0 || x0 >= n.x || y1 < 0 || y1 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec2(x0, y1), 0));
+  real4 t11 = x1 < 0 || x1 >= n.x || y1 < 0 || y1 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec2(x1, y1), 0));
+  real2 c00 = real2(t00.x, t00.y);
+  real2 c10 = real2(t10.x, t10.y);
+  real2 c01 = real2(t01.x, t01.y);
+  real2 c11 = real2(t11.x, t11.y);
   return mix(mix(c00, c10, wx), mix(c01, c11, wx), wy);
+}
+
+// The column's vertical optical depth at p (the column map's x).
+CV_FN real column_tau(real3 p) {
+  real3 g = ecef_to_sphere(p, u_r0);
+  real3 f;
+  if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, u_grid_start.z, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return real(0.0);
+  return column_map(f).x;
 }
 
 CV_FN real node_sum(int x, int y, int z) { return node(u_liquid, x, y, z) + node(u_ice, x, y, z); }
@@ -113,21 +123,8 @@ CV_FN real cell_max(real3 p, real alt_m) {
   return m;
 }
 
-// The ground's altitude (m) under grid index f: bilinear with column_tau's rules, from u_column_tau.g.
-CV_FN real column_ground(real3 f) {
-  ivec2 n = ivec2(u_grid_count);
-  real wx;
-  real wy;
-  int x0 = volume_fetch_index(f.x, n.x, wx);
-  int y0 = volume_fetch_index(f.y, n.y, wy);
-  int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
-  int y1 = y0 + 1;
-  real c00 = x0 < 0 || x0 >= n.x || y0 < 0 || y0 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x0, y0), 0).g);
-  real c10 = x1 < 0 || x1 >= n.x || y0 < 0 || y0 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x1, y0), 0).g);
-  real c01 = x0 < 0 || x0 >= n.x || y1 < 0 || y1 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x0, y1), 0).g);
-  real c11 = x1 < 0 || x1 >= n.x || y1 < 0 || y1 >= n.y ? real(0.0) : real(texelFetch(u_column_tau, ivec2(x1, y1), 0).g);
-  return mix(mix(c00, c10, wx), mix(c01, c11, wx), wy);
-}
+// The ground's altitude (m) under grid index f (the column map's y).
+CV_FN real column_ground(real3 f) { return column_map(f).y; }
 
 // The layer mask (march_settings.def, layer_bottom_m): whether the point at grid index f and
 // altitude alt_m is in the band shown. Every point falls in exactly one of adjacent bands
