@@ -40,8 +40,6 @@ namespace {
 namespace fs = std::filesystem;
 using clock = std::chrono::steady_clock;
 
-double seconds_since(clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); }
-
 struct BenchArgs {
   std::vector<std::string> scenes;
   int spp = 64, width = 96, height = 54, repeats = 3;

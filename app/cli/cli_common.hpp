@@ -2,6 +2,7 @@
 // numbers and lists in arguments.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <optional>
 #include <utility>
@@ -11,6 +12,11 @@
 namespace cv::cli {
 
 constexpr int kExitBadInput = 2;
+
+// Wall-clock seconds since t0 (steady clock), for the commands' timing lines.
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 // Bad command-line input: one line naming the argument, what was found and what was expected.
 struct UsageError {

@@ -42,8 +42,6 @@ namespace {
 namespace fs = std::filesystem;
 using clock = std::chrono::steady_clock;
 
-double seconds_since(clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); }
-
 struct RecordArgs {
   std::string scene_path, out;
   double fps = 30.0;

@@ -55,7 +55,6 @@ bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
-double seconds_since(clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); }
 
 // The most view steps one ray may take: beyond it a render runs for hours (a step of 1 m across a
 // 20 km layer is a million steps per ray), so it is refused before it starts.
