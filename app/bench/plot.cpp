@@ -112,9 +112,9 @@ Rgb8Image plot_error_vs_time(const std::vector<PlotPoint>& pts, const std::vecto
     const TimeError a = pts[front[i - 1]].p, b = pts[front[i]].p;
     cv.line(px(a.time), py(a.error), px(b.time), py(b.error), front_c);
   }
-  const Color kinds[3] = {{40, 90, 200}, {20, 150, 60}, {230, 140, 0}};
+  const Color kinds[4] = {{40, 90, 200}, {20, 150, 60}, {230, 140, 0}, {140, 60, 200}};
   for (const auto& q : pts) {
-    if (ok(q.p)) cv.square(px(q.p.time), py(q.p.error), 2, kinds[std::clamp(q.kind, 0, 2)]);
+    if (ok(q.p)) cv.square(px(q.p.time), py(q.p.error), 2, kinds[std::clamp(q.kind, 0, 3)]);
   }
   for (std::size_t i : front) {  // the front's points ringed in red
     const int x = px(pts[i].p.time), y = py(pts[i].p.error);

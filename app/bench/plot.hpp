@@ -17,7 +17,7 @@ using namespace cv::core;
 
 struct PlotPoint {
   TimeError p;
-  int kind = 0;  // 0: a sweep configuration, 1: one of our presets, 2: a seed document's preset
+  int kind = 0;  // 0: a sweep configuration, 1: one of our presets, 2: a seed document's preset, 3: the path tracer
 };
 
 struct Rgb8Image {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -46,7 +47,29 @@ struct BenchArgs {
   double ref_error = 0.0;  // stop a reference early at this mean relative standard error (0: at spp)
   std::string out = "bench_out";
   bool cache = true;  // copy quality_front.json to the per-user cache
+  // The GPU path tracer's rows: one per count of samples per pixel (empty: none).
+  std::vector<int> path_spp = {1, 4, 16};
 };
+
+// "1,4,16" (each in 1..65536, increasing) or "none".
+std::vector<int> parse_spp_list(const std::string& text) {
+  if (text == "none") return {};
+  std::vector<int> out;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', at), text.size());
+    const std::string item = text.substr(at, comma - at);
+    char* end = nullptr;
+    const long v = item.empty() ? 0 : std::strtol(item.c_str(), &end, 10);
+    if (item.empty() || *end != '\0' || v < 1 || v > 65536 || (!out.empty() && v <= out.back())) {
+      throw UsageError{"cloudviewer bench: --path-spp: found '" + text +
+                       "', expected increasing samples per pixel in 1..65536 separated by commas (such as 1,4,16), or none"};
+    }
+    out.push_back(static_cast<int>(v));
+    at = comma + 1;
+  }
+  return out;
+}
 
 int parse_int(const std::string& opt, const std::string& text, int lo, int hi, const char* expected) {
   const double v = parse_number(opt, text);
@@ -76,6 +99,7 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
     } else if (s == "--repeats") a.repeats = parse_int(s, next(), 1, 100, "an integer in 1..100");
     else if (s == "--out") a.out = next();
     else if (s == "--no-cache") a.cache = false;
+    else if (s == "--path-spp") a.path_spp = parse_spp_list(next());
     else if (s == "--size") {
       const std::string v = next();
       const auto x = v.find('x');
@@ -84,7 +108,7 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
       a.height = parse_int("--size", v.substr(x + 1), 8, 4096, "WxH with each in 8..4096");
     } else if (!s.empty() && s[0] == '-') {
       throw UsageError{"cloudviewer bench: unknown option '" + s +
-                       "', expected --reference-spp, --reference-error, --size, --repeats, --out or --no-cache"};
+                       "', expected --reference-spp, --reference-error, --size, --repeats, --path-spp, --out or --no-cache"};
     } else if (std::find(known.begin(), known.end(), s) == known.end()) {
       std::string names;
       for (const auto& n : known) names += (names.empty() ? "" : ", ") + n;
@@ -249,9 +273,13 @@ double median(std::vector<double> v) {
 }  // namespace
 
 const char* bench_usage() {
-  return "  bench [SCENE...] [--reference-spp N] [--reference-error E] [--size WxH] [--repeats R] [--out DIR] [--no-cache]\n"
+  return "  bench [SCENE...] [--reference-spp N] [--reference-error E] [--size WxH] [--repeats R] [--path-spp LIST]\n"
+         "        [--out DIR] [--no-cache]\n"
          "                           error against run time on the standard scenes (default all, 96x54, 64 spp,\n"
          "                           3 repeats, into bench_out): results.csv, summary.md, plots and error images,\n"
+         "                           the march's quality sweep, presets and the seed documents' methods, and the\n"
+         "                           GPU path tracer at each of --path-spp samples per pixel (default 1,4,16;\n"
+         "                           none: left out; timed once; never a --budget-ms candidate),\n"
          "                           quality_front.json (also cached per user for --budget-ms unless --no-cache).\n"
          "                           References are cached in DIR with their sums: a larger N extends them, an\n"
          "                           interrupted one resumes; --reference-error stops one early at that mean\n"
@@ -391,6 +419,41 @@ int cmd_bench(const std::vector<std::string>& args) {
       std::printf("%s [%zu/%zu] %-22s %8.2f ms  rel. RMSE %-9.3g (raw %-9.3g) bias %+-9.3g worst %-8.3g PSNR %.1f dB\n",
                   name.c_str(), ci + 1, configs.size(), c.name.c_str(), row.wall_ms, row.err.rel_rmse, row.err.rel_rmse_raw,
                   row.err.rel_bias, row.err.worst, row.err.psnr_db);
+      std::fflush(stdout);
+      rows.push_back(row);
+    }
+    // The GPU path tracer (`render --quality reference`) on the reference's transport problem (same
+    // clouds, camera, sun, bounces and forward-peak technique), at each --path-spp count: it is
+    // unbiased, so its error is its own noise, and it falls as 1/sqrt(spp). Its seed is not the
+    // reference's, so the two estimates share no random numbers (with the same seed the float paths
+    // would follow the double ones and the error would read as near zero).
+    render::PathTraceSettings pt;
+    pt.max_bounces = mc.max_bounces, pt.roulette_after = mc.roulette_after, pt.peak_mis = mc.peak_mis;
+    pt.seed = static_cast<std::uint32_t>(mc.seed) ^ 0x9e3779b9u;
+    if (!a.path_spp.empty()) {  // its program compiled (and its first dispatch made) outside the timing
+      core::MonteCarloImage warm;
+      renderer.raymarcher().trace_paths(warm, sc.camera, sc.sun, base, 1, pt);
+    }
+    for (std::size_t k = 0; k < a.path_spp.size(); ++k) {
+      const int spp = a.path_spp[k];
+      pt.samples_per_readback = std::min(spp, 16);
+      core::MonteCarloImage img;
+      const auto t0 = clock::now();
+      renderer.raymarcher().trace_paths(img, sc.camera, sc.sun, base, spp, pt);
+      BenchRow row;
+      row.scene = name, row.config = "path_" + std::to_string(spp) + "spp", row.kind = ConfigKind::PathTracer;
+      row.description = "the GPU path tracer at " + std::to_string(spp) + " samples per pixel";
+      row.phase_hg = base.medium.liquid_phase_hg;
+      row.spp = spp;
+      row.wall_ms = seconds_since(t0) * 1e3;
+      const std::vector<glm::dvec3> rgb = img.radiance();
+      row.err = bench::image_error(rgb, ref_rgb, ref_var);
+      row.error_image = name + "/err_" + row.config + ".png";
+      render::write_png((fs::path(a.out) / row.error_image).string(), a.width, a.height,
+                        error_png(bench::pixel_error(rgb, ref_rgb)));
+      std::printf("%s [path %zu/%zu] %-17s %8.2f ms  rel. RMSE %-9.3g (raw %-9.3g) bias %+-9.3g worst %-8.3g PSNR %.1f dB\n",
+                  name.c_str(), k + 1, a.path_spp.size(), row.config.c_str(), row.wall_ms, row.err.rel_rmse,
+                  row.err.rel_rmse_raw, row.err.rel_bias, row.err.worst, row.err.psnr_db);
       std::fflush(stdout);
       rows.push_back(row);
     }

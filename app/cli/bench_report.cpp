@@ -12,11 +12,17 @@
 
 namespace cv::cli {
 
-namespace {
-
 const char* kind_name(ConfigKind k) {
-  return k == ConfigKind::Seed ? "seed" : k == ConfigKind::Preset ? "preset" : "sweep";
+  switch (k) {
+    case ConfigKind::Seed: return "seed";
+    case ConfigKind::Preset: return "preset";
+    case ConfigKind::PathTracer: return "path_tracer";
+    case ConfigKind::Sweep: break;
+  }
+  return "sweep";
 }
+
+namespace {
 
 std::vector<std::string> scene_order(const std::vector<BenchRow>& rows) {
   std::vector<std::string> out;
@@ -49,7 +55,7 @@ void mark_pareto(std::vector<BenchRow>& rows) {
     std::vector<std::size_t> idx;
     std::vector<bench::TimeError> pts;
     for (std::size_t i = 0; i < rows.size(); ++i) {
-      if (rows[i].scene != scene) continue;
+      if (rows[i].scene != scene || rows[i].kind == ConfigKind::PathTracer) continue;
       idx.push_back(i);
       pts.push_back({rows[i].wall_ms, rows[i].err.rel_rmse});
     }
@@ -60,7 +66,7 @@ void mark_pareto(std::vector<BenchRow>& rows) {
 const char* results_csv_header() {
   return "scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,"
          "wall_ms,gpu_ms,rel_rmse,rel_rmse_raw,ref_noise_floor,rel_rmse_resolution,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,"
-         "error_image";
+         "error_image,path_spp";
 }
 
 void write_results_csv(const std::string& path, const std::vector<BenchRow>& rows, const std::vector<SceneReference>& refs) {
@@ -71,11 +77,11 @@ void write_results_csv(const std::string& path, const std::vector<BenchRow>& row
       for (const auto& s : refs) {
         if (s.scene == r.scene) ref = &s;
       }
-      std::fprintf(f, "%s,%s,%s,%.6g,%d,%d,%d,%.3g,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.6g,%s\n",
+      std::fprintf(f, "%s,%s,%s,%.6g,%d,%d,%d,%.3g,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.6g,%s,%d\n",
                    r.scene.c_str(), r.config.c_str(), kind_name(r.kind), r.view_step_m, r.knobs.sun_steps, r.knobs.octaves,
                    r.knobs.accumulate, r.knobs.resolution_scale, r.phase_hg ? "hg" : "mie", r.knobs.adaptive ? 1 : 0, r.wall_ms, r.gpu_ms,
                    r.err.rel_rmse, r.err.rel_rmse_raw, r.err.rel_noise_floor, r.err.rel_rmse_resolution, r.err.rel_bias, r.err.worst, r.err.psnr_db, r.pareto ? 1 : 0, ref ? ref->spp : 0,
-                   ref ? ref->mean_rel_stderr : 0.0, r.error_image.c_str());
+                   ref ? ref->mean_rel_stderr : 0.0, r.error_image.c_str(), r.spp);
     }
   });
 }
@@ -97,8 +103,11 @@ void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows
                  "worst = max |L - L_ref| / max L_ref; PSNR against max L_ref. Time = wall time per output image "
                  "(all its accumulated frames, read-back included), median of the repeats. `*` = on the Pareto front "
                  "(time, rel. RMSE) of all configurations. Plots: rel. RMSE (log, vertical, decades labelled eN) "
-                 "against wall ms (log, horizontal); blue = sweep, green = our presets, orange = seed presets, red = "
-                 "Pareto front.\n\n");
+                 "against wall ms (log, horizontal); blue = sweep, green = our presets, orange = seed presets, purple = "
+                 "the GPU path tracer (`render --quality reference`, full multiple scattering) at the samples per pixel "
+                 "its name gives, red = Pareto front of the march configurations. The path tracer's error is its own "
+                 "noise against the reference's (its paths use another seed, so the two share no random numbers); "
+                 "it is timed once, not over the repeats, and is no candidate for --budget-ms.\n\n");
     for (const auto& scene : scene_order(rows)) {
       auto list = rows_of(rows, scene);
       std::sort(list.begin(), list.end(), [](const BenchRow* a, const BenchRow* b) { return a->wall_ms < b->wall_ms; });
@@ -119,9 +128,13 @@ void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows
       std::fprintf(f, "| | config | kind | step m | sun | oct | acc | scale | phase | wall ms | GPU ms | rel. RMSE | raw | floor | bias | worst | PSNR dB |\n");
       std::fprintf(f, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
       for (const BenchRow* r : list) {
-        std::fprintf(f, "| %s | %s | %s | %.4g%s | %d | %d | %d | %.2g | %s | %.4g | %s | %s | %s | %s | %s | %s | %s |\n",
-                     r->pareto ? "*" : "", r->config.c_str(), kind_name(r->kind), r->view_step_m, r->knobs.adaptive ? " adapt." : "",
-                     r->knobs.sun_steps, r->knobs.octaves, r->knobs.accumulate, r->knobs.resolution_scale, r->phase_hg ? "HG" : "Mie", r->wall_ms,
+        const bool pt = r->kind == ConfigKind::PathTracer;
+        std::fprintf(f, "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %.4g | %s | %s | %s | %s | %s | %s | %s |\n",
+                     r->pareto ? "*" : "", r->config.c_str(), kind_name(r->kind),
+                     pt ? "-" : (num(r->view_step_m, "%.4g") + (r->knobs.adaptive ? " adapt." : "")).c_str(),
+                     pt ? "-" : std::to_string(r->knobs.sun_steps).c_str(), pt ? "-" : std::to_string(r->knobs.octaves).c_str(),
+                     pt ? (std::to_string(r->spp) + " spp").c_str() : std::to_string(r->knobs.accumulate).c_str(),
+                     pt ? "-" : num(r->knobs.resolution_scale, "%.2g").c_str(), r->phase_hg ? "HG" : "Mie", r->wall_ms,
                      r->gpu_ms > 0 ? num(r->gpu_ms, "%.4g").c_str() : "-",
                      r->err.rel_rmse < r->err.rel_rmse_resolution ? ("< " + num(r->err.rel_rmse_resolution)).c_str()
                                                                    : num(r->err.rel_rmse).c_str(),
@@ -131,7 +144,7 @@ void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows
       std::vector<bench::TimeError> ours_pts;
       const BenchRow* def = nullptr;
       for (const BenchRow* r : list) {
-        if (r->kind != ConfigKind::Seed) ours_pts.push_back({r->wall_ms, r->err.rel_rmse});
+        if (r->kind == ConfigKind::Sweep || r->kind == ConfigKind::Preset) ours_pts.push_back({r->wall_ms, r->err.rel_rmse});
         if (r->config == "default") def = r;
       }
       std::vector<bench::TimeError> front;
@@ -168,11 +181,16 @@ std::vector<std::string> write_plots(const std::string& dir, const std::vector<B
   for (const auto& scene : scene_order(rows)) {
     std::vector<bench::PlotPoint> pts;
     std::vector<bench::TimeError> te;
+    std::vector<std::size_t> te_at;  // te[k] is pts[te_at[k]]
     for (const BenchRow* r : rows_of(rows, scene)) {
       pts.push_back({{r->wall_ms, r->err.rel_rmse}, static_cast<int>(r->kind)});
+      if (r->kind == ConfigKind::PathTracer) continue;  // the front is the march configurations'
       te.push_back(pts.back().p);
+      te_at.push_back(pts.size() - 1);
     }
-    const auto img = bench::plot_error_vs_time(pts, bench::pareto_front(te), 320, 240);
+    std::vector<std::size_t> front;
+    for (std::size_t k : bench::pareto_front(te)) front.push_back(te_at[k]);
+    const auto img = bench::plot_error_vs_time(pts, front, 320, 240);
     const std::string name = scene + "_pareto.png";
     render::write_png(dir + "/" + name, img.width, img.height, img.rgb);
     out.push_back(name);

@@ -11,8 +11,14 @@
 
 namespace cv::cli {
 
-// Which family a configuration belongs to: our sweep, our named presets, a seed document's preset.
-enum class ConfigKind { Sweep = 0, Preset = 1, Seed = 2 };
+// Which family a configuration belongs to: our sweep, our named presets, a seed document's preset,
+// or the GPU path tracer (`--quality reference`) at a number of samples per pixel. The path tracer's
+// rows are measured and plotted beside the others, but they are not march settings: they stay off
+// the Pareto front of candidates that `render --budget-ms` and the viewer's frame budget choose from.
+enum class ConfigKind { Sweep = 0, Preset = 1, Seed = 2, PathTracer = 3 };
+
+// The kind as results.csv, summary.md and quality_front.json name it.
+const char* kind_name(ConfigKind k);
 
 struct BenchRow {
   std::string scene, config, description;
@@ -21,6 +27,7 @@ struct BenchRow {
   // The quality knobs (core/settings/quality_knobs.def), view_step_dz this scene's step / dz.
   core::QualityKnobs knobs;
   bool phase_hg = false;
+  int spp = 0;  // the path tracer's samples per pixel (ConfigKind::PathTracer), else 0
   double wall_ms = 0.0;  // median over repeats, per output image (all its accumulated frames)
   double gpu_ms = 0.0;   // median GL_TIME_ELAPSED; 0 when the driver reports none
   bench::ImageError err;
@@ -37,7 +44,8 @@ struct SceneReference {
   int cached_spp = 0;    // samples per pixel read from the cache
 };
 
-// Marks BenchRow::pareto on each scene's rows (by wall time and relative RMSE).
+// Marks BenchRow::pareto on each scene's rows (by wall time and relative RMSE), over the march
+// configurations (the path tracer's rows are never marked).
 void mark_pareto(std::vector<BenchRow>& rows);
 
 // The CSV header line (no newline), shared with the smoke test's expectation.

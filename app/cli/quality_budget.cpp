@@ -24,10 +24,6 @@ using bench::FrontConfig;
 // 960x540 candidate is then timed in a fraction of its own frame time).
 constexpr double kCalibrationPixels = 320.0 * 180.0;
 
-const char* kind_name(ConfigKind k) {
-  return k == ConfigKind::Seed ? "seed" : k == ConfigKind::Preset ? "preset" : "sweep";
-}
-
 }  // namespace
 
 void write_quality_front(const std::string& out_dir, const std::vector<BenchRow>& rows,
@@ -39,6 +35,7 @@ void write_quality_front(const std::string& out_dir, const std::vector<BenchRow>
   std::map<std::string, std::pair<double, int>>
       log_ratio;  // sum of log(view step / dz) and count, per config
   for (const BenchRow& r : rows) {
+    if (r.kind == ConfigKind::PathTracer) continue;  // not march settings: nothing a budget could apply
     auto [it, fresh] = index.emplace(r.config, front.configs.size());
     if (fresh) {
       FrontConfig c;

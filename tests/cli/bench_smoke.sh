@@ -2,34 +2,45 @@
 # Smoke test of `cloudviewer bench`: one scene, tiny size and spp, into a fresh folder; the CSV must
 # have the expected header and one row per configuration, the summary and plot must exist, and a
 # second run must reuse the cached reference. The quality front is written beside them and into the
-# per-user cache (here a folder of the run's own, so that a test never touches the real one).
+# per-user cache (here a folder of the run's own, so that a test never touches the real one). The
+# GPU path tracer's rows (--path-spp) are in the CSV and the plot, and never in the front.
 set -eu
 exe=$1 dir=$2
 rm -rf "$dir"
 XDG_CACHE_HOME=$dir/cache
 export XDG_CACHE_HOME
-"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --out "$dir"
-header='scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,wall_ms,gpu_ms,rel_rmse,rel_rmse_raw,ref_noise_floor,rel_rmse_resolution,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,error_image'
+"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --path-spp 1,4 --out "$dir"
+header='scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,wall_ms,gpu_ms,rel_rmse,rel_rmse_raw,ref_noise_floor,rel_rmse_resolution,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,error_image,path_spp'
 test "$(head -n 1 "$dir/results.csv")" = "$header" || { echo "bad header: $(head -n 1 "$dir/results.csv")"; exit 1; }
 rows=$(tail -n +2 "$dir/results.csv" | grep -c '^stratocumulus,')
-test "$rows" -eq 20 || { echo "expected 20 rows, found $rows"; exit 1; }
+test "$rows" -eq 22 || { echo "expected 22 rows, found $rows"; exit 1; }
+for n in 1 4; do
+  awk -F, -v n=$n '$2 == "path_" n "spp" && $3 == "path_tracer" && $20 == 0 && $24 == n { f = 1 } END { exit !f }' "$dir/results.csv" \
+    || { echo "no path tracer row at $n spp (kind path_tracer, off the front)"; exit 1; }
+  test -s "$dir/stratocumulus/err_path_${n}spp.png" || { echo "no error image of the path tracer at $n spp"; exit 1; }
+done
+# Unbiased, so more samples bring the error down (here 4x the samples: about half the error, far
+# from equal given 336 pixels).
+awk -F, '$2 == "path_1spp" { a = $13 } $2 == "path_4spp" { b = $13 } END { exit !(b < 0.8 * a) }' "$dir/results.csv" \
+  || { echo "the path tracer's error did not fall from 1 to 4 spp"; exit 1; }
+if grep -q '"name": "path_' "$dir/quality_front.json"; then echo "a path tracer row is in the quality front"; exit 1; fi
 for c in low default high costa2023 haggstrom2018 fordsung2024; do
   grep -q "^stratocumulus,$c," "$dir/results.csv" || { echo "no row for $c"; exit 1; }
 done
 test "$(awk -F, 'NR > 1 && $20 == 1' "$dir/results.csv" | wc -l)" -ge 1 || { echo "no configuration on the Pareto front"; exit 1; }
 test -s "$dir/summary.md" && test -s "$dir/stratocumulus_pareto.png" && test -s "$dir/stratocumulus/err_default.png"
 # (Output to a file first: grep -q on a pipe would end the run early by SIGPIPE.)
-"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --out "$dir" > "$dir/run2.txt"
+"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --path-spp none --out "$dir" > "$dir/run2.txt"
 grep -q 'holds 2 spp' "$dir/run2.txt" \
   || { echo "the second run did not reuse the cached reference"; exit 1; }
 grep -q '"format": "cloudviewer-quality-front"' "$dir/quality_front.json" || { echo "no quality_front.json"; exit 1; }
 grep -q '"candidate": true' "$dir/quality_front.json" || { echo "no candidate in quality_front.json"; exit 1; }
 cmp -s "$dir/quality_front.json" "$dir/cache/cloudviewer/quality_front.json" || { echo "the front was not cached"; exit 1; }
 rm "$dir/cache/cloudviewer/quality_front.json"
-"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --out "$dir" --no-cache >/dev/null
+"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --path-spp none --out "$dir" --no-cache >/dev/null
 test ! -e "$dir/cache/cloudviewer/quality_front.json" || { echo "--no-cache wrote the cache"; exit 1; }
 # A larger --reference-spp extends the cached reference instead of starting over.
-"$exe" bench stratocumulus --size 24x14 --reference-spp 3 --repeats 1 --out "$dir" > "$dir/run3.txt"
+"$exe" bench stratocumulus --size 24x14 --reference-spp 3 --repeats 1 --path-spp none --out "$dir" > "$dir/run3.txt"
 grep -q 'at 3 spp (1 new' "$dir/run3.txt" \
   || { echo "the third run did not extend the cached reference"; exit 1; }
 test "$(awk -F, 'NR == 2 { print $21 }' "$dir/results.csv")" = 3 || { echo "results.csv does not say 3 spp"; exit 1; }
