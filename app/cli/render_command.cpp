@@ -705,6 +705,11 @@ int cmd_render(const std::vector<std::string>& args) {
   }
   glFinish();
   const double t_upload = seconds_since(t0);
+  // The ground texture (the relief image and the shorelines rasterised into its water fraction):
+  // loaded once per process, so it is timed here and not as frame time.
+  t0 = clock::now();
+  if (!ra.reference) gpu.prepare_ground(frame.march);
+  const double t_ground = seconds_since(t0);
   scene.render.march.quality.view_step_m = frame.march.quality.view_step_m;
   if (ra.march_overridden) scene.render.quality = "custom";
   scene.camera = cam;
@@ -840,8 +845,8 @@ int cmd_render(const std::vector<std::string>& args) {
   // next to nothing; on a real GPU this is the march without queueing and read-back).
   if (gpu_s > 0.0) std::snprintf(gpu_text, sizeof gpu_text, "%.3f ms (GL timer query)", gpu_s * 1e3);
   else std::snprintf(gpu_text, sizeof gpu_text, "not reported by the driver");
-  std::printf("timings (%s):\n  load/import %.3f s\n  upload      %.3f s\n  march       %.3f s wall, GPU %s\n",
-              ctx->info().renderer.c_str(), t_load, t_upload, t_march, gpu_text);
+  std::printf("timings (%s):\n  load/import %.3f s\n  upload      %.3f s\n  ground      %.3f s\n  march       %.3f s wall, GPU %s\n",
+              ctx->info().renderer.c_str(), t_load, t_upload, t_ground, t_march, gpu_text);
   for (std::size_t i = 0; i < built.size(); ++i) {
     const std::size_t v = (built[i].mesh ? built[i].mesh->positions.size() : 0) + (built[i].view_mesh ? built[i].view_mesh->positions.size() : 0);
     const double draw = i < renderer.overlay_draw_ms().size() ? renderer.overlay_draw_ms()[i] : 0.0;

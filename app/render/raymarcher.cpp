@@ -154,13 +154,7 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
   volume_ = std::move(volume);
 }
 
-// The march kernel's inputs for a frame, shared by the march and the path tracer: the ground
-// texture (loaded once per path and model), the parameters packed into the uniform block, the
-// two-stream source when it is used, the noise, the pyramid, the counters and the textures bound.
-kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
-                                               const OpaqueInput& opaque) {
-  const core::PreparedVolume& v = *volume_;
-  const core::VolumeGrid& grid = v.grid;
+bool GpuRaymarcher::prepare_ground(const core::MarchSettings& s) {
   const bool textured = s.features.globe && !s.medium.ground_texture.empty();
   if (textured && (s.medium.ground_texture != ground_path_ || s.medium.ground_map_colours != ground_map_colours_)) {
     const core::AlbedoMap map = load_albedo_map(s.medium.ground_texture, s.medium.ground_map_colours);
@@ -175,6 +169,17 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
     ground_path_ = s.medium.ground_texture;
     ground_map_colours_ = s.medium.ground_map_colours;
   }
+  return textured;
+}
+
+// The march kernel's inputs for a frame, shared by the march and the path tracer: the ground
+// texture (loaded once per path and model), the parameters packed into the uniform block, the
+// two-stream source when it is used, the noise, the pyramid, the counters and the textures bound.
+kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const core::Sun& sun, const core::MarchSettings& s,
+                                               const OpaqueInput& opaque) {
+  const core::PreparedVolume& v = *volume_;
+  const core::VolumeGrid& grid = v.grid;
+  const bool textured = prepare_ground(s);
   // The kernel's parameters, built as the CPU kernel builds them, packed into the uniform block.
   kernel::MarchParams params =
       core::march_params(v, cam, sun, s, textured ? glm::ivec2(ground_w_, ground_h_) : glm::ivec2(0));

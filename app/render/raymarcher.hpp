@@ -120,6 +120,13 @@ class GpuRaymarcher {
   // before a render with settings.noise_amount > 0, not done otherwise.
   void upload_noise(const core::ErosionNoise& noise);
 
+  // Loads and uploads the ground texture the settings name (globe on and a ground_texture), unless
+  // it is the one already uploaded; returns whether the frame is textured. A render does this
+  // itself; a caller that times its frames calls it first, so that the one-time load (the image,
+  // and the GSHHS shorelines rasterised into the water fraction) is not counted as frame time.
+  // A file that cannot be read throws GroundImageError.
+  bool prepare_ground(const core::MarchSettings& settings);
+
   // Renders: rgb = radiance, a = view transmittance (0 where the globe shows), rows top to bottom.
   // With noise_amount 0 the program without the noise code runs and the noise textures are not
   // bound. With settings.globe and a ground_texture, the image is loaded (once per path and ground
