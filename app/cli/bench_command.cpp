@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -49,6 +50,9 @@ struct BenchArgs {
   bool cache = true;  // copy quality_front.json to the per-user cache
   // The GPU path tracer's rows: one per count of samples per pixel (empty: none).
   std::vector<int> path_spp = {1, 4, 16};
+  // Frame times only: no reference, no error, no front (scripts/bench-gpu at 1920x1080, where a
+  // Monte Carlo reference on the CPU would take hours).
+  bool timing_only = false;
 };
 
 // "1,4,16" (each in 1..65536, increasing) or "none".
@@ -100,6 +104,7 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
     else if (s == "--out") a.out = next();
     else if (s == "--no-cache") a.cache = false;
     else if (s == "--path-spp") a.path_spp = parse_spp_list(next());
+    else if (s == "--timing-only") a.timing_only = true;
     else if (s == "--size") {
       const std::string v = next();
       const auto x = v.find('x');
@@ -108,7 +113,7 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
       a.height = parse_int("--size", v.substr(x + 1), 8, 4096, "WxH with each in 8..4096");
     } else if (!s.empty() && s[0] == '-') {
       throw UsageError{"cloudviewer bench: unknown option '" + s +
-                       "', expected --reference-spp, --reference-error, --size, --repeats, --path-spp, --out or --no-cache"};
+                       "', expected --reference-spp, --reference-error, --size, --repeats, --path-spp, --timing-only, --out or --no-cache"};
     } else if (std::find(known.begin(), known.end(), s) == known.end()) {
       std::string names;
       for (const auto& n : known) names += (names.empty() ? "" : ", ") + n;
@@ -274,12 +279,14 @@ double median(std::vector<double> v) {
 
 const char* bench_usage() {
   return "  bench [SCENE...] [--reference-spp N] [--reference-error E] [--size WxH] [--repeats R] [--path-spp LIST]\n"
-         "        [--out DIR] [--no-cache]\n"
+         "        [--timing-only] [--out DIR] [--no-cache]\n"
          "                           error against run time on the standard scenes (default all, 96x54, 64 spp,\n"
          "                           3 repeats, into bench_out): results.csv, summary.md, plots and error images,\n"
          "                           the march's quality sweep, presets and the seed documents' methods, and the\n"
          "                           GPU path tracer at each of --path-spp samples per pixel (default 1,4,16;\n"
          "                           none: left out; timed once; never a --budget-ms candidate),\n"
+         "                           --timing-only: frame times (wall and GL timer) without references or errors,\n"
+         "                           the path tracer with its own relative standard error; no front is written,\n"
          "                           quality_front.json (also cached per user for --budget-ms unless --no-cache).\n"
          "                           References are cached in DIR with their sums: a larger N extends them, an\n"
          "                           interrupted one resumes; --reference-error stops one early at that mean\n"
@@ -312,63 +319,80 @@ int cmd_bench(const std::vector<std::string>& args) {
     base.features.atmosphere = base.features.globe = false;
     base.medium.ambient = 0.0, base.medium.noise_amount = 0.0;
     if (!(base.medium.droplet_diameter_um > 0.0)) base.medium.droplet_diameter_um = 20.0;
+    const core::MonteCarloSettings mc;
+    std::vector<glm::dvec3> ref_rgb;  // the reference's mean and variance per pixel (none with --timing-only)
+    std::vector<double> ref_var;
     // The reference: cached by scene, size and a hash of what decides it, with its running sums, so
     // a later run with more samples (or one resumed after an interruption) extends it.
-    const core::MonteCarloSettings mc;
-    const std::uint64_t key = bench::reference_key_hash(reference_key(sc, medium, base, mc));
-    char hash[20];
-    std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(key));
-    SceneReference ref{name, "ref_" + name + "_" + std::to_string(a.width) + "x" + std::to_string(a.height) + "_" + hash + ".cvref",
-                       a.spp, 0.0, false, 0.0};
-    const fs::path ref_path = fs::path(a.out) / ref.file;
-    const core::MonteCarloRenderer mcr(sc.grid, medium, sc.camera, sc.sun, base, mc);
-    core::MonteCarloImage img = mcr.start();
-    std::string why;
-    if (bench::read_reference_cache(ref_path.string(), key, a.width, a.height, img, &why)) {
-      std::printf("%s: reference %s holds %llu spp (mean relative standard error %.3g)\n", name.c_str(), ref_path.c_str(),
-                  static_cast<unsigned long long>(img.spp), img.mean_relative_standard_error());
-    } else if (why != "no file") {
-      std::printf("%s: not using %s (%s): rendering it afresh\n", name.c_str(), ref_path.c_str(), why.c_str());
+    if (!a.timing_only) {
+      const std::uint64_t key = bench::reference_key_hash(reference_key(sc, medium, base, mc));
+      char hash[20];
+      std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(key));
+      SceneReference ref{name, "ref_" + name + "_" + std::to_string(a.width) + "x" + std::to_string(a.height) + "_" + hash + ".cvref",
+                         a.spp, 0.0, false, 0.0};
+      const fs::path ref_path = fs::path(a.out) / ref.file;
+      const core::MonteCarloRenderer mcr(sc.grid, medium, sc.camera, sc.sun, base, mc);
+      core::MonteCarloImage img = mcr.start();
+      std::string why;
+      if (bench::read_reference_cache(ref_path.string(), key, a.width, a.height, img, &why)) {
+        std::printf("%s: reference %s holds %llu spp (mean relative standard error %.3g)\n", name.c_str(), ref_path.c_str(),
+                    static_cast<unsigned long long>(img.spp), img.mean_relative_standard_error());
+      } else if (why != "no file") {
+        std::printf("%s: not using %s (%s): rendering it afresh\n", name.c_str(), ref_path.c_str(), why.c_str());
+      }
+      const std::uint64_t cached_spp = img.spp;
+      auto converged = [&] {
+        return img.spp >= static_cast<std::uint64_t>(a.spp) ||
+               (a.ref_error > 0.0 && img.spp >= 16 && img.mean_relative_standard_error() <= a.ref_error);
+      };
+      const auto t0 = clock::now();
+      int chunk = 1;  // grows so that each chunk takes about 10 s; every chunk is saved
+      while (!converged()) {
+        const int n = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(chunk), a.spp - img.spp));
+        const auto tc = clock::now();
+        mcr.add_samples(img, n);
+        const double dt = seconds_since(tc);
+        bench::write_reference_cache(ref_path.string(), key, img);
+        const double per_spp = dt / n;
+        chunk = static_cast<int>(std::clamp(10.0 / std::max(per_spp, 1e-6), 1.0, 4.0 * n));
+        std::printf("\r%s: Monte Carlo reference %llu/%d spp, mean rel. s.e. %.3g, %.0f s, about %.0f s to go   ",
+                    name.c_str(), static_cast<unsigned long long>(img.spp), a.spp, img.mean_relative_standard_error(),
+                    seconds_since(t0), per_spp * static_cast<double>(a.spp - img.spp));
+        std::fflush(stdout);
+      }
+      if (img.spp > cached_spp) {
+        ref.seconds = seconds_since(t0);
+        std::printf("\n%s: reference at %llu spp (%llu new, %.1f s), mean relative standard error %.3g, saved in %s\n",
+                    name.c_str(), static_cast<unsigned long long>(img.spp),
+                    static_cast<unsigned long long>(img.spp - cached_spp), ref.seconds, img.mean_relative_standard_error(),
+                    ref_path.c_str());
+      }
+      ref.cached = cached_spp > 0;
+      ref.cached_spp = static_cast<int>(cached_spp);
+      ref.spp = static_cast<int>(img.spp);
+      ref.mean_rel_stderr = img.mean_relative_standard_error();
+      ref_rgb = img.radiance();
+      ref_var.assign(ref_rgb.size(), 0.0);
+      for (std::size_t i = 0; i < ref_var.size(); ++i) {
+        const double se = img.luminance_standard_error(i);
+        ref_var[i] = std::isfinite(se) ? se * se : 0.0;
+      }
+      refs.push_back(ref);
     }
-    const std::uint64_t cached_spp = img.spp;
-    auto converged = [&] {
-      return img.spp >= static_cast<std::uint64_t>(a.spp) ||
-             (a.ref_error > 0.0 && img.spp >= 16 && img.mean_relative_standard_error() <= a.ref_error);
-    };
-    const auto t0 = clock::now();
-    int chunk = 1;  // grows so that each chunk takes about 10 s; every chunk is saved
-    while (!converged()) {
-      const int n = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(chunk), a.spp - img.spp));
-      const auto tc = clock::now();
-      mcr.add_samples(img, n);
-      const double dt = seconds_since(tc);
-      bench::write_reference_cache(ref_path.string(), key, img);
-      const double per_spp = dt / n;
-      chunk = static_cast<int>(std::clamp(10.0 / std::max(per_spp, 1e-6), 1.0, 4.0 * n));
-      std::printf("\r%s: Monte Carlo reference %llu/%d spp, mean rel. s.e. %.3g, %.0f s, about %.0f s to go   ",
-                  name.c_str(), static_cast<unsigned long long>(img.spp), a.spp, img.mean_relative_standard_error(),
-                  seconds_since(t0), per_spp * static_cast<double>(a.spp - img.spp));
-      std::fflush(stdout);
-    }
-    if (img.spp > cached_spp) {
-      ref.seconds = seconds_since(t0);
-      std::printf("\n%s: reference at %llu spp (%llu new, %.1f s), mean relative standard error %.3g, saved in %s\n",
-                  name.c_str(), static_cast<unsigned long long>(img.spp),
-                  static_cast<unsigned long long>(img.spp - cached_spp), ref.seconds, img.mean_relative_standard_error(),
-                  ref_path.c_str());
-    }
-    ref.cached = cached_spp > 0;
-    ref.cached_spp = static_cast<int>(cached_spp);
-    ref.spp = static_cast<int>(img.spp);
-    ref.mean_rel_stderr = img.mean_relative_standard_error();
-    const std::vector<glm::dvec3> ref_rgb = img.radiance();
-    std::vector<double> ref_var(ref_rgb.size());
-    for (std::size_t i = 0; i < ref_var.size(); ++i) {
-      const double se = img.luminance_standard_error(i);
-      ref_var[i] = std::isfinite(se) ? se * se : 0.0;
-    }
-    refs.push_back(ref);
     fs::create_directories(fs::path(a.out) / name);
+    // The row's error against the reference and its error image; with --timing-only, none (NaN).
+    auto set_error = [&](BenchRow& row, const std::string& image, const std::vector<glm::dvec3>& rgb) {
+      if (a.timing_only) {
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        row.err.rel_rmse = row.err.rel_rmse_raw = row.err.rel_noise_floor = row.err.rel_rmse_resolution = nan;
+        row.err.rel_bias = row.err.worst = row.err.psnr_db = nan;
+        return;
+      }
+      row.err = bench::image_error(rgb, ref_rgb, ref_var);
+      row.error_image = image;
+      render::write_png((fs::path(a.out) / row.error_image).string(), a.width, a.height,
+                        error_png(bench::pixel_error(rgb, ref_rgb)));
+    };
     const auto prepared = std::make_shared<const core::PreparedVolume>(core::prepare_volume(sc.grid, medium));
     renderer.use_volume(prepared);
     const auto configs = make_configs(sc, base, prepared->layer);
@@ -412,10 +436,7 @@ int cmd_bench(const std::vector<std::string>& args) {
       row.knobs = core::knobs_of(marched, c.march.quality.view_step_m, sc.grid.alt_m.step);
       row.phase_hg = c.march.medium.liquid_phase_hg;
       row.wall_ms = median(wall), row.gpu_ms = median(gpu_t);
-      row.err = bench::image_error(rgb, ref_rgb, ref_var);
-      row.error_image = name + "/err_" + c.name + ".png";
-      render::write_png((fs::path(a.out) / row.error_image).string(), a.width, a.height,
-                        error_png(bench::pixel_error(rgb, ref_rgb)));
+      set_error(row, name + "/err_" + c.name + ".png", rgb);
       std::printf("%s [%zu/%zu] %-22s %8.2f ms  rel. RMSE %-9.3g (raw %-9.3g) bias %+-9.3g worst %-8.3g PSNR %.1f dB\n",
                   name.c_str(), ci + 1, configs.size(), c.name.c_str(), row.wall_ms, row.err.rel_rmse, row.err.rel_rmse_raw,
                   row.err.rel_bias, row.err.worst, row.err.psnr_db);
@@ -447,22 +468,26 @@ int cmd_bench(const std::vector<std::string>& args) {
       row.spp = spp;
       row.wall_ms = seconds_since(t0) * 1e3;
       const std::vector<glm::dvec3> rgb = img.radiance();
-      row.err = bench::image_error(rgb, ref_rgb, ref_var);
-      row.error_image = name + "/err_" + row.config + ".png";
-      render::write_png((fs::path(a.out) / row.error_image).string(), a.width, a.height,
-                        error_png(bench::pixel_error(rgb, ref_rgb)));
-      std::printf("%s [path %zu/%zu] %-17s %8.2f ms  rel. RMSE %-9.3g (raw %-9.3g) bias %+-9.3g worst %-8.3g PSNR %.1f dB\n",
+      set_error(row, name + "/err_" + row.config + ".png", rgb);
+      row.own_rel_stderr = img.mean_relative_standard_error();
+      std::printf("%s [path %zu/%zu] %-17s %8.2f ms  rel. RMSE %-9.3g (raw %-9.3g) bias %+-9.3g worst %-8.3g PSNR %.1f dB, "
+                  "own mean rel. s.e. %.3g\n",
                   name.c_str(), k + 1, a.path_spp.size(), row.config.c_str(), row.wall_ms, row.err.rel_rmse,
-                  row.err.rel_rmse_raw, row.err.rel_bias, row.err.worst, row.err.psnr_db);
+                  row.err.rel_rmse_raw, row.err.rel_bias, row.err.worst, row.err.psnr_db, row.own_rel_stderr);
       std::fflush(stdout);
       rows.push_back(row);
     }
   }
-  mark_pareto(rows);
+  if (!a.timing_only) mark_pareto(rows);
   std::string command = "cloudviewer bench";
   for (const auto& s : args) command += " " + s;
   write_results_csv((fs::path(a.out) / "results.csv").string(), rows, refs);
   write_summary_md((fs::path(a.out) / "summary.md").string(), rows, refs, command, machine);
+  if (a.timing_only) {
+    std::printf("wrote %s/results.csv (%zu rows) and %s/summary.md (frame times only: no reference, no error, no front)\n",
+                a.out.c_str(), rows.size(), a.out.c_str());
+    return 0;
+  }
   const auto plots = write_plots(a.out, rows);
   write_quality_front(a.out, rows, dz_by_scene, render::machine_id(ctx->info()), a.width, a.height, command, a.cache);
   std::printf("wrote %s/results.csv (%zu rows), %s/summary.md and %zu plot(s)\n", a.out.c_str(), rows.size(), a.out.c_str(),

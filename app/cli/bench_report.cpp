@@ -66,7 +66,7 @@ void mark_pareto(std::vector<BenchRow>& rows) {
 const char* results_csv_header() {
   return "scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,"
          "wall_ms,gpu_ms,rel_rmse,rel_rmse_raw,ref_noise_floor,rel_rmse_resolution,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,"
-         "error_image,path_spp";
+         "error_image,path_spp,path_rel_stderr";
 }
 
 void write_results_csv(const std::string& path, const std::vector<BenchRow>& rows, const std::vector<SceneReference>& refs) {
@@ -77,11 +77,11 @@ void write_results_csv(const std::string& path, const std::vector<BenchRow>& row
       for (const auto& s : refs) {
         if (s.scene == r.scene) ref = &s;
       }
-      std::fprintf(f, "%s,%s,%s,%.6g,%d,%d,%d,%.3g,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.6g,%s,%d\n",
+      std::fprintf(f, "%s,%s,%s,%.6g,%d,%d,%d,%.3g,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.6g,%s,%d,%.6g\n",
                    r.scene.c_str(), r.config.c_str(), kind_name(r.kind), r.view_step_m, r.knobs.sun_steps, r.knobs.octaves,
                    r.knobs.accumulate, r.knobs.resolution_scale, r.phase_hg ? "hg" : "mie", r.knobs.adaptive ? 1 : 0, r.wall_ms, r.gpu_ms,
                    r.err.rel_rmse, r.err.rel_rmse_raw, r.err.rel_noise_floor, r.err.rel_rmse_resolution, r.err.rel_bias, r.err.worst, r.err.psnr_db, r.pareto ? 1 : 0, ref ? ref->spp : 0,
-                   ref ? ref->mean_rel_stderr : 0.0, r.error_image.c_str(), r.spp);
+                   ref ? ref->mean_rel_stderr : 0.0, r.error_image.c_str(), r.spp, r.own_rel_stderr);
     }
   });
 }
@@ -90,6 +90,12 @@ void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows
                       const std::string& command, const std::string& machine) {
   core::write_file_atomically(path, [&](std::FILE* f) {
     std::fprintf(f, "# cloudviewer bench\n\nCommand: `%s`\n\nMachine: %s\n\n", command.c_str(), machine.c_str());
+    const bool timing_only = refs.empty();  // --timing-only: no reference was rendered
+    if (timing_only) {
+      std::fprintf(f, "Frame times only (`--timing-only`): no reference, so no error, no Pareto front and no plots. For the "
+                      "path tracer, `own s.e.` is its own mean relative standard error (its noise, which falls as "
+                      "1/sqrt(spp)).\n\n");
+    }
     std::fprintf(f,
                  "Error = luminance against a Monte Carlo reference with full multiple scattering (clouds only: no air, "
                  "no globe, no ambient light), so it includes the octave approximation's bias, not only the step "
@@ -139,6 +145,14 @@ void write_summary_md(const std::string& path, const std::vector<BenchRow>& rows
                      r->err.rel_rmse < r->err.rel_rmse_resolution ? ("< " + num(r->err.rel_rmse_resolution)).c_str()
                                                                    : num(r->err.rel_rmse).c_str(),
                      num(r->err.rel_rmse_raw).c_str(), num(r->err.rel_noise_floor).c_str(), num(r->err.rel_bias, "%+.3g").c_str(), num(r->err.worst).c_str(), num(r->err.psnr_db, "%.1f").c_str());
+      }
+      if (timing_only) {
+        std::fprintf(f, "\n| path tracer | spp | wall ms | own s.e. |\n|---|---|---|---|\n");
+        for (const BenchRow* r : list) {
+          if (r->kind == ConfigKind::PathTracer) std::fprintf(f, "| %s | %d | %.4g | %s |\n", r->config.c_str(), r->spp, r->wall_ms, num(r->own_rel_stderr).c_str());
+        }
+        std::fprintf(f, "\n");
+        continue;
       }
       // Ratios: our configurations' own front (sweep and presets, no seed) interpolated in log-log.
       std::vector<bench::TimeError> ours_pts;

@@ -28,6 +28,7 @@ struct BenchRow {
   core::QualityKnobs knobs;
   bool phase_hg = false;
   int spp = 0;  // the path tracer's samples per pixel (ConfigKind::PathTracer), else 0
+  double own_rel_stderr = 0.0;  // the path tracer's own mean relative standard error (its noise), else 0
   double wall_ms = 0.0;  // median over repeats, per output image (all its accumulated frames)
   double gpu_ms = 0.0;   // median GL_TIME_ELAPSED; 0 when the driver reports none
   bench::ImageError err;

@@ -10,7 +10,7 @@ rm -rf "$dir"
 XDG_CACHE_HOME=$dir/cache
 export XDG_CACHE_HOME
 "$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --path-spp 1,4 --out "$dir"
-header='scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,wall_ms,gpu_ms,rel_rmse,rel_rmse_raw,ref_noise_floor,rel_rmse_resolution,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,error_image,path_spp'
+header='scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,wall_ms,gpu_ms,rel_rmse,rel_rmse_raw,ref_noise_floor,rel_rmse_resolution,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,error_image,path_spp,path_rel_stderr'
 test "$(head -n 1 "$dir/results.csv")" = "$header" || { echo "bad header: $(head -n 1 "$dir/results.csv")"; exit 1; }
 rows=$(tail -n +2 "$dir/results.csv" | grep -c '^stratocumulus,')
 test "$rows" -eq 22 || { echo "expected 22 rows, found $rows"; exit 1; }
@@ -44,4 +44,11 @@ test ! -e "$dir/cache/cloudviewer/quality_front.json" || { echo "--no-cache wrot
 grep -q 'at 3 spp (1 new' "$dir/run3.txt" \
   || { echo "the third run did not extend the cached reference"; exit 1; }
 test "$(awk -F, 'NR == 2 { print $21 }' "$dir/results.csv")" = 3 || { echo "results.csv does not say 3 spp"; exit 1; }
+# --timing-only: frame times without a reference (no error, no front, no plots); the path tracer
+# with its own noise estimate.
+"$exe" bench stratocumulus --size 24x14 --repeats 1 --path-spp 2 --timing-only --out "$dir/timing" --no-cache > "$dir/run4.txt"
+test "$(tail -n +2 "$dir/timing/results.csv" | grep -c '^stratocumulus,')" -eq 21 || { echo "timing only: expected 21 rows"; exit 1; }
+test ! -e "$dir/timing/quality_front.json" && test ! -e "$dir/timing/stratocumulus_pareto.png" || { echo "timing only wrote a front or a plot"; exit 1; }
+awk -F, '$2 == "default" && $13 == "nan" && $11 > 0 { f = 1 } END { exit !f }' "$dir/timing/results.csv" || { echo "timing only: the default row has an error or no time"; exit 1; }
+awk -F, '$2 == "path_2spp" && $25 > 0 && $25 < 1e300 { f = 1 } END { exit !f }' "$dir/timing/results.csv" || { echo "timing only: no noise estimate of the path tracer"; exit 1; }
 echo "bench smoke: $rows rows"
