@@ -19,6 +19,7 @@
 #include "importer.hpp"
 #include "kernel/prepared_volume.hpp"
 #include "overlays/overlays.hpp"
+#include "physics/physics.hpp"
 #include "reference/raymarcher.hpp"
 #include "render/context.hpp"
 #include "render/frame_renderer.hpp"
@@ -445,6 +446,47 @@ TEST(Coastlines, AVertexLandsOnThePixelTheProjectionGives) {
     }
     EXPECT_EQ(gpu_only, 0) << view.name << ": GPU pixels more than a pixel from the CPU's cast of the same lines";
   }
+}
+
+// The coastlines lie on the renderer's globe as the ground and the clouds do: geodetic latitude and
+// longitude placed as the sphere's own (the march's ground lookup inverts a point with the shared
+// ecef_to_sphere and reads the equirectangular texel there; the importers place the clouds' columns
+// by the same latitudes). A GSHHG vertex of Iceland's shore, taken from the built mesh and inverted
+// by the march's own functions (compiled in double), lands on the texel its latitude and longitude
+// name. Put on the WGS84 ellipsoid instead, it would land 0.15 degrees (17 km) south of that
+// texel's coast on this globe.
+TEST(Coastlines, AVertexLiesOnTheTexelTheGroundLookupGivesItsLatLon) {
+  double best = 1e9, lat = 0.0, lon = 0.0;
+  for (const auto& line : overlays::read_gshhg_lines(overlays::GshhgFeature::Shore, 'c', "", {})) {
+    for (const glm::dvec2& p : line) {
+      const double dd = std::hypot(p.y - 64.1, (p.x + 21.9) * std::cos(64.1 * 3.14159265358979 / 180.0));
+      if (dd < best) best = dd, lon = p.x, lat = p.y;
+    }
+  }
+  ASSERT_LT(best, 1.0) << "no Icelandic vertex in the crude GSHHG shorelines";
+  const double r0 = 6371000.0, kRad = 3.14159265358979323846 / 180.0;
+  const core::OverlayMesh coast = overlays::build_coastlines(overlays::kGshhgDir, 'c', r0, glm::vec4(1.0f));
+  const glm::dvec3 v = geo::sphere_to_ecef({lat, lon, 0.0}, r0);
+  std::size_t vi = coast.positions.size();
+  for (std::size_t i = 0; i < coast.positions.size(); ++i) {
+    if (glm::length(coast.positions[i] - v) < 0.1) vi = i;  // lifted by 8 cm at most (2 km chords)
+  }
+  ASSERT_LT(vi, coast.positions.size()) << "the vertex " << lat << ", " << lon << " is not in the mesh";
+  // The march's inverse (shaders/common/geodesy.glsl) and texel lookup (ground.glsl), in double.
+  const glm::dvec3 g = physics::f64::ecef_to_sphere(coast.positions[vi], r0);
+  EXPECT_NEAR(g.x / kRad, lat, 1e-9);
+  EXPECT_NEAR(g.y / kRad, lon, 1e-9);
+  EXPECT_LT(g.z, 0.1);  // on the ground (the lift of its chords)
+  const int w = 8192, h = 4096;  // a fine ground image: 0.044 degrees a texel
+  const glm::dvec4 at_vertex = physics::f64::equirect_texel(g.x, g.y, w, h);
+  const glm::dvec4 at_latlon = physics::f64::equirect_texel(lat * kRad, lon * kRad, w, h);
+  EXPECT_NEAR(at_vertex.x + at_vertex.z, at_latlon.x + at_latlon.z, 1e-6) << "texels across";
+  EXPECT_NEAR(at_vertex.y + at_vertex.w, at_latlon.y + at_latlon.w, 1e-6) << "texels down";
+  // The ellipsoid's point for the same latitude, inverted the same way: its geocentric latitude,
+  // 3.4 texels away. The test tells the two mappings apart.
+  const glm::dvec3 e = physics::f64::ecef_to_sphere(geo::wgs84_to_ecef({lat, lon, 0.0}), r0);
+  const glm::dvec4 at_ellipsoid = physics::f64::equirect_texel(e.x, e.y, w, h);
+  EXPECT_GT(std::abs(at_ellipsoid.y + at_ellipsoid.w - (at_latlon.y + at_latlon.w)), 3.0) << "texels down";
 }
 
 TEST(GraticuleLabels, StrokesStandBesideTheirCrossingsInTheImage) {
