@@ -400,6 +400,9 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   alloc(core::Field::WindV, have[static_cast<int>(Role::V)]);
   alloc(core::Field::WindW, have[static_cast<int>(Role::Omega)] || have[static_cast<int>(Role::UpwardVelocity)]);
   alloc(core::Field::Temperature, true);
+  // Pressure where the file gives it (its pressure levels, or hybrid levels with the surface
+  // pressure); on height levels it would be the standard atmosphere's, so it is not stored.
+  alloc(core::Field::Pressure, L.vertical_kind != Vertical::Height);
 
   ConversionOptions conv{S.options.r_eff_liquid_um, S.options.r_eff_ice_um};
   // A latitude row at a time, levels outer and longitudes inner: the slabs are read along their
@@ -884,6 +887,7 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
   vol.has_field[static_cast<int>(core::Field::WindW)] =
       L.roles[static_cast<int>(Role::Omega)] != nullptr || L.roles[static_cast<int>(Role::UpwardVelocity)] != nullptr;
   vol.has_field[static_cast<int>(core::Field::Temperature)] = true;
+  vol.has_field[static_cast<int>(core::Field::Pressure)] = L.vertical_kind != Vertical::Height;
   if (!L.roles[static_cast<int>(Role::CloudFraction)] && !S->diagnose) {
     vol.report.notes.push_back("no cloud fraction: water is taken as covering whole grid boxes");
   }

@@ -72,6 +72,8 @@ void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, i
     q(static_cast<int>(core::Field::WindV))[l] = s.v;
     q(static_cast<int>(core::Field::WindW))[l] = s.w;
     q(static_cast<int>(core::Field::Temperature))[l] = s.t_k;
+    // Pressure is interpolated in its logarithm (exact in an isothermal layer), turned back below.
+    q(static_cast<int>(core::Field::Pressure))[l] = s.p_pa > 0.0 ? std::log(s.p_pa) : kNaN;
   }
   for (int l = 1; l < n; ++l) {
     if (!(levels[static_cast<std::size_t>(l)].z_m > levels[static_cast<std::size_t>(l - 1)].z_m)) ++counts.nonmonotonic;
@@ -115,6 +117,7 @@ void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, i
         const double cf = qcf[lz - 1] + a * (qcf[lz] - qcf[lz - 1]);
         if (!std::isnan(cf)) v = v > 0.0 && cf > 0.0 ? v / cf : (std::isnan(v) ? v : 0.0);
       }
+      if (f == static_cast<int>(core::Field::Pressure)) v = std::exp(v);
       dst[p0 + static_cast<std::size_t>(z) * layer] = static_cast<float>(v);
     }
   }

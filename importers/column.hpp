@@ -1,6 +1,6 @@
 // The physics of the conversion, shared by every reader: one model column (levels bottom to top,
-// grid-box-mean water) becomes in-cloud extinction, cloud fraction, winds and temperature on the
-// volume's altitude grid, with the consistency counts the import report needs.
+// grid-box-mean water) becomes in-cloud extinction, cloud fraction, winds, temperature and pressure
+// on the volume's altitude grid, with the consistency counts the import report needs.
 #pragma once
 
 #include <limits>

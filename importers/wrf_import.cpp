@@ -326,6 +326,7 @@ void load_wrf_step(const WrfSource& S, const core::VolumeGrid& grid, std::size_t
   alloc(core::Field::WindV, u.present && v.present);
   alloc(core::Field::WindW, w.present);
   alloc(core::Field::Temperature, true);
+  alloc(core::Field::Pressure, true);  // P + PB
   out.ground_m.assign(grid.columns(), std::numeric_limits<float>::quiet_NaN());
   // A moving nest: this step's own grid.
   std::vector<Sample> own;
@@ -622,6 +623,7 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
   vol.has_field[static_cast<int>(core::Field::WindV)] = vol.has_field[static_cast<int>(core::Field::WindU)];
   vol.has_field[static_cast<int>(core::Field::WindW)] = f.find("W") != nullptr;
   vol.has_field[static_cast<int>(core::Field::Temperature)] = true;
+  vol.has_field[static_cast<int>(core::Field::Pressure)] = true;
   vol.has_ground = true;
   vol.report.notes.push_back("low/mid/high cover by height above the ground ((PH + PHB) / g at the lowest staggered level)");
   if (!f.find("QCLOUD") && !f.find("QICE") && !f.find("QSNOW") && !f.find("CLDFRA")) {

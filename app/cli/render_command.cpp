@@ -850,8 +850,13 @@ int cmd_render(const std::vector<std::string>& args) {
   for (std::size_t i = 0; i < built.size(); ++i) {
     const std::size_t v = (built[i].mesh ? built[i].mesh->positions.size() : 0) + (built[i].view_mesh ? built[i].view_mesh->positions.size() : 0);
     const double draw = i < renderer.overlay_draw_ms().size() ? renderer.overlay_draw_ms()[i] : 0.0;
-    std::printf("  overlay %-11s build %.3f s, draw %.3f s (%zu vertices; the draw is inside the march's wall time)\n",
-                built[i].name.c_str(), built[i].build_ms * 1e-3, draw * 1e-3, v);
+    const std::size_t instances = built[i].mesh ? built[i].mesh->instances.count() : 0;
+    char inst[96] = "";
+    if (instances > 0) {
+      std::snprintf(inst, sizeof inst, ", %zu instances of a %zu-vertex glyph", instances, built[i].mesh->instances.glyph_positions.size());
+    }
+    std::printf("  overlay %-11s build %.3f s, draw %.3f s (%zu vertices%s; the draw is inside the march's wall time)\n",
+                built[i].name.c_str(), built[i].build_ms * 1e-3, draw * 1e-3, v, inst);
   }
   std::printf("  composite/tonemap %.3f s\n  write       %.3f s\n", t_tone, t_write);
   std::printf("wrote %s%s\n", ra.out.c_str(),

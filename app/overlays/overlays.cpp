@@ -11,6 +11,7 @@
 
 #include <glm/glm.hpp>
 
+#include <vtkArrowSource.h>
 #include <vtkCellArray.h>
 #include <vtkCleanPolyData.h>
 #include <vtkFloatArray.h>
@@ -26,6 +27,7 @@
 #include <vtkPolyData.h>
 #include <vtkRungeKutta45.h>
 #include <vtkStreamTracer.h>
+#include <vtkTriangleFilter.h>
 #include <vtkSmartPointer.h>
 
 #include "geo/geodesy.hpp"
@@ -117,7 +119,13 @@ void check_overlays(const std::vector<core::OverlaySpec>& specs, const core::Clo
       const core::OverlaySpec& o = specs[i];
       volume_field(volume, o.text("field"), at + ".field");
       const std::string& kind = o.text("kind");
-      if (kind != "horizontal" && kind != "vertical") throw OverlayError(at + ".kind: found \"" + kind + "\", expected horizontal or vertical");
+      if (kind != "horizontal" && kind != "isobaric" && kind != "vertical") {
+        throw OverlayError(at + ".kind: found \"" + kind + "\", expected horizontal, isobaric or vertical");
+      }
+      if (kind == "isobaric" && !volume.has_field[static_cast<std::size_t>(core::Field::Pressure)]) {
+        throw OverlayError(at + ".kind: found \"isobaric\" for a volume without pressure (its file is on height levels, or gives none), "
+                           "expected a volume that holds pressure (it holds " + hold_list(volume) + ")");
+      }
       const core::RegularAxis& z = volume.grid.alt_m;
       if (kind == "horizontal" && !(o.number("altitude_m") >= z.start && o.number("altitude_m") <= z.last())) {
         char buf[160];
@@ -129,13 +137,27 @@ void check_overlays(const std::vector<core::OverlaySpec>& specs, const core::Clo
         throw OverlayError(at + ".to_lat: found the path's two ends at one point, expected a vertical section's path of non-zero length");
       }
     }
-    if (specs[i].type == "wind") {
+    if (specs[i].type == "wind" || specs[i].type == "arrows") {
       if (!volume.has_field[static_cast<std::size_t>(core::Field::WindU)] || !volume.has_field[static_cast<std::size_t>(core::Field::WindV)]) {
-        throw OverlayError(at + ": found a volume without wind_u and wind_v, expected both for wind streamlines (it holds " + hold_list(volume) + ")");
+        throw OverlayError(at + ": found a volume without wind_u and wind_v, expected both for wind " +
+                           (specs[i].type == "wind" ? "streamlines" : "arrows") + " (it holds " + hold_list(volume) + ")");
+      }
+      if (specs[i].type == "arrows" && specs[i].number("pressure_hpa") > 0.0 && !volume.has_field[static_cast<std::size_t>(core::Field::Pressure)]) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, ".pressure_hpa: found %g for a volume without pressure (its file is on height levels, or gives none), ",
+                      specs[i].number("pressure_hpa"));
+        throw OverlayError(at + buf + "expected 0 (the level at altitude_m) or a volume that holds pressure (it holds " + hold_list(volume) + ")");
+      }
+      if (specs[i].type == "arrows" && !(specs[i].number("speed_min_m_s") < specs[i].number("speed_max_m_s"))) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, ".speed_max_m_s: found %g, expected more than speed_min_m_s (%g)", specs[i].number("speed_max_m_s"),
+                      specs[i].number("speed_min_m_s"));
+        throw OverlayError(at + buf);
       }
       const double a = specs[i].number("altitude_m");
       const core::RegularAxis& z = volume.grid.alt_m;
-      if (!(a >= z.start && a <= z.last())) {
+      const bool by_pressure = specs[i].type == "arrows" && specs[i].number("pressure_hpa") > 0.0;
+      if (!by_pressure && !(a >= z.start && a <= z.last())) {
         char buf[160];
         std::snprintf(buf, sizeof buf, ".altitude_m: found %g, expected an altitude within the grid's levels, %g..%g m", a, z.start, z.last());
         throw OverlayError(at + buf);
@@ -559,6 +581,52 @@ core::OverlayMesh build_horizontal_section(const core::VolumeGrid& g, const std:
   return out;
 }
 
+namespace {
+
+// The lowest fractional level of column (i, j) where the pressure falls through exp(target_ln),
+// ln p linear between the two nodes around it; negative where the column does not cross it.
+double isobaric_level(const core::VolumeGrid& g, const std::vector<float>& pressure, int i, int j, double target_ln) {
+  for (int k = 0; k + 1 < g.alt_m.count; ++k) {
+    const double p0 = pressure[g.index(i, j, k)], p1 = pressure[g.index(i, j, k + 1)];
+    if (!(p0 > 0.0) || !(p1 > 0.0)) continue;  // no data (NaN) or nonsense
+    const double l0 = std::log(p0), l1 = std::log(p1);
+    if (!((l0 >= target_ln && target_ln >= l1) || (l0 <= target_ln && target_ln <= l1)) || l0 == l1) continue;
+    return k + (target_ln - l0) / (l1 - l0);
+  }
+  return -1.0;
+}
+
+}  // namespace
+
+core::OverlayMesh build_isobaric_section(const core::VolumeGrid& g, const std::vector<float>& pressure, const std::vector<float>& field,
+                                         double pressure_pa, const FieldColor& by) {
+  core::OverlayMesh out;
+  const std::size_t n = g.points();
+  if (pressure.size() != n || field.size() != n || n == 0 || !(pressure_pa > 0.0)) return out;
+  const int nx = g.lon_deg.count, ny = g.lat_deg.count;
+  const double target = std::log(pressure_pa);
+  std::vector<std::uint32_t> vertex(g.columns(), std::numeric_limits<std::uint32_t>::max());
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const double z = isobaric_level(g, pressure, i, j, target);
+      if (z < 0.0) continue;
+      vertex[g.column(i, j)] = static_cast<std::uint32_t>(out.positions.size());
+      out.positions.push_back(index_to_ecef(g, i, j, z));
+      out.colors.push_back(mapped(by, trilinear(g, field, i, j, z)));  // linear between the two nodes
+    }
+  }
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  for (int j = 0; j + 1 < ny; ++j) {
+    for (int i = 0; i + 1 < nx; ++i) {
+      const std::uint32_t a = vertex[g.column(i, j)], b = vertex[g.column(i + 1, j)], c = vertex[g.column(i + 1, j + 1)],
+                          d = vertex[g.column(i, j + 1)];
+      if (a != kNone && b != kNone && c != kNone) out.triangles.insert(out.triangles.end(), {a, b, c});
+      if (a != kNone && c != kNone && d != kNone) out.triangles.insert(out.triangles.end(), {a, c, d});
+    }
+  }
+  return out;
+}
+
 core::OverlayMesh build_vertical_section(const core::VolumeGrid& g, const std::vector<float>& field, double from_lat, double from_lon,
                                          double to_lat, double to_lon, const FieldColor& by, int columns) {
   core::OverlayMesh out;
@@ -755,6 +823,96 @@ core::OverlayMesh build_streamlines(const core::VolumeGrid& g, const std::vector
   return build_streamlines_from(g, u, v, w, lattice, length_cells, speed_max_m_s, brightness);
 }
 
+core::OverlayInstances arrow_glyph() {
+  vtkNew<vtkArrowSource> arrow;
+  arrow->SetTipLength(0.35);
+  arrow->SetTipRadius(0.12);
+  arrow->SetShaftRadius(0.04);
+  arrow->SetTipResolution(8);
+  arrow->SetShaftResolution(8);
+  vtkNew<vtkTriangleFilter> triangles;  // the shaft's and the tip's caps are polygons
+  triangles->SetInputConnection(arrow->GetOutputPort());
+  triangles->PassVertsOff();
+  triangles->PassLinesOff();
+  triangles->Update();
+  ++g_vtk_runs;
+  core::OverlayInstances g;
+  vtkPolyData* pd = triangles->GetOutput();
+  vtkPoints* pts = pd->GetPoints();
+  if (!pts) return g;
+  for (vtkIdType i = 0; i < pts->GetNumberOfPoints(); ++i) {
+    double p[3];
+    pts->GetPoint(i, p);
+    g.glyph_positions.emplace_back(static_cast<float>(p[0] - 0.5), static_cast<float>(p[1]), static_cast<float>(p[2]));  // middle at 0
+  }
+  vtkIdType npts = 0;
+  const vtkIdType* ids = nullptr;
+  vtkCellArray* polys = pd->GetPolys();
+  for (polys->InitTraversal(); polys->GetNextCell(npts, ids);) {
+    if (npts != 3) continue;
+    for (int k = 0; k < 3; ++k) g.glyph_triangles.push_back(static_cast<std::uint32_t>(ids[k]));
+  }
+  return g;
+}
+
+core::OverlayMesh build_arrows(const core::VolumeGrid& g, const std::vector<float>& u, const std::vector<float>& v, double altitude_m,
+                               const ArrowStyle& style, const std::vector<float>* pressure) {
+  core::OverlayMesh out;
+  const std::size_t n = g.points();
+  if (u.size() != n || v.size() != n || n == 0 || style.spacing_cells < 1 || !(style.speed_max_m_s > 0.0)) return out;
+  const bool isobaric = style.pressure_pa > 0.0;
+  if (isobaric && (!pressure || pressure->size() != n)) return out;
+  out.instances = arrow_glyph();
+  core::OverlayInstances& in = out.instances;
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  const double target_ln = isobaric ? std::log(style.pressure_pa) : 0.0;
+  const double range = style.speed_max_m_s - style.speed_min_m_s;
+  const int s = style.spacing_cells;
+  // The lattice centred on the grid: as many whole spacings as fit, the rest split at both sides.
+  const int i0 = ((g.lon_deg.count - 1) % s) / 2, j0 = ((g.lat_deg.count - 1) % s) / 2;
+  for (int j = j0; j < g.lat_deg.count; j += s) {
+    for (int i = i0; i < g.lon_deg.count; i += s) {
+      const double z = isobaric ? isobaric_level(g, *pressure, i, j, target_ln) : (altitude_m - g.alt_m.start) / g.alt_m.step;
+      if (z < 0.0) continue;  // the pressure surface does not cross this column
+      const double alt = isobaric ? g.alt_m.start + z * g.alt_m.step : altitude_m;
+      const double wu = trilinear(g, u, i, j, z), wv = trilinear(g, v, i, j, z);
+      const double speed = std::hypot(wu, wv);
+      if (!std::isfinite(speed) || speed == 0.0) continue;
+      const double lat = g.lat_deg.at(j), lon = g.lon_deg.at(i);
+      const geo::EnuFrame f = geo::sphere_enu(lat, lon);
+      const glm::dvec3 along = (wu * f.east + wv * f.north) / speed, left = glm::cross(f.up, along);
+      // The spacing north-south in metres at the arrow; metres of arrow per m/s from it.
+      const double spacing_m = style.spacing_cells * (g.earth_radius_m + alt) * std::abs(g.lat_deg.step) * kDeg;
+      const double length = style.scale * spacing_m / style.speed_max_m_s * speed;
+      in.origins.push_back(geo::sphere_to_ecef({lat, lon, alt}, g.earth_radius_m));
+      in.axis_x.emplace_back(length * along);
+      in.axis_y.emplace_back(length * left);
+      in.axis_z.emplace_back(length * f.up);
+      in.colors.push_back(colormap((speed - style.speed_min_m_s) / range, style.brightness));
+    }
+  }
+  if (in.origins.empty()) in = {};
+  return out;
+}
+
+namespace {
+
+// A pressure level must lie among the time step's pressures (known only once the step is read).
+void check_pressure_level(const std::vector<float>& p, double hpa, std::size_t i) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (float x : p) {
+    if (x > 0.0f) lo = std::min(lo, static_cast<double>(x)), hi = std::max(hi, static_cast<double>(x));
+  }
+  if (!(100.0 * hpa >= lo && 100.0 * hpa <= hi)) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "overlays[%zu].pressure_hpa: found %g, expected a pressure within the volume's, %.6g..%.6g hPa", i, hpa,
+                  lo / 100.0, hi / 100.0);
+    throw OverlayError(buf);
+  }
+}
+
+}  // namespace
+
 std::vector<BuiltOverlay> OverlayBuilder::build(const std::vector<core::OverlaySpec>& specs, core::CloudVolume& volume, std::size_t time_step,
                                                 const core::Camera& cam) {
   std::vector<BuiltOverlay> built;
@@ -773,7 +931,7 @@ std::vector<BuiltOverlay> OverlayBuilder::build(const std::vector<core::OverlayS
       built.push_back(b);
       continue;
     }
-    const bool of_field = s.type == "isosurface" || s.type == "wind" || s.type == "section";
+    const bool of_field = s.type == "isosurface" || s.type == "wind" || s.type == "arrows" || s.type == "section";
     const bool gshhg = s.type == "coastlines" || s.type == "borders" || s.type == "rivers";
     const char res = gshhg ? coastline_resolution(s.text("resolution"), cam.alt_m) : 0;
     const GeoBox box = gshhg ? overlay_box(volume.grid, res, cam) : GeoBox{};
@@ -808,15 +966,31 @@ std::vector<BuiltOverlay> OverlayBuilder::build(const std::vector<core::OverlayS
         const core::TimeStepData& data = volume.step(time_step);
         const core::Field f = volume_field(volume, s.text("field"), "overlays[" + std::to_string(i) + "].field");
         const FieldColor by{nullptr, s.number("color_min"), s.number("color_max"), s.number("brightness")};
-        m = s.text("kind") == "vertical"
-                ? build_vertical_section(volume.grid, data[f], s.number("from_lat"), s.number("from_lon"), s.number("to_lat"), s.number("to_lon"), by)
-                : build_horizontal_section(volume.grid, data[f], s.number("altitude_m"), by);
+        if (s.text("kind") == "vertical") {
+          m = build_vertical_section(volume.grid, data[f], s.number("from_lat"), s.number("from_lon"), s.number("to_lat"), s.number("to_lon"), by);
+        } else if (s.text("kind") == "isobaric") {
+          check_pressure_level(data[core::Field::Pressure], s.number("pressure_hpa"), i);
+          m = build_isobaric_section(volume.grid, data[core::Field::Pressure], data[f], 100.0 * s.number("pressure_hpa"), by);
+        } else {
+          m = build_horizontal_section(volume.grid, data[f], s.number("altitude_m"), by);
+        }
       }
       if (s.type == "wind") {
         const core::TimeStepData& data = volume.step(time_step);
         m = build_streamlines(volume.grid, data[core::Field::WindU], data[core::Field::WindV], data[core::Field::WindW],
                               s.number("altitude_m"), static_cast<int>(s.number("seeds")), s.number("length_cells"),
                               s.number("speed_max_m_s"), s.number("brightness"));
+      }
+      if (s.type == "arrows") {
+        const core::TimeStepData& data = volume.step(time_step);
+        ArrowStyle style;
+        style.spacing_cells = static_cast<int>(std::lround(s.number("spacing_cells")));
+        style.scale = s.number("scale"), style.speed_min_m_s = s.number("speed_min_m_s"), style.speed_max_m_s = s.number("speed_max_m_s");
+        style.brightness = s.number("brightness");
+        style.pressure_pa = 100.0 * s.number("pressure_hpa");
+        if (style.pressure_pa > 0.0) check_pressure_level(data[core::Field::Pressure], s.number("pressure_hpa"), i);
+        m = build_arrows(volume.grid, data[core::Field::WindU], data[core::Field::WindV], s.number("altitude_m"), style,
+                         &data[core::Field::Pressure]);
       }
       if (s.type == "isosurface" || s.type == "section") {  // translucent below 1 (core::kOpaqueAlpha)
         m.colors.resize(m.positions.size(), glm::vec4(1.0f));

@@ -126,6 +126,14 @@ core::OverlayMesh build_isosurface(const core::VolumeGrid& grid, const std::vect
 // circle between two points, `columns` samples along it (vtkProbeFilter samples the field; a
 // stretch outside the grid is left out).
 core::OverlayMesh build_horizontal_section(const core::VolumeGrid& grid, const std::vector<float>& field, double altitude_m, const FieldColor& by);
+// Isobaric: the surface p = pressure_pa, curved in altitude. In each column of the grid the
+// lowest altitude where the pressure field falls through the value, between two nodes, with ln p
+// taken as linear in altitude there (exact in an isothermal layer; the importers interpolate ln p
+// the same way between the file's levels); the field there (linear between the two nodes) colours
+// it. Neighbouring columns that both cross make the surface's triangles; a column without a
+// crossing (no data, or the value outside its pressures) leaves a hole.
+core::OverlayMesh build_isobaric_section(const core::VolumeGrid& grid, const std::vector<float>& pressure, const std::vector<float>& field,
+                                         double pressure_pa, const FieldColor& by);
 core::OverlayMesh build_vertical_section(const core::VolumeGrid& grid, const std::vector<float>& field, double from_lat, double from_lon,
                                          double to_lat, double to_lon, const FieldColor& by, int columns = 128);
 // A colour bar legend for one view: the colour map from lo (bottom) to hi (top) as a bar at the
@@ -151,5 +159,28 @@ core::OverlayMesh build_streamlines_from(const core::VolumeGrid& grid, const std
                                          const std::vector<float>& w, const std::vector<glm::dvec3>& seeds_ijk, double length_cells,
                                          double speed_max_m_s, double brightness,
                                          std::vector<std::vector<glm::dvec3>>* lines_ijk = nullptr);
+
+// Wind arrows on a level, drawn instanced: one arrow glyph (arrow_glyph) and an instance at every
+// spacing_cells-th grid point in longitude and latitude (the lattice centred on the grid), on the
+// sphere at altitude_m. Each instance's glyph x axis points along the horizontal wind (u east, v
+// north, interpolated linearly in altitude between the grid's levels) in the local east-north
+// frame, y to its left and z up; the arrow's middle is at the grid point, its length
+// scale x spacing x speed / speed_max_m_s (the spacing north-south in metres at the arrow), and
+// its colour the colour map over speed_min_m_s..speed_max_m_s. Points without wind data (NaN) or
+// with no wind at all get no arrow.
+// With pressure_pa above 0 and a pressure field given, the level is that pressure surface instead
+// of altitude_m: each arrow at its column's altitude of the surface (as build_isobaric_section
+// finds it), the wind interpolated there; a column the surface does not cross gets no arrow.
+struct ArrowStyle {
+  int spacing_cells = 4;
+  double scale = 1.0, speed_min_m_s = 0.0, speed_max_m_s = 30.0, brightness = 1.0;
+  double pressure_pa = 0.0;
+};
+core::OverlayMesh build_arrows(const core::VolumeGrid& grid, const std::vector<float>& u, const std::vector<float>& v, double altitude_m,
+                               const ArrowStyle& style, const std::vector<float>* pressure = nullptr);
+// The arrow glyph: vtkArrowSource's arrow (a cylinder shaft and a cone tip, round about the x axis)
+// triangulated by vtkTriangleFilter, from x = -0.5 (tail) to 0.5 (tip), tip radius 0.12 and shaft
+// radius 0.04; glyph_positions and glyph_triangles are set, no instance.
+core::OverlayInstances arrow_glyph();
 
 }  // namespace cv::overlays

@@ -37,6 +37,54 @@ OverlayPass::~OverlayPass() {
 
 OverlayPass::Buffers OverlayPass::make_buffers(const core::OverlayMesh& mesh) {
   Buffers b;
+  const core::OverlayInstances& in = mesh.instances;
+  if (!in.empty()) {
+    glCreateVertexArrays(1, &b.inst_vao);
+    glCreateBuffers(1, &b.glyph);
+    glCreateBuffers(1, &b.glyph_index);
+    glCreateBuffers(1, &b.origins);
+    glCreateBuffers(1, &b.frames);
+    glNamedBufferStorage(b.glyph, static_cast<GLsizeiptr>(in.glyph_positions.size() * sizeof(glm::vec3)), in.glyph_positions.data(), 0);
+    glNamedBufferStorage(b.glyph_index, static_cast<GLsizeiptr>(in.glyph_triangles.size() * sizeof(std::uint32_t)), in.glyph_triangles.data(),
+                         0);
+    glNamedBufferStorage(b.origins, static_cast<GLsizeiptr>(in.count() * sizeof(glm::dvec3)), in.origins.data(), 0);
+    // Per instance: axis x, y, z (3 floats each), colour (4, alpha 1: instances are opaque), 3 spare.
+    std::vector<float> frames(16 * in.count(), 0.0f);
+    for (std::size_t k = 0; k < in.count(); ++k) {
+      float* f = &frames[16 * k];
+      for (int c = 0; c < 3; ++c) f[c] = in.axis_x[k][c], f[3 + c] = in.axis_y[k][c], f[6 + c] = in.axis_z[k][c];
+      const glm::vec4 color = k < in.colors.size() ? in.colors[k] : glm::vec4(1.0f);
+      for (int c = 0; c < 3; ++c) f[9 + c] = color[c];
+      f[12] = 1.0f;
+    }
+    glNamedBufferStorage(b.frames, static_cast<GLsizeiptr>(frames.size() * sizeof(float)), frames.data(), 0);
+    // overlay.vert's locations: 2 the glyph's vertex; per instance (divisor 1) 0 the origin in
+    // double (a_position's location), 3, 4, 5 the axes and 6 the colour.
+    glVertexArrayVertexBuffer(b.inst_vao, 0, b.glyph, 0, sizeof(glm::vec3));
+    glVertexArrayAttribFormat(b.inst_vao, 2, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(b.inst_vao, 2, 0);
+    glEnableVertexArrayAttrib(b.inst_vao, 2);
+    glVertexArrayVertexBuffer(b.inst_vao, 1, b.origins, 0, sizeof(glm::dvec3));
+    glVertexArrayBindingDivisor(b.inst_vao, 1, 1);
+    glVertexArrayAttribLFormat(b.inst_vao, 0, 3, GL_DOUBLE, 0);
+    glVertexArrayAttribBinding(b.inst_vao, 0, 1);
+    glEnableVertexArrayAttrib(b.inst_vao, 0);
+    glVertexArrayVertexBuffer(b.inst_vao, 2, b.frames, 0, 16 * sizeof(float));
+    glVertexArrayBindingDivisor(b.inst_vao, 2, 1);
+    for (GLuint a = 0; a < 4; ++a) {
+      glVertexArrayAttribFormat(b.inst_vao, 3 + a, a < 3 ? 3 : 4, GL_FLOAT, GL_FALSE, static_cast<GLuint>(3 * a * sizeof(float)));
+      glVertexArrayAttribBinding(b.inst_vao, 3 + a, 2);
+      glEnableVertexArrayAttrib(b.inst_vao, 3 + a);
+    }
+    glVertexArrayElementBuffer(b.inst_vao, b.glyph_index);
+    b.glyph_indices = in.glyph_triangles.size();
+    b.instances = in.count();
+  }
+  if (mesh.triangles.empty() && mesh.lines.empty()) {  // instances alone (a buffer of no bytes is an error)
+    ++uploads_;
+    check_gl("uploading overlay geometry");
+    return b;
+  }
   glCreateVertexArrays(1, &b.vao);
   glCreateBuffers(1, &b.pos);
   glCreateBuffers(1, &b.color);
@@ -68,9 +116,10 @@ OverlayPass::Buffers OverlayPass::make_buffers(const core::OverlayMesh& mesh) {
 }
 
 void OverlayPass::free_buffers(Buffers& b) {
-  const GLuint buffers[] = {b.pos, b.color, b.index};
-  glDeleteBuffers(3, buffers);
-  glDeleteVertexArrays(1, &b.vao);
+  const GLuint buffers[] = {b.pos, b.color, b.index, b.glyph, b.glyph_index, b.origins, b.frames};
+  glDeleteBuffers(7, buffers);
+  const GLuint arrays[] = {b.vao, b.inst_vao};
+  glDeleteVertexArrays(2, arrays);
   b = Buffers{};
 }
 
@@ -156,6 +205,7 @@ void OverlayPass::use_program(int peel) {
   glUniform1i(glGetUniformLocation(program_.id(), "u_peel"), peel < 0 ? 0 : 1);
   glUniform1i(glGetUniformLocation(program_.id(), "u_has_prev"), peel > 0 ? 1 : 0);
   glUniform1f(glGetUniformLocation(program_.id(), "u_bias"), 0.0f);
+  glUniform1i(glGetUniformLocation(program_.id(), "u_instanced"), 0);
   if (peel >= 0) {
     glBindTextureUnit(kPrevUnit, peel > 0 ? peel_distance_[(peel - 1) % 2] : 0);
     glBindTextureUnit(kOpaqueUnit, distance_);
@@ -182,6 +232,12 @@ double OverlayPass::draw_buffers(const Buffers& b, float line_width_px, std::chr
     glDrawElements(GL_LINES, static_cast<GLsizei>(b.lines), GL_UNSIGNED_INT,
                    reinterpret_cast<const void*>(b.triangles * sizeof(std::uint32_t)));
     glLineWidth(1.0f);
+  }
+  if (b.instances > 0) {  // one draw of the glyph for every instance
+    glUniform1i(glGetUniformLocation(program_.id(), "u_instanced"), 1);
+    glBindVertexArray(b.inst_vao);
+    glDrawElementsInstanced(GL_TRIANGLES, static_cast<GLsizei>(b.glyph_indices), GL_UNSIGNED_INT, nullptr, static_cast<GLsizei>(b.instances));
+    glUniform1i(glGetUniformLocation(program_.id(), "u_instanced"), 0);
   }
   glBindVertexArray(0);
   glUseProgram(0);

@@ -4,7 +4,10 @@
 // to the GPU in double, Earth-centred, and the vertex shader makes them camera-relative in double
 // before it rounds them to float, so they keep their digits at orbit and at the ground alike; a
 // mesh held by a shared_ptr stays on the GPU for as long as it is drawn each frame, so a moving
-// camera uploads nothing. No VTK here: only its geometry, as plain data.
+// camera uploads nothing. A mesh's instances (core::OverlayInstances: wind arrows) are drawn with
+// one instanced draw of their glyph, each instance's origin (double), axes and colour per-instance
+// attributes (shaders/render/overlay.vert, u_instanced), through the same fragment shader. No VTK
+// here: only its geometry, as plain data.
 #pragma once
 
 #include <chrono>
@@ -50,11 +53,15 @@ class OverlayPass {
   double peel_ms() const { return peel_ms_; }
 
  private:
-  // One mesh's buffers: Earth-centred positions in double, colours, triangle then line indices.
+  // One mesh's buffers: Earth-centred positions in double, colours, triangle then line indices;
+  // and its instances': the glyph's vertices and triangles, each instance's origin (double) and
+  // axes and colour (float, 16 to an instance).
   struct Buffers {
     GLuint vao = 0, pos = 0, color = 0, index = 0;
     std::size_t triangles = 0, lines = 0;
     bool translucent = false;  // some triangle vertex has alpha below 1
+    GLuint inst_vao = 0, glyph = 0, glyph_index = 0, origins = 0, frames = 0;
+    std::size_t glyph_indices = 0, instances = 0;
   };
   Buffers make_buffers(const core::OverlayMesh& mesh);
   static void free_buffers(Buffers& b);

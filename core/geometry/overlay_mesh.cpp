@@ -15,6 +15,48 @@ void OverlayMesh::append(const OverlayMesh& other) {
   colors.insert(colors.end(), other.colors.begin(), other.colors.end());
   for (std::uint32_t i : other.lines) lines.push_back(base + i);
   for (std::uint32_t i : other.triangles) triangles.push_back(base + i);
+  const OverlayInstances& oi = other.instances;
+  if (oi.empty()) return;
+  OverlayInstances& ti = instances;
+  if (ti.empty()) {
+    ti = oi;
+    return;
+  }
+  if (ti.glyph_positions == oi.glyph_positions && ti.glyph_triangles == oi.glyph_triangles) {
+    ti.origins.insert(ti.origins.end(), oi.origins.begin(), oi.origins.end());
+    ti.axis_x.insert(ti.axis_x.end(), oi.axis_x.begin(), oi.axis_x.end());
+    ti.axis_y.insert(ti.axis_y.end(), oi.axis_y.begin(), oi.axis_y.end());
+    ti.axis_z.insert(ti.axis_z.end(), oi.axis_z.begin(), oi.axis_z.end());
+    ti.colors.insert(ti.colors.end(), oi.colors.begin(), oi.colors.end());
+    return;
+  }
+  OverlayMesh glyphs;
+  glyphs.instances = oi;
+  append(expand_instances(glyphs));
+}
+
+OverlayMesh expand_instances(const OverlayMesh& mesh) {
+  OverlayMesh out = mesh;
+  out.instances = {};
+  const OverlayInstances& in = mesh.instances;
+  if (in.empty()) return out;
+  out.colors.resize(out.positions.size(), glm::vec4(1.0f));
+  const std::size_t nv = in.glyph_positions.size();
+  out.positions.reserve(out.positions.size() + nv * in.count());
+  out.triangles.reserve(out.triangles.size() + in.glyph_triangles.size() * in.count());
+  for (std::size_t k = 0; k < in.count(); ++k) {
+    const auto base = static_cast<std::uint32_t>(out.positions.size());
+    const glm::dvec3 ax(in.axis_x[k]), ay(in.axis_y[k]), az(in.axis_z[k]);
+    glm::vec4 color = k < in.colors.size() ? in.colors[k] : glm::vec4(1.0f);
+    color.a = 1.0f;  // instances are opaque
+    for (const glm::vec3& g : in.glyph_positions) {
+      // The order of the GPU's vertex shader (overlay_instanced.vert): origin + x + y + z.
+      out.positions.push_back(((in.origins[k] + ax * static_cast<double>(g.x)) + ay * static_cast<double>(g.y)) + az * static_cast<double>(g.z));
+      out.colors.push_back(color);
+    }
+    for (std::uint32_t i : in.glyph_triangles) out.triangles.push_back(base + i);
+  }
+  return out;
 }
 
 Projected project_point(const Camera& cam, const glm::dvec3& rel) {
@@ -60,7 +102,10 @@ void keep(std::vector<Hit>& hits, std::size_t i, double t, const glm::vec4& colo
 
 }  // namespace
 
-OpaqueLayer cast_overlay(const OverlayMesh& mesh, const Camera& cam, double r0_m) {
+OpaqueLayer cast_overlay(const OverlayMesh& given, const Camera& cam, double r0_m) {
+  OverlayMesh expanded;
+  if (!given.instances.empty()) expanded = expand_instances(given);
+  const OverlayMesh& mesh = given.instances.empty() ? given : expanded;
   const int w = cam.width, h = cam.height;
   std::vector<Hit> hits(static_cast<std::size_t>(w) * h);
   const glm::dvec3 c = camera_ecef(cam, r0_m);

@@ -14,12 +14,12 @@ bool VolumeGrid::wraps_lon() const {
 
 const char* field_name(Field f) {
   static const char* names[kFieldCount] = {"extinction_liquid", "extinction_ice", "cloud_fraction", "wind_u",
-                                           "wind_v", "wind_w", "temperature"};
+                                           "wind_v", "wind_w", "temperature", "pressure"};
   return names[static_cast<int>(f)];
 }
 
 const char* field_units(Field f) {
-  static const char* units[kFieldCount] = {"1/m", "1/m", "1", "m/s", "m/s", "m/s", "K"};
+  static const char* units[kFieldCount] = {"1/m", "1/m", "1", "m/s", "m/s", "m/s", "K", "Pa"};
   return units[static_cast<int>(f)];
 }
 

@@ -55,8 +55,9 @@ enum class Field : int {
   WindV,                 // m/s, northward
   WindW,                 // m/s, upward
   Temperature,           // K
+  Pressure,              // Pa; held only where the file gives it (pressure or hybrid levels, WRF's P + PB)
 };
-inline constexpr int kFieldCount = 7;
+inline constexpr int kFieldCount = 8;
 const char* field_name(Field f);
 const char* field_units(Field f);
 

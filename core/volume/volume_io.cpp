@@ -33,8 +33,9 @@ MapArrays map_arrays(const Maps2D& m) {
            {"optical_depth", &m.optical_depth}, {"low_cover", &m.low_cover}, {"mid_cover", &m.mid_cover},
            {"high_cover", &m.high_cover}}};
 }
-// Stored value = SI value x this, for the float16 encoding.
+// Stored value = SI value x this, for the float16 encoding (pressure in hPa: Pa would pass 65504).
 float half_scale(int field) {
+  if (field == static_cast<int>(Field::Pressure)) return 0.01f;
   return field == static_cast<int>(Field::ExtinctionLiquid) || field == static_cast<int>(Field::ExtinctionIce) ? 1000.0f : 1.0f;
 }
 }  // namespace
@@ -101,7 +102,7 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
                              ", \"lat_deg\": " + axis_json(v.grid.lat_deg) + ", \"alt_m\": " + axis_json(v.grid.alt_m) +
                              ", \"earth_radius_m\": " + std::to_string(v.grid.earth_radius_m) + "},\n \"liquid_r_eff_um\": " +
                              std::to_string(v.liquid_r_eff_um) + ",\n" +
-                             (half ? " \"encoding\": \"float16\", \"field_scale\": \"extinction x 1000 (1/km); others x 1\",\n"
+                             (half ? " \"encoding\": \"float16\", \"field_scale\": \"extinction x 1000 (1/km); pressure x 0.01 (hPa); others x 1\",\n"
                                    : "") +
                              " \"times\": " + times +
                              "],\n \"fields\": " + fields + "],\n \"maps\": " + maps +

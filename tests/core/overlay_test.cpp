@@ -87,6 +87,53 @@ TEST(OverlayCast, NearestPrimitiveWinsAndEmptyPixelsStayZero) {
   for (float d : none.distance_m) EXPECT_EQ(d, 0.0f);
 }
 
+// Instances: each puts the glyph at origin + g.x axis_x + g.y axis_y + g.z axis_z with its own
+// colour (alpha 1); the cast of an instanced mesh is the cast of the same triangles given plainly.
+TEST(OverlayCast, InstancesAreCastAsTheirExpandedGlyphs) {
+  PlaneAbove p;
+  OverlayMesh inst;
+  OverlayInstances& in = inst.instances;
+  in.glyph_positions = {{0.0f, -1.0f, -1.0f}, {0.0f, 1.0f, -1.0f}, {0.0f, 1.0f, 1.0f}, {0.0f, -1.0f, 1.0f}};
+  in.glyph_triangles = {0, 1, 2, 0, 2, 3};
+  const glm::dvec3 c = camera_ecef(p.cam, kR0);
+  // Two squares: 300 m above the camera and 100 m across, and 600 m above it and 4 km across.
+  in.origins = {c + 300.0 * p.up, c + 600.0 * p.up};
+  in.axis_x = {glm::vec3(1.0f, 0.0f, 0.0f), glm::vec3(1.0f, 0.0f, 0.0f)};
+  in.axis_y = {glm::vec3(0.0f, 50.0f, 0.0f), glm::vec3(0.0f, 2000.0f, 0.0f)};
+  in.axis_z = {glm::vec3(0.0f, 0.0f, 50.0f), glm::vec3(0.0f, 0.0f, 2000.0f)};
+  in.colors = {glm::vec4(1.0f, 0.0f, 0.0f, 0.25f), glm::vec4(0.5f, 0.25f, 0.125f, 1.0f)};
+  ASSERT_FALSE(inst.empty());
+  const OverlayMesh plain = expand_instances(inst);
+  EXPECT_TRUE(plain.instances.empty());
+  ASSERT_EQ(plain.positions.size(), 8u);
+  ASSERT_EQ(plain.triangles.size(), 12u);
+  EXPECT_EQ(plain.positions[2], c + 300.0 * p.up + glm::dvec3(0.0, 50.0, 50.0));
+  EXPECT_EQ(plain.positions[4], c + 600.0 * p.up + glm::dvec3(0.0, -2000.0, -2000.0));
+  EXPECT_EQ(plain.colors[0], glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));  // opaque whatever the alpha given
+  EXPECT_EQ(plain.triangles[6], 4u);
+  const OpaqueLayer a = cast_overlay(inst, p.cam, kR0), b = cast_overlay(plain, p.cam, kR0);
+  EXPECT_EQ(a.distance_m, b.distance_m);
+  EXPECT_EQ(a.radiance_rgba, b.radiance_rgba);
+  int near = 0;
+  for (std::size_t i = 0; i < 81; ++i) {
+    const double cos_up = glm::dot(camera_ray(p.cam, static_cast<int>(i % 9), static_cast<int>(i / 9)), p.up);
+    near += std::abs(a.distance_m[i] - 300.0 / cos_up) < 1e-4 ? 1 : 0;
+  }
+  EXPECT_GT(near, 0);   // the small square covers the middle of the view...
+  EXPECT_LT(near, 81);  // ...and the large one the rest
+  // Appending joins instances of the same glyph, and expands those of another.
+  OverlayMesh joined = inst;
+  joined.append(inst);
+  EXPECT_EQ(joined.instances.count(), 4u);
+  EXPECT_TRUE(joined.positions.empty());
+  OverlayMesh other = inst;
+  other.instances.glyph_triangles = {0, 1, 2};
+  joined.append(other);
+  EXPECT_EQ(joined.instances.count(), 4u);
+  EXPECT_EQ(joined.positions.size(), 8u);
+  EXPECT_EQ(joined.triangles.size(), 6u);
+}
+
 TEST(OverlayCast, APointProjectsOntoThePixelWhoseRayPassesThroughIt) {
   Camera cam;
   cam.lat_deg = 64.0, cam.lon_deg = -20.0, cam.alt_m = 100.0, cam.heading_deg = 37.0, cam.pitch_deg = -4.0;

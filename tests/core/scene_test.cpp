@@ -311,9 +311,9 @@ TEST(SceneJson, OverlaysAreTypedEntriesOrPlainNames) {
 
 TEST(SceneJson, BadOverlaysAreNamedWithWhatWasExpected) {
   EXPECT_EQ(error_of(R"({"version": 1, "overlays": ["roads"]})"),
-            "scene.json: overlays[0]: found \"roads\", expected one of coastlines, borders, rivers, graticule, isosurface, wind, section");
+            "scene.json: overlays[0]: found \"roads\", expected one of coastlines, borders, rivers, graticule, isosurface, wind, arrows, section");
   EXPECT_EQ(error_of(R"({"version": 1, "overlays": [{"step_deg": 5}]})"),
-            "scene.json: overlays[0].type: found nothing, expected one of coastlines, borders, rivers, graticule, isosurface, wind, section");
+            "scene.json: overlays[0].type: found nothing, expected one of coastlines, borders, rivers, graticule, isosurface, wind, arrows, section");
   EXPECT_EQ(error_of(R"({"version": 1, "overlays": ["coastlines", {"type": "graticule", "step_deg": 0}]})"),
             "scene.json: overlays[1].step_deg: found 0, expected a number 0.5..90 (degrees)");
   EXPECT_EQ(error_of(R"({"version": 1, "overlays": [{"type": "graticule", "colour": [1, 1, 1]}]})"),
@@ -339,7 +339,7 @@ TEST(OverlayFlag, ParsesNameAndTypedParameters) {
     return std::string("no error");
   };
   EXPECT_EQ(message("roads"),
-            "--overlay roads: found \"roads\", expected one of coastlines, borders, rivers, graticule, isosurface, wind, section");
+            "--overlay roads: found \"roads\", expected one of coastlines, borders, rivers, graticule, isosurface, wind, arrows, section");
   EXPECT_EQ(message("graticule:step_deg=0"),
             "--overlay graticule:step_deg=0: found \"0\" for step_deg, expected a number 0.5..90 (degrees)");
   EXPECT_EQ(message("graticule:spacing=5"),

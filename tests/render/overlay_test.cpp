@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <vector>
@@ -15,13 +16,16 @@
 
 #include "geo/geodesy.hpp"
 #include "geometry/overlay_mesh.hpp"
+#include "importer.hpp"
 #include "kernel/prepared_volume.hpp"
 #include "overlays/overlays.hpp"
+#include "physics/physics.hpp"
 #include "reference/raymarcher.hpp"
 #include "render/context.hpp"
 #include "render/frame_renderer.hpp"
 #include "render/land_sea_mask.hpp"
 #include "render/overlay_pass.hpp"
+#include "support/nc_builder.hpp"
 
 namespace {
 using namespace cv;
@@ -444,6 +448,47 @@ TEST(Coastlines, AVertexLandsOnThePixelTheProjectionGives) {
   }
 }
 
+// The coastlines lie on the renderer's globe as the ground and the clouds do: geodetic latitude and
+// longitude placed as the sphere's own (the march's ground lookup inverts a point with the shared
+// ecef_to_sphere and reads the equirectangular texel there; the importers place the clouds' columns
+// by the same latitudes). A GSHHG vertex of Iceland's shore, taken from the built mesh and inverted
+// by the march's own functions (compiled in double), lands on the texel its latitude and longitude
+// name. Put on the WGS84 ellipsoid instead, it would land 0.15 degrees (17 km) south of that
+// texel's coast on this globe.
+TEST(Coastlines, AVertexLiesOnTheTexelTheGroundLookupGivesItsLatLon) {
+  double best = 1e9, lat = 0.0, lon = 0.0;
+  for (const auto& line : overlays::read_gshhg_lines(overlays::GshhgFeature::Shore, 'c', "", {})) {
+    for (const glm::dvec2& p : line) {
+      const double dd = std::hypot(p.y - 64.1, (p.x + 21.9) * std::cos(64.1 * 3.14159265358979 / 180.0));
+      if (dd < best) best = dd, lon = p.x, lat = p.y;
+    }
+  }
+  ASSERT_LT(best, 1.0) << "no Icelandic vertex in the crude GSHHG shorelines";
+  const double r0 = 6371000.0, kRad = 3.14159265358979323846 / 180.0;
+  const core::OverlayMesh coast = overlays::build_coastlines(overlays::kGshhgDir, 'c', r0, glm::vec4(1.0f));
+  const glm::dvec3 v = geo::sphere_to_ecef({lat, lon, 0.0}, r0);
+  std::size_t vi = coast.positions.size();
+  for (std::size_t i = 0; i < coast.positions.size(); ++i) {
+    if (glm::length(coast.positions[i] - v) < 0.1) vi = i;  // lifted by 8 cm at most (2 km chords)
+  }
+  ASSERT_LT(vi, coast.positions.size()) << "the vertex " << lat << ", " << lon << " is not in the mesh";
+  // The march's inverse (shaders/common/geodesy.glsl) and texel lookup (ground.glsl), in double.
+  const glm::dvec3 g = physics::f64::ecef_to_sphere(coast.positions[vi], r0);
+  EXPECT_NEAR(g.x / kRad, lat, 1e-9);
+  EXPECT_NEAR(g.y / kRad, lon, 1e-9);
+  EXPECT_LT(g.z, 0.1);  // on the ground (the lift of its chords)
+  const int w = 8192, h = 4096;  // a fine ground image: 0.044 degrees a texel
+  const glm::dvec4 at_vertex = physics::f64::equirect_texel(g.x, g.y, w, h);
+  const glm::dvec4 at_latlon = physics::f64::equirect_texel(lat * kRad, lon * kRad, w, h);
+  EXPECT_NEAR(at_vertex.x + at_vertex.z, at_latlon.x + at_latlon.z, 1e-6) << "texels across";
+  EXPECT_NEAR(at_vertex.y + at_vertex.w, at_latlon.y + at_latlon.w, 1e-6) << "texels down";
+  // The ellipsoid's point for the same latitude, inverted the same way: its geocentric latitude,
+  // 3.4 texels away. The test tells the two mappings apart.
+  const glm::dvec3 e = physics::f64::ecef_to_sphere(geo::wgs84_to_ecef({lat, lon, 0.0}), r0);
+  const glm::dvec4 at_ellipsoid = physics::f64::equirect_texel(e.x, e.y, w, h);
+  EXPECT_GT(std::abs(at_ellipsoid.y + at_ellipsoid.w - (at_latlon.y + at_latlon.w)), 3.0) << "texels down";
+}
+
 TEST(GraticuleLabels, StrokesStandBesideTheirCrossingsInTheImage) {
   EXPECT_EQ(overlays::label_strokes("60N").size(), 6u + 6u + 3u);  // 6: afgedc, 0: abcdef, N: three strokes
   EXPECT_EQ(overlays::label_strokes("1").size(), 2u);
@@ -678,6 +723,358 @@ TEST(OverlayGshhg, TheBuilderChecksTheClassAndKeepsTheGeometry) {
   const auto c = builder.build(specs, vol, 0, cam);
   EXPECT_TRUE(c[0].rebuilt);
   EXPECT_GT(c[0].mesh->positions.size(), a[0].mesh->positions.size());
+}
+
+// Wind arrows (instanced): a grid whose wind turns about (0, 0) as a solid body, u = -omega y and
+// v = omega x (x, y the node's east and north distances from the centre, m), times 1 + 0.25 k on
+// level k, so the wind at a level between two is their linear mix.
+struct RotatingWind {
+  core::VolumeGrid grid;
+  std::vector<float> u, v;
+  static constexpr double kOmega = 1e-4, kDeg = 3.14159265358979323846 / 180.0;
+  explicit RotatingWind(double step_deg) {
+    grid.lon_deg = {-10 * step_deg, step_deg, 21};
+    grid.lat_deg = {-10 * step_deg, step_deg, 21};
+    grid.alt_m = {0.0, 500.0, 9};
+    u.resize(grid.points()), v.resize(grid.points());
+    for (int k = 0; k < grid.alt_m.count; ++k) {
+      for (int j = 0; j < grid.lat_deg.count; ++j) {
+        for (int i = 0; i < grid.lon_deg.count; ++i) {
+          const glm::dvec2 w = wind(i, j, k);
+          u[grid.index(i, j, k)] = static_cast<float>(w.x), v[grid.index(i, j, k)] = static_cast<float>(w.y);
+        }
+      }
+    }
+  }
+  // The wind (east, north) at node (i, j) on the fractional level z, in closed form.
+  glm::dvec2 wind(int i, int j, double z) const {
+    const double lat = grid.lat_deg.at(j), lon = grid.lon_deg.at(i);
+    const double x = grid.earth_radius_m * std::cos(lat * kDeg) * lon * kDeg, y = grid.earth_radius_m * lat * kDeg;
+    return (1.0 + 0.25 * z) * kOmega * glm::dvec2(-y, x);
+  }
+};
+
+// Each arrow stands on its grid point at the level, points along the wind there in the local east
+// and north frame, is as long as the speed says (scale x spacing x speed / speed_max) and is
+// coloured by the speed.
+TEST(Arrows, StandOnTheLevelAlongTheWindWithLengthsProportionalToSpeed) {
+  const RotatingWind w(0.1);
+  const core::VolumeGrid& g = w.grid;
+  overlays::ArrowStyle style;
+  style.spacing_cells = 4, style.scale = 0.8, style.speed_min_m_s = 2.0, style.speed_max_m_s = 40.0, style.brightness = 3.0;
+  const double level = 1250.0, z = level / g.alt_m.step;  // halfway between levels 2 and 3
+  const core::OverlayMesh m = overlays::build_arrows(g, w.u, w.v, level, style);
+  const core::OverlayInstances& in = m.instances;
+  EXPECT_TRUE(m.triangles.empty() && m.lines.empty());  // all of it instanced
+  ASSERT_FALSE(in.glyph_triangles.empty());
+  ASSERT_EQ(in.count(), 36u);  // 6 x 6 grid points: 0, 4, ..., 20 each way (the calm centre, 10, is not one)
+  ASSERT_EQ(in.axis_x.size(), in.count());
+  ASSERT_EQ(in.colors.size(), in.count());
+  const double spacing_m = 4 * (g.earth_radius_m + level) * 0.1 * RotatingWind::kDeg;
+  const double per_m_s = style.scale * spacing_m / style.speed_max_m_s;
+  std::size_t k = 0;
+  double worst_angle = 0.0, worst_length = 0.0;
+  for (int j = 0; j <= 20; j += 4) {
+    for (int i = 0; i <= 20; i += 4) {
+      ASSERT_LT(k, in.count());
+      const double lat = g.lat_deg.at(j), lon = g.lon_deg.at(i);
+      const geo::EnuFrame f = geo::sphere_enu(lat, lon);
+      EXPECT_LT(glm::length(in.origins[k] - geo::sphere_to_ecef({lat, lon, level}, g.earth_radius_m)), 1e-6) << k;
+      const glm::dvec2 wind = w.wind(i, j, z);
+      const double speed = glm::length(wind);
+      const glm::dvec3 expected = (wind.x * f.east + wind.y * f.north) / speed;
+      const glm::dvec3 ax(in.axis_x[k]), ay(in.axis_y[k]), az(in.axis_z[k]);
+      worst_angle = std::max(worst_angle, std::acos(std::clamp(glm::dot(glm::normalize(ax), expected), -1.0, 1.0)));
+      worst_length = std::max(worst_length, std::abs(glm::length(ax) / (per_m_s * speed) - 1.0));
+      // y to the left of the wind and z up, as long as x: the glyph keeps its proportions.
+      EXPECT_NEAR(glm::dot(glm::normalize(ay), glm::cross(f.up, expected)), 1.0, 1e-6) << k;
+      EXPECT_NEAR(glm::dot(glm::normalize(az), f.up), 1.0, 1e-6) << k;
+      EXPECT_NEAR(glm::length(ay) / glm::length(ax), 1.0, 1e-6) << k;
+      EXPECT_NEAR(glm::length(az) / glm::length(ax), 1.0, 1e-6) << k;
+      const glm::vec4 c = overlays::colormap((speed - style.speed_min_m_s) / (style.speed_max_m_s - style.speed_min_m_s), style.brightness);
+      for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(in.colors[k][ch], c[ch], 1e-5f * style.brightness) << k;
+      ++k;
+    }
+  }
+  // The wind is stored in float and the axes are floats: both a few parts in 1e7.
+  std::printf("arrows against the rotating wind: worst direction %.3g rad, worst length %.3g relative\n", worst_angle, worst_length);
+  EXPECT_LT(worst_angle, 1e-6) << "radians between an arrow and the wind";
+  EXPECT_LT(worst_length, 1e-6) << "relative error of an arrow's length against scale x spacing x speed / speed_max";
+  // The glyph runs from -0.5 (tail) to 0.5 (tip) along x: the arrow's middle is on the grid point.
+  float x0 = 1e9f, x1 = -1e9f;
+  for (const glm::vec3& p : in.glyph_positions) x0 = std::min(x0, p.x), x1 = std::max(x1, p.x);
+  EXPECT_NEAR(x0, -0.5f, 1e-6f);
+  EXPECT_NEAR(x1, 0.5f, 1e-6f);
+}
+
+// A uniform wind from the south-west: every arrow points north-east and all are equally long.
+TEST(Arrows, AUniformWindGivesParallelArrowsOfOneLength) {
+  core::VolumeGrid g;
+  g.lon_deg = {10.0, 0.25, 13};
+  g.lat_deg = {40.0, 0.25, 9};
+  g.alt_m = {0.0, 1000.0, 4};
+  const std::vector<float> u(g.points(), 10.0f), v(g.points(), 10.0f);
+  overlays::ArrowStyle style;
+  style.spacing_cells = 3;
+  const core::OverlayMesh m = overlays::build_arrows(g, u, v, 3000.0, style);
+  const core::OverlayInstances& in = m.instances;
+  ASSERT_EQ(in.count(), 5u * 3u);  // longitudes 0, 3, ..., 12; latitudes 1, 4, 7 (the lattice centred)
+  const double length = style.scale * 3 * (g.earth_radius_m + 3000.0) * 0.25 * RotatingWind::kDeg * std::sqrt(200.0) / style.speed_max_m_s;
+  for (std::size_t k = 0; k < in.count(); ++k) {
+    const geo::Geodetic at = geo::ecef_to_sphere(in.origins[k], g.earth_radius_m);
+    const geo::EnuFrame f = geo::sphere_enu(at.lat_deg, at.lon_deg);
+    EXPECT_NEAR(at.alt_m, 3000.0, 1e-6) << k;
+    const glm::dvec3 d = glm::normalize(glm::dvec3(in.axis_x[k]));
+    EXPECT_NEAR(glm::dot(d, glm::normalize(f.east + f.north)), 1.0, 1e-12) << k;
+    EXPECT_NEAR(glm::length(glm::dvec3(in.axis_x[k])) / length, 1.0, 1e-6) << k;
+  }
+  EXPECT_NEAR(geo::ecef_to_sphere(in.origins[0], g.earth_radius_m).lat_deg, 40.25, 1e-9);
+}
+
+// The overlay pass draws the arrows with one instanced draw; the CPU cast of the same mesh
+// (its instances expanded) gives the same layer, and so does the GPU drawing the expanded mesh.
+TEST(Arrows, TheInstancedDrawAgreesWithTheCpuCast) {
+  auto ctx = render::make_headless_context();
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::OverlayPass pass(loader);
+  const RotatingWind w(0.01);  // 21 x 21 points 1.1 km apart
+  const double r0 = w.grid.earth_radius_m;
+  overlays::ArrowStyle style;
+  style.spacing_cells = 4, style.scale = 0.9, style.speed_max_m_s = 2.5;  // 1.1 to 3.5 km long
+  const auto mesh = std::make_shared<const core::OverlayMesh>(overlays::build_arrows(w.grid, w.u, w.v, 1500.0, style));
+  ASSERT_EQ(mesh->instances.count(), 36u);
+  core::Camera cam;
+  cam.alt_m = 30000.0, cam.pitch_deg = -90.0, cam.fov_deg = 40.0, cam.width = 128, cam.height = 96;
+  pass.begin(cam, r0);
+  pass.draw(mesh);
+  const core::OpaqueLayer gpu = pass.read();
+  EXPECT_EQ(pass.uploads(), 1u);
+  const core::OpaqueLayer cpu = core::cast_overlay(*mesh, cam, r0);
+  render::OverlayPass plain_pass(loader);
+  plain_pass.begin(cam, r0);
+  plain_pass.draw(core::expand_instances(*mesh));
+  const core::OpaqueLayer plain = plain_pass.read();
+  const int W = cam.width, H = cam.height;
+  auto covered = [&](const core::OpaqueLayer& l, int x, int y) { return l.distance_m[static_cast<std::size_t>(y) * W + x] > 0.0f; };
+  int both = 0, differ = 0, differ_inside = 0;
+  double worst_distance = 0.0, worst_color = 0.0;
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * W + x;
+      EXPECT_EQ(gpu.distance_m[i], plain.distance_m[i]) << "pixel " << x << ", " << y;
+      const bool a = covered(gpu, x, y), b = covered(cpu, x, y);
+      if (a != b) {
+        ++differ;
+        // Coverage may differ only where a pixel's centre lies on a glyph's edge: there the CPU's
+        // cast has a neighbour that differs from the pixel.
+        bool edge = false;
+        for (const auto& [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+          if (x + dx >= 0 && x + dx < W && y + dy >= 0 && y + dy < H) edge = edge || covered(cpu, x + dx, y + dy) != b;
+        }
+        differ_inside += edge ? 0 : 1;
+        continue;
+      }
+      if (!a) continue;
+      ++both;
+      worst_distance = std::max(worst_distance, std::abs(static_cast<double>(gpu.distance_m[i]) - cpu.distance_m[i]));
+      for (int c = 0; c < 3; ++c) worst_color = std::max(worst_color, std::abs(static_cast<double>(gpu.radiance_rgba[4 * i + c]) - cpu.radiance_rgba[4 * i + c]));
+    }
+  }
+  std::printf("arrows, GPU instanced against the CPU cast: %d pixels covered by both, %d differ; worst distance %.3g m, colour %.3g\n",
+              both, differ, worst_distance, worst_color);
+  EXPECT_GT(both, 200) << "the arrows cover too little of the image for a comparison";
+  EXPECT_EQ(differ_inside, 0);
+  EXPECT_LE(differ, both / 100) << differ << " pixels' coverage differs, of " << both;
+  // Float: camera-relative vertices 28.5 km away (ulp 2 mm) and the interpolated position.
+  EXPECT_LT(worst_distance, 0.02) << "m";
+  EXPECT_LT(worst_color, 1e-6);
+}
+
+// Bad input: a volume without wind, a level outside the grid, a colour range the wrong way round;
+// one line naming the scene key and what was expected.
+TEST(Arrows, BadInputNamesTheKeyAndWhatWasExpected) {
+  core::CloudVolume vol;
+  vol.grid.lon_deg = {-2.0, 0.25, 17};
+  vol.grid.lat_deg = {-2.0, 0.25, 17};
+  vol.grid.alt_m = {0.0, 250.0, 17};
+  vol.has_field[static_cast<std::size_t>(core::Field::ExtinctionLiquid)] = true;
+  auto message = [&](const core::OverlaySpec& spec) {
+    try {
+      overlays::check_overlays({core::default_overlay("graticule"), spec}, vol);
+    } catch (const overlays::OverlayError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  core::OverlaySpec arrows = core::default_overlay("arrows");
+  EXPECT_EQ(message(arrows), "overlays[1]: found a volume without wind_u and wind_v, expected both for wind arrows (it holds extinction_liquid)");
+  vol.has_field[static_cast<std::size_t>(core::Field::WindU)] = vol.has_field[static_cast<std::size_t>(core::Field::WindV)] = true;
+  EXPECT_EQ(message(arrows), "(no error)");
+  arrows.numbers["altitude_m"] = 4500.0;
+  EXPECT_EQ(message(arrows), "overlays[1].altitude_m: found 4500, expected an altitude within the grid's levels, 0..4000 m");
+  arrows.numbers["altitude_m"] = 2000.0;
+  arrows.numbers["speed_min_m_s"] = 30.0;
+  EXPECT_EQ(message(arrows), "overlays[1].speed_max_m_s: found 30, expected more than speed_min_m_s (30)");
+}
+
+// Isobaric sections. An isothermal atmosphere whose pressure at sea level rises with longitude,
+// p = p_sea(lon) exp(-z / H) with H = R_d T / g0: the surface p = P stands at z = H ln(p_sea / P),
+// higher to the east.
+struct Isothermal {
+  static constexpr double kT = 260.0, kRd = 287.05, kG0 = 9.80665, kH = kRd * kT / kG0;  // 7611 m
+  static double p_sea_pa(double lon_deg) { return 101325.0 + 1500.0 * lon_deg; }
+  static double altitude_m(double lon_deg, double p_pa) { return kH * std::log(p_sea_pa(lon_deg) / p_pa); }
+};
+
+// The builder on a grid given the pressure in closed form: every vertex at its column's altitude
+// of the surface, coloured by the field there (here the altitude itself), and no vertex in the
+// columns whose surface lies above the grid's top.
+TEST(Section, AnIsobaricSurfaceStandsWhereThePressureIs) {
+  core::VolumeGrid g;
+  g.lon_deg = {-4.0, 0.5, 17};
+  g.lat_deg = {50.0, 0.5, 5};
+  g.alt_m = {0.0, 250.0, 13};  // to 3 km
+  std::vector<float> p(g.points()), z(g.points());
+  for (int k = 0; k < g.alt_m.count; ++k) {
+    for (int j = 0; j < g.lat_deg.count; ++j) {
+      for (int i = 0; i < g.lon_deg.count; ++i) {
+        p[g.index(i, j, k)] = static_cast<float>(Isothermal::p_sea_pa(g.lon_deg.at(i)) * std::exp(-g.alt_m.at(k) / Isothermal::kH));
+        z[g.index(i, j, k)] = static_cast<float>(g.alt_m.at(k));
+      }
+    }
+  }
+  const double level = 70000.0;  // 700 hPa: 2.35 km at 4 W to 2.98 km at 1.5 E, above the grid's top east of that
+  const overlays::FieldColor by{nullptr, 0.0, 3000.0, 1.0};
+  const core::OverlayMesh m = overlays::build_isobaric_section(g, p, z, level, by);
+  int columns = 0;
+  for (int i = 0; i < g.lon_deg.count; ++i) columns += Isothermal::altitude_m(g.lon_deg.at(i), level) <= g.alt_m.last() ? 1 : 0;
+  ASSERT_EQ(m.positions.size(), static_cast<std::size_t>(columns * g.lat_deg.count));
+  ASSERT_LT(columns, g.lon_deg.count);  // the surface leaves the grid: those columns have none
+  EXPECT_EQ(m.triangles.size(), static_cast<std::size_t>(6 * (columns - 1) * (g.lat_deg.count - 1)));
+  double worst = 0.0;
+  for (std::size_t v = 0; v < m.positions.size(); ++v) {
+    const geo::Geodetic at = geo::ecef_to_sphere(m.positions[v], g.earth_radius_m);
+    const double expected = Isothermal::altitude_m(at.lon_deg, level);
+    worst = std::max(worst, std::abs(at.alt_m - expected));
+    const glm::vec4 c = overlays::colormap(expected / 3000.0);
+    for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(m.colors[v][ch], c[ch], 1e-5f) << v;  // the field linear between nodes: exact
+  }
+  // Float pressures (6e-8 of the value) move ln p by as much: H x 6e-8, half a millimetre.
+  std::printf("isobaric section against the closed form: worst %.3g m\n", worst);
+  EXPECT_LT(worst, 0.01) << "m from the closed form";
+  // Wind arrows on the same pressure surface: each at its column's altitude of it, none where the
+  // surface is above the grid.
+  const std::vector<float> u(g.points(), 5.0f), v(g.points(), 0.0f);
+  overlays::ArrowStyle style;
+  style.spacing_cells = 2, style.pressure_pa = level;
+  const core::OverlayMesh arrows = overlays::build_arrows(g, u, v, 0.0, style, &p);
+  std::size_t expected_arrows = 0;
+  for (int i = 0; i < g.lon_deg.count; i += 2) expected_arrows += Isothermal::altitude_m(g.lon_deg.at(i), level) <= g.alt_m.last() ? 3 : 0;
+  ASSERT_EQ(arrows.instances.count(), expected_arrows);
+  double worst_arrow = 0.0;
+  for (const glm::dvec3& o : arrows.instances.origins) {
+    const geo::Geodetic at = geo::ecef_to_sphere(o, g.earth_radius_m);
+    worst_arrow = std::max(worst_arrow, std::abs(at.alt_m - Isothermal::altitude_m(at.lon_deg, level)));
+  }
+  EXPECT_LT(worst_arrow, 0.01) << "m from the closed form";
+}
+
+// Through a file: the same atmosphere written as a CF file on pressure levels (geopotential and
+// temperature), imported, and the isobaric section built by the overlay builder from a scene's
+// entry; and the same entry refused, with the key named, for a volume without pressure.
+TEST(Section, AnIsobaricSectionOfAFileOnPressureLevels) {
+  const std::string path = ::testing::TempDir() + "isobaric_section.nc";
+  constexpr double kR = 6371000.0;
+  const std::vector<double> levels_pa = {100000.0, 92500.0, 85000.0, 77500.0, 70000.0, 62500.0, 55000.0};
+  const int nx = 9, ny = 3, nz = static_cast<int>(levels_pa.size());
+  {
+    test::NcBuilder b(path);
+    const int dt = b.dim("time", 1), dz = b.dim("level", levels_pa.size()), dy = b.dim("latitude", ny), dx = b.dim("longitude", nx);
+    const int vlon = b.var("longitude", NC_DOUBLE, {dx});
+    b.text(vlon, "units", "degrees_east");
+    b.text(vlon, "standard_name", "longitude");
+    const int vlat = b.var("latitude", NC_DOUBLE, {dy});
+    b.text(vlat, "units", "degrees_north");
+    b.text(vlat, "standard_name", "latitude");
+    const int vlev = b.var("level", NC_DOUBLE, {dz});
+    b.text(vlev, "units", "Pa");
+    b.text(vlev, "standard_name", "air_pressure");
+    b.text(vlev, "positive", "down");
+    const int vtime = b.var("time", NC_INT, {dt});
+    b.text(vtime, "units", "hours since 2026-12-02 00:00:00");
+    b.text(vtime, "calendar", "gregorian");
+    const std::vector<int> dims{dt, dz, dy, dx};
+    const int vz = b.var("z", NC_DOUBLE, dims);
+    b.text(vz, "units", "m**2 s**-2");
+    b.text(vz, "standard_name", "geopotential");
+    const int vt = b.var("t", NC_DOUBLE, dims);
+    b.text(vt, "units", "K");
+    b.text(vt, "standard_name", "air_temperature");
+    const int vq = b.var("clwc", NC_DOUBLE, dims);
+    b.text(vq, "units", "kg kg**-1");
+    b.text(vq, "long_name", "specific cloud liquid water content");
+    std::vector<double> lon, lat, z, t, q;
+    for (int i = 0; i < nx; ++i) lon.push_back(-4.0 + i);
+    for (int j = 0; j < ny; ++j) lat.push_back(50.0 + j);
+    for (int k = 0; k < nz; ++k) {
+      for (int j = 0; j < ny; ++j) {
+        for (int i = 0; i < nx; ++i) {
+          const double alt = Isothermal::altitude_m(lon[static_cast<std::size_t>(i)], levels_pa[static_cast<std::size_t>(k)]);
+          z.push_back(Isothermal::kG0 * kR * alt / (kR + alt));  // the inverse of the importer's z = Phi R / (g0 R - Phi)
+          t.push_back(Isothermal::kT);
+          q.push_back(k == 2 ? 1e-4 : 0.0);
+        }
+      }
+    }
+    b.put(vlon, lon);
+    b.put(vlat, lat);
+    b.put(vlev, levels_pa);
+    b.put(vtime, {0.0});
+    b.put(vz, z);
+    b.put(vt, t);
+    b.put(vq, q);
+    b.close();
+  }
+  importers::ImportOptions o;
+  o.dz_m = 100.0;
+  o.keep_cloudless_levels = true;  // the whole column, not just the cloud's levels
+  core::CloudVolume vol = importers::import_file(path, o);
+  ASSERT_TRUE(vol.has_field[static_cast<std::size_t>(core::Field::Pressure)]);
+  core::OverlaySpec spec = core::default_overlay("section");
+  spec.texts["kind"] = "isobaric", spec.texts["field"] = "temperature";
+  spec.numbers["pressure_hpa"] = 735.0, spec.numbers["legend_px"] = 0.0;
+  overlays::check_overlays({spec}, vol);
+  overlays::OverlayBuilder builder;
+  core::Camera cam;
+  cam.alt_m = 5.0e6;
+  const auto built = builder.build({spec}, vol, 0, cam);
+  ASSERT_EQ(built.size(), 1u);
+  const core::OverlayMesh& m = *built[0].mesh;
+  ASSERT_EQ(m.positions.size(), static_cast<std::size_t>(nx * ny));  // 735 hPa lies inside every column
+  EXPECT_EQ(m.triangles.size(), static_cast<std::size_t>(6 * (nx - 1) * (ny - 1)));
+  double worst = 0.0;
+  for (const glm::dvec3& v : m.positions) {
+    const geo::Geodetic at = geo::ecef_to_sphere(v, vol.grid.earth_radius_m);
+    worst = std::max(worst, std::abs(at.alt_m - Isothermal::altitude_m(at.lon_deg, 73500.0)));
+  }
+  // ln p is linear in altitude here, as the importer interpolates it: only float rounding remains.
+  std::printf("isobaric section of the imported file against the closed form: worst %.3g m\n", worst);
+  EXPECT_LT(worst, 0.01) << "m from the closed form";
+  // A level outside the volume's pressures, and a volume without pressure: the key named.
+  spec.numbers["pressure_hpa"] = 400.0;
+  try {
+    overlays::OverlayBuilder().build({spec}, vol, 0, cam);
+    ADD_FAILURE() << "no error for 400 hPa";
+  } catch (const overlays::OverlayError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("overlays[0].pressure_hpa: found 400, expected a pressure within the volume's, ", 0), 0u) << e.what();
+  }
+  vol.has_field[static_cast<std::size_t>(core::Field::Pressure)] = false;
+  try {
+    overlays::check_overlays({spec}, vol);
+    ADD_FAILURE() << "no error without pressure";
+  } catch (const overlays::OverlayError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("overlays[0].kind: found \"isobaric\" for a volume without pressure", 0), 0u) << e.what();
+  }
 }
 
 }  // namespace
