@@ -311,6 +311,41 @@ void path_panel(ViewerState& s, PanelContext& ctx) {
   if (!ed.message.empty()) ImGui::TextWrapped("%s", ed.message.c_str());
 }
 
+// Several views (issue 17): the views open with their source and valid time, the layout (a grid, or
+// a swipe divider between two views), the link of cameras and time, and a view to add.
+void views_panel(ViewerState& s) {
+  if (!ImGui::CollapsingHeader("Views")) return;
+  ViewsPanel& v = s.views;
+  const int n = static_cast<int>(v.labels.size());
+  for (int i = 0; i < n; ++i) {
+    ImGui::PushID(i);
+    if (ImGui::SmallButton("<")) v.step_view = i, v.step_dir = -1;
+    ImGui::SameLine();
+    if (ImGui::SmallButton(">")) v.step_view = i, v.step_dir = +1;
+    ImGui::SameLine();
+    if (i > 0 && ImGui::SmallButton("close")) v.remove_requested = i;
+    if (i > 0) ImGui::SameLine();
+    ImGui::TextWrapped("%d: %s", i, v.labels[static_cast<std::size_t>(i)].c_str());
+    ImGui::PopID();
+  }
+  int layout = v.layout == ViewLayout::Swipe ? 1 : 0;
+  if (ImGui::Combo("layout", &layout, "grid\0swipe (two views)\0")) {
+    if (layout == 1 && n != 2) v.message = "a swipe divider splits two views; " + std::to_string(n) + " are open";
+    else v.layout = layout == 1 ? ViewLayout::Swipe : ViewLayout::Grid, v.message.clear();
+  }
+  if (v.layout == ViewLayout::Swipe) slider_double("divider", &v.divider, 0.0, 1.0, "%.2f");
+  ImGui::Checkbox("link cameras", &v.link_camera);
+  ImGui::SameLine();
+  ImGui::Checkbox("link time", &v.link_time);
+  if (n < kMaxViews) {
+    ImGui::InputText("source", &v.add_source);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("FILE, FILE@TIME (a step or a UTC time), or @TIME: this file at another time");
+    ImGui::SameLine();
+    if (ImGui::Button("add view")) v.add_requested = true;
+  }
+  if (!v.message.empty()) ImGui::TextWrapped("%s", v.message.c_str());
+}
+
 void scene_panel(ViewerState& s, PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Scene file")) return;
   ImGui::InputText("path", &ctx.scene_path);
@@ -360,6 +395,7 @@ void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats)
     quality_panel(state, ctx);
     overlay_panel(state, stats);
     path_panel(state, ctx);
+    views_panel(state);
     scene_panel(state, ctx);
     ImGui::TextDisabled("F1 hides the panels; %s", stats.renderer.c_str());
   }
