@@ -739,7 +739,6 @@ int run_viewer(const ViewerOptions& o) {
       ctx.sun_error = e.what();
       main_view.spec = resolve(s.scene, s.volume);
     }
-    const core::FrameSpec& spec = main_view.spec;
     // The other views: view 0's settings, sun, overlays and interpolation on their own data, camera,
     // time and size; the prepared instant shared with any view of the same source and instant.
     std::vector<ViewGpu*> gpus = {&main_view};
@@ -875,8 +874,10 @@ int run_viewer(const ViewerOptions& o) {
         const ImVec2 size = ImGui::CalcTextSize(text);
         const bool right = s.views.layout == ViewLayout::Swipe && i == 1;
         const ImVec2 p(right ? float(r.x + r.w) / fx - size.x - 8.0f : float(r.x) / fx + 8.0f, float(r.y + r.h) / fy - size.y - 8.0f);
+        dl->PushClipRect(ImVec2(float(r.x) / fx, float(r.y) / fy), ImVec2(float(r.x + r.w) / fx, float(r.y + r.h) / fy), true);
         dl->AddRectFilled(ImVec2(p.x - 4.0f, p.y - 2.0f), ImVec2(p.x + size.x + 4.0f, p.y + size.y + 2.0f), IM_COL32(0, 0, 0, 170));
         dl->AddText(p, IM_COL32(255, 255, 255, 255), text);
+        dl->PopClipRect();
       }
       if (s.views.layout == ViewLayout::Swipe) {
         const float x = float(swipe_column(fbw, s.views.divider)) / fx;
