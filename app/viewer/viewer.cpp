@@ -36,6 +36,7 @@
 #include "kernel/volume_cache.hpp"
 #include "scene/instant.hpp"
 #include "viewer/playback.hpp"
+#include "viewer/probe_panel.hpp"
 #include "viewer/view_compose.hpp"
 #include "viewer/views.hpp"
 #include "overlays/overlays.hpp"
@@ -484,6 +485,7 @@ int run_viewer(const ViewerOptions& o) {
   s.views.link_camera = s.views.link_time = !o.unlinked;
   LinkedViews link;
   MouseRouter mouse;
+  ClickDetector click;  // a click without a drag: the probe
   int active_view = 0;  // the view the keys fly: the last one the mouse acted on
 
   auto win = render::make_window_context(o.width, o.height, "cloudviewer - " + o.input);
@@ -608,6 +610,35 @@ int run_viewer(const ViewerOptions& o) {
       if (target >= 0) active_view = target;
       active_view = std::min(active_view, n_views - 1);
       navigate(win->window(), *scene_of(active_view).camera, volume_of(active_view).grid.earth_radius_m, s.fly_mode, target >= 0, dt);
+      // A click (a press and release without a drag) on a view probes the column under it: the
+      // file's step nearest the view's instant, read as `cloudviewer probe` reads it.
+      if (click.update(io.MouseDown[0] && (click.down || !io.WantCaptureMouse), io.MousePos.x * fx, io.MousePos.y * fy)) {
+        const int vi = view_at(s.views.layout, n_views, fbw, fbh, s.views.divider, click.x0, click.y0);
+        if (vi >= 0) {
+          const ViewRect r = view_rects(s.views.layout, n_views, fbw, fbh)[static_cast<std::size_t>(vi)];
+          const core::Camera& cam = *scene_of(vi).camera;  // at its march size
+          const std::optional<glm::dvec2> ll = pixel_ground(cam, (click.x0 - r.x) * cam.width / r.w, (click.y0 - r.y) * cam.height / r.h,
+                                                            volume_of(vi).grid.earth_radius_m);
+          s.probe.open = true;
+          if (!ll) {
+            s.probe.message = "the click is on the sky: no column there";
+          } else {
+            std::size_t step = static_cast<std::size_t>(std::max(0, scene_of(vi).time_step));
+            try {
+              const core::Instant at = core::scene_instant(scene_of(vi), volume_of(vi), scene_of(vi).data.path);
+              step = at.fraction < 0.5 ? at.step0 : at.step1;
+            } catch (const core::TimeError&) {  // the step index stands
+            }
+            step = std::min(step, volume_of(vi).times.size() - 1);
+            try {
+              probe_into(s.probe, volume_of(vi), scene_of(vi).data.path, step, ll->x, ll->y);
+              s.probe.view = vi;
+            } catch (const std::exception& e) {  // the step could not be read
+              s.probe.message = e.what();
+            }
+          }
+        }
+      }
     }
     if (show_ui) draw_panels(s, ctx, stats);
     if (s.views.step_view >= 0 && s.views.step_view < n_views) {  // a view's "<" or ">": its file's previous or next step

@@ -15,6 +15,7 @@
 #include "volume/cloud_volume.hpp"
 #include "viewer/keyframes.hpp"
 #include "viewer/playback.hpp"
+#include "viewer/probe_panel.hpp"
 #include "viewer/views.hpp"
 
 namespace cv::viewer {
@@ -47,6 +48,7 @@ struct ViewerState {
   bool timeline = false;      // the file has two or more ascending UTC valid times: play, scrub
   KeyframeEditor keys;        // the camera-path panel (keyframes.hpp)
   ViewsPanel views;           // several views (views.hpp); view 0 is this scene
+  ProbePanel probe;           // the column under the last click (probe_panel.hpp)
 };
 
 
