@@ -228,6 +228,11 @@ ExtraView open_view(const std::string& spec, const std::string& option, ViewerSt
   const std::string time = at == std::string::npos ? "" : spec.substr(at + 1);
   if (file.empty()) file = s.scene.data.path;
   const std::string bad = "cloudviewer view: " + option + ": found '" + spec + "'";
+  // Another name of a file already open (./a.nc, a link) is that file: its volume and instants are shared.
+  if (file != s.scene.data.path && core::same_file(file, s.scene.data.path)) file = s.scene.data.path;
+  for (const auto& [path, volume] : sources) {
+    if (file != path && core::same_file(file, path)) file = path;
+  }
   if (at != std::string::npos && time.empty()) throw ViewerInputError(bad + ", expected a time after '@' (a step index or a UTC time)");
   ExtraView v;
   v.scene = s.scene;
