@@ -93,18 +93,9 @@ int cmd_probe(const std::vector<std::string>& args) {
       throw UsageError{std::string("cloudviewer probe: --camera: ") + e.what()};
     }
   }
-  const bool has[] = {vol.has_field[static_cast<int>(core::Field::Temperature)], vol.has_field[static_cast<int>(core::Field::WindU)],
-                      vol.has_field[static_cast<int>(core::Field::WindV)], vol.has_field[static_cast<int>(core::Field::WindW)]};
   std::printf("probe %s at lat %.6g, lon %.6g, step %zu (%s); ground %s\n", c.file.c_str(), lat, lon, step, vol.times[step].iso_utc.c_str(),
               std::isfinite(p.ground_m) ? (num(p.ground_m, "%.1f") + " m").c_str() : "unknown (heights above sea level)");
-  std::string table = "alt_m,above_ground_m,cloud_fraction,ext_liquid_per_m,ext_ice_per_m,march_liquid_per_m,march_ice_per_m,temperature_k,"
-                      "wind_u_m_s,wind_v_m_s,wind_w_m_s\n";
-  for (const auto& l : p.levels) {
-    table += num(l.alt_m, "%.1f") + "," + num(l.above_ground_m, "%.1f") + "," + num(l.cloud_fraction, "%.6g") + "," + num(l.ext_liquid_per_m, "%.6g") +
-             "," + num(l.ext_ice_per_m, "%.6g") + "," + num(l.march_liquid_per_m, "%.6g") + "," + num(l.march_ice_per_m, "%.6g") + "," +
-             (has[0] ? num(l.temperature_k, "%.3f") : "") + "," + (has[1] ? num(l.wind_u_m_s, "%.3f") : "") + "," +
-             (has[2] ? num(l.wind_v_m_s, "%.3f") : "") + "," + (has[3] ? num(l.wind_w_m_s, "%.4f") : "") + "\n";
-  }
+  const std::string table = core::probe_levels_csv(p, vol);
   std::printf("%s", table.c_str());
   std::string summary = "cover " + num(p.cover, "%.4f") + ", base " + (std::isfinite(p.base_m) ? num(p.base_m, "%.1f") + " m" : "none") +
                         ", top " + (std::isfinite(p.top_m) ? num(p.top_m, "%.1f") + " m" : "none") + ", optical depth " +
@@ -121,8 +112,7 @@ int cmd_probe(const std::vector<std::string>& args) {
   if (!csv.empty()) {
     core::write_file_atomically(csv, [&](std::FILE* f) {
       put(f, "# probe of " + c.file + " at lat " + num(lat) + " lon " + num(lon) + ", valid " + vol.times[step].iso_utc + "\n");
-      put(f, "# cover=" + num(p.cover, "%.6g") + ",base_m=" + num(p.base_m, "%.1f") + ",top_m=" + num(p.top_m, "%.1f") +
-                 ",optical_depth=" + num(p.optical_depth, "%.6g") + ",ground_m=" + num(p.ground_m, "%.1f"));
+      put(f, core::probe_summary_csv(p));
       if (have_camera) {
         put(f, ",first_cloud_m=" + (ray.first_cloud_m >= 0 ? num(ray.first_cloud_m, "%.1f") : "") + ",half_transmittance_m=" +
                    (ray.half_transmittance_m >= 0 ? num(ray.half_transmittance_m, "%.1f") : "") + ",ray_transmittance=" +

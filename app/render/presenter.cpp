@@ -100,7 +100,7 @@ void Presenter::accumulate(int count) {
   check_gl("accumulating the viewer's frames");
 }
 
-void Presenter::draw(const ToneSettings& tone, int x, int y, int w, int h) const {
+void Presenter::draw(const ToneSettings& tone, int x, int y, int w, int h, const std::optional<std::array<int, 4>>& clip) const {
   const GLuint p = present_.id();
   glProgramUniform1f(p, loc(p, "u_exposure"), static_cast<float>(tone.exposure));
   glProgramUniform3f(p, loc(p, "u_background"), static_cast<float>(tone.background.x),
@@ -109,13 +109,19 @@ void Presenter::draw(const ToneSettings& tone, int x, int y, int w, int h) const
   glViewport(x, y, w, h);
   glDisable(GL_BLEND);
   glDisable(GL_DEPTH_TEST);
-  glDisable(GL_SCISSOR_TEST);
+  if (clip) {
+    glEnable(GL_SCISSOR_TEST);
+    glScissor((*clip)[0], (*clip)[1], (*clip)[2], (*clip)[3]);
+  } else {
+    glDisable(GL_SCISSOR_TEST);
+  }
   glDisable(GL_CULL_FACE);
   glBindTextureUnit(0, mean_);
   glUseProgram(p);
   glBindVertexArray(vao_);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glBindVertexArray(0);
+  glDisable(GL_SCISSOR_TEST);
   check_gl("drawing the tonemapped image");
 }
 

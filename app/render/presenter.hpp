@@ -3,7 +3,9 @@
 // fullscreen tonemap draw (present.vert/.frag) with the same curve as image_output.
 #pragma once
 
+#include <array>
 #include <filesystem>
+#include <optional>
 
 #include "render/image_output.hpp"
 #include "render/shader_loader.hpp"
@@ -37,8 +39,9 @@ class Presenter {
 
   // Draws the mean, tonemapped, over the currently bound framebuffer's viewport (x, y, w, h),
   // upscaled bilinearly in linear radiance when the march size differs, exactly as upscale_linear
-  // (the `render` command's image).
-  void draw(const ToneSettings& tone, int x, int y, int w, int h) const;
+  // (the `render` command's image). `clip`, when given (x, y, w, h in the same window pixels), keeps
+  // the draw within that rectangle (a swipe divider's side): the pixels drawn are those of the whole draw.
+  void draw(const ToneSettings& tone, int x, int y, int w, int h, const std::optional<std::array<int, 4>>& clip = std::nullopt) const;
 
  private:
   GlProgram accumulate_;

@@ -311,6 +311,87 @@ void path_panel(ViewerState& s, PanelContext& ctx) {
   if (!ed.message.empty()) ImGui::TextWrapped("%s", ed.message.c_str());
 }
 
+// Several views (issue 17): the views open with their source and valid time, the layout (a grid, or
+// a swipe divider between two views), the link of cameras and time, and a view to add.
+void views_panel(ViewerState& s) {
+  if (!ImGui::CollapsingHeader("Views")) return;
+  ViewsPanel& v = s.views;
+  const int n = static_cast<int>(v.labels.size());
+  for (int i = 0; i < n; ++i) {
+    ImGui::PushID(i);
+    if (ImGui::SmallButton("<")) v.step_view = i, v.step_dir = -1;
+    ImGui::SameLine();
+    if (ImGui::SmallButton(">")) v.step_view = i, v.step_dir = +1;
+    ImGui::SameLine();
+    if (i > 0 && ImGui::SmallButton("close")) v.remove_requested = i;
+    if (i > 0) ImGui::SameLine();
+    ImGui::TextWrapped("%d: %s", i, v.labels[static_cast<std::size_t>(i)].c_str());
+    ImGui::PopID();
+  }
+  int layout = v.layout == ViewLayout::Swipe ? 1 : 0;
+  if (ImGui::Combo("layout", &layout, "grid\0swipe (two views)\0")) {
+    if (layout == 1 && n != 2) v.message = "a swipe divider splits two views; " + std::to_string(n) + " are open";
+    else v.layout = layout == 1 ? ViewLayout::Swipe : ViewLayout::Grid, v.message.clear();
+  }
+  if (v.layout == ViewLayout::Swipe) slider_double("divider", &v.divider, 0.0, 1.0, "%.2f");
+  ImGui::Checkbox("link cameras", &v.link_camera);
+  ImGui::SameLine();
+  ImGui::Checkbox("link time", &v.link_time);
+  if (n < kMaxViews) {
+    ImGui::InputText("source", &v.add_source);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("FILE, FILE@TIME (a step or a UTC time), or @TIME: this file at another time");
+    ImGui::SameLine();
+    if (ImGui::Button("add view")) v.add_requested = true;
+  }
+  if (!v.message.empty()) ImGui::TextWrapped("%s", v.message.c_str());
+}
+
+// The probe (a click on a pixel): the column there per level, its summary, and a CSV of it, as
+// `cloudviewer probe --csv` writes it.
+void probe_window(ProbePanel& p) {
+  if (!p.open) return;
+  ImGui::SetNextWindowSize(ImVec2(520, 360), ImGuiCond_FirstUseEver);
+  if (!ImGui::Begin("Probe", &p.open)) {
+    ImGui::End();
+    return;
+  }
+  if (!p.source.empty()) {
+    const core::ColumnProbe& c = p.column;
+    ImGui::TextWrapped("view %d: %s, step %zu (%s), lat %.4f, lon %.4f; ground %s", p.view, p.source.c_str(), p.step, p.valid.c_str(),
+                       p.lat_deg, p.lon_deg, std::isfinite(c.ground_m) ? (std::to_string(std::lround(c.ground_m)) + " m").c_str() : "unknown");
+    char base[32] = "none", top[32] = "none";
+    if (std::isfinite(c.base_m)) std::snprintf(base, sizeof base, "%.0f m", c.base_m);
+    if (std::isfinite(c.top_m)) std::snprintf(top, sizeof top, "%.0f m", c.top_m);
+    ImGui::Text("cover %.3f, base %s, top %s, optical depth %.4g", c.cover, base, top, c.optical_depth);
+    ImGui::InputText("CSV", &p.csv_path);
+    ImGui::SameLine();
+    if (ImGui::Button("save")) save_probe_csv(p);
+    const ImGuiTableFlags flags = ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_SizingFixedFit;
+    if (ImGui::BeginTable("levels", 7, flags, ImVec2(0, 0))) {
+      ImGui::TableSetupScrollFreeze(0, 1);
+      for (const char* h : {"alt (m)", "cloud fraction", "ext liquid (1/m)", "ext ice (1/m)", "T (K)", "u (m/s)", "v (m/s)"}) {
+        ImGui::TableSetupColumn(h);
+      }
+      ImGui::TableHeadersRow();
+      for (auto it = c.levels.rbegin(); it != c.levels.rend(); ++it) {  // top first, as a sounding reads
+        ImGui::TableNextRow();
+        const double v[] = {it->alt_m, it->cloud_fraction, it->ext_liquid_per_m, it->ext_ice_per_m, it->temperature_k, it->wind_u_m_s,
+                            it->wind_v_m_s};
+        const bool shown[] = {true, true, true, true, p.has_temperature, p.has_wind, p.has_wind};
+        const char* fmt[] = {"%.0f", "%.3f", "%.3g", "%.3g", "%.1f", "%.1f", "%.1f"};
+        for (int k = 0; k < 7; ++k) {
+          ImGui::TableSetColumnIndex(k);
+          if (shown[k] && std::isfinite(v[k])) ImGui::Text(fmt[k], v[k]);
+          else ImGui::TextDisabled("-");
+        }
+      }
+      ImGui::EndTable();
+    }
+  }
+  if (!p.message.empty()) ImGui::TextWrapped("%s", p.message.c_str());
+  ImGui::End();
+}
+
 void scene_panel(ViewerState& s, PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Scene file")) return;
   ImGui::InputText("path", &ctx.scene_path);
@@ -360,10 +441,12 @@ void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats)
     quality_panel(state, ctx);
     overlay_panel(state, stats);
     path_panel(state, ctx);
+    views_panel(state);
     scene_panel(state, ctx);
-    ImGui::TextDisabled("F1 hides the panels; %s", stats.renderer.c_str());
+    ImGui::TextDisabled("F1 hides the panels; a click (no drag) on the globe probes the column; %s", stats.renderer.c_str());
   }
   ImGui::End();
+  probe_window(state.probe);
 }
 
 void draw_stats_overlay(const FrameStats& s, int target) {

@@ -14,6 +14,9 @@
 #include <cmath>
 #include <climits>
 #include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <map>
 #include <memory>
 
 #include "importer.hpp"
@@ -33,6 +36,9 @@
 #include "kernel/volume_cache.hpp"
 #include "scene/instant.hpp"
 #include "viewer/playback.hpp"
+#include "viewer/probe_panel.hpp"
+#include "viewer/view_compose.hpp"
+#include "viewer/views.hpp"
 #include "overlays/overlays.hpp"
 #include "render/frame_renderer.hpp"
 #include "scene/framing.hpp"
@@ -114,24 +120,175 @@ void save_screenshot(const std::string& path, int w, int h) {
   render::write_png(path, w, h, flipped);
 }
 
-// Keyboard and mouse navigation, unless ImGui wants them.
-void navigate(GLFWwindow* win, ViewerState& s, double dt_s) {
+// Keyboard and mouse navigation of `cam` (the view the mouse is over, or the last one), unless ImGui
+// wants them; `mouse` false: this frame's mouse is not for a view (the swipe divider is dragged).
+void navigate(GLFWwindow* win, core::Camera& cam, double r0, bool fly_mode, bool mouse, double dt_s) {
   const ImGuiIO& io = ImGui::GetIO();
-  core::Camera& cam = *s.scene.camera;
-  const double r0 = s.volume.grid.earth_radius_m;
-  if (!io.WantCaptureMouse) {
+  if (!io.WantCaptureMouse && mouse) {
     const double dx = io.MouseDelta.x, dy = io.MouseDelta.y;
     const bool moved = dx != 0.0 || dy != 0.0;
-    if (moved && io.MouseDown[0] && !s.fly_mode) orbit(cam, dx, dy, r0);
-    else if (moved && (io.MouseDown[1] || (io.MouseDown[0] && s.fly_mode))) look(cam, dx, dy);
+    if (moved && io.MouseDown[0] && !fly_mode) orbit(cam, dx, dy, r0);
+    else if (moved && (io.MouseDown[1] || (io.MouseDown[0] && fly_mode))) look(cam, dx, dy);
     if (io.MouseWheel != 0.0f) zoom(cam, io.MouseWheel, r0);
   }
-  if (!io.WantCaptureKeyboard && s.fly_mode) {
+  if (!io.WantCaptureKeyboard && fly_mode) {
     auto key = [&](int k) { return glfwGetKey(win, k) == GLFW_PRESS ? 1.0 : 0.0; };
     const glm::dvec3 dir(key(GLFW_KEY_W) - key(GLFW_KEY_S), key(GLFW_KEY_D) - key(GLFW_KEY_A), key(GLFW_KEY_E) - key(GLFW_KEY_Q));
     const double boost = key(GLFW_KEY_LEFT_SHIFT) > 0.0 ? 5.0 : 1.0;
     if (dir != glm::dvec3(0.0)) fly(cam, dir * boost, dt_s, r0);
   }
+}
+
+// One view's GPU side: its renderer (the prepared instant it shows, uploaded), its march and mean
+// textures, its overlays, its accumulation and exposure, and this frame's resolved frame.
+struct ViewGpu {
+  explicit ViewGpu(const render::ShaderLoader& loader) : renderer(loader), presenter(loader) {}
+  render::FrameRenderer renderer;
+  render::Presenter presenter;
+  overlays::OverlayBuilder overlay_builder;
+  int accumulated = 0;
+  bool marching = false;
+  core::Scene previous;
+  double auto_exposure = render::kDefaultExposure;
+  core::FrameSpec spec;
+};
+
+// A view besides view 0 (issue 17): its scene holds its data, camera and time, and takes view 0's
+// settings each frame; its volume is shared by the views of one source (view 0's own when the file
+// is view 0's), and so is the prepared instant where two views show the same one.
+struct ExtraView {
+  core::Scene scene;
+  core::CloudVolume* volume = nullptr;
+  double view_step_ratio = 1.0;  // its grid's vertical spacing over view 0's: the view step scales with it
+  std::shared_ptr<const core::PreparedVolume> prepared;
+  std::string prepared_key;
+  std::unique_ptr<ViewGpu> gpu;
+};
+
+// What identifies a prepared instant: the source, the instant (or the step) and how it was made.
+std::string prepared_key(const std::string& source, const core::Instant& at, core::TimeInterpolation mode) {
+  return source + (at.time_known ? "@" + std::to_string(at.unix_s) : "#" + std::to_string(at.step0)) + "/" +
+         std::to_string(static_cast<int>(mode));
+}
+
+// A view's camera and time for the link: UTC seconds where the file has UTC valid times, else the step.
+ViewCursor cursor_of(const core::Scene& sc, const core::CloudVolume& vol) {
+  ViewCursor c;
+  c.camera = *sc.camera;
+  c.utc = core::times_known(vol.times);
+  const std::size_t step = static_cast<std::size_t>(std::clamp(sc.time_step, 0, static_cast<int>(vol.times.size()) - 1));
+  if (c.utc) {
+    const std::optional<std::int64_t> t = sc.time.valid_utc.empty() ? std::nullopt : core::parse_iso_utc(sc.time.valid_utc);
+    c.t = double(t ? *t : vol.times[step].unix_s);
+    c.t_first = double(vol.times.front().unix_s), c.t_last = double(vol.times.back().unix_s);
+  } else {
+    c.t = double(step);
+    c.t_first = 0.0, c.t_last = double(vol.times.size() - 1);
+  }
+  return c;
+}
+
+void set_time(core::Scene& sc, const ViewCursor& c) {
+  if (c.utc) {
+    sc.time.valid_utc = core::format_iso_utc(static_cast<std::int64_t>(std::llround(c.t)));
+  } else {
+    sc.time_step = static_cast<int>(std::lround(c.t));
+    sc.time.valid_utc.clear();
+  }
+}
+
+// The previous (dir -1) or next (+1) step of the file from time t (in the cursor's unit).
+double step_from(const core::CloudVolume& vol, const ViewCursor& c, int dir) {
+  if (!c.utc) return std::clamp(c.t + dir, c.t_first, c.t_last);
+  double best = c.t;
+  for (const core::ValidTime& v : vol.times) {
+    const double t = double(v.unix_s);
+    if (dir > 0 && t > c.t) return t;
+    if (dir < 0 && t < c.t) best = t;
+  }
+  return best;
+}
+
+// A view's label: its file and its valid time.
+std::string view_label(const core::Scene& sc, const core::CloudVolume& vol) {
+  const ViewCursor c = cursor_of(sc, vol);
+  const std::string name = std::filesystem::path(sc.data.path).filename().string();
+  if (c.utc) return name + "  " + core::format_iso_utc(static_cast<std::int64_t>(std::llround(c.t)));
+  const std::size_t step = static_cast<std::size_t>(c.t);
+  return name + "  step " + std::to_string(step) + " (" + vol.times[step].iso_utc + ")";
+}
+
+// Opens a view of FILE[@TIME] (@TIME: view 0's file at another time), or throws ViewerInputError
+// with one line naming `option`, what was found and what was expected. Without a time it takes
+// view 0's instant (held within the file's span) or view 0's step.
+ExtraView open_view(const std::string& spec, const std::string& option, ViewerState& s,
+                    std::map<std::string, std::unique_ptr<core::CloudVolume>>& sources) {
+  const std::size_t at = spec.rfind('@');
+  std::string file = at == std::string::npos ? spec : spec.substr(0, at);
+  const std::string time = at == std::string::npos ? "" : spec.substr(at + 1);
+  if (file.empty()) file = s.scene.data.path;
+  const std::string bad = "cloudviewer view: " + option + ": found '" + spec + "'";
+  // Another name of a file already open (./a.nc, a link) is that file: its volume and instants are shared.
+  if (file != s.scene.data.path && core::same_file(file, s.scene.data.path)) file = s.scene.data.path;
+  for (const auto& [path, volume] : sources) {
+    if (file != path && core::same_file(file, path)) file = path;
+  }
+  if (at != std::string::npos && time.empty()) throw ViewerInputError(bad + ", expected a time after '@' (a step index or a UTC time)");
+  ExtraView v;
+  v.scene = s.scene;
+  v.scene.data.path = file;
+  v.scene.path.reset();
+  if (file == s.scene.data.path) {
+    v.volume = &s.volume;
+  } else if (auto it = sources.find(file); it != sources.end()) {
+    v.volume = it->second.get();
+  } else {
+    if (!std::filesystem::exists(file)) throw ViewerInputError(bad + ": " + file + " does not exist, expected a NetCDF file or a .cvvol volume");
+    auto vol = std::make_unique<core::CloudVolume>();
+    try {
+      *vol = importers::load_scene_volume(v.scene, 2);
+    } catch (const std::exception& e) {
+      throw ViewerInputError(bad + ": " + file + " does not import (" + e.what() + "), expected a NetCDF file or a .cvvol volume");
+    }
+    const core::VolumeGrid& g = vol->grid;
+    if (g.lon_deg.count < 2 || g.lat_deg.count < 2 || g.alt_m.count < 2 || vol->times.empty()) {
+      throw ViewerInputError(bad + ": " + file + " holds " + std::to_string(g.lon_deg.count) + " x " + std::to_string(g.lat_deg.count) +
+                             " x " + std::to_string(g.alt_m.count) + " points, expected at least 2 along each axis");
+    }
+    v.volume = vol.get();
+    sources.emplace(file, std::move(vol));
+  }
+  const core::CloudVolume& vol = *v.volume;
+  v.scene.time.valid_utc.clear();
+  v.scene.time_step = 0;
+  if (!time.empty() && core::parse_iso_utc(time)) {
+    try {
+      core::instant_at_time(vol.times, time, file);
+    } catch (const core::TimeError& e) {
+      throw ViewerInputError(bad + ": " + e.what());
+    }
+    v.scene.time.valid_utc = time;
+  } else if (!time.empty()) {
+    const int n = static_cast<int>(vol.times.size());
+    try {
+      std::size_t used = 0;
+      v.scene.time_step = std::stoi(time, &used);
+      if (used != time.size()) v.scene.time_step = -1;
+    } catch (const std::exception&) {
+      v.scene.time_step = -1;
+    }
+    if (v.scene.time_step < 0 || v.scene.time_step >= n) {
+      throw ViewerInputError(bad + ", expected a step 0.." + std::to_string(n - 1) + " of " + file + " or a UTC time YYYY-MM-DDThh:mm:ssZ");
+    }
+  } else if (core::times_known(vol.times) && core::times_known(s.volume.times)) {
+    ViewCursor c = cursor_of(s.scene, s.volume);
+    c.t = std::clamp(c.t, double(vol.times.front().unix_s), double(vol.times.back().unix_s));
+    set_time(v.scene, c);
+  } else {
+    v.scene.time_step = std::min(s.scene.time_step, static_cast<int>(vol.times.size()) - 1);
+  }
+  v.view_step_ratio = vol.grid.alt_m.step / s.volume.grid.alt_m.step;
+  return v;
 }
 }  // namespace
 
@@ -196,6 +353,17 @@ int cmd_view(const std::vector<std::string>& args) {
         if (!(o.frame_budget_ms >= 0.0 && o.frame_budget_ms <= 1e7)) {
           throw ViewerInputError("cloudviewer view: --frame-budget: found '" + v + "', expected a frame time in ms 0..1e7 (0: off)");
         }
+      } else if (a == "--compare") {
+        o.compare.push_back(next());
+        if (o.compare.size() > static_cast<std::size_t>(kMaxViews - 1)) {
+          throw ViewerInputError("cloudviewer view: --compare: found " + std::to_string(o.compare.size()) + " of them, expected at most " +
+                                 std::to_string(kMaxViews - 1) + " (" + std::to_string(kMaxViews) + " views)");
+        }
+      } else if (a == "--layout") {
+        o.layout = next();
+        if (!parse_view_layout(o.layout)) throw ViewerInputError("cloudviewer view: --layout: found '" + o.layout + "', expected grid or swipe");
+      } else if (a == "--unlinked") {
+        o.unlinked = true;
       } else if (a == "--realtime") {
         o.realtime = true;
       } else if (a == "--hide-ui") {
@@ -209,6 +377,10 @@ int cmd_view(const std::vector<std::string>& args) {
       }
     }
     if (o.input.empty()) throw ViewerInputError("cloudviewer view: expected INPUT (.nc, .cvvol or a scene .json)");
+    if (o.layout == "swipe" && o.compare.size() != 1) {
+      throw ViewerInputError("cloudviewer view: --layout: found 'swipe' with " + std::to_string(o.compare.size() + 1) +
+                             " view(s), expected exactly one --compare (a swipe divider splits two views)");
+    }
     if (!o.screenshot.empty() && o.frames == 0) {
       throw ViewerInputError("cloudviewer view: --screenshot: expected --frames N as well (the frame to save is the Nth)");
     }
@@ -305,13 +477,30 @@ int run_viewer(const ViewerOptions& o) {
   if (!o.scene || o.scale_given) s.scene.render.resolution_scale = o.scale;
   if (o.frame_budget_ms >= 0.0) s.scene.render.budget_ms = o.frame_budget_ms;
 
+  // More views (--compare): opened before the window, so bad input costs no frames.
+  std::map<std::string, std::unique_ptr<core::CloudVolume>> sources;  // the other files' volumes, one per file
+  std::vector<ExtraView> extra;
+  try {
+    for (const std::string& c : o.compare) extra.push_back(open_view(c, "--compare", s, sources));
+  } catch (const ViewerInputError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  }
+  s.views.layout = *parse_view_layout(o.layout);
+  s.views.link_camera = s.views.link_time = !o.unlinked;
+  LinkedViews link;
+  MouseRouter mouse;
+  ClickDetector click;  // a click without a drag: the probe
+  int active_view = 0;  // the view the keys fly: the last one the mouse acted on
+
   auto win = render::make_window_context(o.width, o.height, "cloudviewer - " + o.input);
   glfwSwapInterval(o.frames > 0 ? 0 : 1);
   const render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
-  render::FrameRenderer renderer(loader);
-  render::Presenter presenter(loader);
-  core::PreparedVolumeCache volumes;  // the time steps shown last, prepared once each
-  overlays::OverlayBuilder overlay_builder;  // the overlays' geometry, rebuilt only when its inputs change
+  ViewGpu main_view(loader);  // view 0: the scene the panels edit
+  render::FrameRenderer& renderer = main_view.renderer;
+  core::PreparedVolumeCache volumes;  // the time steps shown last, prepared once each (shared by every view)
+  std::shared_ptr<const core::PreparedVolume> shown0;  // view 0's prepared instant, and its key: a view
+  std::string shown0_key;                               // of the same source and instant shares it
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -334,13 +523,12 @@ int run_viewer(const ViewerOptions& o) {
   FrameStats stats;
   stats.renderer = win->info().renderer;
   PassTimer march_timer, present_timer;
-  int accumulated = 0;
-  double auto_exposure = render::kDefaultExposure;  // the last automatic exposure (render::auto_exposure)
   bool show_ui = !o.hide_ui, f1_was_down = false;
-  core::Scene previous;
   using clock = std::chrono::steady_clock;
   const auto start = clock::now();
   auto last = start, fps_since = start;
+  auto after_first = start;            // the end of frame 0: --frames reports the mean frame after it
+  std::clock_t cpu_after_first = 0;    // the process's CPU time then (all threads: llvmpipe's too)
   int fps_frames = 0;
   for (int frame = 0; o.frames == 0 ? !win->should_close() : frame < o.frames; ++frame) {
     glfwPollEvents();
@@ -354,13 +542,62 @@ int run_viewer(const ViewerOptions& o) {
       glfwWaitEvents();
       continue;
     }
-    s.scene.width = fbw;
-    s.scene.height = fbh;
+    // The Views panel's requests from the last frame: a view to open or to close.
+    if (s.views.add_requested) {
+      s.views.add_requested = false;
+      try {
+        if (extra.size() + 1 >= static_cast<std::size_t>(kMaxViews)) throw ViewerInputError("at most " + std::to_string(kMaxViews) + " views");
+        extra.push_back(open_view(s.views.add_source, "add view", s, sources));
+        s.views.message = "opened " + s.views.add_source;
+      } catch (const ViewerInputError& e) {
+        s.views.message = e.what();
+      }
+    }
+    if (s.views.remove_requested >= 1 && s.views.remove_requested <= static_cast<int>(extra.size())) {
+      extra.erase(extra.begin() + (s.views.remove_requested - 1));
+    }
+    s.views.remove_requested = -1;
+    const int n_views = 1 + static_cast<int>(extra.size());
+    if (n_views != 2) s.views.layout = ViewLayout::Grid;  // a swipe divider splits two views
+    const std::vector<ViewRect> rects = view_rects(s.views.layout, n_views, fbw, fbh);
+    s.scene.width = rects[0].w;
+    s.scene.height = rects[0].h;
     if (!s.scene.camera) {
-      s.scene.camera = core::auto_camera(g, fbw, fbh);
+      s.scene.camera = core::auto_camera(g, rects[0].w, rects[0].h);
       ctx.home = *s.scene.camera;
       ctx.goto_lat_deg = ctx.home.lat_deg, ctx.goto_lon_deg = ctx.home.lon_deg, ctx.goto_alt_m = ctx.home.alt_m;
     }
+    for (ExtraView& v : extra) {
+      if (!v.scene.camera) v.scene.camera = *s.scene.camera;  // a new view starts where view 0 looks
+    }
+    // The link (views.hpp): every view's camera and time before this frame's interactions; after
+    // them (the mouse, the keys, the panels, playback), the one that changed moves the others.
+    auto scene_of = [&](int i) -> core::Scene& { return i == 0 ? s.scene : extra[static_cast<std::size_t>(i - 1)].scene; };
+    auto volume_of = [&](int i) -> core::CloudVolume& { return i == 0 ? s.volume : *extra[static_cast<std::size_t>(i - 1)].volume; };
+    auto read_cursors = [&] {
+      link.views.resize(static_cast<std::size_t>(n_views));
+      for (int i = 0; i < n_views; ++i) link.views[static_cast<std::size_t>(i)] = cursor_of(scene_of(i), volume_of(i));
+    };
+    auto link_views = [&] {
+      read_cursors();
+      const std::vector<ViewCursor> before = link.views;
+      const std::vector<bool> changed = link.sync();
+      for (int i = 0; i < n_views; ++i) {
+        const std::size_t k = static_cast<std::size_t>(i);
+        if (!changed[k]) continue;
+        core::Scene& sc = scene_of(i);
+        if (!same_view_camera(before[k].camera, link.views[k].camera)) sc.camera = link.views[k].camera;
+        if (before[k].t != link.views[k].t) {
+          set_time(sc, link.views[k]);
+          if (i == 0 && link.views[k].utc) s.play.t_s = link.views[k].t;
+        }
+      }
+      link.begin();
+    };
+    link.link_camera = s.views.link_camera;
+    link.link_time = s.views.link_time;
+    read_cursors();
+    link.begin();
 
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
@@ -368,8 +605,54 @@ int run_viewer(const ViewerOptions& o) {
     const bool f1 = glfwGetKey(win->window(), GLFW_KEY_F1) == GLFW_PRESS;
     if (f1 && !f1_was_down) show_ui = !show_ui;
     f1_was_down = f1;
-    navigate(win->window(), s, dt);
+    {  // the mouse goes to the view under it (a drag stays with its view; the swipe divider drags)
+      const ImGuiIO& io = ImGui::GetIO();
+      const double fx = io.DisplayFramebufferScale.x, fy = io.DisplayFramebufferScale.y;
+      const bool pressed = !io.WantCaptureMouse && (io.MouseClicked[0] || io.MouseClicked[1]);
+      const int target = n_views == 1 ? 0
+                                       : mouse.route(s.views.layout, n_views, fbw, fbh, s.views.divider, io.MousePos.x * fx,
+                                                     io.MousePos.y * fy, pressed, io.MouseDown[0] || io.MouseDown[1]);
+      if (target >= 0) active_view = target;
+      active_view = std::min(active_view, n_views - 1);
+      navigate(win->window(), *scene_of(active_view).camera, volume_of(active_view).grid.earth_radius_m, s.fly_mode, target >= 0, dt);
+      // A click (a press and release without a drag) on a view probes the column under it: the
+      // file's step nearest the view's instant, read as `cloudviewer probe` reads it.
+      if (click.update(io.MouseDown[0] && (click.down || !io.WantCaptureMouse), io.MousePos.x * fx, io.MousePos.y * fy)) {
+        const int vi = view_at(s.views.layout, n_views, fbw, fbh, s.views.divider, click.x0, click.y0);
+        if (vi >= 0) {
+          const ViewRect r = view_rects(s.views.layout, n_views, fbw, fbh)[static_cast<std::size_t>(vi)];
+          const core::Camera& cam = *scene_of(vi).camera;  // at its march size
+          const std::optional<glm::dvec2> ll = pixel_ground(cam, (click.x0 - r.x) * cam.width / r.w, (click.y0 - r.y) * cam.height / r.h,
+                                                            volume_of(vi).grid.earth_radius_m);
+          s.probe.open = true;
+          if (!ll) {
+            s.probe.message = "the click is on the sky: no column there";
+          } else {
+            std::size_t step = static_cast<std::size_t>(std::max(0, scene_of(vi).time_step));
+            try {
+              const core::Instant at = core::scene_instant(scene_of(vi), volume_of(vi), scene_of(vi).data.path);
+              step = at.fraction < 0.5 ? at.step0 : at.step1;
+            } catch (const core::TimeError&) {  // the step index stands
+            }
+            step = std::min(step, volume_of(vi).times.size() - 1);
+            try {
+              probe_into(s.probe, volume_of(vi), scene_of(vi).data.path, step, ll->x, ll->y);
+              s.probe.view = vi;
+            } catch (const std::exception& e) {  // the step could not be read
+              s.probe.message = e.what();
+            }
+          }
+        }
+      }
+    }
     if (show_ui) draw_panels(s, ctx, stats);
+    if (s.views.step_view >= 0 && s.views.step_view < n_views) {  // a view's "<" or ">": its file's previous or next step
+      ViewCursor c = cursor_of(scene_of(s.views.step_view), volume_of(s.views.step_view));
+      c.t = step_from(volume_of(s.views.step_view), c, s.views.step_dir);
+      set_time(scene_of(s.views.step_view), c);
+      if (s.views.step_view == 0 && c.utc) s.play.t_s = c.t;
+    }
+    s.views.step_view = -1;
     // The camera path's preview: the camera and the weather time follow the path at wall time.
     if (s.keys.previewing) {
       if (const std::optional<core::Scene> at = preview_step(s.scene, s.keys, dt)) {
@@ -388,7 +671,7 @@ int run_viewer(const ViewerOptions& o) {
     ctx.budget_text = budget.on() ? budget.status() + "; from " + budget.source() : "";
     // The march size follows the window and the resolution scale; the camera renders at it.
     int mw = 0, mh = 0;
-    march_size(s.scene, fbw, fbh, mw, mh);
+    march_size(s.scene, rects[0].w, rects[0].h, mw, mh);
     s.scene.camera->width = mw;
     s.scene.camera->height = mh;
     s.scene.time_step = std::clamp(s.scene.time_step, 0, static_cast<int>(s.volume.times.size()) - 1);
@@ -404,6 +687,7 @@ int run_viewer(const ViewerOptions& o) {
       }
       s.scene.time.valid_utc = core::format_iso_utc(s.play.shown());
     }
+    link_views();  // the interactions and playback so far move the linked views
     if (prefetch && (on_timeline || s.play.playing)) {
       const std::int64_t want_t = *core::parse_iso_utc(s.scene.time.valid_utc);
       std::vector<std::int64_t> wanted = {want_t};
@@ -417,6 +701,9 @@ int run_viewer(const ViewerOptions& o) {
       auto v = first_ask ? prefetch->get(want_t, (o.frames > 0 && !o.realtime) || !have_volume, &interp) : nullptr;
       if (v) {
         renderer.use_volume(v);
+        core::Instant shown_at;
+        shown_at.time_known = true, shown_at.unix_s = want_t;
+        shown0 = v, shown0_key = prepared_key(s.scene.data.path, shown_at, s.scene.time.interpolation);
         shown_instant = want_t;
         // The step slider shows the step at or before the instant.
         s.scene.time_step = static_cast<int>(core::instant_at_time(s.volume.times, s.scene.time.valid_utc, s.scene.data.path).step0);
@@ -447,12 +734,15 @@ int run_viewer(const ViewerOptions& o) {
         at = core::instant_at_step(s.volume.times, static_cast<std::size_t>(s.scene.time_step), s.scene.data.path);
       }
       core::TimeInterpolationReport interp;
-      renderer.use_volume(volumes.get(s.scene.data.path, s.volume, at, s.scene.time.interpolation, &interp));
+      shown0 = volumes.get(s.scene.data.path, s.volume, at, s.scene.time.interpolation, &interp);
+      shown0_key = prepared_key(s.scene.data.path, at, s.scene.time.interpolation);
+      renderer.use_volume(shown0);
       ctx.time_warning = interp.warning;
       ctx.instant_text = at.iso_utc + (at.between() ? std::string(" (") + core::time_interpolation_name(interp.used) + " between steps)" : "");
       have_volume = true;
       shown_instant = INT64_MIN;
     }
+    link_views();  // view 0's playhead held on the instant shown holds the linked views too
     if (core::times_known(s.volume.times)) {  // the valid time shown, and the local solar time at the view centre
       const std::int64_t t = shown_instant != INT64_MIN ? shown_instant
                              : !s.scene.time.valid_utc.empty() ? *core::parse_iso_utc(s.scene.time.valid_utc)
@@ -465,68 +755,134 @@ int run_viewer(const ViewerOptions& o) {
                     s.scene.sun.mode == core::SunMode::LocalNoon ? "; sun: local noon (teaching)" : "");
       ctx.instant_text = text;
     }
-    if (presenter.width() != mw || presenter.height() != mh) presenter.resize(mw, mh);
-    // The frame as `render` resolves it (camera at the march size, sun, settings).
-    core::FrameSpec spec;
+    // The frame as `render` resolves it (camera at the march size, sun, settings); a date/time being
+    // typed keeps the last good sun.
+    auto resolve = [&](const core::Scene& sc, const core::CloudVolume& vol) {
+      try {
+        return render::resolve_frame(sc, vol);
+      } catch (const std::invalid_argument&) {
+        core::Scene held = sc;
+        held.sun.mode = core::SunMode::Manual;
+        held.sun.subsolar_lat_deg = ctx.sun.subsolar_lat_deg, held.sun.subsolar_lon_deg = ctx.sun.subsolar_lon_deg;
+        return render::resolve_frame(held, vol);
+      }
+    };
     try {
-      spec = render::resolve_frame(s.scene, s.volume);
-      ctx.sun = spec.sun;
+      main_view.spec = render::resolve_frame(s.scene, s.volume);
+      ctx.sun = main_view.spec.sun;
       ctx.sun_error.clear();
     } catch (const std::invalid_argument& e) {
-      ctx.sun_error = e.what();  // keep the last good sun while the date/time is being typed
-      core::Scene held = s.scene;
-      held.sun.mode = core::SunMode::Manual;
-      held.sun.subsolar_lat_deg = ctx.sun.subsolar_lat_deg, held.sun.subsolar_lon_deg = ctx.sun.subsolar_lon_deg;
-      spec = render::resolve_frame(held, s.volume);
+      ctx.sun_error = e.what();
+      main_view.spec = resolve(s.scene, s.volume);
     }
-    if (frame == 0 || !same_march(s.scene, previous)) accumulated = 0;
-    previous = s.scene;
+    // The other views: view 0's settings, sun, overlays and interpolation on their own data, camera,
+    // time and size; the prepared instant shared with any view of the same source and instant.
+    std::vector<ViewGpu*> gpus = {&main_view};
+    for (std::size_t k = 0; k < extra.size(); ++k) {
+      ExtraView& v = extra[k];
+      const ViewRect r = rects[k + 1];
+      v.scene.render = s.scene.render;
+      v.scene.render.march.quality.view_step_m *= v.view_step_ratio;  // as many steps per cell of its own grid
+      v.scene.sun = s.scene.sun;
+      v.scene.overlays = s.scene.overlays;
+      v.scene.time.interpolation = s.scene.time.interpolation;
+      v.scene.width = r.w, v.scene.height = r.h;
+      march_size(v.scene, r.w, r.h, v.scene.camera->width, v.scene.camera->height);
+      if (!v.gpu) v.gpu = std::make_unique<ViewGpu>(loader);
+      core::Instant at;
+      try {
+        at = core::scene_instant(v.scene, *v.volume, v.scene.data.path);
+      } catch (const core::TimeError& e) {
+        std::fprintf(stderr, "%s; the time step is used instead\n", e.what());
+        v.scene.time.valid_utc.clear();
+        at = core::instant_at_step(v.volume->times, static_cast<std::size_t>(v.scene.time_step), v.scene.data.path);
+      }
+      v.scene.time_step = static_cast<int>(at.step0);
+      const std::string key = prepared_key(v.scene.data.path, at, v.scene.time.interpolation);
+      if (key != v.prepared_key) {
+        v.prepared = key == shown0_key ? shown0 : nullptr;
+        for (const ExtraView& other : extra) {
+          if (!v.prepared && &other != &v && other.prepared_key == key) v.prepared = other.prepared;
+        }
+        if (!v.prepared) v.prepared = volumes.get(v.scene.data.path, *v.volume, at, v.scene.time.interpolation);
+        v.prepared_key = key;
+      }
+      v.gpu->renderer.use_volume(v.prepared);
+      v.gpu->spec = resolve(v.scene, *v.volume);
+      gpus.push_back(v.gpu.get());
+    }
 
-    // One more jittered frame into the mean until the target; a target of 1 marches at step middles
-    // exactly as `render` does without --accumulate.
-    marched_last = accumulated < s.scene.render.accumulate;
-    if (marched_last) {
-      if (accumulated == 0) {  // a new mean: the overlays for this view (VTK only when a scene has some)
-        try {
-          const auto built = overlay_builder.build(s.scene.overlays, s.volume, static_cast<std::size_t>(s.scene.time_step), spec.march_camera);
+    // Each view: one more jittered frame into its mean until the target (a target of 1 marches at
+    // step middles exactly as `render` does without --accumulate).
+    bool any_march = false;
+    for (std::size_t i = 0; i < gpus.size(); ++i) {
+      ViewGpu& v = *gpus[i];
+      const core::Scene& sc = scene_of(static_cast<int>(i));
+      if (frame == 0 || !same_march(sc, v.previous)) v.accumulated = 0;
+      v.previous = sc;
+      v.marching = v.accumulated < sc.render.accumulate;
+      any_march = any_march || v.marching;
+      const int w = v.spec.march_camera.width, h = v.spec.march_camera.height;
+      if (v.presenter.width() != w || v.presenter.height() != h) v.presenter.resize(w, h);
+      if (!v.marching || v.accumulated != 0) continue;
+      try {  // a new mean: the overlays for this view (VTK only when a scene has some)
+        const auto built = v.overlay_builder.build(sc.overlays, volume_of(static_cast<int>(i)), static_cast<std::size_t>(sc.time_step),
+                                                   v.spec.march_camera);
+        std::vector<render::OverlayDraw> draws = overlays::OverlayBuilder::draws(built);
+        if (i == 0) {
           stats.overlays.resize(built.size());
-          for (std::size_t i = 0; i < built.size(); ++i) {
-            if (built[i].rebuilt) stats.overlays[i].build_ms = built[i].build_ms;
+          for (std::size_t j = 0; j < built.size(); ++j) {
+            if (built[j].rebuilt) stats.overlays[j].build_ms = built[j].build_ms;
           }
-          std::vector<render::OverlayDraw> draws = overlays::OverlayBuilder::draws(built);
           if (s.keys.draw_path && s.scene.path) {  // the camera path on the globe, after the scene's overlays
             auto track = std::make_shared<const core::OverlayMesh>(path_mesh(s.scene, g.earth_radius_m));
             if (!track->empty()) draws.push_back({"camera path", track, nullptr, 2.0f});
           }
-          renderer.set_overlays(std::move(draws));
-        } catch (const overlays::OverlayError& e) {
-          ctx.scene_message = e.what();
-          renderer.set_overlays({});
+        }
+        v.renderer.set_overlays(std::move(draws));
+      } catch (const overlays::OverlayError& e) {
+        ctx.scene_message = e.what();
+        v.renderer.set_overlays({});
+      }
+    }
+    marched_last = main_view.marching;
+    if (any_march) march_timer.begin();
+    for (ViewGpu* v : gpus) {
+      if (v->marching) v->renderer.march_into(v->presenter.frame_texture(), v->spec, v->accumulated);
+    }
+    if (any_march) march_timer.end();
+    present_timer.begin();
+    std::vector<const render::Presenter*> presenters;
+    std::vector<render::ToneSettings> tones;
+    for (std::size_t i = 0; i < gpus.size(); ++i) {
+      ViewGpu& v = *gpus[i];
+      const core::Scene& sc = scene_of(static_cast<int>(i));
+      if (v.marching) {
+        v.presenter.accumulate(v.accumulated);
+        ++v.accumulated;
+        // The automatic exposure from the mean at the march size (as `render` takes it), when the mean
+        // starts and when it is complete: not frame by frame, so the picture does not pulse.
+        if (v.spec.auto_exposure && (v.accumulated == 1 || v.accumulated == sc.render.accumulate)) {
+          std::vector<glm::vec4> mean(static_cast<std::size_t>(v.presenter.width()) * v.presenter.height());
+          glGetTextureImage(v.presenter.mean_texture(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(mean.size() * sizeof(glm::vec4)),
+                            mean.data());
+          v.auto_exposure = render::auto_exposure(mean);
         }
       }
-      march_timer.begin();
-      renderer.march_into(presenter.frame_texture(), spec, accumulated);
-      march_timer.end();
-      present_timer.begin();
-      presenter.accumulate(accumulated);
-      ++accumulated;
-      // The automatic exposure from the mean at the march size (as `render` takes it), when the mean
-      // starts and when it is complete: not frame by frame, so the picture does not pulse.
-      if (spec.auto_exposure && (accumulated == 1 || accumulated == s.scene.render.accumulate)) {
-        std::vector<glm::vec4> mean(static_cast<std::size_t>(mw) * mh);
-        glGetTextureImage(presenter.mean_texture(), 0, GL_RGBA, GL_FLOAT,
-                          static_cast<GLsizei>(mean.size() * sizeof(glm::vec4)), mean.data());
-        auto_exposure = render::auto_exposure(mean);
-      }
-    } else {
-      present_timer.begin();
+      render::ToneSettings tone;
+      tone.exposure = v.spec.auto_exposure ? v.auto_exposure : v.spec.exposure;
+      if (sc.render.march.features.atmosphere || sc.render.march.features.globe) tone.background = glm::dvec3(0.0);
+      presenters.push_back(&v.presenter);
+      tones.push_back(tone);
     }
+    ctx.auto_exposure = main_view.auto_exposure;
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    render::ToneSettings tone;
-    tone.exposure = spec.auto_exposure ? auto_exposure : spec.exposure;
-    ctx.auto_exposure = auto_exposure;
-    if (s.scene.render.march.features.atmosphere || s.scene.render.march.features.globe) tone.background = glm::dvec3(0.0);
-    presenter.draw(tone, 0, 0, fbw, fbh);
+    if (n_views > 1) {  // a grid of three leaves a cell empty
+      glViewport(0, 0, fbw, fbh);
+      glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+      glClear(GL_COLOR_BUFFER_BIT);
+    }
+    compose_views(presenters, tones, s.views.layout, s.views.divider, fbw, fbh);
     present_timer.end();
     stats.march_ms = march_timer.ms();
     stats.present_ms = present_timer.ms();
@@ -534,10 +890,36 @@ int run_viewer(const ViewerOptions& o) {
       stats.overlays[i].draw_ms = i < renderer.overlay_draw_ms().size() ? renderer.overlay_draw_ms()[i] : 0.0;
     }
     if (show_ui) stats.march = renderer.last_stats();  // read back only when shown (it waits for the march)
-    stats.accumulated = accumulated;
+    stats.accumulated = main_view.accumulated;
     stats.march_w = mw;
     stats.march_h = mh;
     if (show_ui) draw_stats_overlay(stats, s.scene.render.accumulate);  // built after the march: this frame's count
+    // Each view's label (its file and valid time) at the bottom of the part that shows, and the
+    // swipe divider; also with the panels hidden, when there are several views.
+    s.views.labels.resize(static_cast<std::size_t>(n_views));
+    for (int i = 0; i < n_views; ++i) s.views.labels[static_cast<std::size_t>(i)] = view_label(scene_of(i), volume_of(i));
+    if (n_views > 1) {
+      const ImGuiIO& io = ImGui::GetIO();
+      const float fx = io.DisplayFramebufferScale.x > 0.0f ? io.DisplayFramebufferScale.x : 1.0f;
+      const float fy = io.DisplayFramebufferScale.y > 0.0f ? io.DisplayFramebufferScale.y : 1.0f;
+      ImDrawList* dl = ImGui::GetForegroundDrawList();
+      for (int i = 0; i < n_views; ++i) {
+        const ViewRect r = visible_rect(s.views.layout, n_views, i, fbw, fbh, s.views.divider);
+        if (r.w <= 0 || r.h <= 0) continue;
+        const char* text = s.views.labels[static_cast<std::size_t>(i)].c_str();
+        const ImVec2 size = ImGui::CalcTextSize(text);
+        const bool right = s.views.layout == ViewLayout::Swipe && i == 1;
+        const ImVec2 p(right ? float(r.x + r.w) / fx - size.x - 8.0f : float(r.x) / fx + 8.0f, float(r.y + r.h) / fy - size.y - 8.0f);
+        dl->PushClipRect(ImVec2(float(r.x) / fx, float(r.y) / fy), ImVec2(float(r.x + r.w) / fx, float(r.y + r.h) / fy), true);
+        dl->AddRectFilled(ImVec2(p.x - 4.0f, p.y - 2.0f), ImVec2(p.x + size.x + 4.0f, p.y + size.y + 2.0f), IM_COL32(0, 0, 0, 170));
+        dl->AddText(p, IM_COL32(255, 255, 255, 255), text);
+        dl->PopClipRect();
+      }
+      if (s.views.layout == ViewLayout::Swipe) {
+        const float x = float(swipe_column(fbw, s.views.divider)) / fx;
+        dl->AddLine(ImVec2(x, 0.0f), ImVec2(x, float(fbh) / fy), IM_COL32(255, 255, 255, 220), 2.0f);
+      }
+    }
 
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
@@ -546,12 +928,18 @@ int run_viewer(const ViewerOptions& o) {
       march_timer.finish();
       stats.march_ms = march_timer.ms();
       std::printf("wrote %s (%d x %d window, %d frame(s) accumulated in %.2f s wall, GPU march %.1f ms per frame on %s)\n",
-                  o.screenshot.c_str(), fbw, fbh, accumulated, std::chrono::duration<double>(clock::now() - start).count(),
+                  o.screenshot.c_str(), fbw, fbh, main_view.accumulated, std::chrono::duration<double>(clock::now() - start).count(),
                   stats.march_ms, stats.renderer.c_str());
+      if (o.frames > 1) {  // what a frame costs once the shaders are compiled and the data prepared
+        std::printf("%d view(s), %s: frames 2..%d took %.1f ms wall, %.1f ms process CPU each\n", n_views, view_layout_name(s.views.layout),
+                    o.frames, std::chrono::duration<double, std::milli>(clock::now() - after_first).count() / (o.frames - 1),
+                    1e3 * double(std::clock() - cpu_after_first) / CLOCKS_PER_SEC / (o.frames - 1));
+      }
       if (budget.on()) std::printf("frame budget %g ms: ended on %s\n", s.scene.render.budget_ms, budget.status().c_str());
       if (!stats.prefetch.empty()) std::printf("%s\n", stats.prefetch.c_str());
     }
     win->swap_buffers();
+    if (frame == 0) after_first = clock::now(), cpu_after_first = std::clock();
     ++fps_frames;
     const double since = std::chrono::duration<double>(clock::now() - fps_since).count();
     if (since >= 0.5) {

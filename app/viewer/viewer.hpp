@@ -24,6 +24,9 @@ struct ViewerOptions {
   bool hide_ui = false;     // start with the panels hidden (F1 toggles them)
   double scale = 1.0;       // resolution scale: march at this fraction of the window size
   double frame_budget_ms = -1.0;  // --frame-budget: the scene's render.budget_ms (0 off); < 0: not given
+  std::vector<std::string> compare;  // --compare FILE[@TIME] | @TIME: more views (issue 17), up to 3
+  std::string layout = "grid";       // --layout grid|swipe (swipe: two views)
+  bool unlinked = false;             // --unlinked: cameras and time not linked between views
 };
 
 // Parses the `view` arguments and runs; returns the exit code (2 with one line for bad arguments).

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "frame/camera.hpp"
 #include "frame/march_stats.hpp"
@@ -14,12 +15,28 @@
 #include "volume/cloud_volume.hpp"
 #include "viewer/keyframes.hpp"
 #include "viewer/playback.hpp"
+#include "viewer/probe_panel.hpp"
+#include "viewer/views.hpp"
 
 namespace cv::viewer {
 
 // Bad viewer input (arguments, a date/time typed in): one line naming what and what was expected.
 struct ViewerInputError : std::runtime_error {
   using std::runtime_error::runtime_error;
+};
+
+// The "Views" panel (several views side by side, issue 17): the layout and the link, what each view
+// shows, and what the panel asks of the main loop (which owns the views).
+struct ViewsPanel {
+  ViewLayout layout = ViewLayout::Grid;
+  double divider = 0.5;  // the swipe divider, a fraction of the width
+  bool link_camera = true, link_time = true;
+  std::vector<std::string> labels;  // per view (view 0 first): its source and valid time
+  std::string add_source;           // FILE, FILE@TIME, or @TIME (this view's file at another time)
+  bool add_requested = false;
+  int remove_requested = -1;        // a view (1..) to close
+  int step_view = -1, step_dir = 0;  // a view whose time goes to its file's previous / next step
+  std::string message;              // the last request's problem, or empty
 };
 
 struct ViewerState {
@@ -30,6 +47,8 @@ struct ViewerState {
   Playhead play;              // the timeline: where in the file's times, playing or not
   bool timeline = false;      // the file has two or more ascending UTC valid times: play, scrub
   KeyframeEditor keys;        // the camera-path panel (keyframes.hpp)
+  ViewsPanel views;           // several views (views.hpp); view 0 is this scene
+  ProbePanel probe;           // the column under the last click (probe_panel.hpp)
 };
 
 

@@ -18,6 +18,32 @@ namespace cv::core {
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string num(double v, const char* fmt = "%.6g") {
+  if (!std::isfinite(v)) return "";
+  char buf[48];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+}  // namespace
+
+std::string probe_levels_csv(const ColumnProbe& p, const CloudVolume& vol) {
+  const bool has[] = {vol.has_field[static_cast<int>(Field::Temperature)], vol.has_field[static_cast<int>(Field::WindU)],
+                      vol.has_field[static_cast<int>(Field::WindV)], vol.has_field[static_cast<int>(Field::WindW)]};
+  std::string table = "alt_m,above_ground_m,cloud_fraction,ext_liquid_per_m,ext_ice_per_m,march_liquid_per_m,march_ice_per_m,temperature_k,"
+                      "wind_u_m_s,wind_v_m_s,wind_w_m_s\n";
+  for (const auto& l : p.levels) {
+    table += num(l.alt_m, "%.1f") + "," + num(l.above_ground_m, "%.1f") + "," + num(l.cloud_fraction, "%.6g") + "," + num(l.ext_liquid_per_m, "%.6g") +
+             "," + num(l.ext_ice_per_m, "%.6g") + "," + num(l.march_liquid_per_m, "%.6g") + "," + num(l.march_ice_per_m, "%.6g") + "," +
+             (has[0] ? num(l.temperature_k, "%.3f") : "") + "," + (has[1] ? num(l.wind_u_m_s, "%.3f") : "") + "," +
+             (has[2] ? num(l.wind_v_m_s, "%.3f") : "") + "," + (has[3] ? num(l.wind_w_m_s, "%.4f") : "") + "\n";
+  }
+  return table;
+}
+
+std::string probe_summary_csv(const ColumnProbe& p) {
+  return "# cover=" + num(p.cover, "%.6g") + ",base_m=" + num(p.base_m, "%.1f") + ",top_m=" + num(p.top_m, "%.1f") +
+         ",optical_depth=" + num(p.optical_depth, "%.6g") + ",ground_m=" + num(p.ground_m, "%.1f");
 }
 
 bool grid_holds(const VolumeGrid& g, double lat_deg, double lon_deg) {

@@ -49,6 +49,12 @@ std::string grid_extent_text(const VolumeGrid& grid);
 ColumnProbe probe_column(const CloudVolume& volume, const TimeStepData& data, const GridMeanExtinction& medium,
                          double lat_deg, double lon_deg, const MapOptions& options = {});
 
+// The probe as `probe --csv` writes it and the viewer's probe panel saves it: the per-level table
+// (a header, then one row per level, bottom to top; a field the volume lacks is left empty) and the
+// column's summary (cover, base, top, optical depth, ground; empty where there is none).
+std::string probe_levels_csv(const ColumnProbe& probe, const CloudVolume& volume);
+std::string probe_summary_csv(const ColumnProbe& probe);
+
 // Where the light came from along the view ray from a camera position to a point: the march
 // kernel's own state for that one ray (one pixel looking straight at the point).
 struct ViewRayProbe {
