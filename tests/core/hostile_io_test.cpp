@@ -201,7 +201,7 @@ TEST_F(HostileInput, ASceneFileWritesNothingAndRunsNothing) {
     error = e.what();
   }
   fs::current_path(cwd);
-  EXPECT_EQ(error, "evil.json: overlays[0]: found \"$(touch pwned_overlay)\", expected one of coastlines, borders, rivers, graticule, isosurface, wind, section");
+  EXPECT_EQ(error, "evil.json: overlays[0]: found \"$(touch pwned_overlay)\", expected one of coastlines, borders, rivers, graticule, isosurface, wind, arrows, section");
   EXPECT_EQ(listing(), before);
   EXPECT_FALSE(fs::exists("pwned_data") || fs::exists("pwned_texture") || fs::exists("pwned_overlay"));
   // Without the overlay the same file loads, its strings kept as text.
