@@ -16,7 +16,7 @@
 #include "importer.hpp"
 #include "io/output_file.hpp"
 #include "kernel/prepared_volume.hpp"
-#include "plot_canvas.hpp"
+#include "plots/analysis_plots.hpp"
 #include "render/image_output.hpp"
 #include "scene/framing.hpp"
 #include "scene/instant.hpp"
@@ -186,105 +186,23 @@ int cmd_section(const std::vector<std::string>& args) {
   }
   check_outputs("section", out, csv, c.file);
   core::CloudVolume vol = load(c.file);
-  core::SectionField field;
-  try {
-    field = core::section_field(vol, field_name);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError{"cloudviewer section: --field: " + std::string(e.what()) + " (" + c.file + ")"};
-  }
-  check_point(vol.grid, "section", "--from", lat1, lon1, c.file);
-  check_point(vol.grid, "section", "--to", lat2, lon2, c.file);
-  {
-    const double len = geo::great_circle_distance_m(lat1, lon1, lat2, lon2, vol.grid.earth_radius_m);
-    const double cell = core::smallest_cell_m(vol.grid);
-    if (!(len >= cell)) {
-      throw UsageError{"cloudviewer section: --from/--to: the path is " + num(len, "%.4g") + " m long, expected at least one grid cell (" +
-                       num(cell, "%.4g") + " m) of " + c.file};
-    }
+  plots::SectionInputs in;
+  in.field = field_name;
+  in.lat1 = lat1, in.lon1 = lon1, in.lat2 = lat2, in.lon2 = lon2;
+  in.width = width, in.height = height, in.columns = columns;
+  in.have_range = have_range, in.lo = lo, in.hi = hi;
+  if (const std::string problem = plots::section_problem(vol, c.file, in); !problem.empty()) {
+    throw UsageError{"cloudviewer section: " + problem};
   }
   const std::size_t step = resolve_step(vol, c);
-  const core::TimeStepData& data = vol.step(step);
-  const core::GridMeanExtinction medium = core::grid_mean_extinction(vol.grid, data);
-  const core::VolumeGrid& g = vol.grid;
-  // The plot: altitude from the lowest of the grid and the ground (or 0) to the grid's top.
-  const Area area{70, 34, width - 110, height - 44};
-  const double z_top = g.alt_m.last(), z_bot = std::min(0.0, g.alt_m.start);
-  std::vector<double> rows(static_cast<std::size_t>(area.h()));
-  for (int y = 0; y < area.h(); ++y) rows[static_cast<std::size_t>(y)] = z_top - (y + 0.5) / area.h() * (z_top - z_bot);
-  std::reverse(rows.begin(), rows.end());  // ascending: row k is pixel y = h - 1 - k
-  const core::Section px = core::vertical_section(vol, data, medium, field, lat1, lon1, lat2, lon2, area.w(), rows);
-  const core::Section grid_rows = core::vertical_section(vol, data, medium, field, lat1, lon1, lat2, lon2, columns,
-                                                         [&] {
-                                                           std::vector<double> z;
-                                                           for (int k = 0; k < g.alt_m.count; ++k) z.push_back(g.alt_m.at(k));
-                                                           return z;
-                                                         }());
-  if (!have_range) {
-    lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (double v : px.value)
-      if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
-    if (!std::isfinite(lo)) lo = 0.0, hi = 1.0;
-    if (!(hi > lo)) hi = lo + (lo == 0.0 ? 1.0 : std::abs(lo) * 1e-3);
-  }
-  Canvas cv(width, height, kPaper);
-  const std::size_t nr = rows.size();
-  for (int x = 0; x < area.w(); ++x) {
-    const double ground = px.ground_m[static_cast<std::size_t>(x)];
-    for (std::size_t k = 0; k < nr; ++k) {
-      const int y = area.y1 - static_cast<int>(k);
-      const double v = px.value[static_cast<std::size_t>(x) * nr + k];
-      Rgb col = std::isfinite(v) ? sequential_colour((v - lo) / (hi - lo)) : kNoData;
-      if (rows[k] < (std::isfinite(ground) ? ground : 0.0)) col = kGround;
-      // The cloud's boundary: a cloudy point with a clear neighbour.
-      const auto cloudy = [&](int xx, std::size_t kk) { return px.cloudy[static_cast<std::size_t>(xx) * nr + kk] != 0; };
-      if (cloudy(x, k) && ((x > 0 && !cloudy(x - 1, k)) || (x + 1 < area.w() && !cloudy(x + 1, k)) || (k > 0 && !cloudy(x, k - 1)) ||
-                           (k + 1 < nr && !cloudy(x, k + 1)))) {
-        col = kInk;
-      }
-      cv.set(area.x0 + x, y, col);
-    }
-  }
-  cv.box(area.x0 - 1, area.y0 - 1, area.x1 + 1, area.y1 + 1, kInk);
-  // Axes: altitude in km at the left, distance in km below.
-  for (int i = 0; i <= 4; ++i) {
-    const double z = z_bot + i / 4.0 * (z_top - z_bot);
-    const double y = area.y1 - (z - z_bot) / (z_top - z_bot) * (area.h() - 1);
-    cv.line(area.x0 - 5, y, area.x0 - 1, y, kInk);
-    cv.text(area.x0 - 8, y + 4, 9, tick_text(z / 1000.0), kInk, Canvas::Align::Right);
-    const double d = i / 4.0 * px.length_m;
-    const double x = area.x0 + i / 4.0 * (area.w() - 1);
-    cv.line(x, area.y1 + 1, x, area.y1 + 5, kInk);
-    cv.text(x, area.y1 + 18, 9, tick_text(d / 1000.0), kInk, Canvas::Align::Centre);
-  }
-  cv.text(area.x0 - 60, area.y0 - 8, 9, "alt km", kInk);
-  cv.text(0.5 * (area.x0 + area.x1), height - 6, 9, "distance km", kInk, Canvas::Align::Centre);
-  char title[200];
-  std::snprintf(title, sizeof title, "%s %.4g %.4g to %.4g %.4g  %s", field.name().c_str(), lat1, lon1, lat2, lon2,
-                vol.times[step].iso_utc.c_str());
-  cv.text(area.x0, 16, 10, title, kInk);
-  colour_bar(cv, width - 95, area.y0 + 14, width - 80, area.y1, lo, hi, field.units(), sequential_colour);
+  const plots::SectionFigure fig = plots::section_figure(vol, c.file, step, in);
   core::OutputGroup group;
-  group.write(out, [&](std::FILE* f) { render::encode_png(f, width, height, cv.rgb()); });
-  if (!csv.empty()) {
-    group.write(csv, [&](std::FILE* f) {
-      put(f, "# section of " + c.file + " from " + num(lat1) + "," + num(lon1) + " to " + num(lat2) + "," + num(lon2) + ", " +
-                 field.name() + " [" + field.units() + "], valid " + vol.times[step].iso_utc + "\n");
-      put(f, "distance_m,lat_deg,lon_deg,alt_m,ground_m," + field.name() + ",cloudy\n");
-      const std::size_t n = grid_rows.rows();
-      for (std::size_t i = 0; i < grid_rows.path.size(); ++i) {
-        const auto& p = grid_rows.path[i];
-        for (std::size_t k = 0; k < n; ++k) {
-          put(f, num(p.distance_m, "%.1f") + "," + num(p.lat_deg, "%.6f") + "," + num(p.lon_deg, "%.6f") + "," + num(grid_rows.alt_m[k], "%.1f") +
-                     "," + num(grid_rows.ground_m[i], "%.1f") + "," + num(grid_rows.value[i * n + k]) + "," +
-                     (grid_rows.cloudy[i * n + k] ? "1" : "0") + "\n");
-        }
-      }
-    });
-  }
+  group.write(out, [&](std::FILE* f) { render::encode_png(f, width, height, fig.canvas.rgb()); });
+  if (!csv.empty()) group.write(csv, [&](std::FILE* f) { put(f, fig.csv); });
   group.commit();
   std::printf("section of %s (%s) from %.6g,%.6g to %.6g,%.6g: %.4g km, step %zu (%s), colour %.4g..%.4g %s\nwrote %s%s%s\n",
-              c.file.c_str(), field.name().c_str(), lat1, lon1, lat2, lon2, px.length_m / 1000.0, step, vol.times[step].iso_utc.c_str(), lo,
-              hi, field.units().c_str(), out.c_str(), csv.empty() ? "" : " and ", csv.c_str());
+              c.file.c_str(), fig.field.name().c_str(), lat1, lon1, lat2, lon2, fig.pixels.length_m / 1000.0, step, vol.times[step].iso_utc.c_str(),
+              fig.lo, fig.hi, fig.field.units().c_str(), out.c_str(), csv.empty() ? "" : " and ", csv.c_str());
   return 0;
 }
 
@@ -328,82 +246,16 @@ int cmd_series(const std::vector<std::string>& args) {
   if (c.file.empty() || !have_at || out.empty()) throw UsageError{"cloudviewer series: expected FILE, --at LAT,LON and -o OUT.png"};
   check_outputs("series", out, csv, c.file);
   core::CloudVolume vol = load(c.file);
-  check_point(vol.grid, "series", "--at", lat, lon, c.file);
-  std::vector<core::ColumnProbe> col;
-  for (std::size_t t = 0; t < vol.times.size(); ++t) {
-    const core::TimeStepData& d = vol.step(t);
-    col.push_back(core::probe_column(vol, d, core::grid_mean_extinction(vol.grid, d), lat, lon));
+  if (const std::string problem = plots::series_problem(vol, c.file, lat, lon); !problem.empty()) {
+    throw UsageError{"cloudviewer series: " + problem};
   }
-  const bool timed = core::times_known(vol.times);
-  auto hours = [&](std::size_t t) {
-    return timed ? (vol.times[t].unix_s - vol.times[0].unix_s) / 3600.0 : static_cast<double>(t);
-  };
-  // Three panels: cover (0..1), optical depth, base and top (km).
-  Canvas cv(width, height, kPaper);
-  const int left = 70, right = width - 20, top = 30, gap = 30, bottom = height - 40;
-  const int ph = (bottom - top - 2 * gap) / 3;
-  const double t_end = std::max(hours(vol.times.size() - 1), 1e-9);
-  auto xat = [&](double h) { return left + h / t_end * (right - left); };
-  double tau_max = 0.0, z_max = 0.0;
-  for (const auto& p : col) {
-    tau_max = std::max(tau_max, p.optical_depth);
-    if (std::isfinite(p.top_m)) z_max = std::max(z_max, p.top_m);
-  }
-  if (!(tau_max > 0)) tau_max = 1.0;
-  if (!(z_max > 0)) z_max = vol.grid.alt_m.last();
-  struct Panel {
-    const char* name;
-    double hi;
-  };
-  const Panel panels[3] = {{"cover", 1.0}, {"optical depth", tau_max * 1.05}, {"base and top km", z_max * 1.05 / 1000.0}};
-  for (int pi = 0; pi < 3; ++pi) {
-    const int y0 = top + pi * (ph + gap), y1 = y0 + ph;
-    cv.box(left, y0, right, y1, kInk);
-    cv.text(left, y0 - 6, 9, panels[pi].name, kInk);
-    for (int i = 0; i <= 2; ++i) {
-      const double v = i / 2.0 * panels[pi].hi;
-      const double y = y1 - i / 2.0 * ph;
-      cv.line(left - 4, y, left, y, kInk);
-      cv.text(left - 7, y + 4, 9, tick_text(v), kInk, Canvas::Align::Right);
-    }
-    auto yat = [&](double v) { return y1 - v / panels[pi].hi * ph; };
-    auto series = [&](auto value, Rgb colour) {
-      for (std::size_t t = 0; t < col.size(); ++t) {
-        const double v = value(col[t]);
-        if (!std::isfinite(v)) continue;
-        const double x = xat(hours(t)), y = yat(v);
-        cv.box(static_cast<int>(x) - 2, static_cast<int>(y) - 2, static_cast<int>(x) + 2, static_cast<int>(y) + 2, colour);
-        if (t + 1 < col.size() && std::isfinite(value(col[t + 1]))) cv.line(x, y, xat(hours(t + 1)), yat(value(col[t + 1])), colour);
-      }
-    };
-    const Rgb blue{30, 80, 190}, red{190, 40, 30};
-    if (pi == 0) series([](const core::ColumnProbe& p) { return p.cover; }, blue);
-    if (pi == 1) series([](const core::ColumnProbe& p) { return p.optical_depth; }, blue);
-    if (pi == 2) {
-      series([](const core::ColumnProbe& p) { return p.base_m / 1000.0; }, blue);
-      series([](const core::ColumnProbe& p) { return p.top_m / 1000.0; }, red);
-    }
-  }
-  for (int i = 0; i <= 4; ++i) {
-    const double h = i / 4.0 * t_end;
-    cv.line(xat(h), bottom - 4, xat(h), bottom, kInk);
-    cv.text(xat(h), bottom + 14, 9, tick_text(h), kInk, Canvas::Align::Centre);
-  }
-  cv.text(0.5 * (left + right), height - 6, 9, std::string(timed ? "hours after " : "step from ") + vol.times[0].iso_utc, kInk,
-          Canvas::Align::Centre);
-  char title[160];
-  std::snprintf(title, sizeof title, "lat %.4g lon %.4g", lat, lon);
-  cv.text(right, 14, 10, title, kInk, Canvas::Align::Right);
+  const plots::SeriesFigure fig = plots::series_figure(vol, lat, lon, width, height);
+  const std::string& table = fig.csv;
   core::OutputGroup group;
-  group.write(out, [&](std::FILE* f) { render::encode_png(f, width, height, cv.rgb()); });
-  std::string table = "valid_utc,hours,cover,optical_depth,base_m,top_m\n";
-  for (std::size_t t = 0; t < col.size(); ++t) {
-    table += vol.times[t].iso_utc + "," + num(hours(t), "%.4f") + "," + num(col[t].cover, "%.6g") + "," + num(col[t].optical_depth, "%.6g") + "," +
-             num(col[t].base_m, "%.1f") + "," + num(col[t].top_m, "%.1f") + "\n";
-  }
+  group.write(out, [&](std::FILE* f) { render::encode_png(f, width, height, fig.canvas.rgb()); });
   if (!csv.empty()) group.write(csv, [&](std::FILE* f) { put(f, table); });
   group.commit();
-  std::printf("series of %s at lat %.6g, lon %.6g: %zu steps\n%swrote %s%s%s\n", c.file.c_str(), lat, lon, col.size(), table.c_str(),
+  std::printf("series of %s at lat %.6g, lon %.6g: %zu steps\n%swrote %s%s%s\n", c.file.c_str(), lat, lon, fig.columns.size(), table.c_str(),
               out.c_str(), csv.empty() ? "" : " and ", csv.c_str());
   return 0;
 }

@@ -12,7 +12,8 @@
 #include "cli_common.hpp"
 #include "importer.hpp"
 #include "io/output_file.hpp"
-#include "plot_canvas.hpp"
+#include "plots/analysis_plots.hpp"
+#include "plots/plot_canvas.hpp"
 #include "scene/framing.hpp"
 #include "scene/instant.hpp"
 #include "volume/volume_io.hpp"
@@ -67,19 +68,8 @@ inline std::pair<double, double> parse_lat_lon(const std::string& cmd, const std
 
 inline void check_point(const core::VolumeGrid& g, const std::string& cmd, const std::string& option, double lat, double lon,
                  const std::string& file) {
-  if (!core::grid_holds(g, lat, lon)) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.6g,%.6g", lat, lon);
-    throw UsageError{"cloudviewer " + cmd + ": " + option + ": found " + buf + ", outside the data of " + file + ", expected a point within " +
-                     core::grid_extent_text(g)};
-  }
-}
-
-inline std::string num(double v, const char* fmt = "%.6g") {
-  if (!std::isfinite(v)) return "";
-  char buf[48];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
+  const std::string problem = plots::point_problem(g, option, lat, lon, file);
+  if (!problem.empty()) throw UsageError{"cloudviewer " + cmd + ": " + problem};
 }
 
 inline void check_outputs(const std::string& cmd, const std::string& png, const std::string& csv, const std::string& input) {
@@ -100,13 +90,7 @@ inline void put(std::FILE* f, const std::string& s) {
   if (std::fwrite(s.data(), 1, s.size(), f) != s.size()) throw core::WriteError("write failed");
 }
 
-// Fills the plot area of a canvas with a function of (x, y) in the area's own pixels.
-struct Area {
-  int x0, y0, x1, y1;  // inclusive
-  int w() const { return x1 - x0 + 1; }
-  int h() const { return y1 - y0 + 1; }
-};
-
-inline const Rgb kInk{20, 20, 20}, kPaper{255, 255, 255}, kNoData{170, 170, 170}, kGround{110, 84, 60};
+// The plots' raster, area and colours, and num (app/plots/).
+using namespace cv::plots;
 
 }  // namespace cv::cli::analysis

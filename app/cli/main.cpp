@@ -69,6 +69,7 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
       {"view",
        "  view INPUT [--size WxH] [--time ISO|N] [--play H] [--scale S] [--hide-ui] [--frame-budget MS]\n"
        "             [--compare FILE[@T] | @T ...] [--layout grid|swipe] [--unlinked] [--frames N --screenshot OUT.png]\n"
+       "             [--section LAT,LON,LAT,LON[,FIELD]] [--series LAT,LON]\n"
        "                           --time: an instant (UTC) or a step; --play H: start playing at H forecast\n"
        "                           hours per second (the timeline is in the data panel); with --frames it moves\n"
        "                           one instant per frame and waits for each, unless --realtime (wall time, no wait)\n"
@@ -78,7 +79,9 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
        "                           --compare: one more view (up to 3) of FILE, of FILE at T (a step or a UTC time),\n"
        "                           or of INPUT at T (@T), each on its own grid, labelled with its file and valid time;\n"
        "                           --layout: a grid of the views (default) or a swipe divider between two (drag it);\n"
-       "                           cameras and time are linked (a change in one view moves all) unless --unlinked\n"},
+       "                           cameras and time are linked (a change in one view moves all) unless --unlinked;\n"
+       "                           --section, --series: open the Section (default field extinction) or Series panel\n"
+       "                           with that path or point, drawn as the section and series commands draw them\n"},
   };
 }
 

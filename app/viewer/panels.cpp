@@ -8,12 +8,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdarg>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <type_traits>
 
 #include <glm/glm.hpp>
 
+#include "render/gl.hpp"
 #include "viewer/camera_controller.hpp"
 #include "scene/quality.hpp"
 #include "scene/scene_json.hpp"
@@ -392,6 +395,129 @@ void probe_window(ProbePanel& p) {
   ImGui::End();
 }
 
+// A figure's canvas as an RGB8 texture, uploaded again when its version changed.
+void upload_figure(unsigned& texture, int& shown_version, int version, const plots::Canvas& canvas) {
+  if (texture != 0 && shown_version == version) return;
+  if (texture == 0) {
+    GLuint t = 0;
+    glGenTextures(1, &t);
+    texture = t;
+  }
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, canvas.width(), canvas.height(), 0, GL_RGB, GL_UNSIGNED_BYTE, canvas.rgb().data());
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  shown_version = version;
+}
+
+// Shows a figure at the window's width (at most its own size); returns its top left on screen and
+// the scale from the figure's pixels.
+ImVec2 show_figure(unsigned texture, const plots::Canvas& canvas, float& scale) {
+  const float avail = ImGui::GetContentRegionAvail().x;
+  scale = std::min(1.0f, std::max(0.1f, avail / static_cast<float>(canvas.width())));
+  const ImVec2 at = ImGui::GetCursorScreenPos();
+  ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<std::uintptr_t>(texture)),
+               ImVec2(canvas.width() * scale, canvas.height() * scale));
+  return at;
+}
+
+// A line in the disabled colour, wrapped at the window's edge.
+void note(const char* fmt, ...) IM_FMTARGS(1);
+void note(const char* fmt, ...) {
+  ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+  va_list args;
+  va_start(args, fmt);
+  ImGui::TextWrappedV(fmt, args);
+  va_end(args);
+  ImGui::PopStyleColor();
+}
+
+void message_line(const std::string& m) {
+  if (!m.empty()) ImGui::TextWrapped("%s", m.c_str());
+}
+
+// The vertical section (plot_panels.hpp): two ends typed or taken from the last probe click, a
+// field, the figure `cloudviewer section` draws, and save.
+void section_window(ViewerState& s, PanelContext& ctx) {
+  SectionPanel& p = s.section;
+  if (!p.open) return;
+  ImGui::SetNextWindowPos(ImVec2(356, 8), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(620, 500), ImGuiCond_FirstUseEver);
+  if (!ImGui::Begin("Section", &p.open)) {
+    ImGui::End();
+    return;
+  }
+  plots::SectionInputs& in = p.inputs;
+  double from[2] = {in.lat1, in.lon1}, to[2] = {in.lat2, in.lon2};
+  if (ImGui::InputScalarN("from lat, lon", ImGuiDataType_Double, from, 2, nullptr, nullptr, "%.4f")) in.lat1 = from[0], in.lon1 = from[1];
+  ImGui::SameLine();
+  if (ImGui::Button("probe##from")) take_probe_point(p, s.probe, 0);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("the point of the last probe click");
+  if (ImGui::InputScalarN("to lat, lon", ImGuiDataType_Double, to, 2, nullptr, nullptr, "%.4f")) in.lat2 = to[0], in.lon2 = to[1];
+  ImGui::SameLine();
+  if (ImGui::Button("probe##to")) take_probe_point(p, s.probe, 1);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("the point of the last probe click");
+  ImGui::InputText("field", &in.field);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("extinction (what the march samples) or a 3-D field the file holds, as section --field");
+  ImGui::SameLine();
+  if (ImGui::Button("draw")) p.requested = true;
+  if (p.has_figure) {
+    note("%s, step %zu (%s); brown: ground, black: cloud boundary, grey: no data", p.source.c_str(), p.step,
+                        p.valid.c_str());
+    upload_figure(ctx.section_texture, ctx.section_version, p.version, p.figure.canvas);
+    float scale = 1.0f;
+    show_figure(ctx.section_texture, p.figure.canvas, scale);
+    ImGui::InputText("PNG", &p.png_path);
+    ImGui::InputText("CSV", &p.csv_path);
+    ImGui::SameLine();
+    if (ImGui::Button("save")) save_section(p);
+  }
+  message_line(p.message);
+  ImGui::End();
+}
+
+// The time series at a point (plot_panels.hpp): cover, optical depth, base and top at each of the
+// file's steps, as `cloudviewer series` draws them, with a marker at view 0's time, and save.
+void series_window(ViewerState& s, PanelContext& ctx) {
+  SeriesPanel& p = s.series;
+  if (!p.open) return;
+  ImGui::SetNextWindowPos(ImVec2(660, 200), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(600, 500), ImGuiCond_FirstUseEver);
+  if (!ImGui::Begin("Series", &p.open)) {
+    ImGui::End();
+    return;
+  }
+  double at[2] = {p.lat_deg, p.lon_deg};
+  if (ImGui::InputScalarN("at lat, lon", ImGuiDataType_Double, at, 2, nullptr, nullptr, "%.4f")) p.lat_deg = at[0], p.lon_deg = at[1];
+  ImGui::SameLine();
+  if (ImGui::Button("probe")) take_probe_point(p, s.probe);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("the point of the last probe click");
+  ImGui::SameLine();
+  if (ImGui::Button("draw")) p.requested = true;
+  if (p.has_figure) {
+    note("%s at lat %.4f, lon %.4f, %zu steps; blue: base, red: top; the line: the time shown", p.source.c_str(),
+                        p.at_lat, p.at_lon, p.figure.columns.size());
+    upload_figure(ctx.series_texture, ctx.series_version, p.version, p.figure.canvas);
+    float scale = 1.0f;
+    const ImVec2 o = show_figure(ctx.series_texture, p.figure.canvas, scale);
+    const double x = series_marker_x(p, s.series_now_hours);
+    if (std::isfinite(x)) {
+      ImGui::GetWindowDrawList()->AddLine(ImVec2(o.x + static_cast<float>(x) * scale, o.y + p.figure.top * scale),
+                                          ImVec2(o.x + static_cast<float>(x) * scale, o.y + p.figure.bottom * scale),
+                                          IM_COL32(230, 140, 0, 255), 2.0f);
+    }
+    ImGui::InputText("PNG", &p.png_path);
+    ImGui::InputText("CSV", &p.csv_path);
+    ImGui::SameLine();
+    if (ImGui::Button("save")) save_series(p);
+  }
+  message_line(p.message);
+  ImGui::End();
+}
+
 void scene_panel(ViewerState& s, PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Scene file")) return;
   ImGui::InputText("path", &ctx.scene_path);
@@ -443,10 +569,25 @@ void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats)
     path_panel(state, ctx);
     views_panel(state);
     scene_panel(state, ctx);
+    if (ImGui::Button("section")) state.section.open = !state.section.open;
+    ImGui::SameLine();
+    if (ImGui::Button("series")) state.series.open = !state.series.open;
     ImGui::TextDisabled("F1 hides the panels; a click (no drag) on the globe probes the column; %s", stats.renderer.c_str());
   }
   ImGui::End();
   probe_window(state.probe);
+  section_window(state, ctx);
+  series_window(state, ctx);
+}
+
+void release_panel_textures(PanelContext& ctx) {
+  for (unsigned* t : {&ctx.section_texture, &ctx.series_texture}) {
+    if (*t != 0) {
+      const GLuint id = *t;
+      glDeleteTextures(1, &id);
+      *t = 0;
+    }
+  }
 }
 
 void draw_stats_overlay(const FrameStats& s, int target) {

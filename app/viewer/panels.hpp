@@ -43,9 +43,14 @@ struct PanelContext {
   std::string budget_text;      // the frame budget's candidate and its source, when the budget is on
   std::string instant_text;     // the scene's instant, and how the medium there was made
   std::string time_warning;     // why `advected` fell back to `linear` (no winds), shown on screen
+  // The Section and Series panels' figures as GL textures, re-uploaded when a figure changes.
+  unsigned section_texture = 0, series_texture = 0;
+  int section_version = 0, series_version = 0;
 };
 
 void draw_panels(ViewerState& state, PanelContext& ctx, const FrameStats& stats);
+// Deletes the panels' textures (before the GL context goes).
+void release_panel_textures(PanelContext& ctx);
 void draw_stats_overlay(const FrameStats& stats, int target);
 
 }  // namespace cv::viewer

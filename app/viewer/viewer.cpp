@@ -368,6 +368,12 @@ int cmd_view(const std::vector<std::string>& args) {
         o.realtime = true;
       } else if (a == "--hide-ui") {
         o.hide_ui = true;
+      } else if (a == "--section" || a == "--series") {
+        (a == "--section" ? o.section : o.series) = next();
+        SectionPanel sec;
+        SeriesPanel ser;
+        const std::string problem = a == "--section" ? section_from_option(sec, o.section) : series_from_option(ser, o.series);
+        if (!problem.empty()) throw ViewerInputError(problem);
       } else if (!a.empty() && a[0] == '-') {
         throw ViewerInputError("cloudviewer view: unknown option '" + a + "'");
       } else if (o.input.empty()) {
@@ -399,6 +405,8 @@ int cmd_view(const std::vector<std::string>& args) {
 
 int run_viewer(const ViewerOptions& o) {
   ViewerState s;
+  if (!o.section.empty()) section_from_option(s.section, o.section);  // checked by cmd_view; drawn on the first frame
+  if (!o.series.empty()) series_from_option(s.series, o.series);
   if (o.scene) {
     s.scene = *o.scene;
   } else {
@@ -520,6 +528,10 @@ int run_viewer(const ViewerOptions& o) {
   if (!budget.warning().empty()) std::printf("frame budget: %s\n", budget.warning().c_str());
   bool marched_last = false;
   PanelContext ctx;
+  struct PanelTextureGuard {  // the panels' figure textures go before the window's context
+    PanelContext& ctx;
+    ~PanelTextureGuard() { release_panel_textures(ctx); }
+  } panel_texture_guard{ctx};
   FrameStats stats;
   stats.renderer = win->info().renderer;
   PassTimer march_timer, present_timer;
@@ -574,6 +586,16 @@ int run_viewer(const ViewerOptions& o) {
     // them (the mouse, the keys, the panels, playback), the one that changed moves the others.
     auto scene_of = [&](int i) -> core::Scene& { return i == 0 ? s.scene : extra[static_cast<std::size_t>(i - 1)].scene; };
     auto volume_of = [&](int i) -> core::CloudVolume& { return i == 0 ? s.volume : *extra[static_cast<std::size_t>(i - 1)].volume; };
+    // A view's file's step nearest its instant (what the probe and the section read).
+    auto nearest_step = [&](int vi) {
+      std::size_t step = static_cast<std::size_t>(std::max(0, scene_of(vi).time_step));
+      try {
+        const core::Instant at = core::scene_instant(scene_of(vi), volume_of(vi), scene_of(vi).data.path);
+        step = at.fraction < 0.5 ? at.step0 : at.step1;
+      } catch (const core::TimeError&) {  // the step index stands
+      }
+      return std::min(step, volume_of(vi).times.size() - 1);
+    };
     auto read_cursors = [&] {
       link.views.resize(static_cast<std::size_t>(n_views));
       for (int i = 0; i < n_views; ++i) link.views[static_cast<std::size_t>(i)] = cursor_of(scene_of(i), volume_of(i));
@@ -628,15 +650,8 @@ int run_viewer(const ViewerOptions& o) {
           if (!ll) {
             s.probe.message = "the click is on the sky: no column there";
           } else {
-            std::size_t step = static_cast<std::size_t>(std::max(0, scene_of(vi).time_step));
             try {
-              const core::Instant at = core::scene_instant(scene_of(vi), volume_of(vi), scene_of(vi).data.path);
-              step = at.fraction < 0.5 ? at.step0 : at.step1;
-            } catch (const core::TimeError&) {  // the step index stands
-            }
-            step = std::min(step, volume_of(vi).times.size() - 1);
-            try {
-              probe_into(s.probe, volume_of(vi), scene_of(vi).data.path, step, ll->x, ll->y);
+              probe_into(s.probe, volume_of(vi), scene_of(vi).data.path, nearest_step(vi), ll->x, ll->y);
               s.probe.view = vi;
             } catch (const std::exception& e) {  // the step could not be read
               s.probe.message = e.what();
@@ -645,7 +660,14 @@ int run_viewer(const ViewerOptions& o) {
         }
       }
     }
+    {  // view 0's time on the series' axis: hours after the file's first step, or the step index
+      const ViewCursor c = cursor_of(s.scene, s.volume);
+      s.series_now_hours = c.utc ? (c.t - c.t_first) / 3600.0 : c.t;
+    }
     if (show_ui) draw_panels(s, ctx, stats);
+    // The Section and Series panels' "draw": view 0's file (the section at its step nearest the time shown).
+    if (s.section.requested) compute_section(s.section, volume_of(0), scene_of(0).data.path, nearest_step(0));
+    if (s.series.requested) compute_series(s.series, volume_of(0), scene_of(0).data.path);
     if (s.views.step_view >= 0 && s.views.step_view < n_views) {  // a view's "<" or ">": its file's previous or next step
       ViewCursor c = cursor_of(scene_of(s.views.step_view), volume_of(s.views.step_view));
       c.t = step_from(volume_of(s.views.step_view), c, s.views.step_dir);

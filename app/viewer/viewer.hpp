@@ -27,6 +27,7 @@ struct ViewerOptions {
   std::vector<std::string> compare;  // --compare FILE[@TIME] | @TIME: more views (issue 17), up to 3
   std::string layout = "grid";       // --layout grid|swipe (swipe: two views)
   bool unlinked = false;             // --unlinked: cameras and time not linked between views
+  std::string section, series;       // --section LAT,LON,LAT,LON[,FIELD], --series LAT,LON: open those panels, drawn
 };
 
 // Parses the `view` arguments and runs; returns the exit code (2 with one line for bad arguments).

@@ -15,6 +15,7 @@
 #include "volume/cloud_volume.hpp"
 #include "viewer/keyframes.hpp"
 #include "viewer/playback.hpp"
+#include "viewer/plot_panels.hpp"
 #include "viewer/probe_panel.hpp"
 #include "viewer/views.hpp"
 
@@ -49,6 +50,9 @@ struct ViewerState {
   KeyframeEditor keys;        // the camera-path panel (keyframes.hpp)
   ViewsPanel views;           // several views (views.hpp); view 0 is this scene
   ProbePanel probe;           // the column under the last click (probe_panel.hpp)
+  SectionPanel section;       // a vertical section of view 0's file (plot_panels.hpp)
+  SeriesPanel series;         // a time series at a point of view 0's file
+  double series_now_hours = 0.0;  // view 0's time on the series' axis, for its marker
 };
 
 

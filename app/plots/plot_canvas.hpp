@@ -1,5 +1,6 @@
 // A small raster for the analysts' plots (sections, time series, difference maps): lines, boxes,
 // the overlays layer's stroke font and colour map, and a colour bar, into 8-bit RGB for encode_png.
+// Shared by the headless commands (app/cli) and the viewer's section and series panels.
 #pragma once
 
 #include <array>
@@ -7,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace cv::cli {
+namespace cv::plots {
 
 using Rgb = std::array<unsigned char, 3>;
 
@@ -45,4 +46,13 @@ void colour_bar(Canvas& c, int x0, int y0, int x1, int y1, double lo, double hi,
 // A tick label: %.3g, with "0" for a value within 1e-12 of the range of zero.
 std::string tick_text(double v);
 
-}  // namespace cv::cli
+// A plot's area on a canvas, its corners inclusive.
+struct Area {
+  int x0, y0, x1, y1;
+  int w() const { return x1 - x0 + 1; }
+  int h() const { return y1 - y0 + 1; }
+};
+
+inline const Rgb kInk{20, 20, 20}, kPaper{255, 255, 255}, kNoData{170, 170, 170}, kGround{110, 84, 60};
+
+}  // namespace cv::plots

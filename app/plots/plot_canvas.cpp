@@ -1,5 +1,5 @@
 // The analysts' plot raster.
-#include "plot_canvas.hpp"
+#include "plots/plot_canvas.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "overlays/overlays.hpp"
 
-namespace cv::cli {
+namespace cv::plots {
 
 Canvas::Canvas(int width, int height, Rgb bg) : w_(width), h_(height), rgb_(static_cast<std::size_t>(width) * height * 3) {
   for (std::size_t i = 0; i < rgb_.size(); i += 3) rgb_[i] = bg[0], rgb_[i + 1] = bg[1], rgb_[i + 2] = bg[2];
@@ -94,4 +94,4 @@ void colour_bar(Canvas& c, int x0, int y0, int x1, int y1, double lo, double hi,
   c.text(x0, y0 - 8, 9, title, ink);
 }
 
-}  // namespace cv::cli
+}  // namespace cv::plots
