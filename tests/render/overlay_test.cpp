@@ -366,17 +366,22 @@ TEST(Coastlines, MissingDataNamesThePackage) {
   }
 }
 
-// A GSHHG vertex of Iceland's shore (the crude shoreline's point nearest 64.1 N, 21.9 W), its
-// lat/lon as the GMT library reads it, drawn by the overlay pass from the camera: it lands on the
-// pixel the camera's projection gives (within one pixel), from orbit and from 100 m.
-TEST(Coastlines, AVertexLandsOnThePixelTheProjectionGives) {
-  double best = 1e9, lat = 0.0, lon = 0.0;
+// The crude GSHHG shoreline's vertex nearest 64.1 N, 21.9 W (Iceland), and its distance in degrees.
+static void icelandic_shore_vertex(double& best, double& lat, double& lon) {
   for (const auto& line : overlays::read_gshhg_lines(overlays::GshhgFeature::Shore, 'c', "", {})) {
     for (const glm::dvec2& p : line) {
       const double dd = std::hypot(p.y - 64.1, (p.x + 21.9) * std::cos(64.1 * 3.14159265358979 / 180.0));
       if (dd < best) best = dd, lon = p.x, lat = p.y;
     }
   }
+}
+
+// A GSHHG vertex of Iceland's shore (the crude shoreline's point nearest 64.1 N, 21.9 W), its
+// lat/lon as the GMT library reads it, drawn by the overlay pass from the camera: it lands on the
+// pixel the camera's projection gives (within one pixel), from orbit and from 100 m.
+TEST(Coastlines, AVertexLandsOnThePixelTheProjectionGives) {
+  double best = 1e9, lat = 0.0, lon = 0.0;
+  icelandic_shore_vertex(best, lat, lon);
   ASSERT_LT(best, 1.0) << "no Icelandic vertex in the crude GSHHG shorelines";
   const double r0 = 6371000.0;
   const core::OverlayMesh coast = overlays::build_coastlines(overlays::kGshhgDir, 'c', r0, glm::vec4(1.0f));
@@ -457,12 +462,7 @@ TEST(Coastlines, AVertexLandsOnThePixelTheProjectionGives) {
 // texel's coast on this globe.
 TEST(Coastlines, AVertexLiesOnTheTexelTheGroundLookupGivesItsLatLon) {
   double best = 1e9, lat = 0.0, lon = 0.0;
-  for (const auto& line : overlays::read_gshhg_lines(overlays::GshhgFeature::Shore, 'c', "", {})) {
-    for (const glm::dvec2& p : line) {
-      const double dd = std::hypot(p.y - 64.1, (p.x + 21.9) * std::cos(64.1 * 3.14159265358979 / 180.0));
-      if (dd < best) best = dd, lon = p.x, lat = p.y;
-    }
-  }
+  icelandic_shore_vertex(best, lat, lon);
   ASSERT_LT(best, 1.0) << "no Icelandic vertex in the crude GSHHG shorelines";
   const double r0 = 6371000.0, kRad = 3.14159265358979323846 / 180.0;
   const core::OverlayMesh coast = overlays::build_coastlines(overlays::kGshhgDir, 'c', r0, glm::vec4(1.0f));
