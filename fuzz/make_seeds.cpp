@@ -34,10 +34,12 @@ std::size_t cropped(const std::string& name, std::size_t len) {
   return std::min(len, stag ? time + 1 : time);
 }
 
-void crop(const std::string& in, const std::string& out) {
+// format: NC_64BIT_DATA (CDF-5) or NC_NETCDF4 (HDF5; its variables deflated, so the mutations reach
+// the HDF5 filter pipeline too).
+void crop(const std::string& in, const std::string& out, int format) {
   int src = -1, dst = -1;
   check(nc_open(in.c_str(), NC_NOWRITE, &src), in);
-  check(nc_create(out.c_str(), NC_CLOBBER | NC_64BIT_DATA, &dst), out);
+  check(nc_create(out.c_str(), NC_CLOBBER | format, &dst), out);
   int ndims = 0, nvars = 0, natts = 0, unlim = -1;
   check(nc_inq(src, &ndims, &nvars, &natts, &unlim), in);
   std::vector<std::size_t> len(static_cast<std::size_t>(ndims));
@@ -69,6 +71,7 @@ void crop(const std::string& in, const std::string& out) {
     if (t == NC_STRING || t > NC_STRING) continue;
     int id;
     check(nc_def_var(dst, name, t, nd, dims, &id), std::string("def var ") + name);
+    if (format == NC_NETCDF4 && nd > 0) check(nc_def_var_deflate(dst, id, 1, 1, 1), std::string("deflate ") + name);
     copy_atts(v, id, na);
     keep.push_back(v);
   }
@@ -104,7 +107,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path out = argv[1];
-  for (const char* sub : {"netcdf", "cvvol", "scene"}) fs::create_directories(out / sub);
+  for (const char* sub : {"netcdf", "netcdf4", "cvvol", "scene"}) fs::create_directories(out / sub);
   int seeds = 0;
   auto save = [&](const fs::path& p, const std::string& text) {
     std::ofstream(p, std::ios::binary) << text;
@@ -124,7 +127,9 @@ int main(int argc, char** argv) {
         continue;
       }
       const fs::path nc = out / "netcdf" / (in.stem().string() + ".cdf5.nc");
-      crop(in.string(), nc.string());
+      crop(in.string(), nc.string(), NC_64BIT_DATA);
+      ++seeds;
+      crop(in.string(), (out / "netcdf4" / (in.stem().string() + ".nc4.nc")).string(), NC_NETCDF4);
       ++seeds;
       cv::core::CloudVolume v = cv::importers::import_file(nc.string());
       cv::core::write_cvvol((out / "cvvol" / (in.stem().string() + ".cvvol")).string(), v);

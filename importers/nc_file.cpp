@@ -3,12 +3,22 @@
 
 #include <netcdf.h>
 
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <csignal>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <limits>
+#include <stdexcept>
 
 namespace cv::importers {
 namespace {
@@ -179,36 +189,39 @@ void NcFile::fail(int status, const std::string& what) const {
   throw ImportError(path_ + ": " + what + ": " + nc_strerror(status));
 }
 
-NcFile::NcFile(const std::string& path) : path_(path) {
-  std::error_code ec;
-  // A FIFO, a device or a folder is refused before netCDF opens it (it would block or read forever).
-  if (const std::string kind = core::file_kind(path); !kind.empty()) {
-    throw ImportError(path + (kind == "no such file" ? ": no such file" : ": is " + kind + ", expected a regular NetCDF file"));
-  }
-  file_bytes_ = static_cast<long long>(std::filesystem::file_size(path, ec));
-  check_classic_header(path, static_cast<std::uint64_t>(std::max<long long>(file_bytes_, 0)));
-  const int st = nc_open(path.c_str(), NC_NOWRITE, &id_);
-  if (st != NC_NOERR) {
-    throw ImportError(path + ": not a readable NetCDF file (" + nc_strerror(st) +
-                      "); expected NetCDF-3 classic/64-bit or NetCDF-4/HDF5");
-  }
+namespace {
+
+// What the header holds, read by whoever holds the netCDF handle.
+struct Header {
   int format = 0;
-  nc_inq_format(id_, &format);
-  compressed_format_ = format == NC_FORMAT_NETCDF4 || format == NC_FORMAT_NETCDF4_CLASSIC;
+  std::vector<NcDim> dims;
+  std::vector<NcVar> vars;
+  std::vector<NcAtt> global_atts;
+};
+
+std::string open_error(const std::string& path, int status) {
+  return path + ": not a readable NetCDF file (" + nc_strerror(status) +
+         "); expected NetCDF-3 classic/64-bit or NetCDF-4/HDF5";
+}
+
+Header load_header(int id, const std::string& path) {
+  auto fail = [&](int status, const std::string& what) { throw ImportError(path + ": " + what + ": " + nc_strerror(status)); };
+  Header h;
+  nc_inq_format(id, &h.format);
   int ndims = 0, nvars = 0, ngatts = 0, unlimdim = -1;
-  if (const int s = nc_inq(id_, &ndims, &nvars, &ngatts, &unlimdim); s != NC_NOERR) fail(s, "cannot read the header");
+  if (const int s = nc_inq(id, &ndims, &nvars, &ngatts, &unlimdim); s != NC_NOERR) fail(s, "cannot read the header");
   for (int d = 0; d < ndims; ++d) {
     char name[NC_MAX_NAME + 1] = {0};
     size_t len = 0;
-    if (const int s = nc_inq_dim(id_, d, name, &len); s != NC_NOERR) fail(s, "cannot read dimension " + std::to_string(d));
-    dims_.push_back({name, len, d == unlimdim});
+    if (const int s = nc_inq_dim(id, d, name, &len); s != NC_NOERR) fail(s, "cannot read dimension " + std::to_string(d));
+    h.dims.push_back({name, len, d == unlimdim});
   }
   for (int v = 0; v < nvars; ++v) {
     char name[NC_MAX_NAME + 1] = {0};
     nc_type type;
     int nd = 0, natts = 0;
     int dimids[NC_MAX_VAR_DIMS];
-    if (const int s = nc_inq_var(id_, v, name, &type, &nd, dimids, &natts); s != NC_NOERR) {
+    if (const int s = nc_inq_var(id, v, name, &type, &nd, dimids, &natts); s != NC_NOERR) {
       fail(s, "cannot read variable " + std::to_string(v));
     }
     NcVar var;
@@ -219,10 +232,251 @@ NcFile::NcFile(const std::string& path) : path_(path) {
       if (dimids[i] < 0 || dimids[i] >= ndims) throw ImportError(path + ": variable '" + var.name + "' has a bad dimension id");
       var.dims.push_back(dimids[i]);
     }
-    var.atts = read_atts(id_, v, natts, path);
-    vars_.push_back(std::move(var));
+    var.atts = read_atts(id, v, natts, path);
+    h.vars.push_back(std::move(var));
   }
-  global_atts_ = read_atts(id_, NC_GLOBAL, ngatts, path);
+  h.global_atts = read_atts(id, NC_GLOBAL, ngatts, path);
+  return h;
+}
+
+// The reader process's wire format: little-endian host integers and doubles, strings as a length
+// and bytes. Both ends are this build, on this machine.
+struct Wire {
+  std::string b;
+  void u64(std::uint64_t v) { b.append(reinterpret_cast<const char*>(&v), sizeof v); }
+  void i64(std::int64_t v) { b.append(reinterpret_cast<const char*>(&v), sizeof v); }
+  void f64(double v) { b.append(reinterpret_cast<const char*>(&v), sizeof v); }
+  void str(const std::string& s) { u64(s.size()); b.append(s); }
+  void atts(const std::vector<NcAtt>& as) {
+    u64(as.size());
+    for (const auto& a : as) {
+      str(a.name);
+      u64(a.is_text ? 1 : 0);
+      str(a.text);
+      u64(a.values.size());
+      for (double x : a.values) f64(x);
+    }
+  }
+  void header(const Header& h) {
+    i64(h.format);
+    u64(h.dims.size());
+    for (const auto& d : h.dims) str(d.name), u64(d.length), u64(d.unlimited ? 1 : 0);
+    u64(h.vars.size());
+    for (const auto& v : h.vars) {
+      i64(v.id), str(v.name), i64(v.type);
+      u64(v.dims.size());
+      for (int d : v.dims) i64(d);
+      atts(v.atts);
+    }
+    atts(h.global_atts);
+  }
+};
+
+bool send_all(int fd, const void* data, std::size_t n) {
+  const char* p = static_cast<const char*>(data);
+  while (n) {
+    const ssize_t k = ::send(fd, p, n, MSG_NOSIGNAL);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) return false;
+    p += k, n -= static_cast<std::size_t>(k);
+  }
+  return true;
+}
+
+// Blocking receive of exactly n bytes (the reader's side; it has nothing else to do).
+bool recv_all(int fd, void* data, std::size_t n) {
+  char* p = static_cast<char*>(data);
+  while (n) {
+    const ssize_t k = ::recv(fd, p, n, 0);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) return false;
+    p += k, n -= static_cast<std::size_t>(k);
+  }
+  return true;
+}
+
+// Parses what the reader sent; a malformed message is this program's bug, not the file's.
+struct Unwire {
+  const std::string& b;
+  std::size_t pos = 0;
+  template <class T>
+  T get() {
+    if (pos + sizeof(T) > b.size()) throw std::runtime_error("NetCDF reader process: short message");
+    T v;
+    std::memcpy(&v, b.data() + pos, sizeof v);
+    pos += sizeof v;
+    return v;
+  }
+  std::string str() {
+    const auto n = get<std::uint64_t>();
+    if (n > b.size() - pos) throw std::runtime_error("NetCDF reader process: short message");
+    std::string s = b.substr(pos, n);
+    pos += n;
+    return s;
+  }
+  std::vector<NcAtt> atts() {
+    std::vector<NcAtt> out;
+    const auto n = get<std::uint64_t>();
+    for (std::uint64_t i = 0; i < n && pos < b.size(); ++i) {
+      NcAtt a;
+      a.name = str();
+      a.is_text = get<std::uint64_t>() != 0;
+      a.text = str();
+      const auto nv = get<std::uint64_t>();
+      if (nv > (b.size() - pos) / sizeof(double)) throw std::runtime_error("NetCDF reader process: short message");
+      for (std::uint64_t k = 0; k < nv; ++k) a.values.push_back(get<double>());
+      out.push_back(std::move(a));
+    }
+    return out;
+  }
+  Header header() {
+    Header h;
+    h.format = static_cast<int>(get<std::int64_t>());
+    const auto nd = get<std::uint64_t>();
+    for (std::uint64_t i = 0; i < nd && pos < b.size(); ++i) {
+      NcDim d;
+      d.name = str();
+      d.length = get<std::uint64_t>();
+      d.unlimited = get<std::uint64_t>() != 0;
+      h.dims.push_back(std::move(d));
+    }
+    const auto nv = get<std::uint64_t>();
+    for (std::uint64_t i = 0; i < nv && pos < b.size(); ++i) {
+      NcVar v;
+      v.id = static_cast<int>(get<std::int64_t>());
+      v.name = str();
+      v.type = static_cast<int>(get<std::int64_t>());
+      const auto n = get<std::uint64_t>();
+      for (std::uint64_t k = 0; k < n && pos < b.size(); ++k) v.dims.push_back(static_cast<int>(get<std::int64_t>()));
+      v.atts = atts();
+      h.vars.push_back(std::move(v));
+    }
+    h.global_atts = atts();
+    return h;
+  }
+};
+
+bool send_message(int fd, const std::string& m) {
+  const std::uint64_t n = m.size();
+  return send_all(fd, &n, sizeof n) && send_all(fd, m.data(), m.size());
+}
+
+// The reader process: opens the file, sends its header (or the error), then answers reads until
+// the socket closes. It never returns; _exit keeps the parent's buffers and exit handlers out.
+[[noreturn]] void reader_main(int fd, const std::string& path) {
+  // Default actions: not the parent's temporary-file cleanup, and not a sanitizer's or a fuzzer's
+  // crash report for what the parent turns into an ImportError.
+  for (int sig : {SIGTERM, SIGINT, SIGHUP, SIGQUIT, SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT}) std::signal(sig, SIG_DFL);
+  // Only its own socket stays open: a copy of another reader's socket held here would keep that
+  // reader from seeing its end. When the parent dies, its end closes and the reader's next receive
+  // ends it (no PR_SET_PDEATHSIG: that follows the forking thread, not the process).
+  if (fd > 2) {
+    ::close_range(3, static_cast<unsigned>(fd - 1), 0);
+    ::close_range(static_cast<unsigned>(fd + 1), ~0u, 0);
+  }
+  int id = -1;
+  {
+    Wire w;
+    try {
+      const int st = nc_open(path.c_str(), NC_NOWRITE, &id);
+      if (st != NC_NOERR) throw ImportError(open_error(path, st));
+      w.u64(0);
+      w.header(load_header(id, path));
+    } catch (const std::exception& e) {
+      w.b.clear();
+      w.u64(1);
+      w.str(e.what());
+    }
+    if (!send_message(fd, w.b)) ::_exit(0);
+  }
+  std::vector<char> buf;
+  for (;;) {
+    std::uint64_t op = 0;
+    if (!recv_all(fd, &op, sizeof op) || (op != 1 && op != 2)) break;
+    std::int64_t varid = 0;
+    std::uint64_t nd = 0, n = 0;
+    if (!recv_all(fd, &varid, sizeof varid) || !recv_all(fd, &nd, sizeof nd) || nd > NC_MAX_VAR_DIMS) break;
+    std::vector<std::size_t> start(nd), count(nd);
+    if ((nd && (!recv_all(fd, start.data(), nd * sizeof(std::size_t)) || !recv_all(fd, count.data(), nd * sizeof(std::size_t)))) ||
+        !recv_all(fd, &n, sizeof n)) {
+      break;
+    }
+    const std::size_t bytes = op == 1 ? n * sizeof(double) : n;
+    buf.resize(bytes);
+    std::int64_t st = op == 1 ? nc_get_vara_double(id, static_cast<int>(varid), start.data(), count.data(),
+                                                   reinterpret_cast<double*>(buf.data()))
+                              : nc_get_var_text(id, static_cast<int>(varid), buf.data());
+    if (!send_all(fd, &st, sizeof st)) break;
+    if (st == NC_NOERR && !send_all(fd, buf.data(), bytes)) break;
+  }
+  ::_exit(0);
+}
+
+// Seconds the reader may take to answer one request before it is taken for hung.
+int reader_timeout_s() {
+  if (const char* env = std::getenv("CLOUDVIEWER_READ_TIMEOUT_S"); env && std::atoi(env) > 0) return std::atoi(env);
+  return 600;
+}
+
+bool classic_magic(const std::string& path) {
+  unsigned char m[4] = {0, 0, 0, 0};
+  if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
+    const std::size_t got = std::fread(m, 1, 4, f);
+    std::fclose(f);
+    if (got != 4) return false;
+  }
+  return m[0] == 'C' && m[1] == 'D' && m[2] == 'F' && (m[3] == 1 || m[3] == 2 || m[3] == 5);
+}
+
+}  // namespace
+
+NcFile::NcFile(const std::string& path) : path_(path) {
+  std::error_code ec;
+  // A FIFO, a device or a folder is refused before netCDF opens it (it would block or read forever).
+  if (const std::string kind = core::file_kind(path); !kind.empty()) {
+    throw ImportError(path + (kind == "no such file" ? ": no such file" : ": is " + kind + ", expected a regular NetCDF file"));
+  }
+  file_bytes_ = static_cast<long long>(std::filesystem::file_size(path, ec));
+  check_classic_header(path, static_cast<std::uint64_t>(std::max<long long>(file_bytes_, 0)));
+  Header h;
+  if (classic_magic(path)) {
+    const int st = nc_open(path.c_str(), NC_NOWRITE, &id_);
+    if (st != NC_NOERR) throw ImportError(open_error(path, st));
+    try {
+      h = load_header(id_, path);
+    } catch (...) {
+      nc_close(id_);
+      id_ = -1;
+      throw;
+    }
+  } else {
+    isolated_ = true;
+    start_reader();
+    std::uint64_t n = 0;
+    receive(&n, sizeof n, "opening it");
+    if (n > (std::uint64_t(1) << 32)) throw std::runtime_error("NetCDF reader process: a header of " + std::to_string(n) + " bytes");
+    std::string m(n, '\0');
+    receive(m.data(), n, "opening it");
+    Unwire u{m};
+    if (u.get<std::uint64_t>() != 0) {
+      const std::string why = u.str();
+      ::close(sock_);
+      sock_ = -1;
+      ::waitpid(reader_pid_, nullptr, 0);
+      reader_pid_ = -1;
+      throw ImportError(why);
+    }
+    h = u.header();
+  }
+  compressed_format_ = h.format == NC_FORMAT_NETCDF4 || h.format == NC_FORMAT_NETCDF4_CLASSIC;
+  dims_ = std::move(h.dims);
+  vars_ = std::move(h.vars);
+  global_atts_ = std::move(h.global_atts);
+  for (const auto& v : vars_) {
+    for (int d : v.dims) {
+      if (d < 0 || static_cast<std::size_t>(d) >= dims_.size()) throw ImportError(path + ": variable '" + v.name + "' has a bad dimension id");
+    }
+  }
   // A classic-format file stores every value uncompressed: if its variables need more bytes than
   // the file has, it was cut short (netCDF would read the missing part as zeros).
   if (!compressed_format_) {
@@ -240,8 +494,108 @@ NcFile::NcFile(const std::string& path) : path_(path) {
   }
 }
 
+void NcFile::start_reader() {
+  int fds[2];
+  if (::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, fds) != 0) {
+    throw ImportError(path_ + ": cannot start the NetCDF reader process (socketpair: " + std::strerror(errno) + ")");
+  }
+  std::fflush(nullptr);  // nothing buffered is written twice
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]), ::close(fds[1]);
+    throw ImportError(path_ + ": cannot start the NetCDF reader process (fork: " + std::strerror(errno) + ")");
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    reader_main(fds[1], path_);
+  }
+  ::close(fds[1]);
+  sock_ = fds[0];
+  reader_pid_ = pid;
+}
+
+void NcFile::reader_lost(const std::string& what, bool timed_out) const {
+  int status = 0;
+  if (reader_pid_ > 0) {
+    if (timed_out) ::kill(reader_pid_, SIGKILL);
+    ::close(sock_);
+    while (::waitpid(reader_pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+  }
+  sock_ = -1;
+  reader_pid_ = -1;
+  if (timed_out) {
+    throw ImportError(path_ + ": the NetCDF-4/HDF5 library did not answer within " + std::to_string(reader_timeout_s()) +
+                      " s while " + what + "; expected an intact NetCDF file (CLOUDVIEWER_READ_TIMEOUT_S sets the wait)");
+  }
+  std::string how = "stopped";
+  if (WIFSIGNALED(status)) how = std::string("crashed (") + strsignal(WTERMSIG(status)) + ")";
+  else if (WIFEXITED(status)) how = "stopped (exit status " + std::to_string(WEXITSTATUS(status)) + ")";
+  throw ImportError(path_ + ": the NetCDF-4/HDF5 library " + how + " while " + what +
+                    ": the file is corrupt; expected an intact NetCDF file");
+}
+
+void NcFile::receive(void* out, std::size_t bytes, const std::string& what) const {
+  if (sock_ < 0) throw ImportError(path_ + ": the NetCDF reader process stopped earlier; cannot go on " + what);
+  char* p = static_cast<char*>(out);
+  const int timeout_ms = reader_timeout_s() * 1000;
+  while (bytes) {
+    pollfd pfd{sock_, POLLIN, 0};
+    const int r = ::poll(&pfd, 1, timeout_ms);
+    if (r < 0 && errno == EINTR) continue;
+    if (r == 0) reader_lost(what, true);
+    const ssize_t k = ::recv(sock_, p, bytes, 0);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) reader_lost(what, false);
+    p += k, bytes -= static_cast<std::size_t>(k);
+  }
+}
+
+int NcFile::ask_reader(const std::string& request, const std::string& what) const {
+  if (sock_ < 0) throw ImportError(path_ + ": the NetCDF reader process stopped earlier; cannot go on " + what);
+  if (!send_all(sock_, request.data(), request.size())) reader_lost(what, false);
+  std::int64_t st = 0;
+  receive(&st, sizeof st, what);
+  return static_cast<int>(st);
+}
+
+void NcFile::get_doubles(const NcVar& v, const std::vector<std::size_t>& start, const std::vector<std::size_t>& count,
+                         double* out, std::size_t n) const {
+  const std::string what = "reading variable '" + v.name + "'";
+  if (!isolated_) {
+    if (const int s = nc_get_vara_double(id_, v.id, start.data(), count.data(), out); s != NC_NOERR) {
+      fail(s, "variable '" + v.name + "': cannot read values");
+    }
+    return;
+  }
+  Wire w;
+  w.u64(1), w.i64(v.id), w.u64(start.size());
+  for (std::size_t x : start) w.u64(x);
+  for (std::size_t x : count) w.u64(x);
+  w.u64(n);
+  if (const int s = ask_reader(w.b, what); s != NC_NOERR) fail(s, "variable '" + v.name + "': cannot read values");
+  receive(out, n * sizeof(double), what);
+}
+
+void NcFile::get_text(const NcVar& v, char* out, std::size_t n) const {
+  if (!isolated_) {
+    if (const int s = nc_get_var_text(id_, v.id, out); s != NC_NOERR) fail(s, "variable '" + v.name + "'");
+    return;
+  }
+  Wire w;
+  w.u64(2), w.i64(v.id), w.u64(0), w.u64(n);
+  if (const int s = ask_reader(w.b, "reading variable '" + v.name + "'"); s != NC_NOERR) fail(s, "variable '" + v.name + "'");
+  receive(out, n, "reading variable '" + v.name + "'");
+}
+
 NcFile::~NcFile() {
   if (id_ >= 0) nc_close(id_);
+  if (reader_pid_ > 0) {
+    ::close(sock_);
+    ::kill(reader_pid_, SIGKILL);  // it holds nothing to save
+    while (::waitpid(reader_pid_, nullptr, 0) < 0 && errno == EINTR) {
+    }
+  }
 }
 
 const NcVar* NcFile::find(const std::string& name) const {
@@ -318,9 +672,7 @@ std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start,
   }
   std::vector<double> out(n);
   if (n == 0) return out;
-  if (const int s = nc_get_vara_double(id_, v.id, start.data(), count.data(), out.data()); s != NC_NOERR) {
-    fail(s, "variable '" + v.name + "': cannot read values");
-  }
+  get_doubles(v, start, count, out.data(), n);
   // Fill and missing values are compared in the packed (raw) domain, as CF says.
   std::vector<double> missing;
   for (const char* a : {"_FillValue", "missing_value"}) {
@@ -413,7 +765,7 @@ std::vector<std::string> NcFile::read_strings(const NcVar& v) const {
   }
   std::vector<char> buf(rows * cols);
   if (!buf.empty()) {
-    if (const int s = nc_get_var_text(id_, v.id, buf.data()); s != NC_NOERR) fail(s, "variable '" + v.name + "'");
+    get_text(v, buf.data(), buf.size());
   }
   std::vector<std::string> out;
   for (std::size_t r = 0; r < rows; ++r) {

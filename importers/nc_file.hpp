@@ -51,6 +51,12 @@ struct UnpackInfo {
 // before netCDF opens a file; anything else that hands netCDF untrusted bytes must too.
 void check_classic_header(const std::string& path, std::uint64_t file_bytes);
 
+// A NetCDF-4 file is read through the HDF5 library, which crashes on some corrupt files (a single
+// flipped bit in a real WRF file makes nc_open segfault; found by flipping bytes of the shared
+// files). NcFile therefore reads every file that is not classic-format in a child process that
+// holds the netCDF handle and answers header and read requests over a socket: a crash or a hang
+// there becomes an ImportError naming the file and what was being read, never a crash of the
+// caller. Classic files, whose header NcFile checks itself first, are read in-process.
 class NcFile {
  public:
   explicit NcFile(const std::string& path);
@@ -89,12 +95,24 @@ class NcFile {
 
  private:
   [[noreturn]] void fail(int status, const std::string& what) const;
+  void start_reader();  // forks the reader process and takes the header from it
+  // nc_get_vara_double / nc_get_var_text, in-process or through the reader.
+  void get_doubles(const NcVar& v, const std::vector<std::size_t>& start, const std::vector<std::size_t>& count,
+                   double* out, std::size_t n) const;
+  void get_text(const NcVar& v, char* out, std::size_t n) const;
+  // Sends a request and receives its status, or throws naming `what` when the reader died or hung.
+  int ask_reader(const std::string& request, const std::string& what) const;
+  void receive(void* out, std::size_t bytes, const std::string& what) const;
+  [[noreturn]] void reader_lost(const std::string& what, bool timed_out) const;
   // An empty start means all zeros, an empty count the whole extent.
   void whole_if_empty(const NcVar& v, std::vector<std::size_t>& start, std::vector<std::size_t>& count) const;
   std::string path_;
   int id_ = -1;
   long long file_bytes_ = 0;
   bool compressed_format_ = false;
+  bool isolated_ = false;        // read through the reader process
+  mutable int sock_ = -1;        // the reader's socket; -1 once it is gone
+  mutable int reader_pid_ = -1;
   std::vector<NcDim> dims_;
   std::vector<NcVar> vars_;
   std::vector<NcAtt> global_atts_;

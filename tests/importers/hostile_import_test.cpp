@@ -4,13 +4,17 @@
 #include <gtest/gtest.h>
 
 #include <netcdf.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -320,6 +324,140 @@ TEST_F(HostileImport, ARecordCountBeyondAnyIntegerIsNamedNotOverflowed) {
   }
   const std::string msg = import_error(p);
   EXPECT_NE(msg.find(p + ": its variables need 7.38e+19 bytes but the file has "), std::string::npos) << msg;
+}
+
+
+// The HDF5 library (Debian 12's 1.10.8) segfaults in nc_open on some NetCDF-4 files with a single
+// flipped bit: found by flipping bytes of the shared real files (docs/BENCHMARKS.md, "NetCDF-4 under
+// byte flips"). NcFile reads such files in a child process, so the crash is one line naming the
+// file and what was being done, never a crash of the importer.
+TEST_F(HostileImport, ABitFlippedNetcdf4FileThatCrashesHdf5IsNamedNotACrash) {
+  REAL_FILE(real, "wrf_d01_allvars_cropped.nc");
+  const struct {
+    std::streamoff offset;
+    unsigned char mask;
+  } flips[] = {{86262, 0x02}, {119010, 0x08}};
+  for (const auto& flip : flips) {
+    const std::string p = copy_of(real, "flip" + std::to_string(flip.offset) + ".nc");
+    {
+      std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+      f.seekg(flip.offset);
+      char c = 0;
+      f.read(&c, 1);
+      c = static_cast<char>(c ^ flip.mask);
+      f.seekp(flip.offset);
+      f.write(&c, 1);
+    }
+    const std::string msg = import_error(p);
+    // A segmentation fault in this build; under the sanitizers' allocator it may be an abort.
+    EXPECT_NE(msg.find(p + ": the NetCDF-4/HDF5 library crashed ("), std::string::npos) << msg;
+    EXPECT_NE(msg.find(") while opening it: the file is corrupt; expected an intact NetCDF file"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+}
+
+// The reader process's pid: the one child of this test process that appeared since `before`.
+std::vector<int> children() {
+  std::vector<int> out;
+  for (const auto& task : fs::directory_iterator("/proc/self/task")) {
+    std::ifstream f(task.path() / "children");
+    for (int pid; f >> pid;) out.push_back(pid);
+  }
+  return out;
+}
+
+int new_child(const std::vector<int>& before) {
+  for (int pid : children()) {
+    if (std::find(before.begin(), before.end(), pid) == before.end()) return pid;
+  }
+  return -1;
+}
+
+// The mechanism itself, independent of which files crash HDF5: the reader killed by a signal, or
+// stopped, between two reads of an intact file.
+TEST_F(HostileImport, AReaderThatCrashesOrHangsBetweenReadsIsNamed) {
+  REAL_FILE(real, "met-era5-cocip1.nc");
+  const std::string p = copy_of(real, "era5.nc");
+  {
+    const std::vector<int> before = children();
+    importers::NcFile f(p);
+    const int reader = new_child(before);
+    ASSERT_GT(reader, 0) << "a NetCDF-4 file is read in a child process";
+    const importers::NcVar& lat = f.var("latitude");
+    EXPECT_FALSE(f.read(lat).empty());
+    ASSERT_EQ(::kill(reader, SIGSEGV), 0);
+    try {
+      (void)f.read(lat);
+      ADD_FAILURE() << "read after the reader died";
+    } catch (const importers::ImportError& e) {
+      EXPECT_NE(std::string(e.what()).find(p + ": the NetCDF-4/HDF5 library crashed (Segmentation fault) while reading variable 'latitude'"),
+                std::string::npos)
+          << e.what();
+    }
+    // Every later read says so too, without netCDF in this process.
+    EXPECT_THROW((void)f.read(lat), importers::ImportError);
+  }
+  {
+    ::setenv("CLOUDVIEWER_READ_TIMEOUT_S", "1", 1);
+    const std::vector<int> before = children();
+    importers::NcFile f(p);
+    const int reader = new_child(before);
+    ASSERT_GT(reader, 0);
+    ASSERT_EQ(::kill(reader, SIGSTOP), 0);
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      (void)f.read(f.var("longitude"));
+      ADD_FAILURE() << "read from a stopped reader";
+    } catch (const importers::ImportError& e) {
+      EXPECT_NE(std::string(e.what()).find(p + ": the NetCDF-4/HDF5 library did not answer within 1 s while reading variable 'longitude'"),
+                std::string::npos)
+          << e.what();
+    }
+    ::unsetenv("CLOUDVIEWER_READ_TIMEOUT_S");
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 30.0);
+    EXPECT_EQ(::kill(reader, 0), -1) << "the hung reader was killed and reaped";
+  }
+}
+
+// A classic file is read in this process (its header is checked first); a NetCDF-4 one reads the
+// same values through the reader as netCDF gives here.
+TEST_F(HostileImport, TheReaderProcessGivesNetcdfsOwnValues) {
+  REAL_FILE(real, "met-era5-cocip1.nc");
+  importers::NcFile f(real);
+  int id = -1;
+  ASSERT_EQ(nc_open(real.c_str(), NC_NOWRITE, &id), NC_NOERR);
+  for (const char* name : {"latitude", "longitude", "specific_cloud_ice_water_content", "fraction_of_cloud_cover", "time"}) {
+    const importers::NcVar* v = f.find(name);
+    ASSERT_NE(v, nullptr) << name;
+    int vid = -1;
+    ASSERT_EQ(nc_inq_varid(id, name, &vid), NC_NOERR);
+    std::vector<double> direct(f.size(*v));
+    ASSERT_EQ(nc_get_var_double(id, vid, direct.data()), NC_NOERR);
+    importers::UnpackInfo info;
+    const std::vector<double> got = f.read(*v, {}, {}, &info);
+    ASSERT_EQ(got.size(), direct.size()) << name;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      if (std::isnan(got[i])) continue;  // a missing value
+      ASSERT_EQ(got[i], direct[i] * info.scale + info.offset) << name << " at " << i;
+    }
+  }
+  nc_close(id);
+  // A classic file: no reader process.
+  const std::string classic = (dir_ / "classic.nc").string();
+  {
+    int nc, x, v;
+    ASSERT_EQ(nc_create(classic.c_str(), NC_CLOBBER | NC_64BIT_DATA, &nc), NC_NOERR);
+    ASSERT_EQ(nc_def_dim(nc, "x", 3, &x), NC_NOERR);
+    ASSERT_EQ(nc_def_var(nc, "v", NC_DOUBLE, 1, &x, &v), NC_NOERR);
+    ASSERT_EQ(nc_enddef(nc), NC_NOERR);
+    const double vals[3] = {1.5, 2.5, 3.5};
+    ASSERT_EQ(nc_put_var_double(nc, v, vals), NC_NOERR);
+    ASSERT_EQ(nc_close(nc), NC_NOERR);
+  }
+  const std::vector<int> before = children();
+  importers::NcFile c(classic);
+  EXPECT_EQ(new_child(before), -1) << "a classic file is read in this process";
+  EXPECT_EQ(c.read(c.var("v")), (std::vector<double>{1.5, 2.5, 3.5}));
 }
 
 }  // namespace
