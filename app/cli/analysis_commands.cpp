@@ -32,12 +32,12 @@ const char* probe_usage() {
   return "  probe FILE --at LAT,LON [--time ISO|N] [--csv OUT.csv] [--camera LAT,LON,ALT_M [--view-step M]]\n"
          "                           the column at a point, per grid level: altitude, height above the ground, cloud\n"
          "                           fraction, in-cloud liquid and ice extinction, the grid-mean extinction the march\n"
-         "                           samples, temperature and wind where the volume has them (the march's trilinear\n"
+         "                           samples, temperature, wind and pressure where the volume has them (the march's trilinear\n"
          "                           sampler); its cover, base, top and optical depth; with --camera, where along the view\n"
          "                           ray from there to the point's ground the light came from (the first cloud, and where\n"
          "                           the transmittance fell to 0.5: the CPU march kernel's own record of that ray);\n"
-         "                           --time: one of the file's valid times or a step (default the first); the volume holds\n"
-         "                           no pressure, so none is given\n";
+         "                           --time: one of the file's valid times or a step (default the first); pressure is\n"
+         "                           given where the file has it (pressure or hybrid levels, WRF's P + PB)\n";
 }
 
 int cmd_probe(const std::vector<std::string>& args) {
@@ -113,11 +113,7 @@ int cmd_probe(const std::vector<std::string>& args) {
     core::write_file_atomically(csv, [&](std::FILE* f) {
       put(f, "# probe of " + c.file + " at lat " + num(lat) + " lon " + num(lon) + ", valid " + vol.times[step].iso_utc + "\n");
       put(f, core::probe_summary_csv(p));
-      if (have_camera) {
-        put(f, ",first_cloud_m=" + (ray.first_cloud_m >= 0 ? num(ray.first_cloud_m, "%.1f") : "") + ",half_transmittance_m=" +
-                   (ray.half_transmittance_m >= 0 ? num(ray.half_transmittance_m, "%.1f") : "") + ",ray_transmittance=" +
-                   num(ray.transmittance, "%.6g"));
-      }
+      if (have_camera) put(f, core::view_ray_csv(ray));
       put(f, "\n" + table);
     });
     std::printf("wrote %s\n", csv.c_str());

@@ -366,23 +366,30 @@ void probe_window(ProbePanel& p) {
     if (std::isfinite(c.base_m)) std::snprintf(base, sizeof base, "%.0f m", c.base_m);
     if (std::isfinite(c.top_m)) std::snprintf(top, sizeof top, "%.0f m", c.top_m);
     ImGui::Text("cover %.3f, base %s, top %s, optical depth %.4g", c.cover, base, top, c.optical_depth);
+    if (p.ray) {  // where the light came from along the clicked pixel's ray
+      char first[32] = "none", half[32] = "never";
+      if (p.ray->first_cloud_m >= 0) std::snprintf(first, sizeof first, "%.2f km", p.ray->first_cloud_m / 1000.0);
+      if (p.ray->half_transmittance_m >= 0) std::snprintf(half, sizeof half, "%.2f km", p.ray->half_transmittance_m / 1000.0);
+      ImGui::Text("view ray (%.1f km to the ground): first cloud %s, transmittance 0.5 at %s, ray transmittance %.3g",
+                  p.ray->distance_to_target_m / 1000.0, first, half, p.ray->transmittance);
+    }
     ImGui::InputText("CSV", &p.csv_path);
     ImGui::SameLine();
     if (ImGui::Button("save")) save_probe_csv(p);
     const ImGuiTableFlags flags = ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_SizingFixedFit;
-    if (ImGui::BeginTable("levels", 7, flags, ImVec2(0, 0))) {
+    if (ImGui::BeginTable("levels", 8, flags, ImVec2(0, 0))) {
       ImGui::TableSetupScrollFreeze(0, 1);
-      for (const char* h : {"alt (m)", "cloud fraction", "ext liquid (1/m)", "ext ice (1/m)", "T (K)", "u (m/s)", "v (m/s)"}) {
+      for (const char* h : {"alt (m)", "p (hPa)", "cloud fraction", "ext liquid (1/m)", "ext ice (1/m)", "T (K)", "u (m/s)", "v (m/s)"}) {
         ImGui::TableSetupColumn(h);
       }
       ImGui::TableHeadersRow();
       for (auto it = c.levels.rbegin(); it != c.levels.rend(); ++it) {  // top first, as a sounding reads
         ImGui::TableNextRow();
-        const double v[] = {it->alt_m, it->cloud_fraction, it->ext_liquid_per_m, it->ext_ice_per_m, it->temperature_k, it->wind_u_m_s,
-                            it->wind_v_m_s};
-        const bool shown[] = {true, true, true, true, p.has_temperature, p.has_wind, p.has_wind};
-        const char* fmt[] = {"%.0f", "%.3f", "%.3g", "%.3g", "%.1f", "%.1f", "%.1f"};
-        for (int k = 0; k < 7; ++k) {
+        const double v[] = {it->alt_m, it->pressure_pa / 100.0, it->cloud_fraction, it->ext_liquid_per_m, it->ext_ice_per_m, it->temperature_k,
+                            it->wind_u_m_s, it->wind_v_m_s};
+        const bool shown[] = {true, p.has_pressure, true, true, true, p.has_temperature, p.has_wind, p.has_wind};
+        const char* fmt[] = {"%.0f", "%.1f", "%.3f", "%.3g", "%.3g", "%.1f", "%.1f", "%.1f"};
+        for (int k = 0; k < 8; ++k) {
           ImGui::TableSetColumnIndex(k);
           if (shown[k] && std::isfinite(v[k])) ImGui::Text(fmt[k], v[k]);
           else ImGui::TextDisabled("-");

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <stdexcept>
 
 #include <glm/glm.hpp>
 
@@ -44,7 +45,7 @@ std::optional<glm::dvec2> pixel_ground(const core::Camera& cam, double px, doubl
 }
 
 void probe_into(ProbePanel& panel, core::CloudVolume& volume, const std::string& source, std::size_t step, double lat_deg,
-                double lon_deg) {
+                double lon_deg, const core::Camera* camera, double view_step_m) {
   panel.open = true;
   char at[64];
   std::snprintf(at, sizeof at, "%.4f, %.4f", lat_deg, lon_deg);
@@ -54,16 +55,26 @@ void probe_into(ProbePanel& panel, core::CloudVolume& volume, const std::string&
   }
   const core::TimeStepData& data = volume.step(step);
   panel.column = core::probe_column(volume, data, core::grid_mean_extinction(volume.grid, data), lat_deg, lon_deg);
+  panel.ray.reset();
+  if (camera) {
+    const double ground = std::isfinite(panel.column.ground_m) ? panel.column.ground_m : 0.0;
+    try {
+      panel.ray = core::probe_view_ray(core::prepare_volume(volume.grid, data), camera->lat_deg, camera->lon_deg, camera->alt_m,
+                                       lat_deg, lon_deg, ground, view_step_m);
+    } catch (const std::invalid_argument&) {  // the camera stands at the point: no ray to record
+    }
+  }
   panel.source = source;
   panel.step = step;
   panel.valid = volume.times[step].iso_utc;
   panel.lat_deg = lat_deg, panel.lon_deg = lon_deg;
   panel.has_temperature = volume.has_field[static_cast<int>(core::Field::Temperature)];
+  panel.has_pressure = volume.has_field[static_cast<int>(core::Field::Pressure)];
   panel.has_wind = volume.has_field[static_cast<int>(core::Field::WindU)] && volume.has_field[static_cast<int>(core::Field::WindV)];
   char where[96];
   std::snprintf(where, sizeof where, " at lat %.6g lon %.6g, valid ", lat_deg, lon_deg);
-  panel.csv = "# probe of " + source + where + panel.valid + "\n" + core::probe_summary_csv(panel.column) + "\n" +
-              core::probe_levels_csv(panel.column, volume);
+  panel.csv = "# probe of " + source + where + panel.valid + "\n" + core::probe_summary_csv(panel.column) +
+              (panel.ray ? core::view_ray_csv(*panel.ray) : std::string()) + "\n" + core::probe_levels_csv(panel.column, volume);
   panel.message.clear();
 }
 

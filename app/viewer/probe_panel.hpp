@@ -36,7 +36,10 @@ struct ProbePanel {
   int view = 0;               // the view clicked
   double lat_deg = 0.0, lon_deg = 0.0;
   core::ColumnProbe column;
-  bool has_temperature = false, has_wind = false;
+  // Where the light came from along the clicked view's ray to the column's ground (issue 17, item
+  // 4): the march kernel's record for that one ray, as `probe --camera` gives it.
+  std::optional<core::ViewRayProbe> ray;
+  bool has_temperature = false, has_wind = false, has_pressure = false;
   std::string csv;            // as `probe --csv` writes it
   std::string csv_path = "probe.csv";
   std::string message;        // the last probe's or save's problem or result
@@ -44,9 +47,10 @@ struct ProbePanel {
 
 // Reads the column at (lat, lon) of `step` of the volume (its data and its grid-mean extinction, as
 // the probe command reads them) into the panel; outside the data, only the message (naming the
-// data's extent) is set.
+// data's extent) is set. With a camera, also the view ray from it to the column's ground, marched
+// at view_step_m (the probe command's --camera and --view-step).
 void probe_into(ProbePanel& panel, core::CloudVolume& volume, const std::string& source, std::size_t step, double lat_deg,
-                double lon_deg);
+                double lon_deg, const core::Camera* camera = nullptr, double view_step_m = 100.0);
 
 // Writes the panel's CSV to panel.csv_path (atomically); the message says where or why not.
 bool save_probe_csv(ProbePanel& panel);

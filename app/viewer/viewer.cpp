@@ -651,7 +651,8 @@ int run_viewer(const ViewerOptions& o) {
             s.probe.message = "the click is on the sky: no column there";
           } else {
             try {
-              probe_into(s.probe, volume_of(vi), scene_of(vi).data.path, nearest_step(vi), ll->x, ll->y);
+              probe_into(s.probe, volume_of(vi), scene_of(vi).data.path, nearest_step(vi), ll->x, ll->y, &cam,
+                         core::resolve_view_step_m(scene_of(vi).render, volume_of(vi).grid));
               s.probe.view = vi;
             } catch (const std::exception& e) {  // the step could not be read
               s.probe.message = e.what();

@@ -29,14 +29,16 @@ std::string num(double v, const char* fmt = "%.6g") {
 
 std::string probe_levels_csv(const ColumnProbe& p, const CloudVolume& vol) {
   const bool has[] = {vol.has_field[static_cast<int>(Field::Temperature)], vol.has_field[static_cast<int>(Field::WindU)],
-                      vol.has_field[static_cast<int>(Field::WindV)], vol.has_field[static_cast<int>(Field::WindW)]};
+                      vol.has_field[static_cast<int>(Field::WindV)], vol.has_field[static_cast<int>(Field::WindW)],
+                      vol.has_field[static_cast<int>(Field::Pressure)]};
   std::string table = "alt_m,above_ground_m,cloud_fraction,ext_liquid_per_m,ext_ice_per_m,march_liquid_per_m,march_ice_per_m,temperature_k,"
-                      "wind_u_m_s,wind_v_m_s,wind_w_m_s\n";
+                      "wind_u_m_s,wind_v_m_s,wind_w_m_s,pressure_hpa\n";
   for (const auto& l : p.levels) {
     table += num(l.alt_m, "%.1f") + "," + num(l.above_ground_m, "%.1f") + "," + num(l.cloud_fraction, "%.6g") + "," + num(l.ext_liquid_per_m, "%.6g") +
              "," + num(l.ext_ice_per_m, "%.6g") + "," + num(l.march_liquid_per_m, "%.6g") + "," + num(l.march_ice_per_m, "%.6g") + "," +
              (has[0] ? num(l.temperature_k, "%.3f") : "") + "," + (has[1] ? num(l.wind_u_m_s, "%.3f") : "") + "," +
-             (has[2] ? num(l.wind_v_m_s, "%.3f") : "") + "," + (has[3] ? num(l.wind_w_m_s, "%.4f") : "") + "\n";
+             (has[2] ? num(l.wind_v_m_s, "%.3f") : "") + "," + (has[3] ? num(l.wind_w_m_s, "%.4f") : "") + "," +
+             (has[4] ? num(l.pressure_pa / 100.0, "%.2f") : "") + "\n";
   }
   return table;
 }
@@ -44,6 +46,12 @@ std::string probe_levels_csv(const ColumnProbe& p, const CloudVolume& vol) {
 std::string probe_summary_csv(const ColumnProbe& p) {
   return "# cover=" + num(p.cover, "%.6g") + ",base_m=" + num(p.base_m, "%.1f") + ",top_m=" + num(p.top_m, "%.1f") +
          ",optical_depth=" + num(p.optical_depth, "%.6g") + ",ground_m=" + num(p.ground_m, "%.1f");
+}
+
+std::string view_ray_csv(const ViewRayProbe& ray) {
+  return ",first_cloud_m=" + (ray.first_cloud_m >= 0 ? num(ray.first_cloud_m, "%.1f") : "") + ",half_transmittance_m=" +
+         (ray.half_transmittance_m >= 0 ? num(ray.half_transmittance_m, "%.1f") : "") + ",ray_transmittance=" +
+         num(ray.transmittance, "%.6g");
 }
 
 bool grid_holds(const VolumeGrid& g, double lat_deg, double lon_deg) {
@@ -88,6 +96,7 @@ ColumnProbe probe_column(const CloudVolume& volume, const TimeStepData& data, co
   const VolumeSampler cf(g, field(Field::CloudFraction)), el(g, field(Field::ExtinctionLiquid)), ei(g, field(Field::ExtinctionIce));
   const VolumeSampler ml(g, medium.liquid_per_m), mi(g, medium.ice_per_m);
   const VolumeSampler t(g, field(Field::Temperature)), u(g, field(Field::WindU)), v(g, field(Field::WindV)), w(g, field(Field::WindW));
+  const VolumeSampler pr(g, field(Field::Pressure));
   const bool has_cf = !field(Field::CloudFraction).empty();
   MaxRandomOverlap overlap;
   c.base_m = c.top_m = kNaN;
@@ -109,6 +118,7 @@ ColumnProbe probe_column(const CloudVolume& volume, const TimeStepData& data, co
     l.wind_u_m_s = u.sample(lat_deg, lon_deg, alt, kNaN);
     l.wind_v_m_s = v.sample(lat_deg, lon_deg, alt, kNaN);
     l.wind_w_m_s = w.sample(lat_deg, lon_deg, alt, kNaN);
+    l.pressure_pa = pr.sample(lat_deg, lon_deg, alt, kNaN);
     // A level without data in any cloud field is left out of the summary, as derive_maps leaves it.
     have[static_cast<std::size_t>(k)] = std::isfinite(cf.sample(lat_deg, lon_deg, alt, kNaN)) ||
                                         std::isfinite(el.sample(lat_deg, lon_deg, alt, kNaN)) ||

@@ -24,6 +24,7 @@ struct ProbeLevel {
   double march_liquid_per_m = 0.0;   // grid-box mean (fraction x in-cloud): what the march samples
   double march_ice_per_m = 0.0;
   double temperature_k = 0.0, wind_u_m_s = 0.0, wind_v_m_s = 0.0, wind_w_m_s = 0.0;
+  double pressure_pa = 0.0;          // where the file gives pressure (Field::Pressure), else NaN
 };
 
 struct ColumnProbe {
@@ -66,5 +67,8 @@ struct ViewRayProbe {
 };
 ViewRayProbe probe_view_ray(const PreparedVolume& volume, double cam_lat_deg, double cam_lon_deg, double cam_alt_m,
                             double target_lat_deg, double target_lon_deg, double target_alt_m, double view_step_m);
+// The view ray's record as the probe CSV's summary line continues it:
+// ",first_cloud_m=...,half_transmittance_m=...,ray_transmittance=..." (empty where there is none).
+std::string view_ray_csv(const ViewRayProbe& ray);
 
 }  // namespace cv::core

@@ -74,6 +74,9 @@ TEST_F(Analysis, ProbeAtAGridColumnIsTheVolumesColumnAndMaps) {
         const float t = d[core::Field::Temperature][n];
         if (std::isnan(t)) EXPECT_TRUE(std::isnan(l.temperature_k));
         else EXPECT_DOUBLE_EQ(l.temperature_k, double(t));
+        const float pa = d[core::Field::Pressure][n];  // the file is on pressure levels: the volume holds it
+        if (std::isnan(pa)) EXPECT_TRUE(std::isnan(l.pressure_pa));
+        else EXPECT_DOUBLE_EQ(l.pressure_pa, double(pa));
       }
       const std::size_t col = g.column(i, j);
       EXPECT_NEAR(p.cover, d.maps.cloud_cover[col], 1e-6);
@@ -138,6 +141,8 @@ TEST_F(Analysis, ProbeGivesTheRawFilesValuesAfterTheConversions) {
   EXPECT_NEAR(l.ext_liquid_per_m, synthetic_extinction(70000.0, 0.5), 1e-6 * synthetic_extinction(70000.0, 0.5));
   EXPECT_NEAR(l.march_liquid_per_m, 0.5 * synthetic_extinction(70000.0, 0.5), 1e-6 * synthetic_extinction(70000.0, 0.5));
   EXPECT_NEAR(l.temperature_k, 260.0, 1e-3);
+  ASSERT_TRUE(vol_.has_field[static_cast<int>(core::Field::Pressure)]);
+  EXPECT_NEAR(l.pressure_pa, 70000.0, 10.0);  // the level's altitude is the node's within 0.5 m: ~6 Pa
   EXPECT_NEAR(l.wind_u_m_s, 14.5, 1e-4);
   EXPECT_NEAR(l.wind_v_m_s, -1.8, 1e-4);
   EXPECT_EQ(p.levels[0].ext_liquid_per_m, 0.0);  // clear at 1000 hPa

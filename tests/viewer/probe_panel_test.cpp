@@ -90,4 +90,35 @@ TEST(ProbePanel, ReadsTheColumnTheProbeCommandReadsDownToTheCsv) {
   EXPECT_NE(p.message.find("probe CSV"), std::string::npos) << p.message;
 }
 
+// With the clicked view's camera, the panel records where the light came from along the view ray,
+// as `probe --camera` does: the same march kernel's record, down to the CSV's summary line.
+TEST(ProbePanel, RecordsTheViewRayAsTheProbeCommandWithACamera) {
+  core::CloudVolume vol = importers::import_file(CV_SAMPLE_FILE);
+  core::Camera cam;
+  cam.lat_deg = 40.0, cam.lon_deg = 180.0, cam.alt_m = 300000.0;
+  viewer::ProbePanel p;
+  viewer::probe_into(p, vol, CV_SAMPLE_FILE, 1, 45.0, 185.0, &cam, 200.0);
+  ASSERT_TRUE(p.message.empty()) << p.message;
+  ASSERT_TRUE(p.ray.has_value());
+  EXPECT_GT(p.ray->first_cloud_m, 0.0);  // the cyclone's cloud lies on the way: the record holds values
+  EXPECT_LT(p.ray->first_cloud_m, p.ray->distance_to_target_m);
+  EXPECT_LT(p.ray->transmittance, 1.0);
+  EXPECT_EQ(p.ray->view_step_m, 200.0);
+
+  const std::string dir = ::testing::TempDir();
+  const std::string cli_csv = dir + "/probe_ray_cli.csv", panel_csv = dir + "/probe_ray_panel.csv";
+  const std::string cmd = std::string("\"") + CV_CLOUDVIEWER + "\" probe \"" + CV_SAMPLE_FILE +
+                          "\" --at 45,185 --time 1 --camera 40,180,300000 --view-step 200 --csv \"" + cli_csv + "\" > /dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  p.csv_path = panel_csv;
+  ASSERT_TRUE(viewer::save_probe_csv(p)) << p.message;
+  const std::string panel = read_all(panel_csv);
+  EXPECT_EQ(panel, read_all(cli_csv));
+  EXPECT_NE(panel.find(",first_cloud_m="), std::string::npos);
+
+  // Without a camera (a probe by coordinates), no ray is kept from the click before.
+  viewer::probe_into(p, vol, CV_SAMPLE_FILE, 1, 45.0, 185.0);
+  EXPECT_FALSE(p.ray.has_value());
+}
+
 }  // namespace
