@@ -80,6 +80,8 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
        "                           or of INPUT at T (@T), each on its own grid, labelled with its file and valid time;\n"
        "                           --layout: a grid of the views (default) or a swipe divider between two (drag it);\n"
        "                           cameras and time are linked (a change in one view moves all) unless --unlinked;\n"
+       "                           without --compare, a scene file's \"views\" open (its layout and link unless\n"
+       "                           --layout or --unlinked is given); the Scene file panel saves the open views\n"
        "                           --section, --series: open the Section (default field extinction) or Series panel\n"
        "                           with that path or point, drawn as the section and series commands draw them\n"},
   };

@@ -530,7 +530,7 @@ void scene_panel(ViewerState& s, PanelContext& ctx) {
   ImGui::InputText("path", &ctx.scene_path);
   if (ImGui::Button("save")) {
     try {
-      core::save_scene(s.scene, ctx.scene_path);
+      core::save_scene(scene_to_save(s), ctx.scene_path);
       ctx.scene_message = "saved " + ctx.scene_path;
     } catch (const std::exception& e) {
       ctx.scene_message = e.what();

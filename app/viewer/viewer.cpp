@@ -218,22 +218,34 @@ std::string view_label(const core::Scene& sc, const core::CloudVolume& vol) {
   return name + "  step " + std::to_string(step) + " (" + vol.times[step].iso_utc + ")";
 }
 
-// Opens a view of FILE[@TIME] (@TIME: view 0's file at another time), or throws ViewerInputError
-// with one line naming `option`, what was found and what was expected. Without a time it takes
-// view 0's instant (held within the file's span) or view 0's step.
-ExtraView open_view(const std::string& spec, const std::string& option, ViewerState& s,
-                    std::map<std::string, std::unique_ptr<core::CloudVolume>>& sources) {
+// FILE[@TIME] or @TIME (view 0's file at another time) as a file and a time ("" where not given).
+core::ViewSource parse_view_spec(const std::string& spec) {
   const std::size_t at = spec.rfind('@');
-  std::string file = at == std::string::npos ? spec : spec.substr(0, at);
-  const std::string time = at == std::string::npos ? "" : spec.substr(at + 1);
-  if (file.empty()) file = s.scene.data.path;
+  if (at == std::string::npos) return {spec, ""};
+  core::ViewSource v{spec.substr(0, at), spec.substr(at + 1)};
+  if (v.time.empty()) v.time = "@";  // '@' with nothing after it: refused by open_view
+  return v;
+}
+
+// The --compare text of a view source, for messages.
+std::string view_spec_text(const core::ViewSource& v) { return v.path + (v.time.empty() ? "" : "@" + (v.time == "@" ? "" : v.time)); }
+
+// Opens a view of a file (empty: view 0's) at a time (a step or a UTC time; empty: view 0's
+// instant, held within the file's span, or view 0's step), or throws ViewerInputError with one line
+// naming `option`, what was found and what was expected.
+ExtraView open_view(const core::ViewSource& source, const std::string& option, ViewerState& s,
+                    std::map<std::string, std::unique_ptr<core::CloudVolume>>& sources) {
+  const std::string spec = view_spec_text(source);
+  std::string file = source.path.empty() ? s.scene.data.path : source.path;
+  const std::string time = source.time == "@" ? "" : source.time;
+  const bool at_given = !source.time.empty();
   const std::string bad = "cloudviewer view: " + option + ": found '" + spec + "'";
   // Another name of a file already open (./a.nc, a link) is that file: its volume and instants are shared.
   if (file != s.scene.data.path && core::same_file(file, s.scene.data.path)) file = s.scene.data.path;
   for (const auto& [path, volume] : sources) {
     if (file != path && core::same_file(file, path)) file = path;
   }
-  if (at != std::string::npos && time.empty()) throw ViewerInputError(bad + ", expected a time after '@' (a step index or a UTC time)");
+  if (at_given && time.empty()) throw ViewerInputError(bad + ", expected a time after '@' (a step index or a UTC time)");
   ExtraView v;
   v.scene = s.scene;
   v.scene.data.path = file;
@@ -361,6 +373,7 @@ int cmd_view(const std::vector<std::string>& args) {
         }
       } else if (a == "--layout") {
         o.layout = next();
+        o.layout_given = true;
         if (!parse_view_layout(o.layout)) throw ViewerInputError("cloudviewer view: --layout: found '" + o.layout + "', expected grid or swipe");
       } else if (a == "--unlinked") {
         o.unlinked = true;
@@ -383,8 +396,11 @@ int cmd_view(const std::vector<std::string>& args) {
       }
     }
     if (o.input.empty()) throw ViewerInputError("cloudviewer view: expected INPUT (.nc, .cvvol or a scene .json)");
-    if (o.layout == "swipe" && o.compare.size() != 1) {
-      throw ViewerInputError("cloudviewer view: --layout: found 'swipe' with " + std::to_string(o.compare.size() + 1) +
+    if (ends_with(o.input, ".json")) o.scene = core::load_scene(o.input);
+    // The views: --compare, else the scene file's "views".
+    const std::size_t more = !o.compare.empty() || !o.scene || !o.scene->views ? o.compare.size() : o.scene->views->compare.size();
+    if (o.layout == "swipe" && more != 1) {
+      throw ViewerInputError("cloudviewer view: --layout: found 'swipe' with " + std::to_string(more + 1) +
                              " view(s), expected exactly one --compare (a swipe divider splits two views)");
     }
     if (!o.screenshot.empty() && o.frames == 0) {
@@ -395,7 +411,6 @@ int cmd_view(const std::vector<std::string>& args) {
       core::check_output_path(o.screenshot, "--screenshot");
       core::check_output_not_input(o.screenshot, "--screenshot", o.input, "the input");
     }
-    if (ends_with(o.input, ".json")) o.scene = core::load_scene(o.input);
   } catch (const std::runtime_error& e) {  // ViewerInputError, core::InputError and core::SceneError
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
@@ -485,17 +500,26 @@ int run_viewer(const ViewerOptions& o) {
   if (!o.scene || o.scale_given) s.scene.render.resolution_scale = o.scale;
   if (o.frame_budget_ms >= 0.0) s.scene.render.budget_ms = o.frame_budget_ms;
 
-  // More views (--compare): opened before the window, so bad input costs no frames.
+  // More views (--compare, else the scene file's "views"): opened before the window, so bad input
+  // costs no frames. The command line's --layout and --unlinked override the scene file's.
   std::map<std::string, std::unique_ptr<core::CloudVolume>> sources;  // the other files' volumes, one per file
   std::vector<ExtraView> extra;
+  const bool scene_views = o.compare.empty() && s.scene.views.has_value();
   try {
-    for (const std::string& c : o.compare) extra.push_back(open_view(c, "--compare", s, sources));
+    if (scene_views) {
+      for (std::size_t i = 0; i < s.scene.views->compare.size(); ++i) {
+        extra.push_back(open_view(s.scene.views->compare[i], o.input + ": views.compare[" + std::to_string(i) + "]", s, sources));
+      }
+    } else {
+      for (const std::string& c : o.compare) extra.push_back(open_view(parse_view_spec(c), "--compare", s, sources));
+    }
   } catch (const ViewerInputError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
   }
-  s.views.layout = *parse_view_layout(o.layout);
-  s.views.link_camera = s.views.link_time = !o.unlinked;
+  s.views.layout = *parse_view_layout(scene_views && !o.layout_given ? s.scene.views->layout : o.layout);
+  s.views.link_camera = s.views.link_time = !o.unlinked && (!scene_views || s.scene.views->linked);
+  if (scene_views) s.views.divider = s.scene.views->divider;
   LinkedViews link;
   MouseRouter mouse;
   ClickDetector click;  // a click without a drag: the probe
@@ -559,7 +583,7 @@ int run_viewer(const ViewerOptions& o) {
       s.views.add_requested = false;
       try {
         if (extra.size() + 1 >= static_cast<std::size_t>(kMaxViews)) throw ViewerInputError("at most " + std::to_string(kMaxViews) + " views");
-        extra.push_back(open_view(s.views.add_source, "add view", s, sources));
+        extra.push_back(open_view(parse_view_spec(s.views.add_source), "add view", s, sources));
         s.views.message = "opened " + s.views.add_source;
       } catch (const ViewerInputError& e) {
         s.views.message = e.what();
@@ -921,6 +945,12 @@ int run_viewer(const ViewerOptions& o) {
     // swipe divider; also with the panels hidden, when there are several views.
     s.views.labels.resize(static_cast<std::size_t>(n_views));
     for (int i = 0; i < n_views; ++i) s.views.labels[static_cast<std::size_t>(i)] = view_label(scene_of(i), volume_of(i));
+    // What a saved scene keeps of views 1..: each file (empty: view 0's) at its own instant or step.
+    s.views.sources.clear();
+    for (const ExtraView& v : extra) {
+      s.views.sources.push_back({v.scene.data.path == s.scene.data.path ? "" : v.scene.data.path,
+                                 v.scene.time.valid_utc.empty() ? std::to_string(v.scene.time_step) : v.scene.time.valid_utc});
+    }
     if (n_views > 1) {
       const ImGuiIO& io = ImGui::GetIO();
       const float fx = io.DisplayFramebufferScale.x > 0.0f ? io.DisplayFramebufferScale.x : 1.0f;

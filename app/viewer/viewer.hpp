@@ -26,6 +26,7 @@ struct ViewerOptions {
   double frame_budget_ms = -1.0;  // --frame-budget: the scene's render.budget_ms (0 off); < 0: not given
   std::vector<std::string> compare;  // --compare FILE[@TIME] | @TIME: more views (issue 17), up to 3
   std::string layout = "grid";       // --layout grid|swipe (swipe: two views)
+  bool layout_given = false;         // --layout overrides the scene file's views.layout
   bool unlinked = false;             // --unlinked: cameras and time not linked between views
   std::string section, series;       // --section LAT,LON,LAT,LON[,FIELD], --series LAT,LON: open those panels, drawn
 };

@@ -19,6 +19,20 @@ core::Sun resolve_sun(const core::Scene& scene, const core::CloudVolume& volume)
   return core::resolve_sun(scene.sun, valid, scene.camera ? scene.camera->lon_deg : 0.0);
 }
 
+core::Scene scene_to_save(const ViewerState& s) {
+  core::Scene out = s.scene;
+  out.views.reset();
+  if (!s.views.sources.empty()) {
+    core::ViewsSpec v;
+    v.layout = s.views.layout == ViewLayout::Swipe ? "swipe" : "grid";
+    v.linked = s.views.link_camera && s.views.link_time;
+    v.divider = s.views.divider;
+    v.compare = s.views.sources;
+    out.views = v;
+  }
+  return out;
+}
+
 void march_size(const core::Scene& scene, int window_w, int window_h, int& w, int& h) {
   core::march_size(window_w, window_h, scene.render.resolution_scale, w, h);  // as resolve_frame sizes `render`'s march
 }

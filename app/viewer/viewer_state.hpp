@@ -33,6 +33,7 @@ struct ViewsPanel {
   double divider = 0.5;  // the swipe divider, a fraction of the width
   bool link_camera = true, link_time = true;
   std::vector<std::string> labels;  // per view (view 0 first): its source and valid time
+  std::vector<core::ViewSource> sources;  // views 1..: file (empty: view 0's) and time, for a saved scene
   std::string add_source;           // FILE, FILE@TIME, or @TIME (this view's file at another time)
   bool add_requested = false;
   int remove_requested = -1;        // a view (1..) to close
@@ -67,5 +68,10 @@ void march_size(const core::Scene& scene, int window_w, int window_h, int& w, in
 // True when two scenes give the same marched image (so the accumulation can go on). Exposure is
 // left out: it only changes the tonemap of the same accumulated mean.
 bool same_march(const core::Scene& a, const core::Scene& b);
+
+// The scene the "Scene file" panel saves: view 0's scene with the open views (each other view's
+// file and instant, the layout, the link, the divider) as its "views", or none with one view open.
+// Cameras and time count as linked only when both are.
+core::Scene scene_to_save(const ViewerState& s);
 
 }  // namespace cv::viewer

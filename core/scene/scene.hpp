@@ -76,6 +76,23 @@ struct TimeSpec {
   TimeInterpolation interpolation = TimeInterpolation::Auto;  // auto: advected where the file has winds, else linear
 };
 
+// One more view beside the scene's own in the viewer (issue 17): a file (empty: the scene's own) at a
+// time (empty: the scene's instant; else a UTC time YYYY-MM-DDThh:mm:ssZ or a step index of that
+// file), as `view --compare FILE[@T] | @T` gives it.
+struct ViewSource {
+  std::string path;  // a relative path is taken from the scene file's folder
+  std::string time;
+};
+
+// The viewer's views when the scene is opened: the scene's own first, then `compare`.
+struct ViewsSpec {
+  static constexpr int kMaxCompare = 3;  // four views in all
+  std::string layout = "grid";           // grid, or swipe (a divider between exactly two views)
+  bool linked = true;                    // cameras and time move together
+  double divider = 0.5;                  // the swipe divider, a fraction of the width
+  std::vector<ViewSource> compare;
+};
+
 struct Scene {
   static constexpr int kVersion = 1;
   DataSource data;
@@ -91,6 +108,8 @@ struct Scene {
   RenderSettings render;
   // Overlays drawn with the clouds, composited by depth (settings/overlay_settings.def).
   std::vector<OverlaySpec> overlays;
+  // Several views in the viewer (nothing: the scene's view alone). `render` draws the scene's own.
+  std::optional<ViewsSpec> views;
 };
 
 }  // namespace cv::core

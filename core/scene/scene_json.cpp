@@ -329,6 +329,48 @@ ojson march_to_json(const MarchSettings& m) {
 
 // "overlays": each entry a type name (its defaults) or an object {"type": NAME, key: value, ...}
 // typed by the overlay table (settings/overlay_settings.def).
+// "views": {"layout": "grid"|"swipe", "linked": bool, "divider": 0..1,
+//           "compare": [{"path": "b.nc", "time": "2024-01-15T06:00:00Z" | 3}, ...]}
+void read_views(const Reader& r, ViewsSpec& v) {
+  r.only({"layout", "linked", "divider", "compare"});
+  r.string("layout", v.layout);
+  if (v.layout != "grid" && v.layout != "swipe") r.fail("layout", json(v.layout).dump(), "\"grid\" or \"swipe\"");
+  r.boolean("linked", v.linked);
+  r.number("divider", v.divider, 0.0, 1.0, "a fraction of the width 0..1");
+  if (const json* c = r.find("compare"); c && !c->is_null()) {
+    const std::string most = std::to_string(ViewsSpec::kMaxCompare);
+    if (!c->is_array() || c->size() > static_cast<std::size_t>(ViewsSpec::kMaxCompare)) {
+      r.fail("compare", shown(*c), "an array of at most " + most + " views {\"path\": FILE, \"time\": UTC time or step}");
+    }
+    for (std::size_t i = 0; i < c->size(); ++i) {
+      const std::string key = "compare[" + std::to_string(i) + "]";
+      const json& e = (*c)[i];
+      if (!e.is_object()) r.fail(key, shown(e), "an object {\"path\": FILE, \"time\": UTC time or step}");
+      const Reader er(r.source(), e, r.where(key));
+      er.only({"path", "time"});
+      ViewSource s;
+      er.string("path", s.path);
+      if (const json* t = er.find("time"); t && !t->is_null()) {
+        const std::string expected = "a UTC time YYYY-MM-DDThh:mm:ssZ or a step index >= 0";
+        if (t->is_string()) {
+          s.time = t->get<std::string>();
+          if (!parse_iso_utc(s.time)) er.fail("time", shown(*t), expected);
+        } else if (t->is_number_integer() && t->get<long long>() >= 0 && t->get<long long>() < (1LL << 30)) {
+          s.time = std::to_string(t->get<long long>());
+        } else {
+          er.fail("time", shown(*t), expected);
+        }
+      }
+      if (s.path.empty() && s.time.empty()) er.fail("path", "neither path nor time", "a file, a time of the scene's file, or both");
+      v.compare.push_back(std::move(s));
+    }
+  }
+  if (v.layout == "swipe" && v.compare.size() != 1) {
+    r.fail("layout", "\"swipe\" with " + std::to_string(v.compare.size() + 1) + " view(s)",
+           "exactly one view in compare (a swipe divider splits two views)");
+  }
+}
+
 void read_overlays(const std::string& source, const json& o, std::vector<OverlaySpec>& out) {
   const json empty = json::object();
   const Reader top(source, empty, "");
@@ -404,7 +446,7 @@ Scene scene_from_json(const std::string& text, const std::string& source) {
   }
   if (!root.is_object()) throw SceneError(source + ": found " + shown(root) + " at the top, expected a JSON object { ... }");
   const Reader r(source, root, "");
-  r.only({"version", "data", "time_step", "time", "camera", "path", "width", "height", "sun", "render", "overlays"});
+  r.only({"version", "data", "time_step", "time", "camera", "path", "width", "height", "sun", "render", "overlays", "views"});
   const json* version = r.find("version");
   if (!version) r.fail("version", "nothing", "\"version\": " + std::to_string(Scene::kVersion));
   if (!version->is_number_integer() || version->get<long long>() < 1) r.fail("version", shown(*version), "an integer >= 1");
@@ -431,6 +473,10 @@ Scene scene_from_json(const std::string& text, const std::string& source) {
   if (const auto s = r.child("sun")) read_sun(*s, scene.sun);
   if (const auto rs = r.child("render")) read_render(*rs, scene.render);
   if (const json* o = r.find("overlays")) read_overlays(source, *o, scene.overlays);
+  if (const auto v = r.child("views")) {
+    scene.views = ViewsSpec{};
+    read_views(*v, *scene.views);
+  }
   return scene;
 }
 
@@ -492,6 +538,22 @@ std::string scene_to_json(const Scene& s) {
     overlays.push_back(entry);
   }
   root["overlays"] = overlays;
+  if (s.views) {
+    ojson compare = ojson::array();
+    for (const ViewSource& v : s.views->compare) {
+      ojson e = ojson::object();
+      if (!v.path.empty()) e["path"] = v.path;
+      if (!v.time.empty()) {
+        // A step index is written as a number, a UTC time as a string.
+        if (v.time.find_first_not_of("0123456789") == std::string::npos) e["time"] = std::stoll(v.time);
+        else e["time"] = v.time;
+      }
+      compare.push_back(e);
+    }
+    root["views"] = {{"layout", s.views->layout}, {"linked", s.views->linked}, {"divider", s.views->divider}, {"compare", compare}};
+  } else {
+    root["views"] = nullptr;  // the scene's view alone
+  }
   return root.dump(2) + "\n";
 }
 
@@ -511,6 +573,9 @@ Scene load_scene(const std::string& path) {
   };
   beside(scene.data.path);
   if (scene.render.march.medium.ground_texture != "none") beside(scene.render.march.medium.ground_texture);
+  if (scene.views) {
+    for (ViewSource& v : scene.views->compare) beside(v.path);
+  }
   return scene;
 }
 

@@ -202,7 +202,7 @@ TEST(SceneJson, UnknownKeysAreNamedSoTyposAreCaught) {
             "horizontal cell)");
   EXPECT_EQ(error_of(R"({"version": 1, "camra": {}})"),
             "scene.json: camra: unknown key, expected one of version, data, time_step, time, camera, path, width, height, sun, render, "
-            "overlays");
+            "overlays, views");
 }
 
 TEST(SceneJson, VersionIsRequiredAndANewerOneIsRefused) {
@@ -322,6 +322,64 @@ TEST(SceneJson, BadOverlaysAreNamedWithWhatWasExpected) {
             "scene.json: overlays[0].color: found [1,1], expected [r, g, b], each 0..1000");
   EXPECT_EQ(error_of(R"({"version": 1, "overlays": "coastlines"})"),
             "scene.json: overlays: found \"coastlines\", expected an array of overlays (names or {\"type\": ...} objects)");
+}
+
+// Several views in the viewer (issue 17): the scene file keeps them, and its reader names what is wrong.
+TEST(SceneJson, ViewsRoundTripAndTheirPathsAreTakenFromTheSceneFilesFolder) {
+  const Scene s = scene_from_json(
+      R"({"version": 1, "views": {"layout": "grid", "linked": false, "compare": [{"time": 2}, {"path": "b.nc", "time": "2024-01-15T06:00:00Z"},
+          {"path": "c.cvvol"}]}})", "scene.json");
+  ASSERT_TRUE(s.views);
+  EXPECT_EQ(s.views->layout, "grid");
+  EXPECT_FALSE(s.views->linked);
+  ASSERT_EQ(s.views->compare.size(), 3u);
+  EXPECT_EQ(s.views->compare[0].path, "");
+  EXPECT_EQ(s.views->compare[0].time, "2");
+  EXPECT_EQ(s.views->compare[1].path, "b.nc");
+  EXPECT_EQ(s.views->compare[1].time, "2024-01-15T06:00:00Z");
+  EXPECT_EQ(s.views->compare[2].time, "");
+  const Scene again = scene_from_json(scene_to_json(s), "again.json");
+  ASSERT_TRUE(again.views);
+  EXPECT_EQ(again.views->linked, false);
+  ASSERT_EQ(again.views->compare.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(again.views->compare[i].path, s.views->compare[i].path);
+    EXPECT_EQ(again.views->compare[i].time, s.views->compare[i].time);
+  }
+  EXPECT_NE(scene_to_json(s).find("\"time\": 2\n"), std::string::npos) << "a step is written as a number";
+  // None: written as null, read back as none.
+  EXPECT_FALSE(scene_from_json(scene_to_json(Scene{}), "none.json").views);
+  // A swipe of two, the divider kept.
+  const Scene w = scene_from_json(R"({"version": 1, "views": {"layout": "swipe", "divider": 0.3, "compare": [{"time": 1}]}})", "w.json");
+  EXPECT_EQ(w.views->divider, 0.3);
+
+  const fs::path dir = fs::temp_directory_path() / "cv_scene_views" / "scenes";
+  fs::create_directories(dir);
+  std::ofstream(dir / "s.json") << R"({"version": 1, "views": {"compare": [{"path": "../data/b.nc"}, {"time": 1}]}})";
+  const Scene l = load_scene((dir / "s.json").string());
+  EXPECT_EQ(l.views->compare[0].path, (dir.parent_path() / "data" / "b.nc").string());
+  EXPECT_EQ(l.views->compare[1].path, "");  // the scene's own file stays the scene's own
+  fs::remove_all(dir.parent_path());
+}
+
+TEST(SceneJson, BadViewsAreNamedWithWhatWasExpected) {
+  EXPECT_EQ(error_of(R"({"version": 1, "views": {"layout": "tiles"}})"),
+            "scene.json: views.layout: found \"tiles\", expected \"grid\" or \"swipe\"");
+  EXPECT_EQ(error_of(R"({"version": 1, "views": {"compare": [{"time": 1}, {"time": 2}, {"time": 3}, {"time": 4}]}})"),
+            "scene.json: views.compare: found [{\"time\":1},{\"time\":2},{\"time\":3},{\"t..., expected an array of at most 3 views "
+            "{\"path\": FILE, \"time\": UTC time or step}");
+  EXPECT_EQ(error_of(R"({"version": 1, "views": {"compare": [{"time": "soon"}]}})"),
+            "scene.json: views.compare[0].time: found \"soon\", expected a UTC time YYYY-MM-DDThh:mm:ssZ or a step index >= 0");
+  EXPECT_EQ(error_of(R"({"version": 1, "views": {"compare": [{"time": -1}]}})"),
+            "scene.json: views.compare[0].time: found -1, expected a UTC time YYYY-MM-DDThh:mm:ssZ or a step index >= 0");
+  EXPECT_EQ(error_of(R"({"version": 1, "views": {"compare": [{}]}})"),
+            "scene.json: views.compare[0].path: found neither path nor time, expected a file, a time of the scene's file, or both");
+  EXPECT_EQ(error_of(R"({"version": 1, "views": {"compare": [{"file": "b.nc"}]}})"),
+            "scene.json: views.compare[0].file: unknown key, expected one of path, time");
+  EXPECT_EQ(error_of(R"({"version": 1, "views": {"layout": "swipe", "compare": [{"time": 1}, {"time": 2}]}})"),
+            "scene.json: views.layout: found \"swipe\" with 3 view(s), expected exactly one view in compare (a swipe divider splits two views)");
+  EXPECT_EQ(error_of(R"({"version": 1, "views": {"divider": 2}})"), "scene.json: views.divider: found 2, expected a fraction of the width 0..1");
+  EXPECT_EQ(error_of(R"({"version": 1, "views": {"linked": "yes"}})"), "scene.json: views.linked: found \"yes\", expected true or false");
 }
 
 TEST(OverlayFlag, ParsesNameAndTypedParameters) {

@@ -5,7 +5,9 @@
 
 #include <random>
 
+#include "scene/scene_json.hpp"
 #include "viewer/camera_controller.hpp"
+#include "viewer/viewer_state.hpp"
 #include "viewer/views.hpp"
 
 namespace {
@@ -182,6 +184,34 @@ TEST(Views, UnlinkedViewsDoNotFollow) {
   viewer::zoom(v.views[0].camera, 1.0, kR0);
   v.sync();
   expect_same_camera(v);
+}
+
+// The "Scene file" panel saves the open views; the scene file read back holds them, and with one
+// view open it holds none.
+TEST(Views, ASavedSceneKeepsTheOpenViews) {
+  viewer::ViewerState s;
+  s.scene.data.path = "/data/a.nc";
+  EXPECT_FALSE(viewer::scene_to_save(s).views) << "one view: no views entry";
+  s.views.sources = {{"", "2024-01-15T06:00:00Z"}, {"/data/b.nc", "3"}};
+  s.views.layout = ViewLayout::Grid;
+  s.views.link_camera = true, s.views.link_time = false;  // linked only when both are
+  const core::Scene saved = core::scene_from_json(core::scene_to_json(viewer::scene_to_save(s)), "saved.json");
+  ASSERT_TRUE(saved.views);
+  EXPECT_EQ(saved.views->layout, "grid");
+  EXPECT_FALSE(saved.views->linked);
+  ASSERT_EQ(saved.views->compare.size(), 2u);
+  EXPECT_EQ(saved.views->compare[0].path, "");
+  EXPECT_EQ(saved.views->compare[0].time, "2024-01-15T06:00:00Z");
+  EXPECT_EQ(saved.views->compare[1].path, "/data/b.nc");
+  EXPECT_EQ(saved.views->compare[1].time, "3");
+  s.views.sources.resize(1);
+  s.views.layout = ViewLayout::Swipe;
+  s.views.divider = 0.25;
+  s.views.link_time = true;
+  const core::Scene swipe = core::scene_from_json(core::scene_to_json(viewer::scene_to_save(s)), "swipe.json");
+  EXPECT_EQ(swipe.views->layout, "swipe");
+  EXPECT_TRUE(swipe.views->linked);
+  EXPECT_EQ(swipe.views->divider, 0.25);
 }
 
 }  // namespace
