@@ -11,20 +11,29 @@
 #include "analysis/compare.hpp"
 #include "analysis_commands.hpp"
 #include "analysis_common.hpp"
+#include "kernel/prepared_volume.hpp"
+#include "physics/physics.hpp"
+#include "render/context.hpp"
+#include "render/frame_renderer.hpp"
 #include "render/image_output.hpp"
+#include "scene/quality.hpp"
 
 namespace cv::cli {
 
 using namespace analysis;
 
 const char* compare_usage() {
-  return "  compare A B -o OUT.png [--times T | TA,TB] [--csv OUT.csv]\n"
+  return "  compare A B -o OUT.png [--times T | TA,TB] [--csv OUT.csv] [--render OUT3D.png [--render-size WxH]]\n"
          "                           two sources side by side, each on its own grid (cloud cover, labelled with the source\n"
          "                           and valid time), and on a common grid, stated in the image and printed: the coarser\n"
          "                           spacing of the two on each axis over the region and altitudes both hold; there, the\n"
          "                           columns with cloud in A only, B only or both, and maps of B - A of cover, optical\n"
          "                           depth, cloud base and top with a diverging colour map; --times: one of each file's\n"
-         "                           valid times or steps (default: the first valid time both hold); --csv: per column\n";
+         "                           valid times or steps (default: the first valid time both hold); --csv: per column\n"
+         "                           presence, the maps and their differences; --render: the difference view rendered on\n"
+         "                           the GPU, the clouds of the common grid lit by the sun at noon over the view, their\n"
+         "                           light coloured orange where cloud is in A only, blue in B only and white in both\n"
+         "                           (the hue only: each keeps its own brightness), at --render-size (default 960x540)\n";
 }
 
 namespace {
@@ -51,6 +60,70 @@ void draw_map(Canvas& cv, const Area& a, const core::VolumeGrid& g, double lat_l
   cv.box(a.x0 - 1, a.y0 - 1, a.x1 + 1, a.y1 + 1, kInk);
 }
 
+// The false colours of the rendered difference view (march.tint_liquid and tint_ice): their mean is
+// grey, so cloud in both, half in each component, is white.
+constexpr glm::dvec3 kTintA{1.0, 0.525, 0.05}, kTintB{0.05, 0.525, 1.0};
+
+// The difference view: the presence medium (core::presence_medium) on the common grid, rendered by
+// the GPU march as `render` renders a volume (default quality, the camera framing the grid from the
+// south, the sun at noon over it), A only orange, B only blue, both white, with a caption below.
+std::vector<unsigned char> render_difference_view(const core::Comparison& cmp, const core::ValidTime& time, double r_eff_um, int width,
+                                                  int height, const std::vector<std::string>& caption, int& out_h) {
+  core::CloudVolume vol;
+  vol.grid = cmp.grid;
+  vol.times = {time};
+  vol.liquid_r_eff_um = r_eff_um;
+  for (core::Field f : {core::Field::CloudFraction, core::Field::ExtinctionLiquid, core::Field::ExtinctionIce}) {
+    vol.has_field[static_cast<int>(f)] = true;
+  }
+  core::TimeStepData medium = core::presence_medium(cmp);
+  vol.has_ground = !medium.ground_m.empty();
+  const auto prepared = std::make_shared<const core::PreparedVolume>(core::prepare_volume(vol.grid, medium));
+  vol.put(0, std::move(medium));
+  core::Scene scene;
+  scene.width = width, scene.height = height;
+  core::apply_quality("default", scene.render);
+  scene.render.march.quality.view_step_m = core::resolve_view_step_m(scene.render, vol.grid);
+  scene.sun.mode = core::SunMode::LocalNoon;  // lit wherever the view is: a comparison, not a forecast
+  core::MediumSettings& m = scene.render.march.medium;
+  m.droplet_diameter_um = 2.0 * r_eff_um;
+  // One phase function for both components: A and B differ in colour only, not in how they scatter.
+  m.liquid_phase_hg = true;
+  m.ice_g = physics::f64::mie_mean_cosine(physics::f64::mie_params(m.droplet_diameter_um));
+  m.tint_liquid = kTintA;
+  m.tint_ice = kTintB;
+  auto ctx = render::make_headless_context();
+  const render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  render::FrameRenderer renderer(loader);
+  renderer.use_volume(prepared);
+  const core::FrameSpec frame = render::resolve_frame(scene, vol);
+  std::vector<glm::vec4> marched;
+  const std::vector<glm::vec4> pixels = renderer.render(frame, {}, {}, &marched);
+  render::ToneSettings tone;
+  tone.exposure = render::auto_exposure(marched);
+  if (frame.march.features.atmosphere || frame.march.features.globe) tone.background = glm::dvec3(0.0);
+  const std::vector<unsigned char> rgb8 = render::tonemap_srgb8(pixels, tone);
+  const int band = 28 + 14 * static_cast<int>(caption.size());
+  out_h = height + band;
+  Canvas cv(width, out_h, kPaper);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = 3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x));
+      cv.set(x, y, Rgb{rgb8[i], rgb8[i + 1], rgb8[i + 2]});
+    }
+  const Rgb swatch[3] = {{255, 134, 13}, {13, 134, 255}, {235, 235, 235}};
+  const char* label[3] = {"A only", "B only", "both"};
+  for (int k = 0; k < 3; ++k) {
+    const int x0 = 8 + k * 90, y0 = height + 8;
+    for (int y = 0; y < 10; ++y)
+      for (int x = 0; x < 14; ++x) cv.set(x0 + x, y0 + y, swatch[k]);
+    cv.box(x0, y0, x0 + 13, y0 + 9, kInk);
+    cv.text(x0 + 20, y0 + 9, 9, label[k], kInk);
+  }
+  for (std::size_t k = 0; k < caption.size(); ++k) cv.text(8, height + 32 + 14 * static_cast<int>(k), 9, caption[k], kInk);
+  return cv.rgb();
+}
+
 std::size_t resolve_in(const core::CloudVolume& vol, const std::string& file, const std::string& t) {
   Common c{"compare", file, t};
   return resolve_step(vol, c);
@@ -60,7 +133,8 @@ std::size_t resolve_in(const core::CloudVolume& vol, const std::string& file, co
 
 int cmd_compare(const std::vector<std::string>& args) {
   std::vector<std::string> files;
-  std::string out, csv, times;
+  std::string out, csv, times, render_out;
+  int render_w = 960, render_h = 540;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (!a.empty() && a[0] == '-') {
@@ -69,6 +143,13 @@ int cmd_compare(const std::vector<std::string>& args) {
       if (a == "-o") out = v;
       else if (a == "--csv") csv = v;
       else if (a == "--times") times = v;
+      else if (a == "--render") render_out = v;
+      else if (a == "--render-size") {
+        if (std::sscanf(v.c_str(), "%dx%d", &render_w, &render_h) != 2 || render_w < 16 || render_h < 16 || render_w > 8192 ||
+            render_h > 8192 || v.find_first_not_of("0123456789x") != std::string::npos) {
+          throw UsageError{"cloudviewer compare: --render-size: found '" + v + "', expected WxH with 16..8192 each"};
+        }
+      }
       else throw UsageError{"cloudviewer compare: unknown option '" + a + "'"};
     } else {
       files.push_back(a);
@@ -77,6 +158,14 @@ int cmd_compare(const std::vector<std::string>& args) {
   if (files.size() != 2 || out.empty()) throw UsageError{"cloudviewer compare: expected two files A B and -o OUT.png"};
   check_outputs("compare", out, csv, files[0]);
   check_outputs("compare", out, csv, files[1]);
+  if (!render_out.empty()) {
+    for (const std::string& f : files) {
+      core::check_output_extension(render_out, "--render", {".png"});
+      core::check_output_path(render_out, "--render");
+      core::check_output_not_input(render_out, "--render", f, "an input");
+    }
+    if (render_out == out) throw UsageError{"cloudviewer compare: --render: found '" + render_out + "', the same file as -o; expected another PNG"};
+  }
   core::CloudVolume va = load(files[0]), vb = load(files[1]);
   // The steps compared.
   std::size_t sa = 0, sb = 0;
@@ -183,6 +272,22 @@ int cmd_compare(const std::vector<std::string>& args) {
   cv.text(left, height - 14, 9, "grey: no data or no cloud in one of them", kInk);
   core::OutputGroup group;
   group.write(out, [&](std::FILE* f) { render::encode_png(f, width, height, cv.rgb()); });
+  if (!render_out.empty()) {
+    const auto t_render = std::chrono::steady_clock::now();
+    int h3 = 0;
+    const std::vector<std::string> caption = {
+        "A " + std::filesystem::path(files[0]).filename().string() + " " + va.times[sa].iso_utc,
+        "B " + std::filesystem::path(files[1]).filename().string() + " " + vb.times[sb].iso_utc,
+        "common grid " + std::to_string(common.lon_deg.count) + "x" + std::to_string(common.lat_deg.count) + "x" +
+            std::to_string(common.alt_m.count) + ", false colour: the hue only"};
+    const std::vector<unsigned char> view = render_difference_view(cmp, va.times[sa], va.liquid_r_eff_um, render_w, render_h, caption, h3);
+    std::size_t nodes[4] = {0, 0, 0, 0};
+    for (core::Presence p : cmp.points) ++nodes[static_cast<int>(p)];
+    std::printf("difference view: grid nodes with cloud in A only %zu (orange), B only %zu (blue), both %zu (white); rendered %dx%d in %.2f s\n",
+                nodes[1], nodes[2], nodes[3], render_w, render_h,
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t_render).count());
+    group.write(render_out, [&](std::FILE* f) { render::encode_png(f, render_w, h3, view); });
+  }
   if (!csv.empty()) {
     group.write(csv, [&](std::FILE* f) {
       put(f, "# A " + files[0] + " at " + va.times[sa].iso_utc + ", B " + files[1] + " at " + vb.times[sb].iso_utc + "; " + grid_line + "\n");
@@ -201,7 +306,8 @@ int cmd_compare(const std::vector<std::string>& args) {
     });
   }
   group.commit();
-  std::printf("wrote %s%s%s\n", out.c_str(), csv.empty() ? "" : " and ", csv.c_str());
+  std::printf("wrote %s%s%s%s%s\n", out.c_str(), csv.empty() ? "" : " and ", csv.c_str(), render_out.empty() ? "" : " and ",
+              render_out.c_str());
   return 0;
 }
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "volume/grid_mean.hpp"
 #include "volume/sampler.hpp"
 
 namespace cv::core {
@@ -128,6 +129,34 @@ Comparison compare_steps(const VolumeGrid& grid_a, const TimeStepData& a, const 
   c.points.assign(common.points(), Presence::None);
   for (std::size_t p = 0; p < common.points(); ++p) c.points[p] = static_cast<Presence>((cloudy(c.a, p) ? 1 : 0) | (cloudy(c.b, p) ? 2 : 0));
   return c;
+}
+
+TimeStepData presence_medium(const Comparison& c) {
+  const GridMeanExtinction ma = grid_mean_extinction(c.grid, c.a), mb = grid_mean_extinction(c.grid, c.b);
+  const std::size_t n = c.grid.points();
+  TimeStepData out;
+  out[Field::CloudFraction].assign(n, 0.0f);
+  out[Field::ExtinctionLiquid].assign(n, 0.0f);
+  out[Field::ExtinctionIce].assign(n, 0.0f);
+  auto ext = [](const GridMeanExtinction& m, std::size_t p) {
+    const float l = m.liquid_per_m[p], i = m.ice_per_m[p];
+    return (std::isfinite(l) ? l : 0.0f) + (std::isfinite(i) ? i : 0.0f);
+  };
+  for (std::size_t p = 0; p < n; ++p) {
+    float liquid = 0.0f, ice = 0.0f;
+    switch (c.points[p]) {
+      case Presence::OnlyA: liquid = ext(ma, p); break;
+      case Presence::OnlyB: ice = ext(mb, p); break;
+      case Presence::Both: liquid = ice = 0.5f * std::max(ext(ma, p), ext(mb, p)); break;
+      default: break;
+    }
+    out[Field::ExtinctionLiquid][p] = liquid;
+    out[Field::ExtinctionIce][p] = ice;
+    out[Field::CloudFraction][p] = liquid + ice > 0.0f ? 1.0f : 0.0f;
+  }
+  out.ground_m = c.a.ground_m;
+  derive_maps(c.grid, out);
+  return out;
 }
 
 }  // namespace cv::core

@@ -40,4 +40,11 @@ struct Comparison {
 Comparison compare_steps(const VolumeGrid& grid_a, const TimeStepData& a, const VolumeGrid& grid_b, const TimeStepData& b,
                          const VolumeGrid& common, const MapOptions& options = {});
 
+// The medium of the rendered difference view, on the common grid: at each node, cloud in A only as
+// liquid (A's grid-mean extinction), in B only as ice (B's), in both as half the larger of the two
+// in each, so that a tint per component (march.tint_liquid / tint_ice) colours the three and
+// agreement takes the tints' mean. Cloud fraction 1 wherever there is extinction (in-cloud =
+// grid-mean); nodes cloudy in neither (Comparison::points) are clear. A's ground, its maps derived.
+TimeStepData presence_medium(const Comparison& c);
+
 }  // namespace cv::core

@@ -54,7 +54,8 @@ struct MarchKernel : MarchParams {
   const glm::vec2* u_min_max = nullptr;
   // The program switches (compile-time constants on the GPU).
   bool kSkipEmpty = true, kAdaptive = false, kAtmosphere = false, kGlobe = false, kNoise = false, kTwoStream = false,
-       kTranslucent = false, kLayerMask = true;  // the CPU pays nothing for a uniform branch: the mask follows u_mask_band
+       kTranslucent = false, kLayerMask = true,  // the CPU pays nothing for a uniform branch: the mask follows u_mask_band
+       kTint = true;                             // and the tint follows u_tint
 
 #include "kernel/march.glsl"
 

@@ -80,6 +80,7 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
   p.u_layer = {v.layer.bottom_m, v.layer.top_m};
   p.u_cloudless = v.layer.empty;
   p.u_mask_band = layer_band_set(s);
+  p.u_tint = tint_set(s);
   p.u_sigma_max = v.sigma_max_per_m;
   p.u_sun_step_max = sun_step_limit_m(grid, v.layer, s);
   p.u_octave_abc = {s.medium.octave_a, s.medium.octave_b, s.medium.octave_c};

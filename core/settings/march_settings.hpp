@@ -209,6 +209,12 @@ const SettingRow* find_march_setting(const std::string& key);
 // (the whole column). The march's band test is compiled in only then (kernel::MarchVariant).
 inline bool layer_band_set(const MarchSettings& s) { return s.medium.layer_bottom_m > -100000.0 || s.medium.layer_top_m < 1e7; }
 
+// Whether a false colour is set: tint_liquid or tint_ice is not white. The march's tint is compiled
+// in only then (kernel::MarchVariant).
+inline bool tint_set(const MarchSettings& s) {
+  return s.medium.tint_liquid != glm::dvec3(1.0) || s.medium.tint_ice != glm::dvec3(1.0);
+}
+
 // Whether the two march the same image: every row but those marked image = false (`frame`).
 bool same_image(const MarchSettings& a, const MarchSettings& b);
 

@@ -60,6 +60,9 @@ uint g_stats[CV_STAT_COUNT] = uint[CV_STAT_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u
 #ifndef CV_LAYER_MASK
 #define CV_LAYER_MASK 0
 #endif
+#ifndef CV_TINT
+#define CV_TINT 0
+#endif
 const bool kSkipEmpty = CV_SKIP_EMPTY != 0;
 const bool kAdaptive = CV_ADAPTIVE != 0;
 const bool kAtmosphere = CV_ATMOSPHERE != 0;
@@ -68,3 +71,4 @@ const bool kNoise = CV_NOISE != 0;
 const bool kTwoStream = CV_TWO_STREAM != 0;  // the two-stream source; else the octave sum
 const bool kTranslucent = CV_TRANSLUCENT != 0;  // translucent geometry composited among the samples
 const bool kLayerMask = CV_LAYER_MASK != 0;     // a height band masks the medium (u_mask_band)
+const bool kTint = CV_TINT != 0;                // false colour by liquid and ice (u_tint)

@@ -278,6 +278,14 @@ struct MarchState {
 // begins t_entry from the camera: in-scattered light (sun through the air, ambient sky light),
 // attenuation, and where the view transmittance falls to 0.5 (exactly, for the step's constant
 // extinction).
+// The false colour of a sample (kTint): the hue of its tints weighted by its liquid and ice
+// extinction, scaled to luminance 1 (Rec. 709), so the light keeps its luminance and takes the hue.
+CV_FN real3 tint_hue(real sl, real si, real sigma) {
+  real3 mixed = (sl * u_tint_liquid + si * u_tint_ice) / sigma;
+  real lum = dot(mixed, real3(0.2126, 0.7152, 0.0722));
+  return lum > real(0.0) ? mixed / lum : real3(0.0);
+}
+
 CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real3 d, real mu, MieParams mie, CV_INOUT(MarchState) s) {
   real sl;
   real si;
@@ -328,7 +336,9 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
                                     : ms_octaves_mie_gated(sl, mu, mie, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
     scatter = liquid + ms_octaves_hg_gated(si, mu, u_ice_g, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
   }
-  s.radiance += s.t_view * segment_integral(u_irradiance * (sun_air * scatter + diffuse + ambient), sigma, ds);
+  real3 source = u_irradiance * (sun_air * scatter + diffuse + ambient);
+  if (kTint && u_tint) source *= tint_hue(sl, si, sigma);
+  s.radiance += s.t_view * segment_integral(source, sigma, ds);
   // The light the step takes out of the view, t_view (1 - exp(-sigma ds)), without the cancellation
   // of t_view - t_next: in float that is a multiple of 6e-8, which left faint cloud with a mean
   // depth tens of kilometres off.

@@ -35,6 +35,9 @@ CV_PARAM(real, u_noise_amount)
 CV_PARAM(real2, u_layer)             // altitudes (m) between which the data holds cloud (CloudLayer)
 CV_PARAM(ivec2, u_size)              // image size, pixels
 CV_PARAM(ivec2, u_ground_size)       // of the albedo texture; (0, 0): constant albedo
+CV_PARAM(real3, u_tint_liquid)       // false colour (hue) of the liquid's light (march_settings.def tint_liquid)
+CV_PARAM(bool, u_tint)               // a tint is set: each sample's light takes the hue of its tints
+CV_PARAM(real3, u_tint_ice)          // false colour (hue) of the ice's light
 CV_PARAM(real, u_ambient)            // strength of the isotropic sky light on clouds
 CV_PARAM(real, u_ocean_wind)         // m/s, the sea's roughness for the sun glint (cox_munk_mss)
 CV_PARAM(int, u_sun_steps)

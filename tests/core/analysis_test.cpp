@@ -19,7 +19,9 @@
 #include "support/cf_writer.hpp"
 #include "support/nc_builder.hpp"
 #include "reference/raymarcher.hpp"
+#include "scene/framing.hpp"
 #include "support/real_data.hpp"
+#include "volume/grid_mean.hpp"
 
 namespace {
 using namespace cv;
@@ -526,6 +528,81 @@ TEST_F(Compare, ACloudRemovedFromTheCopyIsExactlyTheAOnlyCloud) {
     }
   }
   for (std::size_t p = 0; p < c.points.size(); ++p) EXPECT_NE(static_cast<int>(c.points[p]), static_cast<int>(core::Presence::OnlyB));
+}
+
+// The rendered difference view (compare --render): its medium and its false colour, on the CPU
+// kernel. Without the air the light of a sample is grey, so its colour is its tint's hue alone.
+core::ReferenceImage difference_view(const core::Comparison& c, core::MarchSettings& s) {
+  const core::PreparedVolume pv = core::prepare_volume(c.grid, core::presence_medium(c));
+  core::Camera cam = core::auto_camera(c.grid, 48, 27);
+  core::Sun sun;
+  sun.subsolar_lat_deg = 45.0, sun.subsolar_lon_deg = 9.0;  // noon over the clouds
+  s.quality.view_step_m = 500.0;
+  s.quality.sun_steps = 8;
+  s.medium.tint_liquid = {1.0, 0.525, 0.05};  // compare's orange (A only) and blue (B only)
+  s.medium.tint_ice = {0.05, 0.525, 1.0};
+  return core::render_reference(pv, cam, sun, s);
+}
+
+double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
+TEST_F(Compare, TheDifferenceViewOfAFileWithItselfIsAllBothAndRendersWhite) {
+  core::CloudVolume a = import(true);
+  const core::VolumeGrid g = core::common_grid(a.grid, a.grid, core::grid_overlap(a.grid, a.grid));
+  const core::Comparison c = core::compare_steps(a.grid, a.step(0), a.grid, a.step(0), g);
+  const core::TimeStepData m = core::presence_medium(c);
+  const core::GridMeanExtinction own = core::grid_mean_extinction(g, c.a);
+  int cloudy = 0;
+  for (std::size_t p = 0; p < g.points(); ++p) {
+    const float l = m[core::Field::ExtinctionLiquid][p], i = m[core::Field::ExtinctionIce][p];
+    EXPECT_EQ(l, i) << p;  // both: half in each component
+    if (c.points[p] == core::Presence::Both) {
+      ++cloudy;
+      EXPECT_FLOAT_EQ(l + i, own.liquid_per_m[p] + own.ice_per_m[p]) << p;
+    } else {
+      EXPECT_EQ(l, 0.0f) << p;
+    }
+  }
+  EXPECT_GT(cloudy, 0);
+  core::MarchSettings s;
+  ASSERT_FALSE(s.features.atmosphere);
+  const core::ReferenceImage img = difference_view(c, s);
+  double max_l = 0.0;
+  for (const auto& r : img.radiance) max_l = std::max(max_l, luminance(r));
+  ASSERT_GT(max_l, 0.0);
+  for (const auto& r : img.radiance) {  // white: the tints' mean is grey
+    EXPECT_NEAR(r.x, r.y, 1e-9 * max_l);
+    EXPECT_NEAR(r.z, r.y, 1e-9 * max_l);
+  }
+}
+
+TEST_F(Compare, TheDifferenceViewShowsTheRemovedCloudOrangeAndNothingBlue) {
+  core::CloudVolume a = import(true), b = import(false);
+  const core::VolumeGrid g = core::common_grid(a.grid, b.grid, core::grid_overlap(a.grid, b.grid));
+  const core::Comparison c = core::compare_steps(a.grid, a.step(0), b.grid, b.step(0), g);
+  const core::TimeStepData m = core::presence_medium(c);
+  int only_a = 0;
+  for (std::size_t p = 0; p < g.points(); ++p) {
+    const float l = m[core::Field::ExtinctionLiquid][p], i = m[core::Field::ExtinctionIce][p];
+    if (c.points[p] == core::Presence::OnlyA) {
+      ++only_a;
+      EXPECT_GT(l, 0.0f) << p;
+      EXPECT_EQ(i, 0.0f) << p;  // A only: liquid, the orange component, alone
+    } else {
+      EXPECT_EQ(l, i) << p;
+    }
+  }
+  EXPECT_GT(only_a, 0);
+  core::MarchSettings s;
+  const core::ReferenceImage img = difference_view(c, s);
+  double max_l = 0.0, orange = 0.0;
+  for (const auto& r : img.radiance) max_l = std::max(max_l, luminance(r));
+  ASSERT_GT(max_l, 0.0);
+  for (const auto& r : img.radiance) {
+    EXPECT_LE(r.z, r.x + 1e-9 * max_l);  // no pixel bluer than it is red: nothing is in B only
+    if (luminance(r) > 1e-3 * max_l) orange = std::max(orange, (r.x - r.z) / luminance(r));
+  }
+  EXPECT_GT(orange, 0.5);  // the removed cloud shows orange
 }
 
 TEST_F(Compare, TheCommonGridIsTheCoarserOverTheOverlapAndDisjointGridsHaveNone) {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "kernel/march_params.hpp"
 #include "reference/raymarcher.hpp"
 #include "render/context.hpp"
 #include "render/raymarcher.hpp"
@@ -374,6 +375,68 @@ TEST(Raymarch, LayerMasksMatchTheReference) {
   band.medium.layer_bottom_m = 2000.0;
   band.medium.layer_top_m = 6000.0;
   check(band, "band 2-6 km");
+}
+
+// False colour (march.tint_liquid / tint_ice, `compare --render`): each sample's light takes the hue
+// of its tints at its own luminance. Without the air the untinted light is grey, so a tinted image
+// has the untinted one's luminance at every pixel; with one tint for both, every pixel has that
+// tint's hue exactly; the GPU's compiled-in tint is the CPU kernel's; white tints change nothing.
+TEST(Raymarch, TintKeepsTheLuminanceAndTakesTheHueOnGpuAsOnCpu) {
+  BubbleOnGpu g;
+  auto& [ctx, loader, gpu, sc, medium] = g;
+  const core::Camera cam = bubble_camera(32, 18);
+  const core::Sun sun = low_eastern_sun();
+  core::MarchSettings s;
+  s.quality.view_step_m = 200.0;
+  s.quality.sun_steps = 16;
+  s.quality.octaves = 4;
+  ASSERT_FALSE(s.features.atmosphere);
+  const auto grey = core::render_reference(sc.grid, medium, cam, sun, s);
+  auto lum = [](const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; };
+  double max_l = 0.0;
+  for (const auto& l : grey.radiance) max_l = std::max(max_l, lum(l));
+  ASSERT_GT(max_l, 0.0);
+  const glm::dvec3 orange(1.0, 0.525, 0.05), blue(0.05, 0.525, 1.0);
+
+  core::MarchSettings one = s;
+  one.medium.tint_liquid = one.medium.tint_ice = orange;
+  EXPECT_NE(kernel::MarchVariant::of(one).key(), kernel::MarchVariant::of(s).key());
+  const auto cpu_one = core::render_reference(sc.grid, medium, cam, sun, one);
+  const glm::dvec3 hue = orange / lum(orange);
+  int lit = 0;
+  for (std::size_t i = 0; i < cpu_one.radiance.size(); ++i) {
+    const glm::dvec3 t = cpu_one.radiance[i], w = grey.radiance[i];
+    EXPECT_NEAR(lum(t), lum(w), 1e-9 * max_l) << i;
+    if (lum(w) < 1e-3 * max_l) continue;
+    ++lit;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(t[c], hue[c] * lum(w), 1e-9 * max_l) << i << " channel " << c;
+  }
+  EXPECT_GT(lit, 20);
+
+  core::MarchSettings two = s;
+  two.medium.tint_liquid = orange;
+  two.medium.tint_ice = blue;
+  const auto cpu = core::render_reference(sc.grid, medium, cam, sun, two);
+  const auto img = gpu.render(cam, sun, two);
+  double worst = 0.0, warm = 0.0, cool = 0.0;
+  for (std::size_t i = 0; i < img.size(); ++i) {
+    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(img[i][c] - cpu.radiance[i][c]) / max_l);
+    EXPECT_NEAR(lum(cpu.radiance[i]), lum(grey.radiance[i]), 1e-9 * max_l) << i;
+    if (lum(grey.radiance[i]) < 1e-3 * max_l) continue;
+    const double r_minus_b = (cpu.radiance[i].x - cpu.radiance[i].z) / lum(grey.radiance[i]);
+    warm = std::max(warm, r_minus_b), cool = std::max(cool, -r_minus_b);
+  }
+  std::printf("tint liquid orange, ice blue: GPU vs CPU worst %.3g of the brightest pixel; most orange (r - b) / lum %.3g, most blue %.3g\n",
+              worst, warm, cool);
+  EXPECT_LT(worst, 1e-3);
+  EXPECT_GT(warm, 0.5);  // the liquid bubble's light is orange
+  EXPECT_GT(cool, 0.5);  // and the ice layer's blue
+
+  core::MarchSettings white = s;
+  white.medium.tint_liquid = white.medium.tint_ice = glm::dvec3(1.0);
+  EXPECT_EQ(kernel::MarchVariant::of(white).key(), kernel::MarchVariant::of(s).key());
+  const auto same = core::render_reference(sc.grid, medium, cam, sun, white);
+  for (std::size_t i = 0; i < same.radiance.size(); ++i) EXPECT_EQ(same.radiance[i], grey.radiance[i]) << i;
 }
 
 }  // namespace
