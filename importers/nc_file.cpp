@@ -412,11 +412,19 @@ bool send_message(int fd, const std::string& m) {
   ::_exit(0);
 }
 
-// Seconds the reader may take to answer one request before it is taken for hung.
-int reader_timeout_s() {
-  if (const char* env = std::getenv("CLOUDVIEWER_READ_TIMEOUT_S"); env && std::atoi(env) > 0) return std::atoi(env);
-  return 600;
-}
+// Seconds the reader may take to open the file and send its header, and to answer one read, before
+// it is taken for hung (HDF5 1.10.8 loops forever in nc_open on some corrupt files: one changed byte
+// of the shared ERA5 file does it). A header takes well under a second even for thousands of
+// variables; a read is one slab of a variable.
+struct Wait {
+  const char* env;
+  int default_s;
+  int seconds() const {
+    if (const char* v = std::getenv(env); v && std::atoi(v) > 0) return std::atoi(v);
+    return default_s;
+  }
+};
+constexpr Wait kOpenWait{"CLOUDVIEWER_OPEN_TIMEOUT_S", 30}, kReadWait{"CLOUDVIEWER_READ_TIMEOUT_S", 300};
 
 bool classic_magic(const std::string& path) {
   unsigned char m[4] = {0, 0, 0, 0};
@@ -453,10 +461,10 @@ NcFile::NcFile(const std::string& path) : path_(path) {
     isolated_ = true;
     start_reader();
     std::uint64_t n = 0;
-    receive(&n, sizeof n, "opening it");
+    receive(&n, sizeof n, "opening it", true);
     if (n > (std::uint64_t(1) << 32)) throw std::runtime_error("NetCDF reader process: a header of " + std::to_string(n) + " bytes");
     std::string m(n, '\0');
-    receive(m.data(), n, "opening it");
+    receive(m.data(), n, "opening it", true);
     Unwire u{m};
     if (u.get<std::uint64_t>() != 0) {
       const std::string why = u.str();
@@ -514,7 +522,7 @@ void NcFile::start_reader() {
   reader_pid_ = pid;
 }
 
-void NcFile::reader_lost(const std::string& what, bool timed_out) const {
+void NcFile::reader_lost(const std::string& what, bool timed_out, bool opening) const {
   int status = 0;
   if (reader_pid_ > 0) {
     if (timed_out) ::kill(reader_pid_, SIGKILL);
@@ -525,8 +533,9 @@ void NcFile::reader_lost(const std::string& what, bool timed_out) const {
   sock_ = -1;
   reader_pid_ = -1;
   if (timed_out) {
-    throw ImportError(path_ + ": the NetCDF-4/HDF5 library did not answer within " + std::to_string(reader_timeout_s()) +
-                      " s while " + what + "; expected an intact NetCDF file (CLOUDVIEWER_READ_TIMEOUT_S sets the wait)");
+    const Wait& w = opening ? kOpenWait : kReadWait;
+    throw ImportError(path_ + ": the NetCDF-4/HDF5 library did not answer within " + std::to_string(w.seconds()) + " s while " + what +
+                      "; expected an intact NetCDF file (" + w.env + " sets the wait)");
   }
   std::string how = "stopped";
   if (WIFSIGNALED(status)) how = std::string("crashed (") + strsignal(WTERMSIG(status)) + ")";
@@ -535,18 +544,18 @@ void NcFile::reader_lost(const std::string& what, bool timed_out) const {
                     ": the file is corrupt; expected an intact NetCDF file");
 }
 
-void NcFile::receive(void* out, std::size_t bytes, const std::string& what) const {
+void NcFile::receive(void* out, std::size_t bytes, const std::string& what, bool opening) const {
   if (sock_ < 0) throw ImportError(path_ + ": the NetCDF reader process stopped earlier; cannot go on " + what);
   char* p = static_cast<char*>(out);
-  const int timeout_ms = reader_timeout_s() * 1000;
+  const int timeout_ms = (opening ? kOpenWait : kReadWait).seconds() * 1000;
   while (bytes) {
     pollfd pfd{sock_, POLLIN, 0};
     const int r = ::poll(&pfd, 1, timeout_ms);
     if (r < 0 && errno == EINTR) continue;
-    if (r == 0) reader_lost(what, true);
+    if (r == 0) reader_lost(what, true, opening);
     const ssize_t k = ::recv(sock_, p, bytes, 0);
     if (k < 0 && errno == EINTR) continue;
-    if (k <= 0) reader_lost(what, false);
+    if (k <= 0) reader_lost(what, false, opening);
     p += k, bytes -= static_cast<std::size_t>(k);
   }
 }

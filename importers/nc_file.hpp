@@ -56,7 +56,8 @@ void check_classic_header(const std::string& path, std::uint64_t file_bytes);
 // files). NcFile therefore reads every file that is not classic-format in a child process that
 // holds the netCDF handle and answers header and read requests over a socket: a crash or a hang
 // there becomes an ImportError naming the file and what was being read, never a crash of the
-// caller. Classic files, whose header NcFile checks itself first, are read in-process.
+// caller. Classic files, whose header NcFile checks itself first, are read in-process. The waits:
+// CLOUDVIEWER_OPEN_TIMEOUT_S (default 30 s) for the header, CLOUDVIEWER_READ_TIMEOUT_S (300 s) a read.
 class NcFile {
  public:
   explicit NcFile(const std::string& path);
@@ -102,8 +103,9 @@ class NcFile {
   void get_text(const NcVar& v, char* out, std::size_t n) const;
   // Sends a request and receives its status, or throws naming `what` when the reader died or hung.
   int ask_reader(const std::string& request, const std::string& what) const;
-  void receive(void* out, std::size_t bytes, const std::string& what) const;
-  [[noreturn]] void reader_lost(const std::string& what, bool timed_out) const;
+  // opening: the header, under the open wait (CLOUDVIEWER_OPEN_TIMEOUT_S), else a read's wait.
+  void receive(void* out, std::size_t bytes, const std::string& what, bool opening = false) const;
+  [[noreturn]] void reader_lost(const std::string& what, bool timed_out, bool opening = false) const;
   // An empty start means all zeros, an empty count the whole extent.
   void whole_if_empty(const NcVar& v, std::vector<std::size_t>& start, std::vector<std::size_t>& count) const;
   std::string path_;

@@ -6,7 +6,8 @@
 // up to 4 loaded): exit 0 imported, 2 refused with an InputError (counted apart when the refusal
 // says the HDF5 library crashed or hung in NcFile's reader process; a few of those inputs kept). Anything else is a finding:
 // another exception, a signal (a crash of our code; a crash of HDF5 must come back as an
-// ImportError from NcFile's reader process), or no end within the time limit (a hang). Findings
+// ImportError from NcFile's reader process), or no end within 150 s (a hang; the reader's own waits
+// are set to 30 s for the header and 60 s for a read unless the environment sets them). Findings
 // are kept under OUT_DIR with what happened.
 //   bench_flip_campaign OUT_DIR INPUTS SEED FILE.nc...
 #include <sys/wait.h>
@@ -60,6 +61,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: bench_flip_campaign OUT_DIR INPUTS SEED FILE.nc...\n");
     return argc >= 2 && std::string(argv[1]) == "--help" ? 0 : 2;
   }
+  ::setenv("CLOUDVIEWER_OPEN_TIMEOUT_S", "30", 0);
+  ::setenv("CLOUDVIEWER_READ_TIMEOUT_S", "60", 0);
   const fs::path out = argv[1];
   const long inputs = std::atol(argv[2]);
   std::mt19937_64 rng(std::strtoull(argv[3], nullptr, 10));
@@ -104,7 +107,7 @@ int main(int argc, char** argv) {
     std::fflush(nullptr);
     const pid_t pid = ::fork();
     if (pid == 0) {
-      ::alarm(120);  // a hang: SIGALRM
+      ::alarm(150);  // a hang: SIGALRM
       ::_exit(import_one(work.string()));
     }
     int status = 0;
@@ -121,7 +124,7 @@ int main(int argc, char** argv) {
       }
     } else {
       ++findings;
-      const std::string what = WIFSIGNALED(status) ? (WTERMSIG(status) == SIGALRM ? "hang (120 s)" : std::string("signal ") + strsignal(WTERMSIG(status)))
+      const std::string what = WIFSIGNALED(status) ? (WTERMSIG(status) == SIGALRM ? "hang (150 s)" : std::string("signal ") + strsignal(WTERMSIG(status)))
                                                    : "exit " + std::to_string(WEXITSTATUS(status));
       const fs::path keep = out / ("finding-" + std::to_string(i) + "-" + fs::path(files[which]).filename().string());
       fs::copy_file(work, keep, fs::copy_options::overwrite_existing);

@@ -356,6 +356,29 @@ TEST_F(HostileImport, ABitFlippedNetcdf4FileThatCrashesHdf5IsNamedNotACrash) {
   }
 }
 
+// HDF5 1.10.8 loops forever in nc_open (H5DSget_num_scales reading a global heap) on the shared
+// ERA5 file with one byte changed: found by bench_flip_campaign. The header's wait ends it with one
+// line naming the file, the wait and its setting, and the reader is killed.
+TEST_F(HostileImport, ANetcdf4FileThatHangsHdf5InOpenIsNamedAfterTheWait) {
+  REAL_FILE(real, "met-era5-cocip1.nc");
+  const std::string p = copy_of(real, "hang.nc");
+  {
+    std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(19631);
+    const char two = 2;
+    f.write(&two, 1);
+  }
+  ::setenv("CLOUDVIEWER_OPEN_TIMEOUT_S", "2", 1);
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string msg = import_error(p);
+  ::unsetenv("CLOUDVIEWER_OPEN_TIMEOUT_S");
+  EXPECT_NE(msg.find(p + ": the NetCDF-4/HDF5 library did not answer within 2 s while opening it; expected an intact NetCDF file "
+                         "(CLOUDVIEWER_OPEN_TIMEOUT_S sets the wait)"),
+            std::string::npos)
+      << msg;
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 30.0);
+}
+
 // The reader process's pid: the one child of this test process that appeared since `before`.
 std::vector<int> children() {
   std::vector<int> out;
