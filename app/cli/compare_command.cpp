@@ -1,11 +1,14 @@
 // `cloudviewer compare A B`: two sources side by side on their own grids and on an explicit common
 // grid (core/analysis/compare), with where cloud is in A only, B only or both and the B - A maps.
 #include <algorithm>
+#include <array>
+#include <utility>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 
 #include "analysis/compare.hpp"
@@ -13,9 +16,11 @@
 #include "analysis_common.hpp"
 #include "kernel/prepared_volume.hpp"
 #include "physics/physics.hpp"
+#include "plots/drape.hpp"
 #include "render/context.hpp"
 #include "render/frame_renderer.hpp"
 #include "render/image_output.hpp"
+#include "scene/framing.hpp"
 #include "scene/quality.hpp"
 
 namespace cv::cli {
@@ -23,7 +28,8 @@ namespace cv::cli {
 using namespace analysis;
 
 const char* compare_usage() {
-  return "  compare A B -o OUT.png [--times T | TA,TB] [--csv OUT.csv] [--render OUT3D.png [--render-size WxH]]\n"
+  return "  compare A B -o OUT.png [--times T | TA,TB] [--csv OUT.csv] [--render OUT3D.png] [--render-maps MAPS.png]\n"
+         "          [--render-size WxH]\n"
          "                           two sources side by side, each on its own grid (cloud cover, labelled with the source\n"
          "                           and valid time), and on a common grid, stated in the image and printed: the coarser\n"
          "                           spacing of the two on each axis over the region and altitudes both hold; there, the\n"
@@ -33,7 +39,9 @@ const char* compare_usage() {
          "                           presence, the maps and their differences; --render: the difference view rendered on\n"
          "                           the GPU, the clouds of the common grid lit by the sun at noon over the view, their\n"
          "                           light coloured orange where cloud is in A only, blue in B only and white in both\n"
-         "                           (the hue only: each keeps its own brightness), at --render-size (default 960x540)\n";
+         "                           (the hue only: each keeps its own brightness), at --render-size (default 960x540);\n"
+         "                           --render-maps: the four B - A maps draped on the globe as the same camera sees it,\n"
+         "                           each at half that size, with the diverging colour map and bars of -o's maps\n";
 }
 
 namespace {
@@ -46,18 +54,55 @@ void draw_map(Canvas& cv, const Area& a, const core::VolumeGrid& g, double lat_l
     const double lat = lat_hi - (y + 0.5) / a.h() * (lat_hi - lat_lo);
     for (int x = 0; x < a.w(); ++x) {
       const double lon = lon_lo + (x + 0.5) / a.w() * (lon_hi - lon_lo);
-      const double east = std::fmod(std::fmod(lon - g.lon_deg.start, 360.0) + 360.0, 360.0);
-      int i = static_cast<int>(std::lround(east / g.lon_deg.step));
-      if (g.wraps_lon()) i %= g.lon_deg.count;
-      const int j = static_cast<int>(std::lround((lat - g.lat_deg.start) / g.lat_deg.step));
-      if (i < 0 || i >= g.lon_deg.count || j < 0 || j >= g.lat_deg.count) {
-        cv.set(a.x0 + x, a.y0 + y, kNoData);
-        continue;
-      }
-      cv.set(a.x0 + x, a.y0 + y, colour(g.column(i, j)));
+      const std::optional<std::size_t> col = column_at(g, lat, lon);
+      cv.set(a.x0 + x, a.y0 + y, col ? colour(*col) : kNoData);
     }
   }
   cv.box(a.x0 - 1, a.y0 - 1, a.x1 + 1, a.y1 + 1, kInk);
+}
+
+// The B - A maps: each with its name, values and the scale shown; `range` is the largest magnitude
+// (1 when all are zero: a bar of +-1, the map all white), so 0 is white and the bar symmetric.
+struct Diff {
+  const char* name;
+  const std::vector<float>* d;
+  double scale;
+  double range = 1.0;
+};
+std::array<Diff, 4> difference_maps(const core::Comparison& cmp) {
+  std::array<Diff, 4> diffs = {Diff{"B-A cover", &cmp.d_cover, 1.0}, Diff{"B-A optical depth", &cmp.d_optical_depth, 1.0},
+                               Diff{"B-A base km", &cmp.d_base_m, 1e-3}, Diff{"B-A top km", &cmp.d_top_m, 1e-3}};
+  for (Diff& k : diffs) {
+    double most = 0.0;
+    for (float x : *k.d)
+      if (std::isfinite(x)) most = std::max(most, std::abs(double(x)) * k.scale);
+    k.range = most > 0.0 ? most : 1.0;
+  }
+  return diffs;
+}
+Rgb diff_colour(const Diff& k, std::size_t column) {
+  const float x = (*k.d)[column];
+  return std::isfinite(x) ? diverging_colour(0.5 + 0.5 * x * k.scale / k.range) : kNoData;
+}
+
+// The four maps draped on the globe as the difference view's camera (auto_camera over the common
+// grid at w x h) sees them, in a 2 x 2 grid, each with its title and colour bar.
+std::vector<unsigned char> draped_maps(const core::Comparison& cmp, int w, int h, int& out_w, int& out_h) {
+  const int right = 80, title = 24, pad = 10;
+  out_w = pad + 2 * (w + right);
+  out_h = pad + 2 * (h + title) + 20;
+  Canvas cv(out_w, out_h, kPaper);
+  const core::Camera cam = core::auto_camera(cmp.grid, w, h);
+  const std::array<Diff, 4> diffs = difference_maps(cmp);
+  for (int k = 0; k < 4; ++k) {
+    const int x0 = pad + (k % 2) * (w + right), y0 = title + (k / 2) * (h + title);
+    const Diff& d = diffs[static_cast<std::size_t>(k)];
+    drape_columns(cv, x0, y0, cam, cmp.grid, [&](std::size_t c) { return diff_colour(d, c); });
+    cv.text(x0, y0 - 8, 9, std::string(d.name) + " on the globe", kInk);
+    colour_bar(cv, x0 + w + 8, y0 + 12, x0 + w + 18, y0 + h - 1, -d.range, d.range, "", diverging_colour);
+  }
+  cv.text(pad, out_h - 8, 9, "light grey: no data, or no cloud in one of them", kInk);
+  return cv.rgb();
 }
 
 // The false colours of the rendered difference view (march.tint_liquid and tint_ice): their mean is
@@ -133,7 +178,7 @@ std::size_t resolve_in(const core::CloudVolume& vol, const std::string& file, co
 
 int cmd_compare(const std::vector<std::string>& args) {
   std::vector<std::string> files;
-  std::string out, csv, times, render_out;
+  std::string out, csv, times, render_out, maps_out;
   int render_w = 960, render_h = 540;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -144,6 +189,7 @@ int cmd_compare(const std::vector<std::string>& args) {
       else if (a == "--csv") csv = v;
       else if (a == "--times") times = v;
       else if (a == "--render") render_out = v;
+      else if (a == "--render-maps") maps_out = v;
       else if (a == "--render-size") {
         if (std::sscanf(v.c_str(), "%dx%d", &render_w, &render_h) != 2 || render_w < 16 || render_h < 16 || render_w > 8192 ||
             render_h > 8192 || v.find_first_not_of("0123456789x") != std::string::npos) {
@@ -158,13 +204,16 @@ int cmd_compare(const std::vector<std::string>& args) {
   if (files.size() != 2 || out.empty()) throw UsageError{"cloudviewer compare: expected two files A B and -o OUT.png"};
   check_outputs("compare", out, csv, files[0]);
   check_outputs("compare", out, csv, files[1]);
-  if (!render_out.empty()) {
+  for (const auto& [path, flag] : {std::pair{render_out, "--render"}, std::pair{maps_out, "--render-maps"}}) {
+    if (path.empty()) continue;
     for (const std::string& f : files) {
-      core::check_output_extension(render_out, "--render", {".png"});
-      core::check_output_path(render_out, "--render");
-      core::check_output_not_input(render_out, "--render", f, "an input");
+      core::check_output_extension(path, flag, {".png"});
+      core::check_output_path(path, flag);
+      core::check_output_not_input(path, flag, f, "an input");
     }
-    if (render_out == out) throw UsageError{"cloudviewer compare: --render: found '" + render_out + "', the same file as -o; expected another PNG"};
+    if (path == out || (path == maps_out && path == render_out)) {
+      throw UsageError{"cloudviewer compare: " + std::string(flag) + ": found '" + path + "', a file another output writes; expected its own PNG"};
+    }
   }
   core::CloudVolume va = load(files[0]), vb = load(files[1]);
   // The steps compared.
@@ -248,26 +297,14 @@ int cmd_compare(const std::vector<std::string>& args) {
   std::snprintf(gl, sizeof gl, "step %.3g deg %.3g deg %.0f m", common.lon_deg.step, common.lat_deg.step, common.alt_m.step);
   cv.text(la.x0, la.y0 + 104, 9, gl, kInk);
   cv.text(la.x0, la.y0 + 118, 9, "the coarser of A and B", kInk);
-  struct Diff {
-    const char* name;
-    const std::vector<float>* d;
-    double scale;
-  };
-  const Diff diffs[4] = {{"B-A cover", &cmp.d_cover, 1.0}, {"B-A optical depth", &cmp.d_optical_depth, 1.0},
-                         {"B-A base km", &cmp.d_base_m, 1e-3}, {"B-A top km", &cmp.d_top_m, 1e-3}};
+  const std::array<Diff, 4> diffs = difference_maps(cmp);
   for (int k = 0; k < 4; ++k) {
-    double most = 0.0;
-    for (float x : *diffs[k].d)
-      if (std::isfinite(x)) most = std::max(most, std::abs(double(x)) * diffs[k].scale);
-    const double r = most > 0.0 ? most : 1.0;  // all zero: a bar of +-1, the map all white
+    const Diff& d = diffs[static_cast<std::size_t>(k)];
     const Area a = area(k, 1);
     draw_map(cv, a, common, common.lat_deg.start, common.lat_deg.last(), common.lon_deg.start,
-             common.wraps_lon() ? common.lon_deg.start + 360.0 : common.lon_deg.last(), [&](std::size_t c) {
-               const float x = (*diffs[k].d)[c];
-               return std::isfinite(x) ? diverging_colour(0.5 + 0.5 * x * diffs[k].scale / r) : kNoData;
-             });
-    cv.text(a.x0, a.y0 - 8, 9, diffs[k].name, kInk);
-    colour_bar(cv, a.x1 + 8, a.y0 + 12, a.x1 + 18, a.y1, -r, r, "", diverging_colour);
+             common.wraps_lon() ? common.lon_deg.start + 360.0 : common.lon_deg.last(), [&](std::size_t c) { return diff_colour(d, c); });
+    cv.text(a.x0, a.y0 - 8, 9, d.name, kInk);
+    colour_bar(cv, a.x1 + 8, a.y0 + 12, a.x1 + 18, a.y1, -d.range, d.range, "", diverging_colour);
   }
   cv.text(left, height - 14, 9, "grey: no data or no cloud in one of them", kInk);
   core::OutputGroup group;
@@ -288,6 +325,11 @@ int cmd_compare(const std::vector<std::string>& args) {
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t_render).count());
     group.write(render_out, [&](std::FILE* f) { render::encode_png(f, render_w, h3, view); });
   }
+  if (!maps_out.empty()) {
+    int mw = 0, mh = 0;
+    const std::vector<unsigned char> maps = draped_maps(cmp, std::max(16, render_w / 2), std::max(16, render_h / 2), mw, mh);
+    group.write(maps_out, [&](std::FILE* f) { render::encode_png(f, mw, mh, maps); });
+  }
   if (!csv.empty()) {
     group.write(csv, [&](std::FILE* f) {
       put(f, "# A " + files[0] + " at " + va.times[sa].iso_utc + ", B " + files[1] + " at " + vb.times[sb].iso_utc + "; " + grid_line + "\n");
@@ -306,8 +348,8 @@ int cmd_compare(const std::vector<std::string>& args) {
     });
   }
   group.commit();
-  std::printf("wrote %s%s%s%s%s\n", out.c_str(), csv.empty() ? "" : " and ", csv.c_str(), render_out.empty() ? "" : " and ",
-              render_out.c_str());
+  std::printf("wrote %s%s%s%s%s%s%s\n", out.c_str(), csv.empty() ? "" : " and ", csv.c_str(), render_out.empty() ? "" : " and ",
+              render_out.c_str(), maps_out.empty() ? "" : " and ", maps_out.c_str());
   return 0;
 }
 

@@ -12,6 +12,8 @@
 #include <sys/wait.h>
 
 #include "importer.hpp"
+#include "plots/drape.hpp"
+#include "scene/framing.hpp"
 #include "viewer/plot_panels.hpp"
 
 namespace {
@@ -203,6 +205,45 @@ TEST(PlotPanels, TheCommandLineOpensThePanelsWithTheirInputs) {
     viewer::SeriesPanel q;
     EXPECT_NE(viewer::series_from_option(q, bad).find("--series: found"), std::string::npos) << bad;
   }
+}
+
+// A map draped on the globe (compare --render-maps): seen from the south, east is to the right, and
+// what lies outside the grid is the globe, not the map.
+TEST(Drape, FromTheSouthEastIsRightAndOnlyTheGridIsMapped) {
+  core::VolumeGrid g;
+  g.lon_deg = {0.0, 1.0, 21};
+  g.lat_deg = {40.0, 1.0, 11};
+  g.alt_m = {0.0, 1000.0, 3};
+  EXPECT_EQ(plots::column_at(g, 45.0, 12.4), g.column(12, 5));
+  EXPECT_EQ(plots::column_at(g, 45.0, 12.4 - 360.0), g.column(12, 5));  // longitude modulo 360
+  EXPECT_FALSE(plots::column_at(g, 45.0, 30.0));
+  EXPECT_FALSE(plots::column_at(g, 60.0, 10.0));
+  const plots::Rgb west{0, 0, 250}, east{250, 0, 0};
+  const core::Camera cam = core::auto_camera(g, 96, 54);
+  plots::Canvas c(96, 54, plots::kPaper);
+  plots::drape_columns(c, 0, 0, cam, g, [&](std::size_t col) { return col % 21 >= 10 ? east : west; });
+  int n_east = 0, n_west = 0, globe = 0;
+  for (int y = 0; y < 54; ++y) {
+    int last_west = -1, first_east = 1000;
+    for (int x = 0; x < 96; ++x) {
+      const plots::Rgb p = c.at(x, y);
+      if (p[0] > 0 && p[1] == 0 && p[2] == 0) {
+        first_east = std::min(first_east, x);
+        ++n_east;
+      } else if (p[2] > 0 && p[0] == 0 && p[1] == 0) {
+        last_west = std::max(last_west, x);
+        ++n_west;
+      } else if (p[1] > 0) {
+        ++globe;  // kGlobe, shaded
+      }
+    }
+    if (last_west >= 0 && first_east < 1000) {
+      EXPECT_LT(last_west, first_east) << "row " << y;
+    }
+  }
+  EXPECT_GT(n_east, 100);
+  EXPECT_GT(n_west, 100);
+  EXPECT_GT(globe, 0);
 }
 
 }  // namespace
