@@ -7,6 +7,9 @@
 #include <vector>
 
 #include "kernel/ms_source.hpp"
+#include "settings/march_settings.hpp"
+#include "support/bubble_scene.hpp"
+#include "volume/grid_mean.hpp"
 
 namespace cv::core {
 namespace {
@@ -94,4 +97,49 @@ TEST(TwoStream, NoNanOrInfAtExtremes) {
 }
 
 }  // namespace
+// A layer mask or a hidden phase leaves that cloud out of the two-stream source as the march leaves
+// it out of the medium: the source of the bubble under its ice with the ice hidden is the source of
+// the bubble alone, and with a band up to 7 km (sea level) the source of the medium cut there,
+// value for value at every node; the ice shown changes it.
+TEST(TwoStream, AHiddenLayerHoldsAndPassesNoDiffuseLight) {
+  const cv::test::BubbleScene with_ice(true), bubble(false);
+  const PreparedVolume whole = prepare_volume(with_ice.grid, with_ice.data);
+  MarchSettings s;
+  const glm::dvec3 to_sun = glm::normalize(glm::dvec3(1.3, 0.2, 1.0));  // high over (0, 0), whose up is +x
+  const MsSource shown = build_ms_source(whole, ms_source_key(s, to_sun));
+  const MsSource alone = build_ms_source(prepare_volume(bubble.grid, bubble.data), ms_source_key(s, to_sun));
+  double moved = 0.0;
+  for (std::size_t i = 0; i < alone.i0.size(); ++i) moved = std::max(moved, double(std::abs(shown.i0[i] - alone.i0[i])));
+  EXPECT_GT(moved, 1e-4) << "the ice above does shade the bubble when it is shown";
+
+  TimeStepData cut = with_ice.data;  // the medium below 7 km: what the band shows
+  for (int k = 0; k < with_ice.grid.alt_m.count; ++k) {
+    if (with_ice.grid.alt_m.at(k) < 7000.0) continue;
+    for (int j = 0; j < with_ice.grid.lat_deg.count; ++j)
+      for (int i = 0; i < with_ice.grid.lon_deg.count; ++i) {
+        cut[Field::ExtinctionLiquid][with_ice.grid.index(i, j, k)] = 0.0f;
+        cut[Field::ExtinctionIce][with_ice.grid.index(i, j, k)] = 0.0f;
+      }
+  }
+  const MsSource below_ref = build_ms_source(prepare_volume(with_ice.grid, cut), ms_source_key(s, to_sun));
+
+  MarchSettings no_ice = s;
+  no_ice.medium.hide_ice = true;
+  MarchSettings below = s;
+  below.medium.layer_sea_level = true;
+  below.medium.layer_bottom_m = 0.0;
+  below.medium.layer_top_m = 7000.0;
+  const std::pair<const MarchSettings*, const MsSource*> cases[] = {{&no_ice, &alone}, {&below, &below_ref}};
+  for (const auto& [m, ref] : cases) {
+    const MsSourceKey key = ms_source_key(*m, to_sun);
+    EXPECT_FALSE(key == ms_source_key(s, to_sun));  // a new mask builds a new source
+    const MsSource got = build_ms_source(whole, key);
+    ASSERT_EQ(got.i0.size(), ref->i0.size());
+    for (std::size_t i = 0; i < got.i0.size(); ++i) {
+      ASSERT_EQ(got.i0[i], ref->i0[i]) << i << (m == &no_ice ? " ice hidden" : " band");
+      ASSERT_EQ(got.i1[i], ref->i1[i]) << i << (m == &no_ice ? " ice hidden" : " band");
+    }
+  }
+}
+
 }  // namespace cv::core
