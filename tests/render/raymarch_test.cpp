@@ -46,6 +46,15 @@ core::Sun low_eastern_sun() {
   return sun;
 }
 
+// The march of the bubble tests: 200 m view steps, 16 sun steps, 4 octaves.
+core::MarchSettings bubble_march() {
+  core::MarchSettings s;
+  s.quality.view_step_m = 200.0;
+  s.quality.sun_steps = 16;
+  s.quality.octaves = 4;
+  return s;
+}
+
 TEST(Raymarch, GpuMatchesTheCpuReference) {
   BubbleOnGpu g;
   auto& [ctx, loader, gpu, sc, medium] = g;
@@ -320,10 +329,7 @@ TEST(Raymarch, LiquidPhaseChoiceMatchesTheReference) {
   auto& [ctx, loader, gpu, sc, medium] = g;
   const core::Camera cam = bubble_camera(32, 18);
   const core::Sun sun = low_eastern_sun();
-  core::MarchSettings s;
-  s.quality.view_step_m = 200.0;
-  s.quality.sun_steps = 16;
-  s.quality.octaves = 4;
+  core::MarchSettings s = bubble_march();
   const auto mie = core::render_reference(sc.grid, medium, cam, sun, s);
   s.medium.liquid_phase_hg = true;
   const auto cpu = core::render_reference(sc.grid, medium, cam, sun, s);
@@ -386,10 +392,7 @@ TEST(Raymarch, TintKeepsTheLuminanceAndTakesTheHueOnGpuAsOnCpu) {
   auto& [ctx, loader, gpu, sc, medium] = g;
   const core::Camera cam = bubble_camera(32, 18);
   const core::Sun sun = low_eastern_sun();
-  core::MarchSettings s;
-  s.quality.view_step_m = 200.0;
-  s.quality.sun_steps = 16;
-  s.quality.octaves = 4;
+  const core::MarchSettings s = bubble_march();
   ASSERT_FALSE(s.features.atmosphere);
   const auto grey = core::render_reference(sc.grid, medium, cam, sun, s);
   auto lum = [](const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; };
