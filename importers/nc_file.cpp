@@ -446,59 +446,55 @@ NcFile::NcFile(const std::string& path) : path_(path) {
   }
   file_bytes_ = static_cast<long long>(std::filesystem::file_size(path, ec));
   check_classic_header(path, static_cast<std::uint64_t>(std::max<long long>(file_bytes_, 0)));
-  Header h;
-  if (classic_magic(path)) {
-    const int st = nc_open(path.c_str(), NC_NOWRITE, &id_);
-    if (st != NC_NOERR) throw ImportError(open_error(path, st));
-    try {
+  // Whatever fails from here on releases what was opened: the netCDF handle, or the reader process.
+  try {
+    Header h;
+    if (classic_magic(path)) {
+      const int st = nc_open(path.c_str(), NC_NOWRITE, &id_);
+      if (st != NC_NOERR) {
+        id_ = -1;
+        throw ImportError(open_error(path, st));
+      }
       h = load_header(id_, path);
-    } catch (...) {
-      nc_close(id_);
-      id_ = -1;
-      throw;
+    } else {
+      isolated_ = true;
+      start_reader();
+      std::uint64_t n = 0;
+      receive(&n, sizeof n, "opening it", true);
+      if (n > (std::uint64_t(1) << 32)) throw std::runtime_error("NetCDF reader process: a header of " + std::to_string(n) + " bytes");
+      std::string m(n, '\0');
+      receive(m.data(), n, "opening it", true);
+      Unwire u{m};
+      if (u.get<std::uint64_t>() != 0) throw ImportError(u.str());
+      h = u.header();
     }
-  } else {
-    isolated_ = true;
-    start_reader();
-    std::uint64_t n = 0;
-    receive(&n, sizeof n, "opening it", true);
-    if (n > (std::uint64_t(1) << 32)) throw std::runtime_error("NetCDF reader process: a header of " + std::to_string(n) + " bytes");
-    std::string m(n, '\0');
-    receive(m.data(), n, "opening it", true);
-    Unwire u{m};
-    if (u.get<std::uint64_t>() != 0) {
-      const std::string why = u.str();
-      ::close(sock_);
-      sock_ = -1;
-      ::waitpid(reader_pid_, nullptr, 0);
-      reader_pid_ = -1;
-      throw ImportError(why);
+    compressed_format_ = h.format == NC_FORMAT_NETCDF4 || h.format == NC_FORMAT_NETCDF4_CLASSIC;
+    dims_ = std::move(h.dims);
+    vars_ = std::move(h.vars);
+    global_atts_ = std::move(h.global_atts);
+    for (const auto& v : vars_) {
+      for (int d : v.dims) {
+        if (d < 0 || static_cast<std::size_t>(d) >= dims_.size()) throw ImportError(path + ": variable '" + v.name + "' has a bad dimension id");
+      }
     }
-    h = u.header();
-  }
-  compressed_format_ = h.format == NC_FORMAT_NETCDF4 || h.format == NC_FORMAT_NETCDF4_CLASSIC;
-  dims_ = std::move(h.dims);
-  vars_ = std::move(h.vars);
-  global_atts_ = std::move(h.global_atts);
-  for (const auto& v : vars_) {
-    for (int d : v.dims) {
-      if (d < 0 || static_cast<std::size_t>(d) >= dims_.size()) throw ImportError(path + ": variable '" + v.name + "' has a bad dimension id");
+    // A classic-format file stores every value uncompressed: if its variables need more bytes than
+    // the file has, it was cut short (netCDF would read the missing part as zeros).
+    if (!compressed_format_) {
+      long double need = 0;
+      for (const auto& v : vars_) need += static_cast<long double>(size(v)) * type_bytes(v.type);
+      if (need > static_cast<long double>(file_bytes_)) {
+        // Beyond 2^63 the count is no integer type's (a declared record count of 2^62 gets here):
+        // written as a float.
+        char needed[32];
+        if (need < 9.0e18L) std::snprintf(needed, sizeof needed, "%lld", static_cast<long long>(need));
+        else std::snprintf(needed, sizeof needed, "%.3Lg", need);
+        throw ImportError(path + ": its variables need " + needed + " bytes but the file has " +
+                          std::to_string(file_bytes_) + " (truncated); expected a complete file");
+      }
     }
-  }
-  // A classic-format file stores every value uncompressed: if its variables need more bytes than
-  // the file has, it was cut short (netCDF would read the missing part as zeros).
-  if (!compressed_format_) {
-    long double need = 0;
-    for (const auto& v : vars_) need += static_cast<long double>(size(v)) * type_bytes(v.type);
-    if (need > static_cast<long double>(file_bytes_)) {
-      // Beyond 2^63 the count is no integer type's (a declared record count of 2^62 gets here):
-      // written as a float.
-      char needed[32];
-      if (need < 9.0e18L) std::snprintf(needed, sizeof needed, "%lld", static_cast<long long>(need));
-      else std::snprintf(needed, sizeof needed, "%.3Lg", need);
-      throw ImportError(path + ": its variables need " + needed + " bytes but the file has " +
-                        std::to_string(file_bytes_) + " (truncated); expected a complete file");
-    }
+  } catch (...) {
+    release();
+    throw;
   }
 }
 
@@ -597,14 +593,19 @@ void NcFile::get_text(const NcVar& v, char* out, std::size_t n) const {
   receive(out, n, "reading variable '" + v.name + "'");
 }
 
-NcFile::~NcFile() {
+NcFile::~NcFile() { release(); }
+
+void NcFile::release() noexcept {
   if (id_ >= 0) nc_close(id_);
+  id_ = -1;
   if (reader_pid_ > 0) {
-    ::close(sock_);
+    if (sock_ >= 0) ::close(sock_);
     ::kill(reader_pid_, SIGKILL);  // it holds nothing to save
     while (::waitpid(reader_pid_, nullptr, 0) < 0 && errno == EINTR) {
     }
   }
+  sock_ = -1;
+  reader_pid_ = -1;
 }
 
 const NcVar* NcFile::find(const std::string& name) const {

@@ -97,6 +97,7 @@ class NcFile {
  private:
   [[noreturn]] void fail(int status, const std::string& what) const;
   void start_reader();  // forks the reader process and takes the header from it
+  void release() noexcept;  // closes the netCDF handle, or stops and reaps the reader
   // nc_get_vara_double / nc_get_var_text, in-process or through the reader.
   void get_doubles(const NcVar& v, const std::vector<std::size_t>& start, const std::vector<std::size_t>& count,
                    double* out, std::size_t n) const;
