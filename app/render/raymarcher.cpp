@@ -140,6 +140,7 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
   glTextureStorage2D(column_tau_, 1, GL_RG32F, columns.nx, columns.ny);
   glTextureSubImage2D(column_tau_, 0, 0, 0, columns.nx, columns.ny, GL_RG, GL_FLOAT, volume->column_maps.data());
   check_gl("uploading the column optical depths");
+  column_mask_ = core::MediumMask{};
   // The two-stream source belongs to a time step: built again, at this size, when a march needs it.
   if (ms_[0]) glDeleteTextures(2, ms_);
   ms_[0] = ms_[1] = 0;
@@ -186,6 +187,13 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
   params.u_has_depth = opaque.depth != 0;
   params.u_has_opaque_color = opaque.depth != 0 && opaque.color != 0;
   params.u_tl_count = opaque.layer_distance != 0 && opaque.layer_color != 0 ? opaque.layers : 0;
+  // The octave gate's column depths of what the march shows: made again when the mask changes.
+  if (const core::MediumMask hidden = core::medium_mask(s); !(hidden == column_mask_)) {
+    const std::vector<float> maps = core::column_maps_for(v, hidden);
+    glTextureSubImage2D(column_tau_, 0, 0, 0, v.columns.nx, v.columns.ny, GL_RG, GL_FLOAT, maps.data());
+    check_gl("uploading the masked column optical depths");
+    column_mask_ = hidden;
+  }
   if (s.medium.ms_two_stream) {  // the two-stream source, for this time step and sun
     const core::MsSourceKey key = core::ms_source_key(s, params.u_to_sun);
     if (!ms_[0] || ms_volume_ != &v || !(key == ms_key_)) {

@@ -182,6 +182,7 @@ class GpuRaymarcher {
   const core::PreparedVolume* ms_volume_ = nullptr;
   double ms_build_ms_ = 0.0;
   GLuint column_tau_ = 0;           // vertical optical depth per column (R32F), for the octave gate
+  core::MediumMask column_mask_;    // the mask column_tau_'s depths were made for (none: the prepared map)
   GLuint jitter_mask_ = 0;          // the blue-noise mask (R32F), uploaded at construction
   GLuint ground_ = 0;               // land albedo and water fraction (RGBA32F), loaded from ground_path_
   // The march's state between dispatches (image-sized, two RGBA32F) and the cloud depth it writes (R32F).

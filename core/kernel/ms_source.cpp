@@ -65,14 +65,7 @@ MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun) {
   k.liquid_g = physics::f64::mie_mean_cosine(mie);  // HG for liquid has the same mean cosine
   k.ice_g = s.medium.ice_g;
   k.ground_albedo = s.features.globe ? (s.medium.ground_albedo.x + s.medium.ground_albedo.y + s.medium.ground_albedo.z) / 3.0 : 0.0;
-  k.hide_liquid = s.medium.hide_liquid;
-  k.hide_ice = s.medium.hide_ice;
-  k.band = layer_band_set(s);
-  if (k.band) {
-    k.sea_level = s.medium.layer_sea_level;
-    k.band_bottom_m = s.medium.layer_bottom_m;
-    k.band_top_m = s.medium.layer_top_m;
-  }
+  k.mask = medium_mask(s);
   return k;
 }
 
@@ -96,10 +89,9 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
       const double ground = 2 * col + 1 < v.column_maps.size() ? double(v.column_maps[2 * col + 1]) : 0.0;
       for (int k = 0; k < nz; ++k) {
         const std::size_t idx = grid.index(i, j, k);
-        const double h = key.sea_level ? grid.alt_m.at(k) : grid.alt_m.at(k) - ground;
-        const bool shown = !key.band || (h >= key.band_bottom_m && h < key.band_top_m);
-        const double sl = shown && !key.hide_liquid ? std::max(0.0, double(v.extinction.liquid_per_m[idx])) : 0.0;
-        const double si = shown && !key.hide_ice ? std::max(0.0, double(v.extinction.ice_per_m[idx])) : 0.0;
+        const bool shown = key.mask.shown(grid.alt_m.at(k), ground);
+        const double sl = shown && !key.mask.hide_liquid ? std::max(0.0, double(v.extinction.liquid_per_m[idx])) : 0.0;
+        const double si = shown && !key.mask.hide_ice ? std::max(0.0, double(v.extinction.ice_per_m[idx])) : 0.0;
         sigma[static_cast<std::size_t>(k)] = sl + si;
         g[static_cast<std::size_t>(k)] = sl + si > 0.0 ? (sl * key.liquid_g + si * key.ice_g) / (sl + si) : 0.0;
         any = any || sl + si > 0.0;

@@ -41,11 +41,9 @@ struct MsSource {
 struct MsSourceKey {
   glm::dvec3 to_sun{0.0};
   double liquid_g = 0.0, ice_g = 0.0, ground_albedo = 0.0;
-  // The layer mask and the hidden phases (march_settings.def layer_*, hide_*): cloud the march leaves
-  // out (medium_in) holds and passes no diffuse light either, so a hidden layer does not shade the
-  // layer shown. The band's heights are above each column's ground, or above sea level.
-  bool hide_liquid = false, hide_ice = false, band = false, sea_level = false;
-  double band_bottom_m = 0.0, band_top_m = 0.0;
+  // The layer mask and the hidden phases: cloud the march leaves out (medium_in) holds and passes
+  // no diffuse light either, so a hidden layer does not shade the layer shown.
+  MediumMask mask;
   bool operator==(const MsSourceKey&) const = default;
 };
 

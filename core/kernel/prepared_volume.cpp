@@ -104,4 +104,41 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
   return p;
 }
 
+MediumMask medium_mask(const MarchSettings& s) {
+  MediumMask m;
+  m.hide_liquid = s.medium.hide_liquid;
+  m.hide_ice = s.medium.hide_ice;
+  m.band = layer_band_set(s);
+  if (m.band) {
+    m.sea_level = s.medium.layer_sea_level;
+    m.bottom_m = s.medium.layer_bottom_m;
+    m.top_m = s.medium.layer_top_m;
+  }
+  return m;
+}
+
+std::vector<float> column_maps_for(const PreparedVolume& v, const MediumMask& mask) {
+  if (!mask.any()) return v.column_maps;
+  std::vector<float> out = v.column_maps;
+  const VolumeGrid& g = v.grid;
+  const int nz = g.alt_m.count;
+  const std::vector<float>& liquid = v.extinction.liquid_per_m;
+  const std::vector<float>& ice = v.extinction.ice_per_m;
+  for (int y = 0; y < g.lat_deg.count; ++y) {
+    for (int x = 0; x < g.lon_deg.count; ++x) {
+      const std::size_t c = g.column(x, y);
+      const double ground = out[2 * c + 1];
+      double sum = 0.0;  // column_depth's trapezoid, in the same order
+      for (int k = 0; k < nz; ++k) {
+        const std::size_t i = g.index(x, y, k);
+        if (!mask.shown(g.alt_m.at(k), ground)) continue;
+        const double s = (liquid.empty() || mask.hide_liquid ? 0.0 : double(liquid[i])) + (ice.empty() || mask.hide_ice ? 0.0 : double(ice[i]));
+        sum += k == 0 || k == nz - 1 ? 0.5 * s : s;
+      }
+      out[2 * c] = nz > 1 ? static_cast<float>(sum * g.alt_m.step) : 0.0f;
+    }
+  }
+  return out;
+}
+
 }  // namespace cv::core

@@ -39,6 +39,27 @@ inline PreparedVolume prepare_volume(const VolumeGrid& grid, const TimeStepData&
   return prepare_volume(grid, grid_mean_extinction(grid, data));
 }
 
+// What of the medium a march leaves out (march_settings.def: the layer band, hide_liquid, hide_ice),
+// for what is derived from the whole medium outside the march: the two-stream source and the octave
+// gate's column optical depths are made without the hidden cloud, as the march samples it.
+struct MediumMask {
+  bool hide_liquid = false, hide_ice = false, band = false, sea_level = false;
+  double bottom_m = 0.0, top_m = 0.0;  // the band's heights above the ground (or sea level)
+  bool any() const { return hide_liquid || hide_ice || band; }
+  // Whether a node at alt_m over ground at ground_m is in the band shown (the kernel's layer_shown).
+  bool shown(double alt_m, double ground_m) const {
+    const double h = sea_level ? alt_m : alt_m - ground_m;
+    return !band || (h >= bottom_m && h < top_m);
+  }
+  bool operator==(const MediumMask&) const = default;
+};
+MediumMask medium_mask(const MarchSettings& s);
+
+// The two-channel column map (optical depth, ground) the kernel reads as u_column_tau for a mask:
+// the prepared one's ground, and the trapezoid over levels of what the mask shows (column_depth's
+// rule, a hidden node counting 0). Without a mask, the prepared map itself.
+std::vector<float> column_maps_for(const PreparedVolume& v, const MediumMask& mask);
+
 // The march kernel's parameters for one frame: the camera (pixels of cam.width x cam.height), the
 // sun, the settings, and the ground texture's size ((0, 0): the constant albedo).
 kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, const Sun& sun, const MarchSettings& s,

@@ -34,7 +34,10 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   const glm::ivec3 n(g.lon_deg.count, g.lat_deg.count, g.alt_m.count);
   k.u_liquid = {v.extinction.liquid_per_m.data(), n};
   k.u_ice = {v.extinction.ice_per_m.data(), n};
-  k.u_column_tau = {v.column_maps.data(), {v.columns.nx, v.columns.ny}, 2};
+  // The octave gate's column depths of what the march shows (the prepared map when nothing is hidden).
+  const MediumMask hidden = medium_mask(s);
+  const std::vector<float> masked_columns = hidden.any() ? column_maps_for(v, hidden) : std::vector<float>{};
+  k.u_column_tau = {(hidden.any() ? masked_columns : v.column_maps).data(), {v.columns.nx, v.columns.ny}, 2};
   MsSource ms;  // the two-stream source, built as the GPU's (core/kernel/ms_source)
   if (s.medium.ms_two_stream) {
     ms = build_ms_source(v, ms_source_key(s, k.u_to_sun));

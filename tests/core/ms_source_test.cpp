@@ -142,4 +142,30 @@ TEST(TwoStream, AHiddenLayerHoldsAndPassesNoDiffuseLight) {
   }
 }
 
+// The octave gate's column depths (u_column_tau) with a mask are those of the medium the march
+// shows: the ice hidden, the bubble alone's map; a band up to 7 km, the map of the medium cut there,
+// bit for bit; no mask, the prepared map itself.
+TEST(MediumMask, TheColumnDepthsAreThoseOfWhatIsShown) {
+  const cv::test::BubbleScene with_ice(true), bubble(false);
+  const PreparedVolume whole = prepare_volume(with_ice.grid, with_ice.data);
+  MarchSettings s;
+  EXPECT_FALSE(medium_mask(s).any());
+  EXPECT_EQ(column_maps_for(whole, medium_mask(s)), whole.column_maps);
+  MarchSettings no_ice = s;
+  no_ice.medium.hide_ice = true;
+  EXPECT_EQ(column_maps_for(whole, medium_mask(no_ice)), prepare_volume(bubble.grid, bubble.data).column_maps);
+  TimeStepData cut = with_ice.data;
+  for (std::size_t i = 0; i < with_ice.grid.points(); ++i) {
+    const int k = static_cast<int>(i / with_ice.grid.columns());
+    if (with_ice.grid.alt_m.at(k) >= 7000.0) cut[Field::ExtinctionLiquid][i] = cut[Field::ExtinctionIce][i] = 0.0f;
+  }
+  MarchSettings below = s;
+  below.medium.layer_sea_level = true;
+  below.medium.layer_bottom_m = 0.0;
+  below.medium.layer_top_m = 7000.0;
+  const std::vector<float> masked = column_maps_for(whole, medium_mask(below));
+  EXPECT_EQ(masked, prepare_volume(with_ice.grid, cut).column_maps);
+  EXPECT_NE(masked, whole.column_maps);  // the ice's depth is gone from every column
+}
+
 }  // namespace cv::core

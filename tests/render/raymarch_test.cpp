@@ -381,6 +381,22 @@ TEST(Raymarch, LayerMasksMatchTheReference) {
   band.medium.layer_bottom_m = 2000.0;
   band.medium.layer_top_m = 6000.0;
   check(band, "band 2-6 km");
+  // The octave gate reads the column depth of what is shown (the GPU uploads the masked map as the
+  // CPU kernel reads it): the thin ice alone, its octaves weighted by its own depth, not the bubble's.
+  core::MarchSettings gated = bubble_march();
+  gated.features.octave_gate = true;
+  gated.medium.hide_liquid = true;
+  const auto cpu = core::render_reference(sc.grid, medium, cam, sun, gated);
+  const auto img = gpu.render(cam, sun, gated);
+  double worst = 0.0, lit = 0.0;
+  for (std::size_t i = 0; i < img.size(); ++i) {
+    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(img[i][c] - cpu.radiance[i][c]) / max_l);
+    lit = std::max(lit, cpu.radiance[i].x / max_l);
+  }
+  std::printf("liquid hidden, octave gate: GPU vs CPU worst %.3g of the whole cloud's brightest pixel (the ice's brightest %.3g)\n", worst,
+              lit);
+  EXPECT_GT(lit, 1e-3);  // the ice is seen
+  EXPECT_LT(worst, 1e-4);
 }
 
 // False colour (march.tint_liquid / tint_ice, `compare --render`): each sample's light takes the hue
