@@ -361,12 +361,26 @@ bool send_message(int fd, const std::string& m) {
   return send_all(fd, &n, sizeof n) && send_all(fd, m.data(), m.size());
 }
 
+// Seconds the reader may take to open the file and send its header, and to answer one read, before
+// it is taken for hung (HDF5 1.10.8 loops forever in nc_open on some corrupt files: one changed byte
+// of the shared ERA5 file does it). A header takes well under a second even for thousands of
+// variables; a read is one slab of a variable.
+struct Wait {
+  const char* env;
+  int default_s;
+  int seconds() const {
+    if (const char* v = std::getenv(env); v && std::atoi(v) > 0) return std::atoi(v);
+    return default_s;
+  }
+};
+constexpr Wait kOpenWait{"CLOUDVIEWER_OPEN_TIMEOUT_S", 30}, kReadWait{"CLOUDVIEWER_READ_TIMEOUT_S", 300};
+
 // The reader process: opens the file, sends its header (or the error), then answers reads until
 // the socket closes. It never returns; _exit keeps the parent's buffers and exit handlers out.
 [[noreturn]] void reader_main(int fd, const std::string& path) {
   // Default actions: not the parent's temporary-file cleanup, and not a sanitizer's or a fuzzer's
   // crash report for what the parent turns into an ImportError.
-  for (int sig : {SIGTERM, SIGINT, SIGHUP, SIGQUIT, SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT}) std::signal(sig, SIG_DFL);
+  for (int sig : {SIGTERM, SIGINT, SIGHUP, SIGQUIT, SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT, SIGALRM}) std::signal(sig, SIG_DFL);
   // Only its own socket stays open: a copy of another reader's socket held here would keep that
   // reader from seeing its end. When the parent dies, its end closes and the reader's next receive
   // ends it (no PR_SET_PDEATHSIG: that follows the forking thread, not the process).
@@ -378,6 +392,10 @@ bool send_message(int fd, const std::string& m) {
   {
     Wire w;
     try {
+      // Each netCDF call runs under an alarm a little past the parent's wait: when HDF5 loops for
+      // ever, SIGALRM ends the reader even if the parent is gone (killed, or interrupted) and so
+      // cannot kill it, instead of a process spinning on alone.
+      ::alarm(static_cast<unsigned>(kOpenWait.seconds() + 5));
       const int st = nc_open(path.c_str(), NC_NOWRITE, &id);
       if (st != NC_NOERR) throw ImportError(open_error(path, st));
       w.u64(0);
@@ -387,6 +405,7 @@ bool send_message(int fd, const std::string& m) {
       w.u64(1);
       w.str(e.what());
     }
+    ::alarm(0);
     if (!send_message(fd, w.b)) ::_exit(0);
   }
   std::vector<char> buf;
@@ -403,28 +422,17 @@ bool send_message(int fd, const std::string& m) {
     }
     const std::size_t bytes = op == 1 ? n * sizeof(double) : n;
     buf.resize(bytes);
+    ::alarm(static_cast<unsigned>(kReadWait.seconds() + 5));
     std::int64_t st = op == 1 ? nc_get_vara_double(id, static_cast<int>(varid), start.data(), count.data(),
                                                    reinterpret_cast<double*>(buf.data()))
                               : nc_get_var_text(id, static_cast<int>(varid), buf.data());
+    ::alarm(0);
     if (!send_all(fd, &st, sizeof st)) break;
     if (st == NC_NOERR && !send_all(fd, buf.data(), bytes)) break;
   }
   ::_exit(0);
 }
 
-// Seconds the reader may take to open the file and send its header, and to answer one read, before
-// it is taken for hung (HDF5 1.10.8 loops forever in nc_open on some corrupt files: one changed byte
-// of the shared ERA5 file does it). A header takes well under a second even for thousands of
-// variables; a read is one slab of a variable.
-struct Wait {
-  const char* env;
-  int default_s;
-  int seconds() const {
-    if (const char* v = std::getenv(env); v && std::atoi(v) > 0) return std::atoi(v);
-    return default_s;
-  }
-};
-constexpr Wait kOpenWait{"CLOUDVIEWER_OPEN_TIMEOUT_S", 30}, kReadWait{"CLOUDVIEWER_READ_TIMEOUT_S", 300};
 
 bool classic_magic(const std::string& path) {
   unsigned char m[4] = {0, 0, 0, 0};

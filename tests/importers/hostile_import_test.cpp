@@ -379,6 +379,61 @@ TEST_F(HostileImport, ANetcdf4FileThatHangsHdf5InOpenIsNamedAfterTheWait) {
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 30.0);
 }
 
+// A process's state letter from /proc (R, S, Z, ...), or 0 when it is gone.
+char process_state(int pid) {
+  std::ifstream f("/proc/" + std::to_string(pid) + "/stat");
+  std::string stat;
+  if (!std::getline(f, stat)) return 0;
+  const std::size_t close = stat.rfind(')');
+  return close != std::string::npos && close + 2 < stat.size() ? stat[close + 2] : 0;
+}
+
+// When the process that opened a file is killed while HDF5 loops in its reader (a user's Ctrl-C,
+// a batch job's kill), nothing is left to kill the reader: its own alarm, a little past the wait,
+// ends it instead of a process spinning on alone.
+TEST_F(HostileImport, AReaderLeftAloneInAnHdf5LoopEndsOnItsOwn) {
+  REAL_FILE(real, "met-era5-cocip1.nc");
+  const std::string p = copy_of(real, "orphan.nc");
+  {
+    std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(19631);
+    const char two = 2;
+    f.write(&two, 1);
+  }
+  // The opener's wait, 3 s, and so the reader's alarm, 3 + 5 s; the opener is killed well before.
+  const pid_t opener = ::fork();
+  if (opener == 0) {
+    ::setenv("CLOUDVIEWER_OPEN_TIMEOUT_S", "3", 1);
+    try {
+      importers::NcFile f(p);
+    } catch (...) {
+    }
+    ::_exit(0);
+  }
+  ASSERT_GT(opener, 0);
+  int reader = -1;
+  for (int i = 0; i < 100 && reader < 0; ++i) {  // the opener's child: its reader
+    std::ifstream kids("/proc/" + std::to_string(opener) + "/task/" + std::to_string(opener) + "/children");
+    if (!(kids >> reader)) reader = -1;
+    if (reader < 0) ::usleep(50000);
+  }
+  ASSERT_GT(reader, 0) << "the opener started no reader";
+  ::usleep(500000);
+  EXPECT_EQ(process_state(reader), 'R') << "HDF5 spins in nc_open on this file";
+  ::kill(opener, SIGKILL);
+  ::waitpid(opener, nullptr, 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  char state = process_state(reader);
+  while (state != 0 && state != 'Z' && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60)) {
+    ::usleep(100000);
+    state = process_state(reader);
+  }
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_TRUE(state == 0 || state == 'Z') << "the reader still runs after " << waited << " s (state " << state << ")";
+  EXPECT_LT(waited, 30.0);
+  if (state != 0 && state != 'Z') ::kill(reader, SIGKILL);  // not left spinning when this fails
+}
+
 // The reader process's pid: the one child of this test process that appeared since `before`.
 std::vector<int> children() {
   std::vector<int> out;
