@@ -42,6 +42,16 @@ class HostileImport : public ::testing::Test {
     fs::permissions(dst, fs::perms::owner_read | fs::perms::owner_write);
     return dst;
   }
+  // Flips the bits of `mask` in the byte at `offset` of the file.
+  static void xor_byte(const std::string& path, std::streamoff offset, unsigned char mask) {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(offset);
+    char c = 0;
+    f.read(&c, 1);
+    c = static_cast<char>(c ^ mask);
+    f.seekp(offset);
+    f.write(&c, 1);
+  }
   // The ImportError's message of importing `path` (fails the test when it imports).
   static std::string import_error(const std::string& path, const importers::ImportOptions& o = {}) {
     try {
@@ -339,15 +349,7 @@ TEST_F(HostileImport, ABitFlippedNetcdf4FileThatCrashesHdf5IsNamedNotACrash) {
   } flips[] = {{86262, 0x02}, {119010, 0x08}};
   for (const auto& flip : flips) {
     const std::string p = copy_of(real, "flip" + std::to_string(flip.offset) + ".nc");
-    {
-      std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
-      f.seekg(flip.offset);
-      char c = 0;
-      f.read(&c, 1);
-      c = static_cast<char>(c ^ flip.mask);
-      f.seekp(flip.offset);
-      f.write(&c, 1);
-    }
+    xor_byte(p, flip.offset, flip.mask);
     const std::string msg = import_error(p);
     // A segmentation fault in this build; under the sanitizers' allocator it may be an abort.
     EXPECT_NE(msg.find(p + ": the NetCDF-4/HDF5 library crashed ("), std::string::npos) << msg;
@@ -362,12 +364,7 @@ TEST_F(HostileImport, ABitFlippedNetcdf4FileThatCrashesHdf5IsNamedNotACrash) {
 TEST_F(HostileImport, ANetcdf4FileThatHangsHdf5InOpenIsNamedAfterTheWait) {
   REAL_FILE(real, "met-era5-cocip1.nc");
   const std::string p = copy_of(real, "hang.nc");
-  {
-    std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
-    f.seekp(19631);
-    const char two = 2;
-    f.write(&two, 1);
-  }
+  xor_byte(p, 19631, 0x02);  // 0 -> 2
   ::setenv("CLOUDVIEWER_OPEN_TIMEOUT_S", "2", 1);
   const auto t0 = std::chrono::steady_clock::now();
   const std::string msg = import_error(p);
@@ -394,12 +391,7 @@ char process_state(int pid) {
 TEST_F(HostileImport, AReaderLeftAloneInAnHdf5LoopEndsOnItsOwn) {
   REAL_FILE(real, "met-era5-cocip1.nc");
   const std::string p = copy_of(real, "orphan.nc");
-  {
-    std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
-    f.seekp(19631);
-    const char two = 2;
-    f.write(&two, 1);
-  }
+  xor_byte(p, 19631, 0x02);  // 0 -> 2
   // The opener's wait, 3 s, and so the reader's alarm, 3 + 5 s; the opener is killed well before.
   const pid_t opener = ::fork();
   if (opener == 0) {
