@@ -1,6 +1,7 @@
 // Hostile files and unsafe writes (issue 13): FIFOs, devices, deep and huge JSON, corrupt .cvvol
 // headers, planted symbolic links, failures and signals in the middle of a write. Every file is
 // written by the test itself.
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
@@ -30,8 +31,11 @@ namespace fs = std::filesystem;
 class HostileInput : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("cv_hostile_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    // A parameterised test's name holds a '/' ("Name/0"): one folder, not a folder left behind
+    // around the one removed.
+    std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    std::replace(name.begin(), name.end(), '/', '_');
+    dir_ = fs::temp_directory_path() / ("cv_hostile_" + std::to_string(::getpid()) + "_" + name);
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
