@@ -145,8 +145,10 @@ CV_FN void medium_in(real3 p, real3 g, real alt_m, CV_OUT(real) sl, CV_OUT(real)
   real3 f;
   if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
   if (!layer_shown(f, alt_m)) return;
-  sl = u_hide_liquid ? real(0.0) : fetch(u_liquid, f);
-  si = u_hide_ice ? real(0.0) : fetch(u_ice, f);
+  // Hidden phases as factors, not branches: the GLSL compiler puts a fetch under `hide ? 0 :
+  // fetch` in a branch of its own, which llvmpipe runs under a mask at every view and sun sample.
+  sl = fetch(u_liquid, f) * (u_hide_liquid ? real(0.0) : real(1.0));
+  si = fetch(u_ice, f) * (u_hide_ice ? real(0.0) : real(1.0));
   if (kNoise && sl + si > real(0.0)) erode_at(p, sl, si);
 }
 
@@ -268,6 +270,12 @@ struct MarchState {
   bool ended;
   int next_step;
   real t_half;  // distance from the camera where the view transmittance fell to 0.5 (3e38: never)
+  // The step where it fell, until march_advance ends (march_half_settle): its view transmittance
+  // before, its extinction (0: none pending) and its length. The logarithm is taken once per ray,
+  // not under a mask at every sample.
+  real half_before;
+  real half_sigma;
+  real half_ds;
   int tl_next;  // the next translucent fragment to composite (kTranslucent)
   // Where the first step holding cloud began, from the camera (3e38: none). Read by the CPU's
   // probes (core/analysis); the GPU driver keeps no copy of it between its dispatches.
@@ -347,7 +355,12 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
   s.depth_t += taken * t;
   real t_before = s.t_view;
   s.t_view *= transmittance(sigma * ds);
-  if (t_before > real(0.5) && !(s.t_view > real(0.5))) s.t_half = t_entry + min(log(real(2.0) * t_before) / sigma, ds);
+  if (t_before > real(0.5) && !(s.t_view > real(0.5))) {
+    s.t_half = t_entry;
+    s.half_before = t_before;
+    s.half_sigma = sigma;
+    s.half_ds = ds;
+  }
 }
 
 // Where in its step a pixel's view samples lie (0..1): step middles without a frame, else the
@@ -449,9 +462,21 @@ CV_FN MarchState march_start() {
   s.ended = false;
   s.next_step = 0;
   s.t_half = real(3.0e38);
+  s.half_before = real(1.0);
+  s.half_sigma = real(0.0);
+  s.half_ds = real(0.0);
   s.tl_next = 0;
   s.t_first = real(3.0e38);
   return s;
+}
+
+// Where in the step recorded by march_sample the view transmittance fell to 0.5 (exactly, for the
+// step's constant extinction): t_half becomes the distance from the camera.
+CV_FN void march_half_settle(CV_INOUT(MarchState) s) {
+  if (s.half_sigma > real(0.0)) {
+    s.t_half += min(log(real(2.0) * s.half_before) / s.half_sigma, s.half_ds);
+    s.half_sigma = real(0.0);
+  }
 }
 
 // Advances the view march of ray r (pixel px) over the view steps [step_begin, step_begin +
@@ -542,6 +567,7 @@ CV_FN void march_advance(MarchRay r, ivec2 px, int step_begin, int step_count, C
     }
   }
   if (step_begin == 0) g_stats[CV_STAT_RAYS_MISSED] += crossed ? 0u : 1u;
+  march_half_settle(s);
   s.ended = !(s.t_view > u_min_t) || s.ended || range_end >= base;
   s.next_step = next_step;
 }

@@ -53,6 +53,9 @@ void main() {
   s.depth_w = state_depth.x;
   s.depth_t = state_depth.y;
   s.t_half = state_depth.z;
+  s.half_before = 1.0;  // march_advance settles t_half before it returns
+  s.half_sigma = 0.0;
+  s.half_ds = 0.0;
   s.t_first = 3.0e38;  // not kept between dispatches: only the CPU's probes read it
   s.ended = ended;
   int code = ended ? -1 - int(state_depth.w) : int(state_depth.w);
