@@ -321,8 +321,8 @@ const char* record_usage() {
          "                           taken from frame 0 for every frame, so the video does not flicker;\n"
          "                           OUT_frames/record.json holds the settings: frames of other ones are refused\n"
          "         [--quality reference [--spp N] [--target-error E]]  each frame by the GPU path tracer (clouds and\n"
-         "                           the ground, no air): N samples per pixel at most (64), fewer once the image's mean\n"
-         "                           relative standard error is E; the frame number seeds it\n"
+         "                           the ground, lit by the sun and the sky): N samples per pixel at most (64), fewer once\n"
+         "                           the image's mean relative standard error is E; the frame number seeds it\n"
          "         [--frames A:B]            render only frames A..B (inclusive, from 0), no video: for batch\n"
          "                           schedulers (scripts/slurm/record.sbatch)\n"
          "         [--assemble]              no rendering: the MP4 from the frames on disk, naming any missing\n"
@@ -432,17 +432,17 @@ int cmd_record(const std::vector<std::string>& args) {
       }
     }
     if (!r.reference) return renderer.render(frame, {}, {}, marched);
-    // The path tracer at the output size, without the air (it does not model it), in batches of 8
-    // samples until spp or the target error; the same frame number gives the same samples.
+    // The path tracer at the output size (sunlight through the air, the sky as an environment
+    // light), in batches of 8 samples until spp or the target error; the same frame number gives
+    // the same samples.
     frame.march_camera = frame.camera;
-    frame.march.features.atmosphere = false;
     core::MonteCarloImage img;
     render::PathTraceSettings pt;
     pt.samples_per_readback = 8;
     pt.seed = static_cast<std::uint32_t>(k) + 1u;
     while (img.spp < static_cast<std::uint64_t>(r.spp)) {
       const int batch = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(r.spp) - img.spp, 8));
-      renderer.raymarcher().trace_paths(img, frame.camera, frame.sun, frame.march, batch, pt);
+      renderer.trace_paths(img, frame, batch, pt);
       if (r.target_error > 0.0 && img.spp >= 8 && img.mean_relative_standard_error() <= r.target_error) break;
     }
     std::vector<glm::vec4> out(img.lum_sum.size());
@@ -462,7 +462,7 @@ int cmd_record(const std::vector<std::string>& args) {
   }
   if (r.reference) {
     std::printf("recording %s: %d frames (%.3g s at %.6g fps), %d..%d here, %dx%d, quality reference: the GPU path tracer, up to %d "
-                "samples per pixel%s (clouds and the ground, no air), into %s\n",
+                "samples per pixel%s (clouds and the ground, lit by the sun and the sky), into %s\n",
                 r.scene_path.c_str(), count, path.duration_s(), r.fps, first, last, scene.width, scene.height, r.spp,
                 r.target_error > 0.0 ? (" or a relative standard error of " + core::short_number(r.target_error)).c_str() : "",
                 folder.c_str());

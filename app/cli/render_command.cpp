@@ -456,7 +456,8 @@ const char* render_usage() {
         "         [--sun-mode valid_time|local_noon]  sun.mode: the physical sun at the instant, or for teaching the\n"
         "                           sun at local noon over the camera (the instant's declination), so no frame is dark\n"
         "         [--quality reference [--spp N] [--target-error E]]  the GPU path tracer (full multiple scattering,\n"
-        "                           clouds and a ground of constant albedo, no air): N samples per pixel at most (1024),\n"
+        "                           clouds and the ground lit by the sun through the air and by the sky; no haze between\n"
+        "                           them): N samples per pixel at most (1024),\n"
         "                           fewer once the image's mean relative standard error is E\n"
         "         [--exposure E|auto] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N]\n"
         "         [--no-sky]  clouds on black: no air, globe or ambient sky light\n"
@@ -708,7 +709,7 @@ int cmd_render(const std::vector<std::string>& args) {
   // The ground texture (the relief image and the shorelines rasterised into its water fraction):
   // loaded once per process, so it is timed here and not as frame time.
   t0 = clock::now();
-  if (!ra.reference) gpu.prepare_ground(frame.march);
+  gpu.prepare_ground(frame.march);  // the path tracer's ground too
   const double t_ground = seconds_since(t0);
   scene.render.march.quality.view_step_m = frame.march.quality.view_step_m;
   if (ra.march_overridden) scene.render.quality = "custom";
@@ -735,11 +736,11 @@ int cmd_render(const std::vector<std::string>& args) {
     outputs.write(ra.save_scene, [&](std::FILE* f) { std::fwrite(text.data(), 1, text.size(), f); });
   }
 
-  if (ra.reference) {  // the path tracer marches nothing: the output size, and no air
+  if (ra.reference) {  // the path tracer marches nothing: the output size
     frame.march_camera = frame.camera;
     if (frame.march.features.atmosphere) {
-      std::printf("the path tracer does not model the air: clouds and the ground only (as --no-sky with the globe)\n");
-      frame.march.features.atmosphere = false;
+      std::printf("the path tracer's air: sunlight reddened through it and the sky's light where paths leave; no haze "
+                  "between the camera and the clouds\n");
     }
   }
   const core::RenderSettings& rs = scene.render;

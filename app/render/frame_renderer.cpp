@@ -83,6 +83,12 @@ void FrameRenderer::march_into(GLuint out, const core::FrameSpec& f, int index, 
   gpu_.render_into(out, f.march_camera, f.sun, m, dispatch, in);
 }
 
+void FrameRenderer::trace_paths(core::MonteCarloImage& img, const core::FrameSpec& f, int spp, const PathTraceSettings& pt,
+                                PathTraceStats* extra) {
+  ensure_noise(f.march);
+  gpu_.trace_paths(img, f.march_camera, f.sun, f.march, spp, pt, extra);
+}
+
 std::vector<glm::vec4> FrameRenderer::render(const core::FrameSpec& f, const DispatchOptions& dispatch,
                                              const std::function<void(int, int)>& on_frame,
                                              std::vector<glm::vec4>* marched) {

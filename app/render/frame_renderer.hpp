@@ -61,6 +61,13 @@ class FrameRenderer {
                                 const std::function<void(int, int)>& on_frame = {},
                                 std::vector<glm::vec4>* marched = nullptr);
 
+  // Adds `spp` path-traced samples per pixel of the spec's march camera into img (the GPU path
+  // tracer, GpuRaymarcher::trace_paths; img empty or made for that camera), generating the erosion
+  // noise the first time it is needed. The viewer's progressive path tracer and `record` trace
+  // through it; the path tracer composites no overlays.
+  void trace_paths(core::MonteCarloImage& img, const core::FrameSpec& frame, int spp, const PathTraceSettings& pt = {},
+                   PathTraceStats* extra = nullptr);
+
   // The overlays drawn before each march (none, or none with geometry: no overlay pass is made or
   // run). Their
   // distance and radiance are the march's opaque input: it stops at the geometry and composites it

@@ -336,7 +336,6 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
                                 const core::MarchSettings& s, int spp, const PathTraceSettings& pt, PathTraceStats* extra,
                                 const std::function<void(int, int)>& on_samples) {
   if (!volume_) throw GlError("trace_paths needs upload() first");
-  if (s.features.atmosphere) throw GlError("the path tracer does not model the air: atmosphere must be off");
   if (pt.max_bounces < 1) throw GlError("the path tracer needs max_bounces >= 1");
   const bool noise = s.medium.noise_amount > 0.0;
   if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
@@ -350,10 +349,13 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
     throw GlError("trace_paths: the accumulator was not made for this camera");
   }
   if (spp <= 0) return;
-  // Only the globe and the noise change the path; the air is off and the rest is the march's.
+  // The globe, the air (sunlight through it and the sky as an environment light) and the noise
+  // change the path; the rest is the march's.
   kernel::MarchVariant variant;
   variant.globe = s.features.globe;
+  variant.atmosphere = s.features.atmosphere;
   variant.noise = noise;
+  variant.layer_mask = kernel::MarchVariant::of(s).layer_mask;  // a height band shown alone
   const GLuint p = path_program_for(variant).id();
   bind_inputs(cam, sun, s, OpaqueInput{});
   if (!path_sums_ || path_pixels_ != n) {

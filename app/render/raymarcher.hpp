@@ -141,9 +141,9 @@ class GpuRaymarcher {
 
   // Adds `spp` path-traced samples per pixel of cam's view into img (made by core::MonteCarloRenderer's
   // start() for this camera, or empty of the camera's size), continuing its sample indices. The
-  // path is the CPU Monte Carlo's (shaders/kernel/path.glsl): clouds and a ground of constant albedo,
-  // no air (settings.features.atmosphere must be off: GlError otherwise). on_samples(done, spp)
-  // after each readback.
+  // path is the CPU Monte Carlo's (shaders/kernel/path.glsl): clouds and the globe's ground (the
+  // ground texture's land albedo and water, else the constant albedo); with the air on, sunlight
+  // reddened by it and the sky as an environment light. on_samples(done, spp) after each readback.
   void trace_paths(core::MonteCarloImage& img, const core::Camera& cam, const core::Sun& sun,
                    const core::MarchSettings& settings, int spp, const PathTraceSettings& pt = {},
                    PathTraceStats* extra = nullptr, const std::function<void(int, int)>& on_samples = {});

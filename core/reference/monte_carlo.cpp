@@ -86,18 +86,16 @@ std::vector<glm::dvec3> MonteCarloImage::radiance() const {
 
 MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExtinction& ext,
                                        const Camera& cam, const Sun& sun, const MarchSettings& march,
-                                       const MonteCarloSettings& mc, const ErosionNoise* noise)
+                                       const MonteCarloSettings& mc, const ErosionNoise* noise,
+                                       const AlbedoMap* ground_map)
     : grid_(grid),
       ext_(ext),
       cam_(cam),
       sun_(sun),
       march_(march),
       mc_(mc),
-      noise_(noise) {
-  if (march.features.atmosphere) {
-    throw std::invalid_argument(
-        "monte carlo: atmosphere on is not modelled (clouds only, optionally the globe)");
-  }
+      noise_(noise),
+      ground_map_(ground_map) {
   if (mc.max_bounces < 1) throw std::invalid_argument("monte carlo: max_bounces must be >= 1");
   if (march.medium.noise_amount > 0.0 && !noise) throw std::invalid_argument("monte carlo: noise_amount > 0 needs the erosion noise textures");
   // The medium as the march kernel reads it (shaders/kernel/march.glsl medium_at_point), erosion
@@ -105,7 +103,9 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
   volume_ = std::make_shared<const PreparedVolume>(prepare_volume(grid, ext));
   kernel_ = std::make_shared<kernel::f64::TrackKernel>();
   kernel::f64::TrackKernel& k = *kernel_;
-  static_cast<kernel::MarchParams&>(k) = march_params(*volume_, cam, sun, march);
+  static_cast<kernel::MarchParams&>(k) =
+      march_params(*volume_, cam, sun, march, ground_map ? glm::ivec2(ground_map->width, ground_map->height) : glm::ivec2(0));
+  if (ground_map) k.u_ground = {ground_map->rgba.data(), {ground_map->width, ground_map->height}, 4};
   const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
   k.u_liquid = {volume_->extinction.liquid_per_m.data(), n};
   k.u_ice = {volume_->extinction.ice_per_m.data(), n};
@@ -123,6 +123,7 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
   k.u_path_roulette_after = mc.roulette_after;
   k.u_path_peak_mis = mc.peak_mis;
   k.kGlobe = march.features.globe;
+  k.kAtmosphere = march.features.atmosphere;
 }
 
 double MonteCarloRenderer::majorant_per_m() const { return kernel_->u_track_majorant; }
@@ -206,9 +207,14 @@ void MonteCarloRenderer::add_samples(MonteCarloImage& img, int spp) const {
         bool misses = false;
         const glm::dvec3 o = kernel_->path_camera_origin(d, misses);
         const std::size_t idx = static_cast<std::size_t>(py) * cam_.width + px;
+        glm::dvec3 sky(0.0);  // a ray that misses the shell sees the sky (none without air)
+        if (misses) {
+          kernel::f64::TrackKernel::TrackCounts c = kernel_->track_counts();
+          sky = kernel_->path_miss(d, c);
+        }
         // Samples in index order into this pixel's sums: the same sums whichever thread does it.
         for (std::uint64_t s = first; s < first + static_cast<std::uint64_t>(spp); ++s) {
-          glm::dvec3 v(0.0);
+          glm::dvec3 v = sky;
           if (!misses) {
             PathRng rng(mc_.seed, idx, s);
             v = trace(o, d, rng, stats[w]).radiance;
@@ -232,8 +238,9 @@ void MonteCarloRenderer::add_samples(MonteCarloImage& img, int spp) const {
 
 MonteCarloImage render_monte_carlo(const VolumeGrid& grid, const GridMeanExtinction& medium,
                                    const Camera& cam, const Sun& sun, const MarchSettings& march,
-                                   const MonteCarloSettings& mc, int spp, const ErosionNoise* noise) {
-  const MonteCarloRenderer r(grid, medium, cam, sun, march, mc, noise);
+                                   const MonteCarloSettings& mc, int spp, const ErosionNoise* noise,
+                                   const AlbedoMap* ground_map) {
+  const MonteCarloRenderer r(grid, medium, cam, sun, march, mc, noise, ground_map);
   MonteCarloImage img = r.start();
   r.add_samples(img, spp);
   return img;

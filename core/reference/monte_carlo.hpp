@@ -79,11 +79,13 @@ struct MonteCarloImage {
 
 class MonteCarloRenderer {
  public:
-  // `noise` is needed when march.noise_amount > 0. Throws std::invalid_argument for settings the
-  // tracer does not model (march.atmosphere: the air's scattering and the sky light).
+  // `noise` is needed when march.noise_amount > 0. `ground_map` (land albedo and water fraction,
+  // as render_reference takes it) is the globe's ground; without it the constant ground_albedo.
+  // With march.atmosphere the sunlight is reddened by the air and the sky lights the paths that
+  // leave (path.glsl); the air between vertices is not modelled.
   MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExtinction& medium, const Camera& cam,
                      const Sun& sun, const MarchSettings& march, const MonteCarloSettings& mc,
-                     const ErosionNoise* noise = nullptr);
+                     const ErosionNoise* noise = nullptr, const AlbedoMap* ground_map = nullptr);
 
   // An empty accumulator for this camera.
   MonteCarloImage start() const;
@@ -122,6 +124,7 @@ class MonteCarloRenderer {
   MarchSettings march_;
   MonteCarloSettings mc_;
   const ErosionNoise* noise_ = nullptr;
+  const AlbedoMap* ground_map_ = nullptr;
   std::shared_ptr<const PreparedVolume> volume_;
   // The march kernel's medium, tracking and path over volume_ (reference/track_kernel.hpp); its
   // functions called here write nothing, so the threads share it.
@@ -132,6 +135,6 @@ class MonteCarloRenderer {
 MonteCarloImage render_monte_carlo(const VolumeGrid& grid, const GridMeanExtinction& medium,
                                    const Camera& cam, const Sun& sun, const MarchSettings& march,
                                    const MonteCarloSettings& mc, int spp,
-                                   const ErosionNoise* noise = nullptr);
+                                   const ErosionNoise* noise = nullptr, const AlbedoMap* ground_map = nullptr);
 
 }  // namespace cv::core

@@ -99,6 +99,19 @@ CV_FN real3 water_radiance(real3 body, real mu_s, real mu_v, real nu_sv, real ms
          body / CV_PI * out_v * (t_sun * in_s + e_sky * in_sky);
 }
 
+// The water's BRDF (1/sr, per channel) between the direction the light comes from (cosine mu_i with
+// the vertical) and the direction to the viewer (mu_o), nu the cosine between those two: the sun
+// glint and the light of the water body let in and out through the surface. water_radiance's sun
+// terms are t_sun mu_s water_brdf(body, mu_s, mu_v, nu_sv, mss); it is symmetric in mu_i and mu_o.
+// The path tracer (shaders/kernel/path.glsl) weights a bounce off water by it.
+CV_FN real3 water_brdf(real3 body, real mu_i, real mu_o, real nu, real mss) {
+  if (!(mu_i > real(0.0)) || !(mu_o > real(0.0))) return real3(0.0);
+  real f0 = fresnel_water(real(1.0));
+  real in_f = (real(1.0) - fresnel_water(mu_i)) / (real(1.0) - f0);
+  real out_f = (real(1.0) - fresnel_water(mu_o)) / (real(1.0) - f0);
+  return real3(sea_glint_brdf(mu_i, mu_o, nu, mss)) + body / CV_PI * (in_f * out_f);
+}
+
 // Radiance of a ground point whose water fraction is `water` (0..1): Lambertian land of albedo
 // `land`, the rest water_radiance with the body reflectance `body`. No water: ground_radiance exactly.
 CV_FN real3 ground_radiance_water(real3 land, real water, real3 body, real mu_s, real mu_v, real nu_sv, real mss, real3 t_sun,

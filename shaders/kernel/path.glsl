@@ -1,11 +1,15 @@
 // Volumetric path tracing through the kernel's medium: the Monte Carlo reference's path, written
 // once for the CPU reference (core/reference/monte_carlo.cpp, in double) and the GPU path tracer
 // (shaders/render/pathtrace.comp, in float). A path starts on a pixel's view ray and scatters in
-// cloud (delta tracking, tracking.glsl) and off a Lambertian ground of constant albedo, with
-// next-event estimation toward the sun (ratio tracking) at every vertex, new directions drawn from
-// the phase function of the component that scattered, multiple importance sampling of the droplets'
-// forward peak toward the sun, and Russian roulette on the throughput (docs/physics.md, "Monte Carlo
-// reference" and "A reference that converges").
+// cloud (delta tracking, tracking.glsl) and off the ground (the march's ground_at: land albedo and
+// water, or the constant albedo without a ground texture), with next-event estimation toward the
+// sun (ratio tracking) at every vertex, new directions drawn from the phase function of the
+// component that scattered, multiple importance sampling of the droplets' forward peak toward the
+// sun, and Russian roulette on the throughput (docs/physics.md, "Monte Carlo reference" and "A
+// reference that converges"). With the air on (kAtmosphere) the sunlight reaching a vertex is
+// reddened by the air's transmittance, and a path that leaves into the sky takes the sky's
+// single-scattered radiance in its direction: the sky as an environment light (docs/physics.md,
+// "The path tracer's sky and ground"). The air between vertices neither dims nor adds light.
 // Needs march.glsl and tracking.glsl, and from the including side: track_bits(rng) (32 random
 // bits, for the Mie sampler's own stream), u_path_max_bounces, u_path_roulette_after and
 // u_path_peak_mis.
@@ -68,7 +72,7 @@ CV_FN real3 path_camera_origin(real3 d, CV_OUT(bool) misses) {
 // (<= 2), and in t_ground the distance to the ground (CV_PATH_FAR: never).
 CV_FN int path_shell_parts(real3 p, real3 d, CV_OUT(real4) seg, CV_OUT(real) t_ground) {
   real r = length(p);
-  real alt = r - u_r0;
+  real alt = max(r - u_r0, real(0.0));  // a ground vertex a hair below the sphere: on it (path_sun_air)
   real3 up = p / r;
   real mu = dot(d, up);
   real nu = length(cross(d, up));
@@ -109,6 +113,43 @@ CV_FN real path_free_path(real3 p, real3 d, CV_INOUT(TrackRng) rng, CV_INOUT(Tra
   int n = path_shell_parts(p, d, seg, t_ground);
   return delta_track(p, d, seg, n, rng, c);
 }
+
+// The air's transmittance (RGB) of the sunlight reaching p (0 in the Earth's shadow); 1 without air.
+CV_FN real3 path_sun_air(real3 p, CV_INOUT(TrackCounts) c) {
+  if (!kAtmosphere) return real3(1.0);
+  c.iterations += uint(u_atmo_sun_steps) + 2u;  // atmo_optical_depth's two loops
+  real r = length(p);
+  real3 up = p / r;
+  // A ground vertex lies on the sphere; rounding may put it a hair below, where every ray would
+  // meet the Earth at once: its altitude is held at 0.
+  return atmo_transmittance(u_r0, max(r - u_r0, real(0.0)), dot(u_to_sun, up), length(cross(u_to_sun, up)), u_atmo_sun_steps);
+}
+
+// The sky's radiance (per unit sun irradiance) arriving at p from direction d: the air's single
+// scattering from p along d out to the top of the atmosphere (atmo_inscatter, as the march's sky),
+// or to the ground where d meets it. 0 without air.
+CV_FN real3 path_sky(real3 p, real3 d, CV_INOUT(TrackCounts) c) {
+  if (!kAtmosphere) return real3(0.0);
+  real r = length(p);
+  real alt = max(r - u_r0, real(0.0));  // a ground vertex a hair below the sphere: on it (path_sun_air)
+  real3 up = p / r;
+  real mu = dot(d, up);
+  real nu = length(cross(d, up));
+  real a0;
+  real a1;
+  if (!ray_sphere_rel_nu(u_r0, alt, mu, nu, CV_ATMO_TOP_M, a0, a1) || !(a1 > real(0.0))) return real3(0.0);
+  real t_end = a1;
+  real g0;
+  real g1;
+  if (ray_sphere_rel_nu(u_r0, alt, mu, nu, real(0.0), g0, g1) && g1 > real(0.0)) t_end = max(g0, real(0.0));
+  c.iterations += uint(u_sky_steps) * (uint(u_atmo_sun_steps) + 3u) + 2u;  // atmo_inscatter's loops
+  real3 tr;
+  return atmo_inscatter(u_r0, alt, mu, dot(u_to_sun, up), dot(d, u_to_sun), max(a0, real(0.0)), t_end, u_sky_steps, u_atmo_sun_steps, tr);
+}
+
+// What a pixel sees whose view ray misses the grid's shell (path_camera_origin): the sky from the
+// camera, none without air.
+CV_FN real3 path_miss(real3 d, CV_INOUT(TrackCounts) c) { return u_irradiance * path_sky(u_cam_ecef, d, c); }
 
 // Transmittance of the cloud from p along d by ratio tracking; 0 when the ray meets the Earth.
 CV_FN real path_transmittance(real3 p, real3 d, CV_INOUT(TrackRng) rng, CV_INOUT(TrackCounts) c) {
@@ -225,7 +266,7 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
         real p_prev = path_phase(s.prev_sl, s.prev_si, dot(s.prev_d, s.d), mie, liquid_g);
         w = p_prev / (p_prev + phase_hg_c(dot(s.d, u_to_sun), mie.g_hg, mie.c_hg));
       }
-      s.radiance += s.beta * u_irradiance *
+      s.radiance += s.beta * u_irradiance * path_sun_air(s.p, c) *
                     (w * path_phase(sl, si, dot(s.d, u_to_sun), mie, liquid_g) * path_transmittance(s.p, u_to_sun, rng, c));
       if (!path_continues(s, rng, pc)) break;
       // The peak technique: a direction wq ~ q around the sun, the free path along it, the sun's
@@ -246,7 +287,7 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
           real sl2;
           real si2;
           medium_at_point(x, sl2, si2);
-          s.radiance += s.beta * u_irradiance *
+          s.radiance += s.beta * u_irradiance * path_sun_air(x, c) *
                         (p_here / (p_here + q) * path_phase(sl2, si2, dot(wq, u_to_sun), mie, liquid_g) *
                          path_transmittance(x, u_to_sun, rng, c));
         }
@@ -272,25 +313,51 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
         s.d = sample_hg(s.d, u_ice_g, real2(v1, v2), pdf);
       }
     } else if (kGlobe && t_ground < CV_PATH_FAR) {
-      // A Lambertian ground of constant albedo: lit by the sun through the clouds, reflecting a
-      // cosine-distributed new direction with throughput times albedo.
+      // The ground as the march sees it (ground_at): Lambertian land of its albedo and a water
+      // fraction with the glint and the water body (water_radiance), lit by the sun through the
+      // air and the clouds; the sky's light reaches it by the paths that leave it.
       s.p = normalize(s.p + t_ground * s.d) * u_r0;
       real3 n = s.p / u_r0;
       s.scatterings += 1;
+      real3 ll = ecef_to_sphere(s.p, u_r0);
+      real4 g = ground_at(ll.x, ll.y);
+      real3 land = real3(g.x, g.y, g.z);
+      real water = clamp(g.w, real(0.0), real(1.0));
+      real mss = cox_munk_mss(u_ocean_wind);
+      real mu_v = -dot(s.d, n);  // toward where the path came from
       real mu_s = dot(n, u_to_sun);
       if (mu_s > real(0.0)) {
         real tr = path_transmittance(s.p, u_to_sun, rng, c);
-        s.radiance += s.beta * u_irradiance * ground_radiance(u_ground_albedo, mu_s, real3(tr), real3(0.0));
+        s.radiance += s.beta * u_irradiance *
+                      ground_radiance_water(land, water, CV_WATER_BODY, mu_s, mu_v, -dot(s.d, u_to_sun), mss,
+                                            path_sun_air(s.p, c) * tr, real3(0.0));
       }
-      s.absorbed += s.beta * (real3(1.0) - u_ground_albedo);
-      s.beta *= u_ground_albedo;
+      // The bounce: off water with the probability of its fraction, a cosine-distributed direction
+      // weighted by pi x the water's BRDF; else off land, the albedo as the weight. Without water
+      // the random numbers are drawn as they always were.
+      bool wet = water > real(0.0) && track_uniform(rng) < water;
+      real3 o = n;
+      real3 weight = land;
+      if (wet) {
+        real u1 = track_uniform(rng);
+        real u2 = track_uniform(rng);
+        o = direction_around(n, sqrt(u1), CV_TWO_PI * u2);
+        weight = CV_PI * water_brdf(CV_WATER_BODY, dot(o, n), mu_v, -dot(s.d, o), mss);
+      }
+      s.absorbed += s.beta * (real3(1.0) - weight);  // in expectation, 1 - the albedo
+      s.beta *= weight;
       if (!path_continues(s, rng, pc)) break;
       s.prev_peak = false;  // a cosine draw from the ground: no other technique makes it
-      real v1 = track_uniform(rng);
-      real v2 = track_uniform(rng);
-      s.d = direction_around(n, sqrt(v1), CV_TWO_PI * v2);
+      if (!wet) {
+        real v1 = track_uniform(rng);
+        real v2 = track_uniform(rng);
+        o = direction_around(n, sqrt(v1), CV_TWO_PI * v2);
+      }
+      s.d = o;
     } else {
       s.end = t_ground < CV_PATH_FAR ? CV_PATH_GROUND : CV_PATH_SPACE;
+      // Into the sky: its light from that direction (none without air).
+      if (s.end == CV_PATH_SPACE) s.radiance += s.beta * u_irradiance * path_sky(s.p, s.d, c);
       s.done = true;
     }
   }

@@ -101,6 +101,10 @@ void main() {
     vec3 o = path_camera_origin(d, misses);
     s = path_begin(o, d);
     s.done = misses;
+    if (misses) {
+      TrackCounts c0 = track_counts();
+      s.radiance = path_miss(d, c0);
+    }
   } else {
     s = load_state(idx, rng);
     if (s.done) return;
