@@ -69,7 +69,7 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
       {"view",
        "  view INPUT [--size WxH] [--time ISO|N] [--play H] [--scale S] [--hide-ui] [--frame-budget MS]\n"
        "             [--compare FILE[@T] | @T ...] [--layout grid|swipe] [--unlinked] [--frames N --screenshot OUT.png]\n"
-       "             [--section LAT,LON,LAT,LON[,FIELD]] [--series LAT,LON]\n"
+       "             [--section LAT,LON,LAT,LON[,FIELD]] [--series LAT,LON] [--quality reference [--spp N]]\n"
        "                           --time: an instant (UTC) or a step; --play H: start playing at H forecast\n"
        "                           hours per second (the timeline is in the data panel); with --frames it moves\n"
        "                           one instant per frame and waits for each, unless --realtime (wall time, no wait)\n"
@@ -83,7 +83,10 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
        "                           without --compare, a scene file's \"views\" open (its layout and link unless\n"
        "                           --layout or --unlinked is given); the Scene file panel saves the open views\n"
        "                           --section, --series: open the Section (default field extinction) or Series panel\n"
-       "                           with that path or point, drawn as the section and series commands draw them\n"},
+       "                           with that path or point, drawn as the section and series commands draw them\n"
+       "                           --quality reference: the progressive path tracer (the Quality panel's switch):\n"
+       "                           one sample per pixel per frame up to N (256), restarted by any change; clouds,\n"
+       "                           ground, sunlight through the air and the sky's light, no overlays\n"},
   };
 }
 

@@ -201,6 +201,10 @@ void features_panel(ViewerState& s) {
 
 void quality_panel(ViewerState& s, const PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Quality")) return;
+  // The GPU path tracer as a progressive mode: full multiple scattering, the sky and the ground,
+  // one sample per pixel per frame (no overlays, no haze in front of the clouds).
+  ImGui::Checkbox("path tracer (progressive reference)", &s.path_trace);
+  if (s.path_trace) ImGui::SliderInt("path samples per pixel", &s.path_spp, 1, 65536, "%d", ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
   march_widgets(s.scene.render.march, core::SettingGroup::Quality);
   core::RenderSettings& r = s.scene.render;
   slider_double("resolution scale", &r.resolution_scale, 0.1, 1.0, "%.2f");
@@ -604,7 +608,14 @@ void draw_stats_overlay(const FrameStats& s, int target) {
   const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
                                  ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoMove;
   if (ImGui::Begin("statistics", nullptr, flags)) {
-    ImGui::Text("march %.2f ms, accumulate + draw %.2f ms", s.march_ms, s.present_ms);
+    ImGui::Text("%s %.2f ms, accumulate + draw %.2f ms", s.path_trace ? "path trace" : "march", s.march_ms, s.present_ms);
+    if (s.path_trace) {
+      ImGui::Text("path tracer: %d / %d samples per pixel at %d x %d", s.accumulated, target, s.march_w, s.march_h);
+      if (s.accumulated >= 2) ImGui::Text("mean relative standard error %.4f", s.path_error);
+      ImGui::Text("%.1f FPS", s.fps);
+      ImGui::End();
+      return;
+    }
     ImGui::Text("frames %d / %d at %d x %d", s.accumulated, target, s.march_w, s.march_h);
     ImGui::Text("%.1f FPS", s.fps);
     const core::MarchStats& m = s.march;

@@ -23,7 +23,9 @@ struct FrameStats {
   double march_ms = 0.0;    // GPU time of the last raymarch dispatch (timer query)
   double present_ms = 0.0;  // GPU time of accumulation + tonemap draw
   double fps = 0.0;         // window frames per second, averaged over ~0.5 s
-  int accumulated = 0;      // frames in the current mean
+  int accumulated = 0;      // frames in the current mean (the path tracer: samples per pixel)
+  bool path_trace = false;  // the mean is the path tracer's
+  double path_error = 0.0;  // its mean relative standard error (MonteCarloImage), once 2 samples are in
   int march_w = 0, march_h = 0;
   core::MarchStats march;   // what the last marched frame sampled and left out
   std::string renderer;     // GL_RENDERER

@@ -149,9 +149,28 @@ struct ViewGpu {
   int accumulated = 0;
   bool marching = false;
   core::Scene previous;
+  // The progressive path tracer's sums (one sample per pixel per frame), and whether the mean
+  // shown is theirs.
+  core::MonteCarloImage paths;
+  bool path_mode = false;
   double auto_exposure = render::kDefaultExposure;
   core::FrameSpec spec;
 };
+
+// One more path-traced sample per pixel of the view's march camera into its sums, and their mean
+// (radiance; alpha 0: no background shows through, as `render --quality reference` writes it) into
+// the presenter's frame texture. The seed is `render`'s default, so after N frames the mean is
+// `render --quality reference --spp N`'s image at the march size.
+void trace_into(ViewGpu& v) {
+  render::PathTraceSettings pt;
+  pt.samples_per_readback = 1;
+  v.renderer.trace_paths(v.paths, v.spec, 1, pt);
+  const int w = v.spec.march_camera.width, h = v.spec.march_camera.height;
+  std::vector<glm::vec4> mean(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  for (std::size_t i = 0; i < mean.size(); ++i) mean[i] = glm::vec4(glm::vec3(v.paths.mean(i)), 0.0f);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(v.presenter.frame_texture(), 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, mean.data());
+}
 
 // A view besides view 0 (issue 17): its scene holds its data, camera and time, and takes view 0's
 // settings each frame; its volume is shared by the views of one source (view 0's own when the file
@@ -381,6 +400,15 @@ int cmd_view(const std::vector<std::string>& args) {
         o.realtime = true;
       } else if (a == "--hide-ui") {
         o.hide_ui = true;
+      } else if (a == "--quality") {
+        const std::string q = next();
+        if (q != "reference") {
+          throw ViewerInputError("cloudviewer view: --quality: found '" + q +
+                                 "', expected reference (the progressive path tracer; the march's quality is the scene's)");
+        }
+        o.path_trace = true;
+      } else if (a == "--spp") {
+        o.path_spp = parse_int("--spp", next(), 1, 1000000);
       } else if (a == "--section" || a == "--series") {
         (a == "--section" ? o.section : o.series) = next();
         SectionPanel sec;
@@ -396,6 +424,9 @@ int cmd_view(const std::vector<std::string>& args) {
       }
     }
     if (o.input.empty()) throw ViewerInputError("cloudviewer view: expected INPUT (.nc, .cvvol or a scene .json)");
+    if (o.path_spp > 0 && !o.path_trace) {
+      throw ViewerInputError("cloudviewer view: --spp: found it without the path tracer, expected --quality reference as well");
+    }
     if (ends_with(o.input, ".json")) o.scene = core::load_scene(o.input);
     // The views: --compare, else the scene file's "views".
     const std::size_t more = !o.compare.empty() || !o.scene || !o.scene->views ? o.compare.size() : o.scene->views->compare.size();
@@ -499,6 +530,8 @@ int run_viewer(const ViewerOptions& o) {
   if (o.frames > 0) s.scene.render.accumulate = o.frames;
   if (!o.scene || o.scale_given) s.scene.render.resolution_scale = o.scale;
   if (o.frame_budget_ms >= 0.0) s.scene.render.budget_ms = o.frame_budget_ms;
+  s.path_trace = o.path_trace;
+  if (o.path_spp > 0) s.path_spp = o.path_spp;
 
   // More views (--compare, else the scene file's "views"): opened before the window, so bad input
   // costs no frames. The command line's --layout and --unlinked override the scene file's.
@@ -711,7 +744,7 @@ int run_viewer(const ViewerOptions& o) {
     // The frame budget steps along its candidates from the last frame's time (after the panels, so
     // that switching it on in the panel takes effect this frame).
     const bool budget_was_on = budget.on();
-    if (budget.update(s.scene.render, g.alt_m.step, frame_ms, marched_last)) {
+    if (!s.path_trace && budget.update(s.scene.render, g.alt_m.step, frame_ms, marched_last)) {  // the path tracer marches nothing
       if (!budget_was_on) std::printf("frame budget %g ms: candidates from %s\n", s.scene.render.budget_ms, budget.source().c_str());
       if (o.frames > 0) std::printf("frame budget %g ms: frame %d: %s\n", s.scene.render.budget_ms, frame, budget.status().c_str());
     }
@@ -865,13 +898,17 @@ int run_viewer(const ViewerOptions& o) {
     for (std::size_t i = 0; i < gpus.size(); ++i) {
       ViewGpu& v = *gpus[i];
       const core::Scene& sc = scene_of(static_cast<int>(i));
-      if (frame == 0 || !same_march(sc, v.previous)) v.accumulated = 0;
+      if (frame == 0 || !same_march(sc, v.previous) || v.path_mode != s.path_trace) {
+        v.accumulated = 0;
+        v.paths = core::MonteCarloImage{};
+      }
+      v.path_mode = s.path_trace;
       v.previous = sc;
-      v.marching = v.accumulated < sc.render.accumulate;
+      v.marching = v.accumulated < (s.path_trace ? s.path_spp : sc.render.accumulate);
       any_march = any_march || v.marching;
       const int w = v.spec.march_camera.width, h = v.spec.march_camera.height;
       if (v.presenter.width() != w || v.presenter.height() != h) v.presenter.resize(w, h);
-      if (!v.marching || v.accumulated != 0) continue;
+      if (!v.marching || v.accumulated != 0 || v.path_mode) continue;  // the path tracer composites no overlays
       try {  // a new mean: the overlays for this view (VTK only when a scene has some)
         const auto built = v.overlay_builder.build(sc.overlays, volume_of(static_cast<int>(i)), static_cast<std::size_t>(sc.time_step),
                                                    v.spec.march_camera);
@@ -895,7 +932,12 @@ int run_viewer(const ViewerOptions& o) {
     marched_last = main_view.marching;
     if (any_march) march_timer.begin();
     for (ViewGpu* v : gpus) {
-      if (v->marching) v->renderer.march_into(v->presenter.frame_texture(), v->spec, v->accumulated);
+      if (!v->marching) continue;
+      if (v->path_mode) {
+        trace_into(*v);
+      } else {
+        v->renderer.march_into(v->presenter.frame_texture(), v->spec, v->accumulated);
+      }
     }
     if (any_march) march_timer.end();
     present_timer.begin();
@@ -905,11 +947,12 @@ int run_viewer(const ViewerOptions& o) {
       ViewGpu& v = *gpus[i];
       const core::Scene& sc = scene_of(static_cast<int>(i));
       if (v.marching) {
-        v.presenter.accumulate(v.accumulated);
+        v.presenter.accumulate(v.path_mode ? 0 : v.accumulated);  // the path tracer's frame texture holds its mean
         ++v.accumulated;
         // The automatic exposure from the mean at the march size (as `render` takes it), when the mean
         // starts and when it is complete: not frame by frame, so the picture does not pulse.
-        if (v.spec.auto_exposure && (v.accumulated == 1 || v.accumulated == sc.render.accumulate)) {
+        const int target = v.path_mode ? s.path_spp : sc.render.accumulate;
+        if (v.spec.auto_exposure && (v.accumulated == 1 || v.accumulated == target)) {
           std::vector<glm::vec4> mean(static_cast<std::size_t>(v.presenter.width()) * v.presenter.height());
           glGetTextureImage(v.presenter.mean_texture(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(mean.size() * sizeof(glm::vec4)),
                             mean.data());
@@ -938,9 +981,11 @@ int run_viewer(const ViewerOptions& o) {
     }
     if (show_ui) stats.march = renderer.last_stats();  // read back only when shown (it waits for the march)
     stats.accumulated = main_view.accumulated;
+    stats.path_trace = main_view.path_mode;
+    if (main_view.path_mode && main_view.paths.spp >= 2 && show_ui) stats.path_error = main_view.paths.mean_relative_standard_error();
     stats.march_w = mw;
     stats.march_h = mh;
-    if (show_ui) draw_stats_overlay(stats, s.scene.render.accumulate);  // built after the march: this frame's count
+    if (show_ui) draw_stats_overlay(stats, s.path_trace ? s.path_spp : s.scene.render.accumulate);  // built after the march: this frame's count
     // Each view's label (its file and valid time) at the bottom of the part that shows, and the
     // swipe divider; also with the panels hidden, when there are several views.
     s.views.labels.resize(static_cast<std::size_t>(n_views));
@@ -980,9 +1025,16 @@ int run_viewer(const ViewerOptions& o) {
       save_screenshot(o.screenshot, fbw, fbh);
       march_timer.finish();
       stats.march_ms = march_timer.ms();
-      std::printf("wrote %s (%d x %d window, %d frame(s) accumulated in %.2f s wall, GPU march %.1f ms per frame on %s)\n",
-                  o.screenshot.c_str(), fbw, fbh, main_view.accumulated, std::chrono::duration<double>(clock::now() - start).count(),
-                  stats.march_ms, stats.renderer.c_str());
+      std::printf("wrote %s (%d x %d window, %d %s in %.2f s wall, GPU %s %.1f ms per frame on %s)\n",
+                  o.screenshot.c_str(), fbw, fbh, main_view.accumulated,
+                  main_view.path_mode ? "path-traced sample(s) per pixel" : "frame(s) accumulated", std::chrono::duration<double>(clock::now() - start).count(),
+                  main_view.path_mode ? "path trace" : "march", stats.march_ms, stats.renderer.c_str());
+      if (main_view.path_mode) {
+        std::printf("path tracer: %llu samples per pixel, mean relative standard error %.4f, %.2f scatterings per path\n",
+                    static_cast<unsigned long long>(main_view.paths.spp),
+                    main_view.paths.spp >= 2 ? main_view.paths.mean_relative_standard_error() : 1.0,
+                    double(main_view.paths.stats.scatterings) / double(std::max<std::uint64_t>(main_view.paths.stats.paths, 1)));
+      }
       if (o.frames > 1) {  // what a frame costs once the shaders are compiled and the data prepared
         std::printf("%d view(s), %s: frames 2..%d took %.1f ms wall, %.1f ms process CPU each\n", n_views, view_layout_name(s.views.layout),
                     o.frames, std::chrono::duration<double, std::milli>(clock::now() - after_first).count() / (o.frames - 1),

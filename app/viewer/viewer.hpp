@@ -29,6 +29,8 @@ struct ViewerOptions {
   bool layout_given = false;         // --layout overrides the scene file's views.layout
   bool unlinked = false;             // --unlinked: cameras and time not linked between views
   std::string section, series;       // --section LAT,LON,LAT,LON[,FIELD], --series LAT,LON: open those panels, drawn
+  bool path_trace = false;           // --quality reference: the progressive path tracer from the first frame
+  int path_spp = 0;                  // --spp N: its samples per pixel (0: the state's default)
 };
 
 // Parses the `view` arguments and runs; returns the exit code (2 with one line for bad arguments).

@@ -54,6 +54,11 @@ struct ViewerState {
   SectionPanel section;       // a vertical section of view 0's file (plot_panels.hpp)
   SeriesPanel series;         // a time series at a point of view 0's file
   double series_now_hours = 0.0;  // view 0's time on the series' axis, for its marker
+  // The progressive path tracer (issue 11, item 4): every view traces one sample per pixel per frame
+  // at its march size into a running mean, up to path_spp, instead of marching; any change that
+  // restarts the march's accumulation restarts it.
+  bool path_trace = false;
+  int path_spp = 256;
 };
 
 
