@@ -357,7 +357,9 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
   variant.noise = noise;
   variant.layer_mask = kernel::MarchVariant::of(s).layer_mask;  // a height band shown alone
   const GLuint p = path_program_for(variant).id();
-  bind_inputs(cam, sun, s, OpaqueInput{});
+  core::MarchSettings paths = s;  // the paths scatter for themselves: no two-stream source is built for them
+  paths.medium.ms_two_stream = false;
+  bind_inputs(cam, sun, paths, OpaqueInput{});
   if (!path_sums_ || path_pixels_ != n) {
     if (path_sums_) glDeleteBuffers(1, &path_sums_);
     if (path_state_) glDeleteBuffers(1, &path_state_);
