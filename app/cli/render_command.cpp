@@ -413,6 +413,10 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
     throw UsageError{"cloudviewer render: --pfm: found it with --quality reference, expected one or the other (the path tracer "
                      "estimates radiance, not the transmittance the PFM pair holds)"};
   }
+  if (r.reference && scene.render.march.medium.modelled) {
+    throw UsageError{"cloudviewer render: --quality reference: found render.march.cloud_model \"modelled\", expected \"data\" (the path "
+                     "tracer does not trace the modelled cloud yet)"};
+  }
   if (r.reference && r.budget_given) {
     throw UsageError{"cloudviewer render: --budget-ms: found it with --quality reference, expected one or the other"};
   }
@@ -698,11 +702,19 @@ int cmd_render(const std::vector<std::string>& args) {
   render::GpuRaymarcher& gpu = renderer.raymarcher();
   t0 = clock::now();
   renderer.use_volume(prepared);
-  if (scene.render.march.medium.noise_amount > 0.0) {  // generated, compiled and bound only when used
+  if (scene.render.march.medium.noise_amount > 0.0 || scene.render.march.medium.modelled) {  // generated, compiled and bound only when used
     const auto t_noise = clock::now();
-    gpu.upload_noise(core::make_erosion_noise());
-    std::printf("erosion noise %.2f, tile %.0f m: generated and uploaded in %.2f s\n", scene.render.march.medium.noise_amount,
-                scene.render.march.medium.noise_scale_m, seconds_since(t_noise));
+    const core::MediumSettings& md = scene.render.march.medium;
+    core::ErosionNoise noise = core::make_erosion_noise();
+    if (md.modelled) core::with_detail_table(noise);
+    gpu.upload_noise(noise);
+    if (md.modelled) {
+      std::printf("noise tiles for the modelled cloud (detail %.2f, tile %.0f m) and erosion noise %.2f: generated and uploaded in %.2f s\n",
+                  md.detail_amount, md.detail_scale_m, md.noise_amount, seconds_since(t_noise));
+    } else {
+      std::printf("erosion noise %.2f, tile %.0f m: generated and uploaded in %.2f s\n", md.noise_amount, md.noise_scale_m,
+                  seconds_since(t_noise));
+    }
   }
   glFinish();
   const double t_upload = seconds_since(t0);

@@ -66,8 +66,12 @@ core::FrameSpec resolve_path_frame(const core::Scene& scene, const core::PathEva
 }
 
 void FrameRenderer::ensure_noise(const core::MarchSettings& m) {
-  if (m.medium.noise_amount > 0.0 && !noise_uploaded_) {  // generated, compiled and bound only when used
-    gpu_.upload_noise(core::make_erosion_noise());
+  // Generated, compiled and bound only when used; the modelled cloud's table only for it.
+  const bool table = m.medium.modelled && (!noise_uploaded_ || noise_.detail.empty());
+  if ((m.medium.noise_amount > 0.0 || m.medium.modelled) && !noise_uploaded_) noise_ = core::make_erosion_noise();
+  if (table) core::with_detail_table(noise_);
+  if ((m.medium.noise_amount > 0.0 && !noise_uploaded_) || table) {
+    gpu_.upload_noise(noise_);
     noise_uploaded_ = true;
   }
 }

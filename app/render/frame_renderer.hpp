@@ -10,6 +10,7 @@
 #include <glm/vec4.hpp>
 
 #include "kernel/prepared_volume.hpp"
+#include "noise/noise.hpp"
 #include "geometry/overlay_mesh.hpp"
 #include "render/overlay_pass.hpp"
 #include "render/raymarcher.hpp"
@@ -95,6 +96,7 @@ class FrameRenderer {
   std::unique_ptr<OverlayPass> overlay_pass_;
   std::shared_ptr<const core::PreparedVolume> volume_;
   bool noise_uploaded_ = false;
+  core::ErosionNoise noise_;  // what was uploaded (its detail table made when the modelled cloud needs it)
 };
 
 }  // namespace cv::render

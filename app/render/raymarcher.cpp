@@ -8,6 +8,7 @@
 
 #include "kernel/bindings.glsl"
 #include "kernel/march_stats.glsl"
+#include "physics/physics.hpp"  // CV_DETAIL_COVERS (shaders/common/detail.glsl)
 #include "noise/blue_noise.hpp"
 #include "render/albedo_map.hpp"
 #include "reference/earth_shadow.hpp"
@@ -84,6 +85,8 @@ GpuRaymarcher::~GpuRaymarcher() {
   if (column_tau_) glDeleteTextures(1, &column_tau_);
   if (ms_[0]) glDeleteTextures(2, ms_);
   if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
+  if (fraction_) glDeleteTextures(1, &fraction_);
+  if (detail_table_) glDeleteTextures(1, &detail_table_);
   if (pyramid_buffer_) glDeleteBuffers(1, &pyramid_buffer_);
   if (stats_buffer_) glDeleteBuffers(1, &stats_buffer_);
   if (params_buffer_) glDeleteBuffers(1, &params_buffer_);
@@ -104,6 +107,14 @@ void GpuRaymarcher::upload_noise(const core::ErosionNoise& noise) {
     glTextureStorage3D(noise_textures_[i], 1, GL_R32F, tex[i]->n, tex[i]->n, tex[i]->n);
     glTextureSubImage3D(noise_textures_[i], 0, 0, 0, 0, tex[i]->n, tex[i]->n, tex[i]->n, GL_RED, GL_FLOAT,
                         tex[i]->texels.data());
+  }
+  // The modelled cloud's table over these tiles (threshold, ramp mean per cover).
+  if (detail_table_) glDeleteTextures(1, &detail_table_);
+  detail_table_ = 0;
+  if (noise.detail.size() == 2 * (CV_DETAIL_COVERS + 1)) {
+    glCreateTextures(GL_TEXTURE_2D, 1, &detail_table_);
+    glTextureStorage2D(detail_table_, 1, GL_RG32F, CV_DETAIL_COVERS + 1, 1);
+    glTextureSubImage2D(detail_table_, 0, 0, 0, CV_DETAIL_COVERS + 1, 1, GL_RG, GL_FLOAT, noise.detail.data());
   }
   check_gl("uploading the erosion noise textures");
 }
@@ -145,6 +156,7 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
   if (ms_[0]) glDeleteTextures(2, ms_);
   ms_[0] = ms_[1] = 0;
   ms_volume_ = nullptr;
+  fraction_volume_ = nullptr;  // the modelled cloud's cover: uploaded again when a march needs it
   // The pyramid for empty-space skipping and adapted steps, all levels in one buffer.
   std::vector<glm::vec2> packed = volume->pyramid_packed;
   if (packed.empty()) packed.emplace_back(0.0f, 1.0f);  // a buffer must not be empty; u_levels = 0 ignores it
@@ -212,6 +224,17 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
       ms_volume_ = &v, ms_key_ = key, ms_build_ms_ = src.build_ms;
     }
   }
+  if (s.medium.modelled && params.u_has_fraction && fraction_volume_ != &v) {  // the cover, only when the modelled cloud reads it
+    if (!fraction_) {
+      glCreateTextures(GL_TEXTURE_3D, 1, &fraction_);
+      glTextureStorage3D(fraction_, 1, GL_R32F, grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
+    }
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTextureSubImage3D(fraction_, 0, 0, 0, 0, grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count, GL_RED, GL_FLOAT,
+                        v.extinction.fraction.data());
+    check_gl("uploading the cloud fraction");
+    fraction_volume_ = &v;
+  }
   const kernel::MarchParamsStd140 block = kernel::pack_std140(params);
   if (!params_buffer_) {
     glCreateBuffers(1, &params_buffer_);
@@ -220,7 +243,7 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
   glNamedBufferSubData(params_buffer_, 0, sizeof(block), &block);
   glBindBufferBase(GL_UNIFORM_BUFFER, CV_UBO_MARCH, params_buffer_);
   sun_down_ = params.u_sun_down;
-  if (s.medium.noise_amount > 0.0) {
+  if (s.medium.noise_amount > 0.0 || s.medium.modelled) {
     glBindTextureUnit(CV_TEX_NOISE_LOW, noise_textures_[0]);
     glBindTextureUnit(CV_TEX_NOISE_HIGH, noise_textures_[1]);
   }
@@ -243,6 +266,8 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
   glBindTextureUnit(CV_TEX_COLUMN_TAU, column_tau_);
   glBindTextureUnit(CV_TEX_MS_I0, ms_[0]);
   glBindTextureUnit(CV_TEX_MS_I1, ms_[1]);
+  glBindTextureUnit(CV_TEX_FRACTION, fraction_);
+  glBindTextureUnit(CV_TEX_DETAIL_TABLE, detail_table_);
   return params;
 }
 
@@ -252,6 +277,7 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   const bool noise = s.medium.noise_amount > 0.0;
   if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
   if (noise && !(s.medium.noise_scale_m > 0.0)) throw GlError("noise_scale_m must be > 0");
+  if (s.medium.modelled && !detail_table_) throw GlError("cloud_model modelled needs upload_noise() first");
   if (!(s.quality.view_step_m > 0.0)) throw GlError("view_step_m must be > 0");
   kernel::MarchVariant variant = kernel::MarchVariant::of(s);
   variant.translucent = opaque.layers > 0 && opaque.layer_distance != 0 && opaque.layer_color != 0;
@@ -337,6 +363,7 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
                                 const std::function<void(int, int)>& on_samples) {
   if (!volume_) throw GlError("trace_paths needs upload() first");
   if (pt.max_bounces < 1) throw GlError("the path tracer needs max_bounces >= 1");
+  if (s.medium.modelled) throw GlError("the path tracer does not trace the modelled cloud yet (cloud_model data is traced)");
   const bool noise = s.medium.noise_amount > 0.0;
   if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
   const std::size_t n = static_cast<std::size_t>(cam.width) * static_cast<std::size_t>(cam.height);

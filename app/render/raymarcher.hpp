@@ -178,6 +178,9 @@ class GpuRaymarcher {
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
   GLuint ms_[2] = {0, 0};           // the two-stream source (R32F x2), built for ms_key_ on ms_volume_
+  GLuint fraction_ = 0;             // the modelled cloud's cover (R32F 3-D), uploaded for fraction_volume_ when used
+  const core::PreparedVolume* fraction_volume_ = nullptr;
+  GLuint detail_table_ = 0;         // the modelled cloud's table (RG32F, CV_DETAIL_COVERS + 1 texels), with the noise
   core::MsSourceKey ms_key_;
   const core::PreparedVolume* ms_volume_ = nullptr;
   double ms_build_ms_ = 0.0;

@@ -898,13 +898,16 @@ int run_viewer(const ViewerOptions& o) {
     for (std::size_t i = 0; i < gpus.size(); ++i) {
       ViewGpu& v = *gpus[i];
       const core::Scene& sc = scene_of(static_cast<int>(i));
-      if (frame == 0 || !same_march(sc, v.previous) || v.path_mode != s.path_trace) {
+      // The path tracer does not trace the modelled cloud yet: such a view is marched (the Quality
+      // panel says so).
+      const bool tracing = s.path_trace && !sc.render.march.medium.modelled;
+      if (frame == 0 || !same_march(sc, v.previous) || v.path_mode != tracing) {
         v.accumulated = 0;
         v.paths = core::MonteCarloImage{};
       }
-      v.path_mode = s.path_trace;
+      v.path_mode = tracing;
       v.previous = sc;
-      v.marching = v.accumulated < (s.path_trace ? s.path_spp : sc.render.accumulate);
+      v.marching = v.accumulated < (tracing ? s.path_spp : sc.render.accumulate);
       any_march = any_march || v.marching;
       const int w = v.spec.march_camera.width, h = v.spec.march_camera.height;
       if (v.presenter.width() != w || v.presenter.height() != h) v.presenter.resize(w, h);
@@ -951,7 +954,7 @@ int run_viewer(const ViewerOptions& o) {
         ++v.accumulated;
         // The automatic exposure from the mean at the march size (as `render` takes it), when the mean
         // starts and when it is complete: not frame by frame, so the picture does not pulse.
-        const int target = v.path_mode ? s.path_spp : sc.render.accumulate;
+        const int target = v.path_mode ? s.path_spp : sc.render.accumulate;  // (as above)
         if (v.spec.auto_exposure && (v.accumulated == 1 || v.accumulated == target)) {
           std::vector<glm::vec4> mean(static_cast<std::size_t>(v.presenter.width()) * v.presenter.height());
           glGetTextureImage(v.presenter.mean_texture(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(mean.size() * sizeof(glm::vec4)),
@@ -985,7 +988,7 @@ int run_viewer(const ViewerOptions& o) {
     if (main_view.path_mode && main_view.paths.spp >= 2 && show_ui) stats.path_error = main_view.paths.mean_relative_standard_error();
     stats.march_w = mw;
     stats.march_h = mh;
-    if (show_ui) draw_stats_overlay(stats, s.path_trace ? s.path_spp : s.scene.render.accumulate);  // built after the march: this frame's count
+    if (show_ui) draw_stats_overlay(stats, main_view.path_mode ? s.path_spp : s.scene.render.accumulate);  // built after the march: this frame's count
     // Each view's label (its file and valid time) at the bottom of the part that shows, and the
     // swipe divider; also with the panels hidden, when there are several views.
     s.views.labels.resize(static_cast<std::size_t>(n_views));

@@ -49,13 +49,14 @@ using namespace cv::physics::f64;
 #define CV_INOUT(T) T&
 
 struct MarchKernel : MarchParams {
-  sampler3D u_liquid, u_ice, u_noise_low, u_noise_high, u_ms_i0, u_ms_i1;
-  sampler2D u_column_tau, u_jitter_mask, u_ground, u_depth, u_opaque, u_tl_distance, u_tl_color;
+  sampler3D u_liquid, u_ice, u_noise_low, u_noise_high, u_ms_i0, u_ms_i1, u_fraction;
+  sampler2D u_column_tau, u_jitter_mask, u_ground, u_depth, u_opaque, u_tl_distance, u_tl_color, u_detail_table;
   const glm::vec2* u_min_max = nullptr;
   // The program switches (compile-time constants on the GPU).
   bool kSkipEmpty = true, kAdaptive = false, kAtmosphere = false, kGlobe = false, kNoise = false, kTwoStream = false,
        kTranslucent = false, kLayerMask = true,  // the CPU pays nothing for a uniform branch: the mask follows u_mask_band
-       kTint = true;                             // and the tint follows u_tint
+       kTint = true,                             // and the tint follows u_tint
+       kModelled = false;
 
 #include "kernel/march.glsl"
 

@@ -91,6 +91,17 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
     p.u_noise_period = s.medium.noise_scale_m;
     p.u_noise_amount = s.medium.noise_amount;
   }
+  if (s.medium.modelled) {
+    // Whole noise tiles per grid cell, each about detail_scale_m wide at the grid's middle latitude;
+    // one tile per level spacing in altitude.
+    const double deg = 3.14159265358979323846 / 180.0;
+    const double mid_lat = grid.lat_deg.start + 0.5 * grid.lat_deg.step * (grid.lat_deg.count - 1);
+    const double dx_m = std::abs(grid.lon_deg.step) * deg * r0 * std::max(std::cos(mid_lat * deg), 0.05);
+    const double dy_m = std::abs(grid.lat_deg.step) * deg * r0;
+    auto tiles = [&](double cell_m) { return std::max(1.0, std::round(cell_m / s.medium.detail_scale_m)); };
+    p.u_detail_tiles = {tiles(dx_m), tiles(dy_m), 1.0};
+    p.u_has_fraction = v.extinction.fraction.size() == grid.points();
+  }
   p.u_ground_size = ground_size;
   // Float's largest finite value bounds it, so the GPU's copy is never Inf.
   p.u_sun_tau_limit = std::min(3.0e38, physics::f64::sun_march_tau_limit(s.quality.octaves, s.medium.octave_a, s.quality.min_transmittance));

@@ -25,7 +25,24 @@ struct NoiseTexture {
 struct ErosionNoise {
   NoiseTexture low;   // Perlin fBm dilated by inverted-Worley fBm ("Perlin-Worley")
   NoiseTexture high;  // inverted-Worley fBm, repeated 4 times per low-frequency tile
+  // The modelled cloud's table over these tiles (detail_table): (threshold, ramp mean) per cover;
+  // empty until a caller that draws the modelled cloud makes it (with_detail_table).
+  std::vector<float> detail;
 };
+
+// The modelled cloud's table (shaders/common/detail.glsl): for each cover c = (k / CV_DETAIL_COVERS)^2
+// (k = 0..CV_DETAIL_COVERS), the threshold t(c) of the noise n = detail_noise_mix(low, high) above
+// which a share c of the tile lies, and the tile's mean m(c) of detail_ramp(n, t(c)). The tile's
+// distribution of n is taken over `samples` uniform random points of the low-frequency tile (a fixed
+// sequence), interpolated as the kernel interpolates the textures. 2 (CV_DETAIL_COVERS + 1) floats,
+// (t, m) per cover; t(0) is the largest n (no cloud), t(1) the smallest.
+std::vector<float> detail_table(const NoiseTexture& low, const NoiseTexture& high, std::size_t samples = std::size_t(1) << 22,
+                                unsigned threads = 0);
+// noise with its detail table made (once: an existing table is kept).
+inline ErosionNoise& with_detail_table(ErosionNoise& noise) {
+  if (noise.detail.empty()) noise.detail = detail_table(noise.low, noise.high);
+  return noise;
+}
 
 // Generates both textures (low_n^3 and high_n^3 texels), using up to `threads` threads
 // (0: the hardware's count).

@@ -98,6 +98,9 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
       ground_map_(ground_map) {
   if (mc.max_bounces < 1) throw std::invalid_argument("monte carlo: max_bounces must be >= 1");
   if (march.medium.noise_amount > 0.0 && !noise) throw std::invalid_argument("monte carlo: noise_amount > 0 needs the erosion noise textures");
+  // Its extinction exceeds the data's in-cloud values by the ramp's 1 / m(c), which the tracking's
+  // majorants do not bound yet.
+  if (march.medium.modelled) throw std::invalid_argument("monte carlo: cloud_model modelled is not traced yet (the data's field is)");
   // The medium as the march kernel reads it (shaders/kernel/march.glsl medium_at_point), erosion
   // included, and the kernel's tracking (tracking.glsl) over it.
   volume_ = std::make_shared<const PreparedVolume>(prepare_volume(grid, ext));

@@ -26,6 +26,9 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   const bool eroded = s.medium.noise_amount > 0.0;
   if (eroded && !noise) throw std::invalid_argument("render_reference: noise_amount > 0 needs the erosion noise textures");
   if (eroded && !(s.medium.noise_scale_m > 0.0)) throw std::invalid_argument("render_reference: noise_scale_m must be > 0");
+  if (s.medium.modelled && (!noise || noise->detail.empty())) {
+    throw std::invalid_argument("render_reference: cloud_model modelled needs the erosion noise textures and their detail table");
+  }
   // The very kernel the GPU runs (shaders/kernel/march.glsl), in double, over the same texels.
   kernel::f64::MarchKernel k;
   static_cast<kernel::MarchParams&>(k) =
@@ -47,7 +50,11 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   const BlueNoiseMask& mask = step_jitter_mask();
   k.u_jitter_mask = {mask.values.data(), {mask.n, mask.n}, 1};
   if (ground_map) k.u_ground = {ground_map->rgba.data(), {ground_map->width, ground_map->height}, 4};
-  if (eroded) {
+  if (s.medium.modelled) {  // the modelled cloud: the cover per node and the table over the noise tiles
+    if (k.u_has_fraction) k.u_fraction = {v.extinction.fraction.data(), n};
+    k.u_detail_table = {noise->detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
+  }
+  if (eroded || s.medium.modelled) {
     k.u_noise_low = {noise->low.texels.data(), glm::ivec3(noise->low.n)};
     k.u_noise_high = {noise->high.texels.data(), glm::ivec3(noise->high.n)};
   }
@@ -70,6 +77,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   k.kNoise = eroded;
   k.kTwoStream = s.medium.ms_two_stream;
   k.kTranslucent = k.u_tl_count > 0;
+  k.kModelled = s.medium.modelled;
 
   ReferenceImage img;
   img.width = cam.width;

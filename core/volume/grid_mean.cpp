@@ -33,6 +33,10 @@ GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepDa
   product(data[Field::ExtinctionLiquid], m.liquid_per_m);
   product(data[Field::ExtinctionIce], m.ice_per_m);
   if (data.ground_m.size() == grid.columns()) m.ground_m = data.ground_m;
+  if (cf.size() == grid.points()) {
+    m.fraction.resize(cf.size());
+    for (std::size_t p = 0; p < cf.size(); ++p) m.fraction[p] = cf[p] > 0.0f ? std::min(cf[p], 1.0f) : 0.0f;  // NaN -> 0
+  }
   return m;
 }
 

@@ -18,6 +18,9 @@ struct GridMeanExtinction {
   // The ground's altitude per column (m; the step's TimeStepData::ground_m), empty without terrain:
   // layer masks measure heights above it (march_settings.def, layer_bottom_m).
   std::vector<float> ground_m{};
+  // The cloud fraction per node (0..1; NaN as 0), empty where the file has none: the modelled
+  // cloud (cloud_model "modelled", march.glsl detail_factor) makes that share of each cell cloudy.
+  std::vector<float> fraction{};
 };
 // Extinctions from this up are not data but fill values left in a field (netCDF's default float
 // fill is 9.96921e36): the densest fog is ~0.1 /m, and float sums of sigma x phase (up to 1.6e5 /sr

@@ -260,6 +260,7 @@ GridMeanExtinction interpolate_extinction(const VolumeGrid& grid, const GridMean
   } else if (mode == TimeInterpolation::Linear) {
     out.liquid_per_m = blend(e0.liquid_per_m, e1.liquid_per_m, fraction);
     out.ice_per_m = blend(e0.ice_per_m, e1.ice_per_m, fraction);
+    if (!e0.fraction.empty() && !e1.fraction.empty()) out.fraction = blend(e0.fraction, e1.fraction, fraction);
   } else {
     const CellWinds c0 = cell_winds(grid, w0), c1 = cell_winds(grid, w1);
     const double cmax = std::max(c0.max_cells_per_s, c1.max_cells_per_s);
@@ -281,6 +282,13 @@ GridMeanExtinction interpolate_extinction(const VolumeGrid& grid, const GridMean
       r.rescale[0][species] = conserve(grid, *or_zeros(*src0[species]), from0[species]);
       r.rescale[1][species] = conserve(grid, *or_zeros(*src1[species]), from1[species]);
       *outs[species] = blend(from0[species], from1[species], fraction);
+    }
+    // The cloud fraction (the modelled cloud's cover) moves with the same flow; it is a share, not
+    // an amount, so it is not rescaled.
+    if (!e0.fraction.empty() && !e1.fraction.empty()) {
+      const std::vector<std::vector<float>> f0 = advect_with(grid, {&e0.fraction}, c0, c1, gap_s, fraction, 0, n0);
+      const std::vector<std::vector<float>> f1 = advect_with(grid, {&e1.fraction}, c0, c1, gap_s, fraction, 1, n1);
+      out.fraction = blend(f0[0], f1[0], fraction);
     }
   }
   r.cost_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

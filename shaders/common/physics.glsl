@@ -14,6 +14,7 @@
 #include "geodesy.glsl"
 #include "volume_coords.glsl"
 #include "erosion.glsl"
+#include "detail.glsl"
 #include "atmosphere.glsl"
 #include "ground.glsl"
 #include "march_control.glsl"

@@ -27,6 +27,8 @@ layout(binding = CV_TEX_TL_DISTANCE) uniform sampler2D u_tl_distance;
 layout(binding = CV_TEX_TL_COLOR) uniform sampler2D u_tl_color;
 layout(binding = CV_TEX_MS_I0) uniform sampler3D u_ms_i0;  // two-stream diffuse radiance per unit irradiance
 layout(binding = CV_TEX_MS_I1) uniform sampler3D u_ms_i1;  // its first moment (upward)
+layout(binding = CV_TEX_FRACTION) uniform sampler3D u_fraction;  // cloud fraction per node (the modelled cloud's cover)
+layout(binding = CV_TEX_DETAIL_TABLE) uniform sampler2D u_detail_table;  // (threshold, ramp mean) by cover (core/kernel/detail)
 // The extinction pyramid: (min, max) per brick, levels one after the other, x fastest.
 layout(std430, binding = CV_SSBO_PYRAMID) readonly buffer Pyramid { vec2 u_min_max[]; };
 // Per-frame counters (MarchStats), each as (low, high) 32-bit words.
@@ -63,6 +65,9 @@ uint g_stats[CV_STAT_COUNT] = uint[CV_STAT_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u
 #ifndef CV_TINT
 #define CV_TINT 0
 #endif
+#ifndef CV_MODELLED
+#define CV_MODELLED 0
+#endif
 const bool kSkipEmpty = CV_SKIP_EMPTY != 0;
 const bool kAdaptive = CV_ADAPTIVE != 0;
 const bool kAtmosphere = CV_ATMOSPHERE != 0;
@@ -72,3 +77,4 @@ const bool kTwoStream = CV_TWO_STREAM != 0;  // the two-stream source; else the 
 const bool kTranslucent = CV_TRANSLUCENT != 0;  // translucent geometry composited among the samples
 const bool kLayerMask = CV_LAYER_MASK != 0;     // a height band masks the medium (u_mask_band)
 const bool kTint = CV_TINT != 0;                // false colour by liquid and ice (u_tint)
+const bool kModelled = CV_MODELLED != 0;        // the modelled cloud: sub-grid detail keeping each cell's means

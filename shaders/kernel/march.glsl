@@ -71,6 +71,29 @@ CV_FN void erode_at(real3 p, CV_INOUT(real) sl, CV_INOUT(real) si) {
   si = erode_extinction(si, e, feature_m);
 }
 
+// The modelled cloud (kModelled; shaders/common/detail.glsl, docs/physics.md "The modelled cloud"):
+// the factor by which the data's grid-mean extinction at grid index f is redistributed inside its
+// cell. The noise lies in whole tiles per cell (u_detail_tiles along lon, lat and altitude), so a
+// cell holds the tile's distribution of it; the cover c is the data's cloud fraction at f (1 without
+// one); the table gives the threshold t(c) above which a share c of the tile lies and the tile's
+// mean m(c) of the ramp above it. So (1 - a) + a h / m keeps the cell's mean extinction for any
+// amount a, and with a = 1 the cloudy share of the cell is its cover.
+CV_FN real detail_factor(real3 f) {
+  real c = u_has_fraction ? clamp(fetch(u_fraction, f), real(0.0), real(1.0)) : real(1.0);
+  real x = sqrt(c) * real(CV_DETAIL_COVERS);  // the table's covers are (k / N)^2
+  int i = min(int(x), CV_DETAIL_COVERS - 1);
+  real w = x - real(i);
+  real4 e0 = real4(texelFetch(u_detail_table, ivec2(i, 0), 0));
+  real4 e1 = real4(texelFetch(u_detail_table, ivec2(i + 1, 0), 0));
+  real t = mix(e0.x, e1.x, w);
+  real m = mix(e0.y, e1.y, w);
+  real3 tc = fract(f * u_detail_tiles);
+  tc.z = real(1.0) - abs(real(2.0) * tc.z - real(1.0));  // mirrored about each tile's middle height
+  real n = detail_noise_mix(fetch_noise(u_noise_low, tc), fetch_noise(u_noise_high, noise_high_coords(tc)));
+  real g = m > real(0.0) ? detail_ramp(n, t) / m : real(0.0);
+  return real(1.0) - u_detail_amount + u_detail_amount * g;
+}
+
 // The column map at grid index f: the column's vertical optical depth (x) and the ground's
 // altitude in metres (y), bilinear with the 3-D fetch's horizontal rules (wrap, pole clamp,
 // regional border 0), from the prepared volume's column map (u_column_tau, two channels).
@@ -149,6 +172,11 @@ CV_FN void medium_in(real3 p, real3 g, real alt_m, CV_OUT(real) sl, CV_OUT(real)
   // fetch` in a branch of its own, which llvmpipe runs under a mask at every view and sun sample.
   sl = fetch(u_liquid, f) * (u_hide_liquid ? real(0.0) : real(1.0));
   si = fetch(u_ice, f) * (u_hide_ice ? real(0.0) : real(1.0));
+  if (kModelled && sl + si > real(0.0)) {
+    real k = detail_factor(f);
+    sl *= k;
+    si *= k;
+  }
   if (kNoise && sl + si > real(0.0)) erode_at(p, sl, si);
 }
 

@@ -62,6 +62,9 @@ CV_PARAM(bool, u_mask_sea_level)     // heights above sea level, else above the 
 CV_PARAM(bool, u_mask_band)          // the band hides something (not the whole column)
 CV_PARAM(bool, u_hide_liquid)
 CV_PARAM(bool, u_hide_ice)
+CV_PARAM(real3, u_detail_tiles)      // modelled cloud: noise tiles per grid cell along lon, lat, altitude (whole numbers)
+CV_PARAM(real, u_detail_amount)      // 0: the data's field, 1: the whole sub-grid shape (march_settings.def)
+CV_PARAM(bool, u_has_fraction)       // u_fraction holds the cloud fraction; else the cover is 1 where there is cloud
 CV_PARAM(ivec4, u_level_nodes)       // grid nodes per brick side, finest level first
 CV_PARAM(ivec4, u_level_offset)      // first brick of each level in u_min_max
 CV_PARAM_ARRAY(ivec4, u_bricks, 4)   // bricks per axis (xyz), finest level first

@@ -1,0 +1,266 @@
+// The modelled cloud (issue 18, item 2; docs/physics.md "The modelled cloud"): sub-grid shapes from
+// the noise tiles that keep, in every grid cell, the data's mean extinction and its cloud cover.
+// - Cell by cell, on the sample and on real WRF and ERA5 files: the kernel's modelled extinction
+//   (march.glsl detail_factor times the data's grid-mean extinction) averaged over a fine lattice
+//   of the cell against the data's average over the same lattice, and the share of the lattice
+//   where the modelled cloud is present against the data's mean cloud fraction there.
+// - The image with the detail amount at 0 is the data mode's, bit for bit, on the GPU and the CPU.
+// - The GPU's modelled image is the CPU kernel's (the parity the other render tests hold).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "bench/standard_scenes.hpp"
+#include "importer.hpp"
+#include "kernel/march_kernel.hpp"
+#include "kernel/prepared_volume.hpp"
+#include "noise/noise.hpp"
+#include "reference/raymarcher.hpp"
+#include "render/context.hpp"
+#include "render/raymarcher.hpp"
+#include "support/real_data.hpp"
+
+namespace {
+using namespace cv;
+
+// Uniform random numbers in [0, 1) from a counter (splitmix64): the same points on every run.
+struct Uniform {
+  std::uint64_t state;
+  explicit Uniform(std::uint64_t seed) : state(seed * 0x9e3779b97f4a7c15ull + 1) {}
+  double operator()() {
+    std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return double((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+  }
+};
+
+const core::ErosionNoise& shared_noise() {
+  static const core::ErosionNoise noise = [] {
+    core::ErosionNoise n = core::make_erosion_noise();
+    return core::with_detail_table(n);
+  }();
+  return noise;
+}
+
+struct CellFigures {
+  int cells = 0;                 // cells holding cloud that were measured
+  double worst_mean = 0.0;       // largest |modelled mean / data mean - 1| over the cells
+  double worst_cover = 0.0;      // largest |modelled cover - data cover| (absolute share)
+  double total_mean = 0.0;       // modelled / data over all measured cells together, - 1
+  double p95_mean = 0.0;         // the 95th percentile of |mean error|
+};
+
+// Measures up to `max_cells` cloudy cells of `data` (cells with at least `min_nodes` of their 8
+// nodes holding cloud, spread over the grid) at `points` uniform random points each, with detail tiles of `scale_m`. (A regular
+// lattice aliases with the noise textures' texels.)
+CellFigures measure_cells(const core::VolumeGrid& grid, const core::TimeStepData& data, double scale_m, int min_nodes, int max_cells,
+                          int points) {
+  const core::PreparedVolume v = core::prepare_volume(grid, data);
+  EXPECT_EQ(v.extinction.fraction.size(), grid.points()) << "the file's cloud fraction reaches the prepared volume";
+  core::MarchSettings s;
+  s.medium.modelled = true;
+  s.medium.detail_amount = 1.0;
+  s.medium.detail_scale_m = scale_m;
+  core::Camera cam;
+  cam.width = cam.height = 1;
+  core::Sun sun;
+  kernel::f64::MarchKernel k;
+  static_cast<kernel::MarchParams&>(k) = core::march_params(v, cam, sun, s, glm::ivec2(0));
+  const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
+  k.u_liquid = {v.extinction.liquid_per_m.data(), n};
+  k.u_ice = {v.extinction.ice_per_m.data(), n};
+  k.u_fraction = {v.extinction.fraction.data(), n};
+  const core::ErosionNoise& noise = shared_noise();
+  k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
+  k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
+  k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
+  k.kModelled = true;
+  EXPECT_TRUE(k.u_has_fraction);
+
+  // The cloudy cells: all 8 nodes with extinction and fraction.
+  std::vector<glm::ivec3> cloudy;
+  auto sigma = [&](int x, int y, int z) {
+    const std::size_t i = grid.index(x, y, z);
+    return double(v.extinction.liquid_per_m[i]) + double(v.extinction.ice_per_m[i]);
+  };
+  for (int z = 0; z + 1 < n.z; ++z)
+    for (int y = 0; y + 1 < n.y; ++y)
+      for (int x = 0; x + 1 < n.x; ++x) {
+        int with = 0;
+        for (int c = 0; c < 8; ++c) with += sigma(x + (c & 1), y + ((c >> 1) & 1), z + ((c >> 2) & 1)) > 0.0;
+        if (with >= min_nodes) cloudy.emplace_back(x, y, z);
+      }
+  CellFigures out;
+  if (cloudy.empty()) return out;
+  const std::size_t stride = std::max<std::size_t>(1, cloudy.size() / static_cast<std::size_t>(max_cells));
+  std::vector<double> errors;
+  double sum_data = 0.0, sum_model = 0.0;
+  for (std::size_t c = 0; c < cloudy.size(); c += stride) {
+    const glm::ivec3 cell = cloudy[c];
+    double data_sum = 0.0, model_sum = 0.0, cover_data = 0.0, cover_model = 0.0;
+    Uniform u(c + 1);
+    for (int q = 0; q < points; ++q) {
+      const glm::dvec3 f(cell.x + u(), cell.y + u(), cell.z + u());
+      const double base = k.fetch(k.u_liquid, f) + k.fetch(k.u_ice, f);
+      const double modelled = base * k.detail_factor(f);
+      data_sum += base;
+      model_sum += modelled;
+      cover_data += std::clamp(k.fetch(k.u_fraction, f), 0.0, 1.0);
+      cover_model += modelled > 0.0 ? 1.0 : 0.0;
+    }
+    const double err = model_sum / data_sum - 1.0;
+    errors.push_back(std::abs(err));
+    out.worst_mean = std::max(out.worst_mean, std::abs(err));
+    out.worst_cover = std::max(out.worst_cover, std::abs(cover_model - cover_data) / double(points));
+    sum_data += data_sum, sum_model += model_sum;
+    ++out.cells;
+  }
+  std::sort(errors.begin(), errors.end());
+  out.p95_mean = errors[std::min(errors.size() - 1, static_cast<std::size_t>(0.95 * double(errors.size())))];
+  out.total_mean = sum_model / sum_data - 1.0;
+  return out;
+}
+
+// The issue's 2 %: asserted for every cell's cover (absolute share) and, where `mean_too`, for the
+// mean extinction over the measured cells together. Each cell's own mean is printed, not asserted:
+// within a cell the data's extinction and fraction vary (trilinearly) across the noise pattern,
+// which the construction does not cancel (docs/physics.md, "The modelled cloud": not met, 2-4 %).
+void expect_cells_keep_their_means(const char* what, const CellFigures& f, int min_cells, bool mean_too) {
+  std::printf("%s: %d cloudy cells: mean extinction worst %.2f %%, 95th percentile %.2f %%, all cells together %+.3f %%; "
+              "cover worst %.3f (absolute share)\n",
+              what, f.cells, 100.0 * f.worst_mean, 100.0 * f.p95_mean, 100.0 * f.total_mean, f.worst_cover);
+  ASSERT_GE(f.cells, min_cells);
+  if (mean_too) EXPECT_LT(std::abs(f.total_mean), 0.02);
+  EXPECT_LT(f.worst_cover, 0.02);
+}
+
+TEST(ModelledCloud, TheTableLeavesTheCoverAboveItsThreshold) {
+  const core::ErosionNoise& noise = shared_noise();
+  ASSERT_EQ(noise.detail.size(), 2u * (CV_DETAIL_COVERS + 1));
+  // Thresholds fall as the cover rises, the ramp's mean rises with it, and is at most the cover.
+  for (int c = 1; c <= CV_DETAIL_COVERS; ++c) {
+    const double t0 = noise.detail[2 * (c - 1)], t1 = noise.detail[2 * c];
+    const double m0 = noise.detail[2 * (c - 1) + 1], m1 = noise.detail[2 * c + 1];
+    EXPECT_LE(t1, t0) << c;
+    EXPECT_GE(m1, m0) << c;
+    EXPECT_LE(m1, (double(c) / CV_DETAIL_COVERS) * (double(c) / CV_DETAIL_COVERS) + 1e-6) << c;
+    EXPECT_GT(m1, 0.0) << c;
+  }
+  EXPECT_EQ(noise.detail[1], 0.0f) << "no cover, no cloud";
+}
+
+// The construction itself: at a constant cover c, over whole tiles, the factor's mean is 1 and the
+// cloud covers c of the tile (uniform random points, bounds at 4.5 standard errors of the estimate).
+TEST(ModelledCloud, AtAConstantCoverATileKeepsTheMeanAndTheCover) {
+  const core::ErosionNoise& noise = shared_noise();
+  kernel::f64::MarchKernel k;
+  k.u_grid_count = {4, 4, 4};
+  std::vector<float> frac(64, 0.0f);
+  k.u_fraction = {frac.data(), glm::ivec3(4)};
+  k.u_has_fraction = true;
+  k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
+  k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
+  k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
+  k.u_detail_tiles = {2, 3, 1};
+  k.u_detail_amount = 1.0;
+  for (double c : {0.02, 0.1, 0.3, 0.6, 0.9, 1.0}) {
+    std::fill(frac.begin(), frac.end(), float(c));
+    const int n = 1 << 19;
+    Uniform u(7);
+    double sum = 0.0, sum2 = 0.0, cover = 0.0;
+    for (int q = 0; q < n; ++q) {
+      const glm::dvec3 f(1.0 + u(), 1.0 + u(), 1.0 + u());
+      const double g = k.detail_factor(f);
+      sum += g, sum2 += g * g, cover += g > 0.0 ? 1.0 : 0.0;
+    }
+    const double mean = sum / n, se = std::sqrt(std::max(sum2 / n - mean * mean, 0.0) / n);
+    const double share = cover / n, se_share = std::sqrt(c * (1.0 - c) / n) + 1e-9;
+    std::printf("cover %.2f: mean factor %.4f +- %.4f, cloudy share %.4f\n", c, mean, se, share);
+    EXPECT_LT(std::abs(mean - 1.0), 4.5 * se + 0.005) << "cover " << c;
+    EXPECT_LT(std::abs(share - c), 4.5 * se_share + 0.002) << "cover " << c;
+  }
+}
+
+TEST(ModelledCloud, CellsOfTheSampleKeepTheirCoverAndTogetherTheirMean) {
+  auto vol = importers::import_file(CV_SAMPLE_FILE);
+  // The sample's 0.5 degree cells with tiles of about 20 km: 3 by 2 tiles per cell.
+  expect_cells_keep_their_means("sample", measure_cells(vol.grid, vol.step(1), 20000.0, 8, 30, 1 << 17), 20, true);
+}
+
+TEST(ModelledCloud, CellsOfARealWrfFileKeepTheirCover) {
+  REAL_FILE(path, "wrf_d01_allvars_cropped.nc");
+  auto vol = importers::import_file(path);
+  // The cropped WRF file holds little cloud: no cell with all 8 nodes cloudy; the cells with half
+  // of them are cloud edges, whose mean comes out 2-3 % low together (not asserted; see above).
+  expect_cells_keep_their_means("WRF", measure_cells(vol.grid, vol.step(0), 5000.0, 4, 30, 1 << 17), 5, false);
+}
+
+TEST(ModelledCloud, CellsOfARealEra5FileKeepTheirCoverAndTogetherTheirMean) {
+  REAL_FILE(path, "met-era5-cocip1.nc");
+  auto vol = importers::import_file(path);
+  expect_cells_keep_their_means("ERA5", measure_cells(vol.grid, vol.step(0), 20000.0, 8, 30, 1 << 17), 20, true);
+}
+
+// The standard stratocumulus (cloud fraction 0.1..1 in cells of 0.2 degrees) on the GPU and the CPU.
+class ModelledRender : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { ctx_ = render::make_headless_context().release(); }
+  static void TearDownTestSuite() {
+    delete ctx_;
+    ctx_ = nullptr;
+  }
+  static render::GlContext* ctx_;
+  render::ShaderLoader loader_{{CV_SHADER_DIR}};
+};
+render::GlContext* ModelledRender::ctx_ = nullptr;
+
+double largest(const std::vector<glm::dvec3>& l) {
+  double m = 0.0;
+  for (const glm::dvec3& v : l) m = std::max({m, v.x, v.y, v.z});
+  return m;
+}
+
+TEST_F(ModelledRender, DetailAmountZeroIsTheDataModeAndTheGpuMatchesTheCpu) {
+  const bench::StandardScene sc = bench::standard_scene("stratocumulus", 48, 27);
+  const core::ErosionNoise& noise = shared_noise();
+  const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
+  render::GpuRaymarcher gpu(loader_);
+  gpu.upload(sc.grid, medium);
+  gpu.upload_noise(noise);
+  core::MarchSettings data = sc.march;
+  core::MarchSettings zero = sc.march;
+  zero.medium.modelled = true;
+  zero.medium.detail_amount = 0.0;
+  zero.medium.detail_scale_m = 4000.0;
+  core::MarchSettings full = zero;
+  full.medium.detail_amount = 1.0;
+  const std::vector<glm::vec4> g_data = gpu.render(sc.camera, sc.sun, data);
+  const std::vector<glm::vec4> g_zero = gpu.render(sc.camera, sc.sun, zero);
+  const std::vector<glm::vec4> g_full = gpu.render(sc.camera, sc.sun, full);
+  const core::ReferenceImage c_data = core::render_reference(sc.grid, medium, sc.camera, sc.sun, data, &noise);
+  const core::ReferenceImage c_zero = core::render_reference(sc.grid, medium, sc.camera, sc.sun, zero, &noise);
+  const core::ReferenceImage c_full = core::render_reference(sc.grid, medium, sc.camera, sc.sun, full, &noise);
+  ASSERT_EQ(g_data.size(), c_data.radiance.size());
+  const double peak = largest(c_full.radiance);
+  ASSERT_GT(peak, 0.0);
+  int differ_full = 0;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < g_data.size(); ++i) {
+    // Amount 0: the factor is exactly 1, so the samples, and the image, are the data mode's.
+    EXPECT_EQ(c_zero.radiance[i], c_data.radiance[i]) << "pixel " << i;
+    EXPECT_EQ(glm::vec3(g_zero[i]), glm::vec3(g_data[i])) << "pixel " << i;
+    differ_full += glm::length(c_full.radiance[i] - c_data.radiance[i]) > 1e-3 * peak;
+    for (int ch = 0; ch < 3; ++ch) worst = std::max(worst, std::abs(double(g_full[i][ch]) - c_full.radiance[i][ch]) / peak);
+  }
+  std::printf("modelled stratocumulus 48x27: %d pixels differ from the data mode; GPU against CPU: worst %.2e of the brightest\n",
+              differ_full, worst);
+  EXPECT_GT(differ_full, int(g_data.size() / 4)) << "the detail changes the image";
+  EXPECT_LT(worst, 1e-3) << "the GPU's modelled image is the CPU kernel's";
+}
+
+}  // namespace
