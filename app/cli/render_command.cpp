@@ -684,6 +684,10 @@ int cmd_render(const std::vector<std::string>& args) {
   // Resolve everything the scene left automatic, so the saved scene reproduces this image exactly.
   core::FrameSpec frame = render::resolve_frame(scene, vol);
   check_view_steps(frame.march.quality.view_step_m, g.earth_radius_m, prepared->layer.empty ? g.alt_m.last() : prepared->layer.top_m);
+  if (frame.march.medium.modelled && prepared->extinction.fraction.empty()) {
+    std::printf("note: %s has no cloud fraction: the modelled cloud takes a cover of 1 wherever there is water (its shapes only "
+                "thin and thicken it)\n", scene.data.path.c_str());
+  }
   const core::Camera& cam = frame.camera;
   const core::Sun& sun = frame.sun;
   const core::ValidTime vt{instant.unix_s, instant.iso_utc};
