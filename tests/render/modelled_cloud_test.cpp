@@ -135,7 +135,9 @@ void expect_cells_keep_their_means(const char* what, const CellFigures& f, int m
               "cover worst %.3f (absolute share)\n",
               what, f.cells, 100.0 * f.worst_mean, 100.0 * f.p95_mean, 100.0 * f.total_mean, f.worst_cover);
   ASSERT_GE(f.cells, min_cells);
-  if (mean_too) EXPECT_LT(std::abs(f.total_mean), 0.02);
+  if (mean_too) {
+    EXPECT_LT(std::abs(f.total_mean), 0.02);
+  }
   EXPECT_LT(f.worst_cover, 0.02);
 }
 
