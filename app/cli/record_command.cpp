@@ -146,10 +146,6 @@ RecordArgs parse_record_args(const std::vector<std::string>& args, core::Scene& 
   if (!r.reference && (r.spp_given || r.target_error > 0.0)) {
     throw UsageError{"cloudviewer record: --spp and --target-error: found them without a path tracer, expected --quality reference"};
   }
-  if (r.reference && scene.render.march.medium.modelled) {
-    throw UsageError{"cloudviewer record: --quality reference: found render.march.cloud_model \"modelled\", expected \"data\" (the path "
-                     "tracer does not trace the modelled cloud yet)"};
-  }
   if (r.assemble && r.frames) throw UsageError{"cloudviewer record: --assemble: found it with --frames, expected one or the other"};
   if (!scene.path) {
     throw UsageError{r.scene_path + ": path: found nothing, expected a camera path {\"keyframes\": [...]} (docs/scene.md, Camera paths)"};

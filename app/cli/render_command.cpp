@@ -413,10 +413,6 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
     throw UsageError{"cloudviewer render: --pfm: found it with --quality reference, expected one or the other (the path tracer "
                      "estimates radiance, not the transmittance the PFM pair holds)"};
   }
-  if (r.reference && scene.render.march.medium.modelled) {
-    throw UsageError{"cloudviewer render: --quality reference: found render.march.cloud_model \"modelled\", expected \"data\" (the path "
-                     "tracer does not trace the modelled cloud yet)"};
-  }
   if (r.reference && r.budget_given) {
     throw UsageError{"cloudviewer render: --budget-ms: found it with --quality reference, expected one or the other"};
   }

@@ -111,6 +111,7 @@ void GpuRaymarcher::upload_noise(const core::ErosionNoise& noise) {
   // The modelled cloud's table over these tiles (threshold, ramp mean per cover).
   if (detail_table_) glDeleteTextures(1, &detail_table_);
   detail_table_ = 0;
+  detail_values_ = noise.detail;
   if (noise.detail.size() == 2 * (CV_DETAIL_COVERS + 1)) {
     glCreateTextures(GL_TEXTURE_2D, 1, &detail_table_);
     glTextureStorage2D(detail_table_, 1, GL_RG32F, CV_DETAIL_COVERS + 1, 1);
@@ -363,7 +364,7 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
                                 const std::function<void(int, int)>& on_samples) {
   if (!volume_) throw GlError("trace_paths needs upload() first");
   if (pt.max_bounces < 1) throw GlError("the path tracer needs max_bounces >= 1");
-  if (s.medium.modelled) throw GlError("the path tracer does not trace the modelled cloud yet (cloud_model data is traced)");
+  if (s.medium.modelled && !detail_table_) throw GlError("cloud_model modelled needs upload_noise() first");
   const bool noise = s.medium.noise_amount > 0.0;
   if (noise && !noise_textures_[0]) throw GlError("noise_amount > 0 needs upload_noise() first");
   const std::size_t n = static_cast<std::size_t>(cam.width) * static_cast<std::size_t>(cam.height);
@@ -383,6 +384,7 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
   variant.atmosphere = s.features.atmosphere;
   variant.noise = noise;
   variant.layer_mask = kernel::MarchVariant::of(s).layer_mask;  // a height band shown alone
+  variant.modelled = s.medium.modelled;
   const GLuint p = path_program_for(variant).id();
   core::MarchSettings paths = s;  // the paths scatter for themselves: no two-stream source is built for them
   paths.medium.ms_two_stream = false;
@@ -407,8 +409,12 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
   glUseProgram(p);
   glProgramUniform1ui(p, loc(p, "u_seed"), pt.seed);
   glProgramUniform1i(p, loc(p, "u_row_offset"), 0);
-  glProgramUniform1f(p, loc(p, "u_track_majorant"), static_cast<float>(volume_->sigma_max_per_m));
-  glProgramUniform1i(p, loc(p, "u_track_bricks"), pt.brick_majorants ? 1 : 0);
+  // The modelled cloud exceeds the data inside its shapes: its own bound, and not the pyramid's
+  // brick bounds (the data's). Float rounding of the fetch stays within the counted 1e-5.
+  const double majorant = core::medium_majorant(*volume_, s, detail_values_);
+  if (!std::isfinite(majorant)) throw GlError("the modelled cloud has extinction where the cloud fraction is 0: no majorant bounds it");
+  glProgramUniform1f(p, loc(p, "u_track_majorant"), static_cast<float>(majorant));
+  glProgramUniform1i(p, loc(p, "u_track_bricks"), pt.brick_majorants && !s.medium.modelled ? 1 : 0);
   glProgramUniform1i(p, loc(p, "u_path_max_bounces"), pt.max_bounces);
   glProgramUniform1i(p, loc(p, "u_path_roulette_after"), pt.roulette_after);
   glProgramUniform1i(p, loc(p, "u_path_peak_mis"), pt.peak_mis ? 1 : 0);

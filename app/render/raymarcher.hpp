@@ -181,6 +181,7 @@ class GpuRaymarcher {
   GLuint fraction_ = 0;             // the modelled cloud's cover (R32F 3-D), uploaded for fraction_volume_ when used
   const core::PreparedVolume* fraction_volume_ = nullptr;
   GLuint detail_table_ = 0;         // the modelled cloud's table (RG32F, CV_DETAIL_COVERS + 1 texels), with the noise
+  std::vector<float> detail_values_;  // the same table on the CPU (the path tracer's majorant)
   core::MsSourceKey ms_key_;
   const core::PreparedVolume* ms_volume_ = nullptr;
   double ms_build_ms_ = 0.0;

@@ -205,7 +205,6 @@ void quality_panel(ViewerState& s, const PanelContext& ctx) {
   // one sample per pixel per frame (no overlays, no haze in front of the clouds).
   ImGui::Checkbox("path tracer (progressive reference)", &s.path_trace);
   if (s.path_trace) ImGui::SliderInt("path samples per pixel", &s.path_spp, 1, 65536, "%d", ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
-  if (s.path_trace && s.scene.render.march.medium.modelled) ImGui::TextWrapped("the path tracer does not trace the modelled cloud yet: marched");
   march_widgets(s.scene.render.march, core::SettingGroup::Quality);
   core::RenderSettings& r = s.scene.render;
   slider_double("resolution scale", &r.resolution_scale, 0.1, 1.0, "%.2f");

@@ -531,9 +531,6 @@ int run_viewer(const ViewerOptions& o) {
   if (!o.scene || o.scale_given) s.scene.render.resolution_scale = o.scale;
   if (o.frame_budget_ms >= 0.0) s.scene.render.budget_ms = o.frame_budget_ms;
   s.path_trace = o.path_trace;
-  if (s.path_trace && s.scene.render.march.medium.modelled) {
-    std::printf("the path tracer does not trace the modelled cloud yet (render.march.cloud_model \"modelled\"): the view is marched\n");
-  }
   if (o.path_spp > 0) s.path_spp = o.path_spp;
 
   // More views (--compare, else the scene file's "views"): opened before the window, so bad input
@@ -901,9 +898,7 @@ int run_viewer(const ViewerOptions& o) {
     for (std::size_t i = 0; i < gpus.size(); ++i) {
       ViewGpu& v = *gpus[i];
       const core::Scene& sc = scene_of(static_cast<int>(i));
-      // The path tracer does not trace the modelled cloud yet: such a view is marched (the Quality
-      // panel says so).
-      const bool tracing = s.path_trace && !sc.render.march.medium.modelled;
+      const bool tracing = s.path_trace;
       if (frame == 0 || !same_march(sc, v.previous) || v.path_mode != tracing) {
         v.accumulated = 0;
         v.paths = core::MonteCarloImage{};

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <algorithm>
+#include <limits>
 #include <utility>
 
 #include "geo/geodesy.hpp"
@@ -113,6 +114,29 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
     p.u_level_offset[static_cast<int>(l)] = v.level_offset[l];
   }
   return p;
+}
+
+double medium_majorant(const PreparedVolume& v, const MarchSettings& s, const std::vector<float>& table) {
+  if (!s.medium.modelled) return v.sigma_max_per_m;
+  double k = 1.0;  // c / m(c) = 1 at full cover
+  for (std::size_t e = 1; 2 * e + 1 < table.size(); ++e) {
+    const double c = (double(e) / CV_DETAIL_COVERS) * (double(e) / CV_DETAIL_COVERS), m = table[2 * e + 1];
+    if (m > 0.0) k = std::max(k, c / m);
+  }
+  const GridMeanExtinction& x = v.extinction;
+  double in_cloud = 0.0;
+  if (x.fraction.empty()) {
+    in_cloud = v.sigma_max_per_m;  // cover 1 everywhere: s / c = s
+  } else {
+    for (std::size_t i = 0; i < x.fraction.size(); ++i) {
+      const double sum = (i < x.liquid_per_m.size() ? double(x.liquid_per_m[i]) : 0.0) + (i < x.ice_per_m.size() ? double(x.ice_per_m[i]) : 0.0);
+      if (!(sum > 0.0)) continue;
+      if (!(x.fraction[i] > 0.0f)) return std::numeric_limits<double>::infinity();
+      in_cloud = std::max(in_cloud, sum / double(x.fraction[i]));
+    }
+  }
+  const double a = std::clamp(s.medium.detail_amount, 0.0, 1.0);
+  return (1.0 - a) * v.sigma_max_per_m + a * k * in_cloud;
 }
 
 MediumMask medium_mask(const MarchSettings& s) {

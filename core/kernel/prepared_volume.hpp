@@ -35,6 +35,14 @@ struct PreparedVolume {
 };
 
 PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinction);
+
+// The largest extinction the march kernel's medium can take with these settings, the tracking's
+// majorant (1/m): the volume's largest node sum for the data's field; for the modelled cloud
+// (march.glsl detail_factor) (1 - a) max s + a K max(s_i / c_i), K the table's largest c / m(c)
+// (`detail_table` of shaders/common/detail.glsl, 2 floats per cover). Trilinear s / c is at most the
+// largest s_i / c_i of a cell's nodes (the mediant inequality), and c / m(c) is largest at a table
+// entry (convex over linear). Nodes with extinction but no fraction make it infinite.
+double medium_majorant(const PreparedVolume& v, const MarchSettings& s, const std::vector<float>& detail_table);
 inline PreparedVolume prepare_volume(const VolumeGrid& grid, const TimeStepData& data) {
   return prepare_volume(grid, grid_mean_extinction(grid, data));
 }

@@ -98,9 +98,9 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
       ground_map_(ground_map) {
   if (mc.max_bounces < 1) throw std::invalid_argument("monte carlo: max_bounces must be >= 1");
   if (march.medium.noise_amount > 0.0 && !noise) throw std::invalid_argument("monte carlo: noise_amount > 0 needs the erosion noise textures");
-  // Its extinction exceeds the data's in-cloud values by the ramp's 1 / m(c), which the tracking's
-  // majorants do not bound yet.
-  if (march.medium.modelled) throw std::invalid_argument("monte carlo: cloud_model modelled is not traced yet (the data's field is)");
+  if (march.medium.modelled && (!noise || noise->detail.empty())) {
+    throw std::invalid_argument("monte carlo: cloud_model modelled needs the erosion noise textures and their detail table");
+  }
   // The medium as the march kernel reads it (shaders/kernel/march.glsl medium_at_point), erosion
   // included, and the kernel's tracking (tracking.glsl) over it.
   volume_ = std::make_shared<const PreparedVolume>(prepare_volume(grid, ext));
@@ -114,14 +114,24 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
   k.u_ice = {volume_->extinction.ice_per_m.data(), n};
   k.u_min_max = volume_->pyramid_packed.data();
   k.kNoise = march.medium.noise_amount > 0.0;
-  if (k.kNoise) {
+  k.kModelled = march.medium.modelled;
+  if (k.kModelled) {  // the modelled cloud: the cover per node and the table over the noise tiles
+    if (k.u_has_fraction) k.u_fraction = {volume_->extinction.fraction.data(), n};
+    k.u_detail_table = {noise->detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
+  }
+  if (k.kNoise || k.kModelled) {
     k.u_noise_low = {noise->low.texels.data(), glm::ivec3(noise->low.n)};
     k.u_noise_high = {noise->high.texels.data(), glm::ivec3(noise->high.n)};
   }
   // Trilinear weights are convex, so liquid + ice anywhere is at most the largest node sum; erosion
-  // only lowers extinction (erode_extinction keeps at most the data's value).
-  k.u_track_majorant = volume_->sigma_max_per_m;
-  k.u_track_bricks = mc.brick_majorants;
+  // only lowers extinction (erode_extinction keeps at most the data's value). The modelled cloud
+  // exceeds the data inside its shapes: its own bound (medium_majorant), and no brick bounds (the
+  // pyramid's are the data's).
+  k.u_track_majorant = medium_majorant(*volume_, march, noise ? noise->detail : std::vector<float>{});
+  if (!std::isfinite(k.u_track_majorant)) {
+    throw std::invalid_argument("monte carlo: the modelled cloud has extinction where the cloud fraction is 0: no majorant bounds it");
+  }
+  k.u_track_bricks = mc.brick_majorants && !march.medium.modelled;
   k.u_path_max_bounces = mc.max_bounces;
   k.u_path_roulette_after = mc.roulette_after;
   k.u_path_peak_mis = mc.peak_mis;

@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "bench/standard_scenes.hpp"
+#include "noise/noise.hpp"
 #include "reference/monte_carlo.hpp"
 #include "render/albedo_map.hpp"
 #include "render/context.hpp"
@@ -26,19 +27,21 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 // Renders sc with `march` by the CPU Monte Carlo (ground_map: its ground, as the GPU loads it from
 // march.medium.ground_texture) and the GPU path tracer, and checks that the two agree within their
 // joint noise. Returns the GPU image's mean luminance.
-double expect_gpu_matches_cpu(const bench::StandardScene& sc, const core::MarchSettings& march, const core::AlbedoMap* ground_map) {
+double expect_gpu_matches_cpu(const bench::StandardScene& sc, const core::MarchSettings& march, const core::AlbedoMap* ground_map,
+                              const core::ErosionNoise* noise = nullptr) {
   const int spp = 48;
   const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
   core::MonteCarloSettings mc;
   mc.seed = 7;
   auto t0 = std::chrono::steady_clock::now();
-  const core::MonteCarloImage cpu = core::render_monte_carlo(sc.grid, medium, sc.camera, sc.sun, march, mc, spp, nullptr, ground_map);
+  const core::MonteCarloImage cpu = core::render_monte_carlo(sc.grid, medium, sc.camera, sc.sun, march, mc, spp, noise, ground_map);
   const double cpu_s = seconds_since(t0);
 
   auto ctx = render::make_headless_context();
   render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
   render::GpuRaymarcher gpu(loader);
   gpu.upload(sc.grid, medium);
+  if (noise) gpu.upload_noise(*noise);
   core::MonteCarloImage img;
   render::PathTraceStats extra;
   render::PathTraceSettings pt;
@@ -119,6 +122,24 @@ TEST_P(PathTracerAirGround, GpuMatchesTheCpuMonteCarloWithinTheirJointNoise) {
   const double mean = expect_gpu_matches_cpu(sc, m, &map);
   EXPECT_GT(mean, 0.0);
 }
+
+// The modelled cloud (issue 18): the tracking's majorant is its own bound (medium_majorant), no
+// brick bounds; the deck (cloud fraction 0.1..1), clouds only.
+class PathTracerModelled : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(PathTracerModelled, GpuMatchesTheCpuMonteCarloWithinTheirJointNoise) {
+  const bench::StandardScene sc = bench::standard_scene(GetParam(), 16, 9);
+  core::MarchSettings m = sc.march;
+  m.medium.modelled = true;
+  m.medium.detail_scale_m = 4000.0;
+  core::ErosionNoise noise = core::make_erosion_noise();
+  core::with_detail_table(noise);
+  const double mean = expect_gpu_matches_cpu(sc, m, nullptr, &noise);
+  EXPECT_GT(mean, 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(All, PathTracerModelled, ::testing::Values("stratocumulus"),
+                         [](const auto& info) { return info.param; });
 
 INSTANTIATE_TEST_SUITE_P(All, PathTracerAirGround, ::testing::Values("stratocumulus", "orbit_globe", "cumulus_field", "clear_sky"),
                          [](const auto& info) { return info.param; });
