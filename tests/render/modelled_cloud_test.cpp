@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -19,6 +20,7 @@
 #include "kernel/march_kernel.hpp"
 #include "kernel/prepared_volume.hpp"
 #include "noise/noise.hpp"
+#include "reference/monte_carlo.hpp"
 #include "reference/raymarcher.hpp"
 #include "render/context.hpp"
 #include "render/raymarcher.hpp"
@@ -265,4 +267,55 @@ TEST_F(ModelledRender, DetailAmountZeroIsTheDataModeAndTheGpuMatchesTheCpu) {
   EXPECT_LT(worst, 1e-3) << "the GPU's modelled image is the CPU kernel's";
 }
 
+
+// Never NaN or Inf (issue 11's "never", for the modelled cloud too): the deck with NaN, fill values
+// and negatives in its extinction and fraction, an optical depth of 100 per metre in one node and a
+// fraction of 1e-9 beside cloud, marched on the GPU and the CPU, and path-traced on the CPU (there
+// with 1 /m in that node).
+TEST_F(ModelledRender, HostileValuesGiveFinitePixels) {
+  bench::StandardScene sc = bench::standard_scene("stratocumulus", 24, 14);
+  auto& liquid = sc.data[core::Field::ExtinctionLiquid];
+  auto& cf = sc.data[core::Field::CloudFraction];
+  ASSERT_FALSE(liquid.empty());
+  ASSERT_FALSE(cf.empty());
+  const float nan = std::numeric_limits<float>::quiet_NaN(), fill = 9.96921e36f;
+  const core::VolumeGrid& g = sc.grid;
+  const int x = g.lon_deg.count / 2, y = g.lat_deg.count / 2;
+  int z = 0;
+  while (z + 1 < g.alt_m.count && !(liquid[g.index(x, y, z)] > 0.0f)) ++z;
+  liquid[g.index(x, y, z)] = nan;
+  liquid[g.index(x + 1, y, z)] = fill;
+  liquid[g.index(x + 2, y, z)] = -1.0f;
+  liquid[g.index(x + 3, y, z)] = 100.0f;
+  cf[g.index(x, y + 1, z)] = nan;
+  cf[g.index(x + 1, y + 1, z)] = fill;
+  cf[g.index(x + 2, y + 1, z)] = 1e-9f;
+  cf[g.index(x + 3, y + 1, z)] = -0.5f;
+  const core::GridMeanExtinction medium = core::grid_mean_extinction(g, sc.data);
+  core::MarchSettings m = sc.march;
+  m.medium.modelled = true;
+  m.medium.detail_scale_m = 4000.0;
+  const core::ErosionNoise& noise = shared_noise();
+  render::GpuRaymarcher gpu(loader_);
+  gpu.upload(g, medium);
+  gpu.upload_noise(noise);
+  const std::vector<glm::vec4> gi = gpu.render(sc.camera, sc.sun, m);
+  const core::ReferenceImage ci = core::render_reference(g, medium, sc.camera, sc.sun, m, &noise);
+  // The path tracer on the same values but the densest node at 1 /m: its majorant is 14 x the
+  // largest in-cloud extinction (medium_majorant), and 1 400 /m would take hours of null collisions.
+  liquid[g.index(x + 3, y, z)] = 1.0f;
+  const core::GridMeanExtinction traced = core::grid_mean_extinction(g, sc.data);
+  core::MonteCarloSettings mc;
+  const core::MonteCarloImage pi = core::render_monte_carlo(g, traced, sc.camera, sc.sun, m, mc, 2, &noise);
+  for (std::size_t i = 0; i < gi.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_TRUE(std::isfinite(gi[i][c]) && gi[i][c] >= 0.0f) << "GPU pixel " << i;
+      EXPECT_TRUE(std::isfinite(ci.radiance[i][c]) && ci.radiance[i][c] >= 0.0) << "CPU pixel " << i;
+      EXPECT_TRUE(std::isfinite(pi.mean(i)[c]) && pi.mean(i)[c] >= 0.0) << "path-traced pixel " << i;
+    }
+    EXPECT_TRUE(gi[i].w >= 0.0f && gi[i].w <= 1.0f) << "GPU transmittance " << i;
+    EXPECT_TRUE(ci.transmittance[i] >= 0.0 && ci.transmittance[i] <= 1.0) << "CPU transmittance " << i;
+  }
+  EXPECT_EQ(pi.stats.majorant_exceeded, 0u);
+}
 }  // namespace
