@@ -422,7 +422,7 @@ int cmd_record(const std::vector<std::string>& args) {
     frame = render::resolve_path_frame(scene, path, vol, k, r.fps, &at);
     const core::Instant& instant = frame.instant;
     core::TimeInterpolationReport rep;
-    renderer.use_volume(volumes.get(scene.data.path, vol, instant, at.time.interpolation, &rep));
+    renderer.use_volume(volumes.get(scene.data.path, vol, instant, at.time.interpolation, &rep, at.render.march.medium.modelled));
     if (!rep.warning.empty() && rep.warning != warned) std::printf("warning: %s\n", (warned = rep.warning).c_str());
     if (!at.overlays.empty()) {
       try {
@@ -492,7 +492,7 @@ int cmd_record(const std::vector<std::string>& args) {
         const auto t_vdb = clock::now();
         core::Scene at;
         const core::FrameSpec f = render::resolve_path_frame(scene, path, vol, k, r.fps, &at);
-        const auto prepared = volumes.get(scene.data.path, vol, f.instant, at.time.interpolation);
+        const auto prepared = volumes.get(scene.data.path, vol, f.instant, at.time.interpolation, nullptr, at.render.march.medium.modelled);
         const bool fraction = !f.instant.between() && vol.has_field[static_cast<int>(core::Field::CloudFraction)];
         core::OutputGroup group;
         vdb::write_vdb(group, vdb_file.string(), prepared->grid, prepared->extinction,

@@ -35,6 +35,7 @@
 #include "scene/instant.hpp"
 #include "scene/quality.hpp"
 #include "scene/scene_json.hpp"
+#include "kernel/detail_drift.hpp"
 #include "kernel/volume_cache.hpp"
 #include "overlays/overlays.hpp"
 #include "render/frame_renderer.hpp"
@@ -599,7 +600,7 @@ int render_series(const RenderArgs& ra, core::Scene scene) {
     scene.time.valid_utc = iso;
     const core::Instant at = core::scene_instant(scene, vol, scene.data.path);
     core::TimeInterpolationReport rep;
-    renderer.use_volume(volumes.get(scene.data.path, vol, at, scene.time.interpolation, &rep));
+    renderer.use_volume(volumes.get(scene.data.path, vol, at, scene.time.interpolation, &rep, scene.render.march.medium.modelled));
     if (!rep.warning.empty() && warned != rep.warning) std::printf("warning: %s\n", (warned = rep.warning).c_str());
     const core::FrameSpec frame = render::resolve_frame(scene, vol);
     if (i == 0) check_view_steps(frame.march.quality.view_step_m, g.earth_radius_m, g.alt_m.last());
@@ -608,7 +609,7 @@ int render_series(const RenderArgs& ra, core::Scene scene) {
     if (!exposure) exposure = render::auto_exposure(marched);
     const auto prepared_layer = renderer.raymarcher().last_stats().sun_down;
     const bool in_shadow = prepared_layer || (scene.sun.mode != core::SunMode::LocalNoon &&
-        core::layer_in_earth_shadow(g, volumes.get(scene.data.path, vol, at, scene.time.interpolation)->layer,
+        core::layer_in_earth_shadow(g, volumes.get(scene.data.path, vol, at, scene.time.interpolation, nullptr, scene.render.march.medium.modelled)->layer,
                                     glm::normalize(geo::sphere_to_ecef({frame.sun.subsolar_lat_deg, frame.sun.subsolar_lon_deg, 0.0}, g.earth_radius_m))));
     dark += in_shadow ? 1 : 0;
     if (complete_png(path)) {  // rendered only for the sequence's exposure
@@ -656,7 +657,7 @@ int cmd_render(const std::vector<std::string>& args) {
   }
   core::PreparedVolumeCache volumes;
   core::TimeInterpolationReport interp;
-  const auto prepared = volumes.get(scene.data.path, vol, instant, scene.time.interpolation, &interp);
+  const auto prepared = volumes.get(scene.data.path, vol, instant, scene.time.interpolation, &interp, scene.render.march.medium.modelled);
   const double t_load = seconds_since(t0);
   if (instant.between()) {
     const core::ValidTime& a = vol.times[instant.step0];
@@ -683,6 +684,16 @@ int cmd_render(const std::vector<std::string>& args) {
   if (frame.march.medium.modelled && prepared->extinction.fraction.empty()) {
     std::printf("note: %s has no cloud fraction: the modelled cloud takes a cover of 1 wherever there is water (its shapes only "
                 "thin and thicken it)\n", scene.data.path.c_str());
+  }
+  if (frame.march.medium.modelled) {
+    if (!vol.has_field[static_cast<int>(core::Field::WindU)] || !vol.has_field[static_cast<int>(core::Field::WindV)]) {
+      std::printf("note: %s has no horizontal winds: the modelled cloud's detail stands still\n", scene.data.path.c_str());
+    } else if (!core::times_known(vol.times)) {
+      std::printf("note: %s has no valid times: the modelled cloud's detail stands still\n", scene.data.path.c_str());
+    } else {
+      const std::string drift = core::detail_drift_note(*prepared, vol.times.front().iso_utc);
+      if (!drift.empty()) std::printf("%s\n", drift.c_str());
+    }
   }
   const core::Camera& cam = frame.camera;
   const core::Sun& sun = frame.sun;

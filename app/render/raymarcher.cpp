@@ -8,6 +8,7 @@
 
 #include "kernel/bindings.glsl"
 #include "kernel/march_stats.glsl"
+#include "kernel/detail_drift.hpp"
 #include "physics/physics.hpp"  // CV_DETAIL_COVERS (shaders/common/detail.glsl)
 #include "noise/blue_noise.hpp"
 #include "render/albedo_map.hpp"
@@ -87,6 +88,8 @@ GpuRaymarcher::~GpuRaymarcher() {
   if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
   if (fraction_) glDeleteTextures(1, &fraction_);
   if (detail_table_) glDeleteTextures(1, &detail_table_);
+  if (detail_shift_) glDeleteTextures(1, &detail_shift_);
+  if (modelled_pyramid_) glDeleteBuffers(1, &modelled_pyramid_);
   if (pyramid_buffer_) glDeleteBuffers(1, &pyramid_buffer_);
   if (stats_buffer_) glDeleteBuffers(1, &stats_buffer_);
   if (params_buffer_) glDeleteBuffers(1, &params_buffer_);
@@ -158,6 +161,7 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
   ms_[0] = ms_[1] = 0;
   ms_volume_ = nullptr;
   fraction_volume_ = nullptr;  // the modelled cloud's cover: uploaded again when a march needs it
+  modelled_pyramid_volume_ = nullptr;  // and its brick bounds
   // The pyramid for empty-space skipping and adapted steps, all levels in one buffer.
   std::vector<glm::vec2> packed = volume->pyramid_packed;
   if (packed.empty()) packed.emplace_back(0.0f, 1.0f);  // a buffer must not be empty; u_levels = 0 ignores it
@@ -236,6 +240,18 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
     check_gl("uploading the cloud fraction");
     fraction_volume_ = &v;
   }
+  if (s.medium.modelled) {  // the detail's wind displacement per level (a few hundred bytes: every frame)
+    const std::vector<float> shift = core::detail_shift_texels(v, params);
+    if (detail_shift_levels_ != grid.alt_m.count) {
+      if (detail_shift_) glDeleteTextures(1, &detail_shift_);
+      glCreateTextures(GL_TEXTURE_2D, 1, &detail_shift_);
+      glTextureStorage2D(detail_shift_, 1, GL_RG32F, grid.alt_m.count, 1);
+      detail_shift_levels_ = grid.alt_m.count;
+    }
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTextureSubImage2D(detail_shift_, 0, 0, 0, grid.alt_m.count, 1, GL_RG, GL_FLOAT, shift.data());
+    check_gl("uploading the detail's wind displacement");
+  }
   const kernel::MarchParamsStd140 block = kernel::pack_std140(params);
   if (!params_buffer_) {
     glCreateBuffers(1, &params_buffer_);
@@ -254,7 +270,20 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
   }
   const GLuint zeros[2 * kStatCounters] = {};
   glNamedBufferSubData(stats_buffer_, 0, sizeof(zeros), zeros);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PYRAMID, pyramid_buffer_);
+  if (s.medium.modelled) {  // the modelled cloud's own brick bounds (core::medium_pyramid), made once per volume and amount
+    if (modelled_pyramid_volume_ != &v || modelled_pyramid_amount_ != s.medium.detail_amount) {
+      const std::vector<glm::vec2> packed = core::medium_pyramid(v, s, detail_values_);
+      if (modelled_pyramid_) glDeleteBuffers(1, &modelled_pyramid_);
+      glCreateBuffers(1, &modelled_pyramid_);
+      glNamedBufferStorage(modelled_pyramid_, static_cast<GLsizeiptr>(std::max<std::size_t>(packed.size(), 1) * sizeof(glm::vec2)),
+                           packed.empty() ? nullptr : packed.data(), 0);
+      check_gl("uploading the modelled cloud's brick bounds");
+      modelled_pyramid_volume_ = &v, modelled_pyramid_amount_ = s.medium.detail_amount;
+    }
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PYRAMID, modelled_pyramid_);
+  } else {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PYRAMID, pyramid_buffer_);
+  }
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_STATS, stats_buffer_);
   glBindTextureUnit(CV_TEX_DEPTH, opaque.depth);
   glBindTextureUnit(CV_TEX_OPAQUE, opaque.color);
@@ -269,6 +298,7 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
   glBindTextureUnit(CV_TEX_MS_I1, ms_[1]);
   glBindTextureUnit(CV_TEX_FRACTION, fraction_);
   glBindTextureUnit(CV_TEX_DETAIL_TABLE, detail_table_);
+  glBindTextureUnit(CV_TEX_DETAIL_SHIFT, detail_shift_);
   return params;
 }
 
@@ -414,7 +444,7 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
   const double majorant = core::medium_majorant(*volume_, s, detail_values_);
   if (!std::isfinite(majorant)) throw GlError("the modelled cloud has extinction where the cloud fraction is 0: no majorant bounds it");
   glProgramUniform1f(p, loc(p, "u_track_majorant"), static_cast<float>(majorant));
-  glProgramUniform1i(p, loc(p, "u_track_bricks"), pt.brick_majorants && !s.medium.modelled ? 1 : 0);
+  glProgramUniform1i(p, loc(p, "u_track_bricks"), pt.brick_majorants ? 1 : 0);
   glProgramUniform1i(p, loc(p, "u_path_max_bounces"), pt.max_bounces);
   glProgramUniform1i(p, loc(p, "u_path_roulette_after"), pt.roulette_after);
   glProgramUniform1i(p, loc(p, "u_path_peak_mis"), pt.peak_mis ? 1 : 0);

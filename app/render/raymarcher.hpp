@@ -180,6 +180,11 @@ class GpuRaymarcher {
   GLuint ms_[2] = {0, 0};           // the two-stream source (R32F x2), built for ms_key_ on ms_volume_
   GLuint fraction_ = 0;             // the modelled cloud's cover (R32F 3-D), uploaded for fraction_volume_ when used
   const core::PreparedVolume* fraction_volume_ = nullptr;
+  GLuint detail_shift_ = 0;         // the modelled cloud's displacement per level (RG32F, detail_shift_levels_ x 1)
+  int detail_shift_levels_ = 0;
+  GLuint modelled_pyramid_ = 0;     // the modelled cloud's brick bounds (core::medium_pyramid) for modelled_pyramid_volume_
+  const core::PreparedVolume* modelled_pyramid_volume_ = nullptr;
+  double modelled_pyramid_amount_ = -1.0;
   GLuint detail_table_ = 0;         // the modelled cloud's table (RG32F, CV_DETAIL_COVERS + 1 texels), with the noise
   std::vector<float> detail_values_;  // the same table on the CPU (the path tracer's majorant)
   core::MsSourceKey ms_key_;

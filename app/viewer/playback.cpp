@@ -116,10 +116,11 @@ Prefetcher::~Prefetcher() {
   worker_.join();
 }
 
-void Prefetcher::want(const std::vector<std::int64_t>& instants, core::TimeInterpolation mode) {
+void Prefetcher::want(const std::vector<std::int64_t>& instants, core::TimeInterpolation mode, bool detail_drift) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (mode != mode_) ready_.clear();  // prepared for another mode: not what is shown now
+  if (mode != mode_ || detail_drift != drift_) ready_.clear();  // prepared for another mode: not what is shown now
   mode_ = mode;
+  drift_ = detail_drift;
   wanted_.assign(instants.begin(), instants.begin() + static_cast<std::ptrdiff_t>(std::min(instants.size(), max_resident_)));
   changed_.notify_all();
 }
@@ -167,12 +168,14 @@ void Prefetcher::run() {
       continue;
     }
     const core::TimeInterpolation mode = mode_;
+    const bool drift = drift_;
     lock.unlock();
     Ready r;
     std::string error;
     const auto t0 = std::chrono::steady_clock::now();
     try {
       const core::Instant at = core::instant_at_time(volume_.times, core::format_iso_utc(todo), scene_.data.path);
+      std::vector<double> d = drift ? detail_drift_.at(volume_, at) : std::vector<double>{};  // may load earlier steps: first
       core::GridMeanExtinction e0 = core::grid_mean_extinction(volume_.grid, volume_.step(at.step0));
       if (at.between()) {
         const core::StepWinds w0 = core::step_winds(volume_.step(at.step0));
@@ -180,6 +183,7 @@ void Prefetcher::run() {
         const core::StepWinds w1 = core::step_winds(volume_.step(at.step1));
         e0 = core::interpolate_extinction(volume_.grid, e0, e1, w0, w1, at.gap_s, at.fraction, mode, &r.report);
       }
+      e0.detail_drift_cells = std::move(d);
       r.volume = std::make_shared<const core::PreparedVolume>(core::prepare_volume(volume_.grid, std::move(e0)));
     } catch (const std::exception& e) {
       error = e.what();
@@ -192,7 +196,7 @@ void Prefetcher::run() {
       changed_.notify_all();
       continue;
     }
-    if (mode != mode_) continue;  // the mode changed meanwhile
+    if (mode != mode_ || drift != drift_) continue;  // the mode changed meanwhile
     // Room: evict what is no longer wanted (oldest instants first), never beyond the bound.
     while (ready_.size() >= max_resident_) {
       auto victim = ready_.end();

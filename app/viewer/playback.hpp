@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "frame/camera.hpp"
+#include "kernel/detail_drift.hpp"
 #include "kernel/prepared_volume.hpp"
 #include "scene/scene.hpp"
 #include "volume/cloud_volume.hpp"
@@ -74,8 +75,9 @@ class Prefetcher {
   Prefetcher& operator=(const Prefetcher&) = delete;
 
   // The instants wanted, most urgent first; those beyond max_resident are ignored. Resident instants
-  // not wanted are evicted as room is needed.
-  void want(const std::vector<std::int64_t>& instants, core::TimeInterpolation mode);
+  // not wanted are evicted as room is needed. `detail_drift`: the media carry the modelled cloud's
+  // wind displacement (core::DetailDrift).
+  void want(const std::vector<std::int64_t>& instants, core::TimeInterpolation mode, bool detail_drift = false);
   // The prepared instant if ready (counted as a hit), else nullptr (a miss). `wait`: block until ready.
   std::shared_ptr<const core::PreparedVolume> get(std::int64_t t, bool wait, core::TimeInterpolationReport* report = nullptr);
   PrefetchStats stats() const;
@@ -94,6 +96,8 @@ class Prefetcher {
   std::condition_variable changed_;
   std::vector<std::int64_t> wanted_;
   core::TimeInterpolation mode_ = core::TimeInterpolation::Auto;
+  bool drift_ = false;
+  core::DetailDrift detail_drift_;  // the worker's alone
   std::map<std::int64_t, Ready> ready_;
   PrefetchStats stats_;
   std::string error_;

@@ -185,9 +185,9 @@ struct ExtraView {
 };
 
 // What identifies a prepared instant: the source, the instant (or the step) and how it was made.
-std::string prepared_key(const std::string& source, const core::Instant& at, core::TimeInterpolation mode) {
+std::string prepared_key(const std::string& source, const core::Instant& at, core::TimeInterpolation mode, bool drift) {
   return source + (at.time_known ? "@" + std::to_string(at.unix_s) : "#" + std::to_string(at.step0)) + "/" +
-         std::to_string(static_cast<int>(mode));
+         std::to_string(static_cast<int>(mode)) + (drift ? "/drift" : "");
 }
 
 // A view's camera and time for the link: UTC seconds where the file has UTC valid times, else the step.
@@ -517,6 +517,7 @@ int run_viewer(const ViewerOptions& o) {
   if (timeline) prefetch = std::make_unique<Prefetcher>(s.scene, kResidentInstants);
   s.timeline = timeline;
   std::int64_t shown_instant = INT64_MIN;  // the instant whose medium is on the GPU
+  bool shown_drift = false;                 // whether it carries the modelled cloud's wind displacement
   bool have_volume = false;
   s.scene.width = o.width;
   s.scene.height = o.height;
@@ -775,16 +776,18 @@ int run_viewer(const ViewerOptions& o) {
         const std::vector<std::int64_t> next = s.play.upcoming(static_cast<int>(kResidentInstants) - 1);
         wanted.insert(wanted.end(), next.begin(), next.end());
       }
-      prefetch->want(wanted, s.scene.time.interpolation);
+      const bool drift = s.scene.render.march.medium.modelled;
+      prefetch->want(wanted, s.scene.time.interpolation, drift);
       core::TimeInterpolationReport interp;
-      const bool first_ask = want_t != shown_instant;
+      const bool first_ask = want_t != shown_instant || drift != shown_drift;
       auto v = first_ask ? prefetch->get(want_t, (o.frames > 0 && !o.realtime) || !have_volume, &interp) : nullptr;
       if (v) {
         renderer.use_volume(v);
         core::Instant shown_at;
         shown_at.time_known = true, shown_at.unix_s = want_t;
-        shown0 = v, shown0_key = prepared_key(s.scene.data.path, shown_at, s.scene.time.interpolation);
+        shown0 = v, shown0_key = prepared_key(s.scene.data.path, shown_at, s.scene.time.interpolation, drift);
         shown_instant = want_t;
+        shown_drift = drift;
         // The step slider shows the step at or before the instant.
         s.scene.time_step = static_cast<int>(core::instant_at_time(s.volume.times, s.scene.time.valid_utc, s.scene.data.path).step0);
         have_volume = true;
@@ -814,8 +817,9 @@ int run_viewer(const ViewerOptions& o) {
         at = core::instant_at_step(s.volume.times, static_cast<std::size_t>(s.scene.time_step), s.scene.data.path);
       }
       core::TimeInterpolationReport interp;
-      shown0 = volumes.get(s.scene.data.path, s.volume, at, s.scene.time.interpolation, &interp);
-      shown0_key = prepared_key(s.scene.data.path, at, s.scene.time.interpolation);
+      const bool drift = s.scene.render.march.medium.modelled;
+      shown0 = volumes.get(s.scene.data.path, s.volume, at, s.scene.time.interpolation, &interp, drift);
+      shown0_key = prepared_key(s.scene.data.path, at, s.scene.time.interpolation, drift);
       renderer.use_volume(shown0);
       ctx.time_warning = interp.warning;
       ctx.instant_text = at.iso_utc + (at.between() ? std::string(" (") + core::time_interpolation_name(interp.used) + " between steps)" : "");
@@ -878,13 +882,14 @@ int run_viewer(const ViewerOptions& o) {
         at = core::instant_at_step(v.volume->times, static_cast<std::size_t>(v.scene.time_step), v.scene.data.path);
       }
       v.scene.time_step = static_cast<int>(at.step0);
-      const std::string key = prepared_key(v.scene.data.path, at, v.scene.time.interpolation);
+      const bool drift = v.scene.render.march.medium.modelled;
+      const std::string key = prepared_key(v.scene.data.path, at, v.scene.time.interpolation, drift);
       if (key != v.prepared_key) {
         v.prepared = key == shown0_key ? shown0 : nullptr;
         for (const ExtraView& other : extra) {
           if (!v.prepared && &other != &v && other.prepared_key == key) v.prepared = other.prepared;
         }
-        if (!v.prepared) v.prepared = volumes.get(v.scene.data.path, *v.volume, at, v.scene.time.interpolation);
+        if (!v.prepared) v.prepared = volumes.get(v.scene.data.path, *v.volume, at, v.scene.time.interpolation, nullptr, drift);
         v.prepared_key = key;
       }
       v.gpu->renderer.use_volume(v.prepared);

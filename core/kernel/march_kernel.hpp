@@ -50,7 +50,7 @@ using namespace cv::physics::f64;
 
 struct MarchKernel : MarchParams {
   sampler3D u_liquid, u_ice, u_noise_low, u_noise_high, u_ms_i0, u_ms_i1, u_fraction;
-  sampler2D u_column_tau, u_jitter_mask, u_ground, u_depth, u_opaque, u_tl_distance, u_tl_color, u_detail_table;
+  sampler2D u_column_tau, u_jitter_mask, u_ground, u_depth, u_opaque, u_tl_distance, u_tl_color, u_detail_table, u_detail_shift;
   const glm::vec2* u_min_max = nullptr;
   // The program switches (compile-time constants on the GPU).
   bool kSkipEmpty = true, kAdaptive = false, kAtmosphere = false, kGlobe = false, kNoise = false, kTwoStream = false,

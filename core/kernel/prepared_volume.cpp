@@ -139,6 +139,57 @@ double medium_majorant(const PreparedVolume& v, const MarchSettings& s, const st
   return (1.0 - a) * v.sigma_max_per_m + a * k * in_cloud;
 }
 
+std::vector<glm::vec2> medium_pyramid(const PreparedVolume& v, const MarchSettings& s, const std::vector<float>& table) {
+  if (!s.medium.modelled) return v.pyramid_packed;
+  const GridMeanExtinction& x = v.extinction;
+  const std::size_t n = v.grid.points();
+  constexpr float kHuge = 3.0e38f;  // extinction without a fraction to bound it: never skipped, never a small step
+  std::vector<float> ratio(n, 0.0f), cover(n, 1.0f);
+  const bool has_fraction = x.fraction.size() == n;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double sum = (i < x.liquid_per_m.size() ? double(x.liquid_per_m[i]) : 0.0) + (i < x.ice_per_m.size() ? double(x.ice_per_m[i]) : 0.0);
+    const double c = has_fraction ? std::clamp(double(x.fraction[i]), 0.0, 1.0) : 1.0;  // NaN -> 0 (prepare_volume made none)
+    cover[i] = static_cast<float>(c);
+    if (!(sum > 0.0)) continue;
+    // Rounded up, so the float bound is not below the double ratio.
+    ratio[i] = c > 0.0 ? static_cast<float>(std::min(sum / c * (1.0 + 1e-6), double(kHuge))) : kHuge;
+  }
+  // Each brick's largest ratio, and its smallest and largest cover, over the same dilated nodes.
+  const ExtinctionPyramid pr(v.grid, ratio, {}), pc(v.grid, cover, {});
+  // K over table entries e0..e1: the largest c / m(c) (1 at full cover).
+  const int covers = int(table.size() / 2) - 1;
+  auto k_between = [&](double lo, double hi) {
+    if (covers < 1) return double(kHuge);
+    const int e0 = std::clamp(int(std::floor(std::sqrt(std::max(lo, 0.0)) * covers)), 0, covers);
+    const int e1 = std::clamp(int(std::ceil(std::sqrt(std::min(hi, 1.0)) * covers)), e0, covers);
+    double k = 1.0;
+    for (int e = std::max(e0, 1); e <= e1; ++e) {
+      const double c = (double(e) / covers) * (double(e) / covers), m = table[2 * std::size_t(e) + 1];
+      if (m > 0.0) k = std::max(k, c / m);
+    }
+    return k;
+  };
+  const double a = std::clamp(s.medium.detail_amount, 0.0, 1.0);
+  std::vector<glm::vec2> out;
+  out.reserve(v.pyramid_packed.size());
+  const auto& ls = v.pyramid.levels();
+  for (std::size_t l = 0; l < ls.size(); ++l) {
+    const auto& S = ls[l].min_max;
+    const auto& R = pr.levels()[l].min_max;
+    const auto& C = pc.levels()[l].min_max;
+    for (std::size_t b = 0; b < S.size(); ++b) {
+      double bound = 0.0;
+      if (R[b].y > 0.0f) {
+        const double c_lo = C[b].x, c_hi = C[b].y;
+        const double r = double(R[b].y) >= double(kHuge) ? double(kHuge) : double(R[b].y) * k_between(c_lo, c_hi);
+        bound = std::min((1.0 - a) * double(S[b].y) + a * r, double(kHuge));
+      }
+      out.emplace_back(0.0f, static_cast<float>(bound * (1.0 + 1e-6)));
+    }
+  }
+  return out;
+}
+
 MediumMask medium_mask(const MarchSettings& s) {
   MediumMask m;
   m.hide_liquid = s.medium.hide_liquid;

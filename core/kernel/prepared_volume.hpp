@@ -43,6 +43,16 @@ PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinct
 // largest s_i / c_i of a cell's nodes (the mediant inequality), and c / m(c) is largest at a table
 // entry (convex over linear). Nodes with extinction but no fraction make it infinite.
 double medium_majorant(const PreparedVolume& v, const MarchSettings& s, const std::vector<float>& detail_table);
+
+// The pyramid's bricks for the medium the kernel draws with these settings, packed as
+// PreparedVolume::pyramid_packed (the kernel's u_min_max: only the max, .y, is read): the prepared
+// pyramid itself in the data mode; for the modelled cloud each brick's bound
+// (1 - a) max s + a max(s_i / c_i) K(c_lo, c_hi) over the brick's dilated nodes, K the table's
+// largest c / m(c) between the brick's smallest and largest cover (convex over linear: largest at
+// a table entry, so the entries bracketing [c_lo, c_hi] bound it). A brick without cloud stays 0
+// (the same empty space), a node with extinction but no fraction makes its bricks 3e38. So the
+// tracking can use brick majorants, and the march's adapted steps its bounds, in this mode too.
+std::vector<glm::vec2> medium_pyramid(const PreparedVolume& v, const MarchSettings& s, const std::vector<float>& detail_table);
 inline PreparedVolume prepare_volume(const VolumeGrid& grid, const TimeStepData& data) {
   return prepare_volume(grid, grid_mean_extinction(grid, data));
 }

@@ -6,13 +6,15 @@
 namespace cv::core {
 
 std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string& source, CloudVolume& volume, const Instant& at,
-                                                               TimeInterpolation mode, TimeInterpolationReport* report) {
+                                                               TimeInterpolation mode, TimeInterpolationReport* report,
+                                                               bool detail_drift) {
   if (!at.between()) {
     if (report) *report = TimeInterpolationReport{};
-    return get(source, volume, at.step0);
+    return get(source, volume, at.step0, detail_drift);
   }
   const auto it = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) {
-    return e.source == source && e.step == at.step0 && e.step1 == at.step1 && e.fraction == at.fraction && e.mode == mode;
+    return e.source == source && e.step == at.step0 && e.step1 == at.step1 && e.fraction == at.fraction && e.mode == mode &&
+           e.drift == detail_drift;
   });
   if (it != entries_.end()) {
     Entry e = *it;
@@ -21,14 +23,17 @@ std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string
     if (report) *report = e.report, report->cost_ms = 0.0;
     return e.volume;
   }
-  // Each step's medium and winds taken before the next step is loaded (which may evict it).
+  // The drift first: it may load earlier steps. Then each step's medium and winds taken before the
+  // next step is loaded (which may evict it).
+  std::vector<double> drift = detail_drift ? drift_.at(volume, at) : std::vector<double>{};
   const GridMeanExtinction e0 = grid_mean_extinction(volume.grid, volume.step(at.step0));
   const StepWinds w0 = step_winds(volume.step(at.step0));
   const GridMeanExtinction e1 = grid_mean_extinction(volume.grid, volume.step(at.step1));
   const StepWinds w1 = step_winds(volume.step(at.step1));
   Entry e;
-  e.source = source, e.step = at.step0, e.step1 = at.step1, e.fraction = at.fraction, e.mode = mode;
+  e.source = source, e.step = at.step0, e.step1 = at.step1, e.fraction = at.fraction, e.mode = mode, e.drift = detail_drift;
   GridMeanExtinction mixed = interpolate_extinction(volume.grid, e0, e1, w0, w1, at.gap_s, at.fraction, mode, &e.report);
+  mixed.detail_drift_cells = std::move(drift);
   e.volume = std::make_shared<const PreparedVolume>(prepare_volume(volume.grid, std::move(mixed)));
   ++prepared_;
   entries_.push_back(e);
@@ -37,19 +42,29 @@ std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string
   return e.volume;
 }
 
-std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string& source, CloudVolume& volume, std::size_t step) {
-  const auto it = std::find_if(entries_.begin(), entries_.end(),
-                               [&](const Entry& e) { return e.source == source && e.step == step && e.step1 == step; });
+std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string& source, CloudVolume& volume, std::size_t step,
+                                                               bool detail_drift) {
+  const auto it = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) {
+    return e.source == source && e.step == step && e.step1 == step && e.drift == detail_drift;
+  });
   if (it != entries_.end()) {
     Entry e = *it;
     entries_.erase(it);
     entries_.push_back(e);
     return e.volume;
   }
-  auto v = std::make_shared<const PreparedVolume>(prepare_volume(volume.grid, volume.step(step)));
+  std::vector<double> drift;
+  if (detail_drift) {  // before the step is taken: the drift may load earlier steps
+    Instant at;
+    at.step0 = at.step1 = step;
+    drift = drift_.at(volume, at);
+  }
+  GridMeanExtinction medium = grid_mean_extinction(volume.grid, volume.step(step));
+  medium.detail_drift_cells = std::move(drift);
+  auto v = std::make_shared<const PreparedVolume>(prepare_volume(volume.grid, std::move(medium)));
   ++prepared_;
   Entry e;
-  e.source = source, e.step = e.step1 = step, e.volume = v;
+  e.source = source, e.step = e.step1 = step, e.drift = detail_drift, e.volume = v;
   entries_.push_back(e);
   if (entries_.size() > kResident) entries_.erase(entries_.begin());
   return v;

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "kernel/detail_drift.hpp"
 #include "kernel/prepared_volume.hpp"
 #include "scene/instant.hpp"
 #include "volume/cloud_volume.hpp"
@@ -19,14 +20,18 @@ class PreparedVolumeCache {
  public:
   static constexpr std::size_t kResident = 2;
   // The prepared time step `step` of `volume`, whose data are named by `source` (a file path):
-  // from the cache, or prepared now (evicting the least recently used beyond kResident).
-  std::shared_ptr<const PreparedVolume> get(const std::string& source, CloudVolume& volume, std::size_t step);
+  // from the cache, or prepared now (evicting the least recently used beyond kResident). With
+  // `detail_drift` (the modelled cloud), the medium carries the detail's wind displacement at the
+  // step (DetailDrift: the winds of the steps before it are read once).
+  std::shared_ptr<const PreparedVolume> get(const std::string& source, CloudVolume& volume, std::size_t step,
+                                            bool detail_drift = false);
   // The medium at an instant: the step itself at a step, else the two neighbouring steps'
   // extinction interpolated (interpolate_extinction) and prepared, once per instant and mode.
   // `report` receives what the interpolation did (its cost, or 0 when it came from the cache).
   // `volume` must keep at least two steps decoded (CloudVolume::set_loader's cache_steps).
   std::shared_ptr<const PreparedVolume> get(const std::string& source, CloudVolume& volume, const Instant& at,
-                                            TimeInterpolation mode, TimeInterpolationReport* report = nullptr);
+                                            TimeInterpolation mode, TimeInterpolationReport* report = nullptr,
+                                            bool detail_drift = false);
   // How many preparations get has run: a test of the cache, and what the viewer's overlay reports.
   std::size_t prepared() const { return prepared_; }
 
@@ -38,11 +43,13 @@ class PreparedVolumeCache {
     std::size_t step1 = 0;
     double fraction = 0.0;
     TimeInterpolation mode = TimeInterpolation::Auto;
+    bool drift = false;
     TimeInterpolationReport report;
     std::shared_ptr<const PreparedVolume> volume;
   };
   std::vector<Entry> entries_;  // most recently used last
   std::size_t prepared_ = 0;
+  DetailDrift drift_;
 };
 
 }  // namespace cv::core

@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "geo/geodesy.hpp"
+#include "kernel/detail_drift.hpp"
 #include "kernel/prepared_volume.hpp"
 #include "physics/physics.hpp"
 #include "reference/track_kernel.hpp"
@@ -112,12 +113,19 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
   const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
   k.u_liquid = {volume_->extinction.liquid_per_m.data(), n};
   k.u_ice = {volume_->extinction.ice_per_m.data(), n};
-  k.u_min_max = volume_->pyramid_packed.data();
+  if (march.medium.modelled) {  // the modelled cloud's own brick bounds
+    bricks_ = std::make_shared<const std::vector<glm::vec2>>(medium_pyramid(*volume_, march, noise->detail));
+    k.u_min_max = bricks_->data();
+  } else {
+    k.u_min_max = volume_->pyramid_packed.data();
+  }
   k.kNoise = march.medium.noise_amount > 0.0;
   k.kModelled = march.medium.modelled;
   if (k.kModelled) {  // the modelled cloud: the cover per node and the table over the noise tiles
     if (k.u_has_fraction) k.u_fraction = {volume_->extinction.fraction.data(), n};
     k.u_detail_table = {noise->detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
+    detail_shift_ = std::make_shared<const std::vector<float>>(detail_shift_texels(*volume_, k));
+    k.u_detail_shift = {detail_shift_->data(), {grid.alt_m.count, 1}, 2};
   }
   if (k.kNoise || k.kModelled) {
     k.u_noise_low = {noise->low.texels.data(), glm::ivec3(noise->low.n)};
@@ -131,7 +139,7 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
   if (!std::isfinite(k.u_track_majorant)) {
     throw std::invalid_argument("monte carlo: the modelled cloud has extinction where the cloud fraction is 0: no majorant bounds it");
   }
-  k.u_track_bricks = mc.brick_majorants && !march.medium.modelled;
+  k.u_track_bricks = mc.brick_majorants;
   k.u_path_max_bounces = mc.max_bounces;
   k.u_path_roulette_after = mc.roulette_after;
   k.u_path_peak_mis = mc.peak_mis;

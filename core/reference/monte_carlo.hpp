@@ -129,6 +129,8 @@ class MonteCarloRenderer {
   // The march kernel's medium, tracking and path over volume_ (reference/track_kernel.hpp); its
   // functions called here write nothing, so the threads share it.
   std::shared_ptr<kernel::f64::TrackKernel> kernel_;
+  std::shared_ptr<const std::vector<float>> detail_shift_;  // the kernel's u_detail_shift texels (the modelled cloud)
+  std::shared_ptr<const std::vector<glm::vec2>> bricks_;     // the modelled cloud's brick bounds (core::medium_pyramid)
 };
 
 // One call: a fresh accumulator with `spp` samples per pixel.

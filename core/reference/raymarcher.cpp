@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "kernel/detail_drift.hpp"
 #include "kernel/march_kernel.hpp"
 #include "kernel/ms_source.hpp"
 #include "kernel/prepared_volume.hpp"
@@ -50,15 +51,18 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   const BlueNoiseMask& mask = step_jitter_mask();
   k.u_jitter_mask = {mask.values.data(), {mask.n, mask.n}, 1};
   if (ground_map) k.u_ground = {ground_map->rgba.data(), {ground_map->width, ground_map->height}, 4};
+  const std::vector<float> detail_shift = s.medium.modelled ? detail_shift_texels(v, k) : std::vector<float>{};
   if (s.medium.modelled) {  // the modelled cloud: the cover per node and the table over the noise tiles
     if (k.u_has_fraction) k.u_fraction = {v.extinction.fraction.data(), n};
     k.u_detail_table = {noise->detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
+    k.u_detail_shift = {detail_shift.data(), {g.alt_m.count, 1}, 2};
   }
   if (eroded || s.medium.modelled) {
     k.u_noise_low = {noise->low.texels.data(), glm::ivec3(noise->low.n)};
     k.u_noise_high = {noise->high.texels.data(), glm::ivec3(noise->high.n)};
   }
-  k.u_min_max = v.pyramid_packed.data();
+  const std::vector<glm::vec2> modelled_bricks = s.medium.modelled ? medium_pyramid(v, s, noise->detail) : std::vector<glm::vec2>{};
+  k.u_min_max = s.medium.modelled ? modelled_bricks.data() : v.pyramid_packed.data();
   if (opaque) {
     k.u_has_depth = true;
     k.u_depth = {opaque->distance_m.data(), {cam.width, cam.height}, 1};

@@ -21,6 +21,9 @@ struct GridMeanExtinction {
   // The cloud fraction per node (0..1; NaN as 0), empty where the file has none: the modelled
   // cloud (cloud_model "modelled", march.glsl detail_factor) makes that share of each cell cloudy.
   std::vector<float> fraction{};
+  // The modelled cloud's detail displacement at this instant (grid cells along the longitude and
+  // latitude indices, 2 per level; core/kernel/detail_drift), empty where nobody asked: it stays still.
+  std::vector<double> detail_drift_cells{};
 };
 // Extinctions from this up are not data but fill values left in a field (netCDF's default float
 // fill is 9.96921e36): the densest fog is ~0.1 /m, and float sums of sigma x phase (up to 1.6e5 /sr

@@ -16,6 +16,7 @@
 #define CV_TEX_TL_COLOR 13
 #define CV_TEX_FRACTION 14
 #define CV_TEX_DETAIL_TABLE 15
+#define CV_TEX_DETAIL_SHIFT 0  // unit 0 is free in the march's program: 16 units is GL's least for compute
 #define CV_IMAGE_OUT 0
 #define CV_IMAGE_STATE_L 6
 #define CV_IMAGE_STATE_DEPTH 7

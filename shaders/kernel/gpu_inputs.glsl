@@ -29,6 +29,7 @@ layout(binding = CV_TEX_MS_I0) uniform sampler3D u_ms_i0;  // two-stream diffuse
 layout(binding = CV_TEX_MS_I1) uniform sampler3D u_ms_i1;  // its first moment (upward)
 layout(binding = CV_TEX_FRACTION) uniform sampler3D u_fraction;  // cloud fraction per node (the modelled cloud's cover)
 layout(binding = CV_TEX_DETAIL_TABLE) uniform sampler2D u_detail_table;  // (threshold, ramp mean) by cover (core/kernel/detail)
+layout(binding = CV_TEX_DETAIL_SHIFT) uniform sampler2D u_detail_shift;  // the detail's wind displacement per level, in tiles (core/kernel/detail_drift)
 // The extinction pyramid: (min, max) per brick, levels one after the other, x fastest.
 layout(std430, binding = CV_SSBO_PYRAMID) readonly buffer Pyramid { vec2 u_min_max[]; };
 // Per-frame counters (MarchStats), each as (low, high) 32-bit words.

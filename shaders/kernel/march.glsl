@@ -77,7 +77,10 @@ CV_FN void erode_at(real3 p, CV_INOUT(real) sl, CV_INOUT(real) si) {
 // cell holds the tile's distribution of it; the cover c is the data's cloud fraction at f (1 without
 // one); the table gives the threshold t(c) above which a share c of the tile lies and the tile's
 // mean m(c) of the ramp above it. So (1 - a) + a h / m keeps the cell's mean extinction for any
-// amount a, and with a = 1 the cloudy share of the cell is its cover.
+// amount a, and with a = 1 the cloudy share of the cell is its cover. The tiles are displaced along
+// the level-mean wind (u_detail_shift, per level in tiles, linear between levels: a shift constant
+// over each horizontal slice of a cell keeps the slice's share of the periodic tile), so the detail
+// travels with the cloud and every cell keeps its cover and mean at every instant.
 CV_FN real detail_factor(real3 f) {
   real c = u_has_fraction ? clamp(fetch(u_fraction, f), real(0.0), real(1.0)) : real(1.0);
   real x = sqrt(c) * real(CV_DETAIL_COVERS);  // the table's covers are (k / N)^2
@@ -87,7 +90,12 @@ CV_FN real detail_factor(real3 f) {
   real4 e1 = real4(texelFetch(u_detail_table, ivec2(i + 1, 0), 0));
   real t = mix(e0.x, e1.x, w);
   real m = mix(e0.y, e1.y, w);
-  real3 tc = fract(f * u_detail_tiles);
+  real wz;
+  int k0 = volume_fetch_index(f.z, int(u_grid_count.z), wz);
+  int k1 = min(k0 + 1, int(u_grid_count.z) - 1);
+  real4 s0 = real4(texelFetch(u_detail_shift, ivec2(k0, 0), 0));
+  real4 s1 = real4(texelFetch(u_detail_shift, ivec2(k1, 0), 0));
+  real3 tc = fract(f * u_detail_tiles - real3(mix(s0.x, s1.x, wz), mix(s0.y, s1.y, wz), real(0.0)));
   tc.z = real(1.0) - abs(real(2.0) * tc.z - real(1.0));  // mirrored about each tile's middle height
   real n = detail_noise_mix(fetch_noise(u_noise_low, tc), fetch_noise(u_noise_high, noise_high_coords(tc)));
   real g = m > real(0.0) ? detail_ramp(n, t) / m : real(0.0);

@@ -17,6 +17,7 @@
 
 #include "bench/standard_scenes.hpp"
 #include "importer.hpp"
+#include "kernel/detail_drift.hpp"
 #include "kernel/march_kernel.hpp"
 #include "kernel/prepared_volume.hpp"
 #include "noise/noise.hpp"
@@ -60,9 +61,18 @@ struct CellFigures {
 // Measures up to `max_cells` cloudy cells of `data` (cells with at least `min_nodes` of their 8
 // nodes holding cloud, spread over the grid) at `points` uniform random points each, with detail tiles of `scale_m`. (A regular
 // lattice aliases with the noise textures' texels.)
+// With `drifted`, the detail is displaced by the wind (core/kernel/detail_drift) by a different
+// number of cells, not whole tiles, at every level.
 CellFigures measure_cells(const core::VolumeGrid& grid, const core::TimeStepData& data, double scale_m, int min_nodes, int max_cells,
-                          int points) {
-  const core::PreparedVolume v = core::prepare_volume(grid, data);
+                          int points, bool drifted = false) {
+  core::GridMeanExtinction medium = core::grid_mean_extinction(grid, data);
+  if (drifted) {
+    for (int z = 0; z < grid.alt_m.count; ++z) {
+      medium.detail_drift_cells.push_back(37.31 + 0.173 * z);  // a day's drift, sheared with height
+      medium.detail_drift_cells.push_back(-4.77 + 0.061 * z);
+    }
+  }
+  const core::PreparedVolume v = core::prepare_volume(grid, std::move(medium));
   EXPECT_EQ(v.extinction.fraction.size(), grid.points()) << "the file's cloud fraction reaches the prepared volume";
   core::MarchSettings s;
   s.medium.modelled = true;
@@ -81,6 +91,8 @@ CellFigures measure_cells(const core::VolumeGrid& grid, const core::TimeStepData
   k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
   k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
   k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
+  const std::vector<float> shift = core::detail_shift_texels(v, k);
+  k.u_detail_shift = {shift.data(), {grid.alt_m.count, 1}, 2};
   k.kModelled = true;
   EXPECT_TRUE(k.u_has_fraction);
 
@@ -159,7 +171,8 @@ TEST(ModelledCloud, TheTableLeavesTheCoverAboveItsThreshold) {
 }
 
 // The construction itself: at a constant cover c, over whole tiles, the factor's mean is 1 and the
-// cloud covers c of the tile (uniform random points, bounds at 4.5 standard errors of the estimate).
+// cloud covers c of the tile (uniform random points, bounds at 4.5 standard errors of the estimate);
+// still, and displaced by the wind by a different fraction of a tile at each level.
 TEST(ModelledCloud, AtAConstantCoverATileKeepsTheMeanAndTheCover) {
   const core::ErosionNoise& noise = shared_noise();
   kernel::f64::MarchKernel k;
@@ -172,7 +185,12 @@ TEST(ModelledCloud, AtAConstantCoverATileKeepsTheMeanAndTheCover) {
   k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
   k.u_detail_tiles = {2, 3, 1};
   k.u_detail_amount = 1.0;
-  for (double c : {0.02, 0.1, 0.3, 0.6, 0.9, 1.0}) {
+  const std::vector<float> still(8, 0.0f), drifted = {0.0f, 0.0f, 0.31f, -0.77f, 1.58f, 0.23f, 0.0f, 0.0f};
+  const double covers[6] = {0.02, 0.1, 0.3, 0.6, 0.9, 1.0};
+  for (int run = 0; run < 12; ++run) {
+    const int d = run / 6;
+    const double c = covers[run % 6];
+    k.u_detail_shift = {(d ? drifted : still).data(), {4, 1}, 2};
     std::fill(frac.begin(), frac.end(), float(c));
     const int n = 1 << 19;
     Uniform u(7);
@@ -184,7 +202,7 @@ TEST(ModelledCloud, AtAConstantCoverATileKeepsTheMeanAndTheCover) {
     }
     const double mean = sum / n, se = std::sqrt(std::max(sum2 / n - mean * mean, 0.0) / n);
     const double share = cover / n, se_share = std::sqrt(c * (1.0 - c) / n) + 1e-9;
-    std::printf("cover %.2f: mean factor %.4f +- %.4f, cloudy share %.4f\n", c, mean, se, share);
+    std::printf("%s, cover %.2f: mean factor %.4f +- %.4f, cloudy share %.4f\n", d ? "drifted" : "still", c, mean, se, share);
     EXPECT_LT(std::abs(mean - 1.0), 4.5 * se + 0.005) << "cover " << c;
     EXPECT_LT(std::abs(share - c), 4.5 * se_share + 0.002) << "cover " << c;
   }
@@ -194,6 +212,8 @@ TEST(ModelledCloud, CellsOfTheSampleKeepTheirCoverAndTogetherTheirMean) {
   auto vol = importers::import_file(CV_SAMPLE_FILE);
   // The sample's 0.5 degree cells with tiles of about 20 km: 3 by 2 tiles per cell.
   expect_cells_keep_their_means("sample", measure_cells(vol.grid, vol.step(1), 20000.0, 8, 30, 1 << 17), 20, true);
+  expect_cells_keep_their_means("sample, detail drifted by the wind",
+                                measure_cells(vol.grid, vol.step(1), 20000.0, 8, 30, 1 << 17, true), 20, true);
 }
 
 TEST(ModelledCloud, CellsOfARealWrfFileKeepTheirCover) {
@@ -208,6 +228,65 @@ TEST(ModelledCloud, CellsOfARealEra5FileKeepTheirCoverAndTogetherTheirMean) {
   REAL_FILE(path, "met-era5-cocip1.nc");
   auto vol = importers::import_file(path);
   expect_cells_keep_their_means("ERA5", measure_cells(vol.grid, vol.step(0), 20000.0, 8, 30, 1 << 17), 20, true);
+}
+
+// The modelled cloud's brick bounds (core::medium_pyramid) hold the kernel's modelled extinction at
+// random points of every finest brick, leave the data's empty bricks empty, and are tighter than
+// the one global majorant in most of the cloud.
+TEST(ModelledCloud, BrickBoundsHoldTheModelledExtinction) {
+  auto vol = importers::import_file(CV_SAMPLE_FILE);
+  const core::VolumeGrid& grid = vol.grid;
+  const core::PreparedVolume v = core::prepare_volume(grid, vol.step(1));
+  const core::ErosionNoise& noise = shared_noise();
+  for (double amount : {1.0, 0.6}) {
+    core::MarchSettings s;
+    s.medium.modelled = true;
+    s.medium.detail_amount = amount;
+    s.medium.detail_scale_m = 20000.0;
+    const std::vector<glm::vec2> bricks = core::medium_pyramid(v, s, noise.detail);
+    ASSERT_EQ(bricks.size(), v.pyramid_packed.size());
+    const double global = core::medium_majorant(v, s, noise.detail);
+    core::Camera cam;
+    cam.width = cam.height = 1;
+    kernel::f64::MarchKernel k;
+    static_cast<kernel::MarchParams&>(k) = core::march_params(v, cam, core::Sun{}, s, glm::ivec2(0));
+    const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
+    k.u_liquid = {v.extinction.liquid_per_m.data(), n};
+    k.u_ice = {v.extinction.ice_per_m.data(), n};
+    k.u_fraction = {v.extinction.fraction.data(), n};
+    k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
+    k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
+    k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
+    const std::vector<float> shift = core::detail_shift_texels(v, k);
+    k.u_detail_shift = {shift.data(), {grid.alt_m.count, 1}, 2};
+    k.kModelled = true;
+    const auto& l0 = v.pyramid.levels()[0];
+    int cloudy = 0, tighter = 0;
+    double worst_ratio = 0.0;  // largest sampled value / its brick's bound
+    for (int bz = 0; bz < l0.nz; ++bz)
+      for (int by = 0; by < l0.ny; ++by)
+        for (int bx = 0; bx < l0.nx; ++bx) {
+          const std::size_t b = l0.index(bx, by, bz);
+          const double data_max = l0.min_max[b].y, bound = bricks[b].y;
+          EXPECT_EQ(data_max > 0.0, bound > 0.0) << "brick " << bx << "," << by << "," << bz << ": the same empty space";
+          if (!(data_max > 0.0)) continue;
+          ++cloudy;
+          tighter += bound < 0.5 * global;
+          Uniform u(b + 11);
+          const int B = core::ExtinctionPyramid::kFinestNodes;
+          for (int q = 0; q < 400; ++q) {
+            const glm::dvec3 f(std::min(bx * B + B * u(), n.x - 1.0), std::min(by * B + B * u(), n.y - 1.0),
+                               std::min(bz * B + B * u(), n.z - 1.0));
+            const double value = (k.fetch(k.u_liquid, f) + k.fetch(k.u_ice, f)) * k.detail_factor(f);
+            worst_ratio = std::max(worst_ratio, value / bound);
+          }
+        }
+    std::printf("amount %.1f: %d cloudy bricks, %d of them bounded below half the global majorant (%.3g /m); largest sample / "
+                "its bound %.3f\n", amount, cloudy, tighter, global, worst_ratio);
+    EXPECT_GT(cloudy, 50);
+    EXPECT_LE(worst_ratio, 1.0) << "a brick bound below the modelled extinction";
+    EXPECT_GT(tighter, cloudy / 2) << "the bricks bound most of the cloud more tightly than the global majorant";
+  }
 }
 
 // The standard stratocumulus (cloud fraction 0.1..1 in cells of 0.2 degrees) on the GPU and the CPU.
@@ -265,6 +344,25 @@ TEST_F(ModelledRender, DetailAmountZeroIsTheDataModeAndTheGpuMatchesTheCpu) {
               differ_full, worst);
   EXPECT_GT(differ_full, int(g_data.size() / 4)) << "the detail changes the image";
   EXPECT_LT(worst, 1e-3) << "the GPU's modelled image is the CPU kernel's";
+
+  // Displaced by the wind (a different shift at each level): the GPU's shift texture is the CPU's.
+  core::GridMeanExtinction drifted = medium;
+  for (int z = 0; z < sc.grid.alt_m.count; ++z) {
+    drifted.detail_drift_cells.push_back(0.37 + 0.05 * z);
+    drifted.detail_drift_cells.push_back(-0.21 * z);
+  }
+  gpu.upload(sc.grid, drifted);
+  const std::vector<glm::vec4> g_drift = gpu.render(sc.camera, sc.sun, full);
+  const core::ReferenceImage c_drift = core::render_reference(sc.grid, drifted, sc.camera, sc.sun, full, &noise);
+  int moved = 0;
+  double worst_drift = 0.0;
+  for (std::size_t i = 0; i < g_drift.size(); ++i) {
+    moved += glm::length(c_drift.radiance[i] - c_full.radiance[i]) > 1e-3 * peak;
+    for (int ch = 0; ch < 3; ++ch) worst_drift = std::max(worst_drift, std::abs(double(g_drift[i][ch]) - c_drift.radiance[i][ch]) / peak);
+  }
+  std::printf("drifted: %d pixels differ from the still detail; GPU against CPU: worst %.2e of the brightest\n", moved, worst_drift);
+  EXPECT_GT(moved, int(g_data.size() / 4)) << "the drift moves the detail";
+  EXPECT_LT(worst_drift, 1e-3) << "the GPU's drifted image is the CPU kernel's";
 }
 
 
