@@ -22,6 +22,7 @@
 #include "quality_budget.hpp"
 #include "geo/geodesy.hpp"
 #include "io/output_file.hpp"
+#include "noise/noise.hpp"
 #include "reference/monte_carlo.hpp"
 #include "render/context.hpp"
 #include "render/image_output.hpp"
@@ -53,6 +54,9 @@ struct BenchArgs {
   // Frame times only: no reference, no error, no front (scripts/bench-gpu at 1920x1080, where a
   // Monte Carlo reference on the CPU would take hours).
   bool timing_only = false;
+  // The cloud models run on each scene (--cloud-model): the data mode, the modelled cloud, or both.
+  // A modelled run is named "<scene>+modelled" throughout (rows, references, images, the front).
+  std::vector<bool> modelled = {false};
 };
 
 // "1,4,16" (each in 1..65536, increasing) or "none".
@@ -105,6 +109,13 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
     else if (s == "--no-cache") a.cache = false;
     else if (s == "--path-spp") a.path_spp = parse_spp_list(next());
     else if (s == "--timing-only") a.timing_only = true;
+    else if (s == "--cloud-model") {
+      const std::string v = next();
+      if (v == "data") a.modelled = {false};
+      else if (v == "modelled") a.modelled = {true};
+      else if (v == "both") a.modelled = {false, true};
+      else throw UsageError{"cloudviewer bench: --cloud-model: found '" + v + "', expected data, modelled or both"};
+    }
     else if (s == "--size") {
       const std::string v = next();
       const auto x = v.find('x');
@@ -113,7 +124,8 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
       a.height = parse_int("--size", v.substr(x + 1), 8, 4096, "WxH with each in 8..4096");
     } else if (!s.empty() && s[0] == '-') {
       throw UsageError{"cloudviewer bench: unknown option '" + s +
-                       "', expected --reference-spp, --reference-error, --size, --repeats, --path-spp, --timing-only, --out or --no-cache"};
+                       "', expected --reference-spp, --reference-error, --size, --repeats, --path-spp, --timing-only, --cloud-model, --out "
+                       "or --no-cache"};
     } else if (std::find(known.begin(), known.end(), s) == known.end()) {
       std::string names;
       for (const auto& n : known) names += (names.empty() ? "" : ", ") + n;
@@ -144,7 +156,14 @@ std::string reference_key(const bench::StandardScene& sc, const core::GridMeanEx
                 sc.sun.irradiance.x, sc.sun.irradiance.y, sc.sun.irradiance.z, m.medium.droplet_diameter_um,
                 m.medium.liquid_phase_hg ? 1 : 0, m.medium.ice_g, m.medium.noise_amount, mc.max_bounces, mc.roulette_after,
                 static_cast<unsigned long long>(mc.seed), mc.peak_mis ? 1 : 0);
-  return b;
+  std::string key = b;
+  if (m.medium.modelled) {  // the modelled cloud's own density (data-mode keys stay as they were)
+    char d[160];
+    std::snprintf(d, sizeof d, " modelled detail%.17g scale%.17g fraction%zu", m.medium.detail_amount, m.medium.detail_scale_m,
+                  medium.fraction.size());
+    key += d;
+  }
+  return key;
 }
 
 struct Config {
@@ -279,7 +298,7 @@ double median(std::vector<double> v) {
 
 const char* bench_usage() {
   return "  bench [SCENE...] [--reference-spp N] [--reference-error E] [--size WxH] [--repeats R] [--path-spp LIST]\n"
-         "        [--timing-only] [--out DIR] [--no-cache]\n"
+         "        [--timing-only] [--cloud-model data|modelled|both] [--out DIR] [--no-cache]\n"
          "                           error against run time on the standard scenes (default all, 96x54, 64 spp,\n"
          "                           3 repeats, into bench_out): results.csv, summary.md, plots and error images,\n"
          "                           the march's quality sweep, presets and the seed documents' methods, and the\n"
@@ -290,7 +309,9 @@ const char* bench_usage() {
          "                           quality_front.json (also cached per user for --budget-ms unless --no-cache).\n"
          "                           References are cached in DIR with their sums: a larger N extends them, an\n"
          "                           interrupted one resumes; --reference-error stops one early at that mean\n"
-         "                           relative standard error\n";
+         "                           relative standard error. --cloud-model modelled (or both) runs each scene\n"
+         "                           with the modelled cloud too, as <scene>+modelled, against the Monte Carlo of\n"
+         "                           the same modelled density (default data)\n";
 }
 
 int cmd_bench(const std::vector<std::string>& args) {
@@ -309,17 +330,32 @@ int cmd_bench(const std::vector<std::string>& args) {
   std::vector<SceneReference> refs;
   std::map<std::string, double> dz_by_scene;  // for the front file: view steps as multiples of dz
   std::set<std::string> variants_warm;  // program variants compiled already (compile time is not frame time)
-  for (const auto& name : a.scenes) {
-    const bench::StandardScene sc = bench::standard_scene(name, a.width, a.height);
+  core::ErosionNoise noise;  // the modelled cloud's tiles and table, made once when a run needs them (as FrameRenderer's)
+  std::vector<std::pair<std::string, bool>> runs;  // (scene, modelled)
+  for (const auto& scene : a.scenes)
+    for (bool m : a.modelled) runs.emplace_back(scene, m);
+  for (const auto& run : runs) {
+    const std::string& scene_name = run.first;
+    const bool modelled = run.second;
+    const bench::StandardScene sc = bench::standard_scene(scene_name, a.width, a.height);
+    const std::string name = scene_name + (modelled ? "+modelled" : "");
     const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
     dz_by_scene[name] = std::abs(sc.grid.alt_m.step);
+    if (modelled && noise.detail.empty()) {
+      noise = core::make_erosion_noise();
+      core::with_detail_table(noise);
+    }
     // Clouds only, as the Monte Carlo reference models them.
     core::MarchSettings base = sc.march;
+    base.medium.modelled = modelled;
     base.medium.ms_two_stream = core::scene_march_defaults().medium.ms_two_stream;  // the model the product renders with
     base.features.atmosphere = base.features.globe = false;
     base.medium.ambient = 0.0, base.medium.noise_amount = 0.0;
     if (!(base.medium.droplet_diameter_um > 0.0)) base.medium.droplet_diameter_um = 20.0;
-    const core::MonteCarloSettings mc;
+    core::MonteCarloSettings mc;
+    // The modelled cloud's one majorant is the densest shape anywhere (about 14x the in-cloud
+    // extinction): its brick bounds are tighter (core::medium_pyramid), the expectation the same.
+    mc.brick_majorants = modelled;
     std::vector<glm::dvec3> ref_rgb;  // the reference's mean and variance per pixel (none with --timing-only)
     std::vector<double> ref_var;
     // The reference: cached by scene, size and a hash of what decides it, with its running sums, so
@@ -331,7 +367,7 @@ int cmd_bench(const std::vector<std::string>& args) {
       SceneReference ref{name, "ref_" + name + "_" + std::to_string(a.width) + "x" + std::to_string(a.height) + "_" + hash + ".cvref",
                          a.spp, 0.0, false, 0.0};
       const fs::path ref_path = fs::path(a.out) / ref.file;
-      const core::MonteCarloRenderer mcr(sc.grid, medium, sc.camera, sc.sun, base, mc);
+      const core::MonteCarloRenderer mcr(sc.grid, medium, sc.camera, sc.sun, base, mc, modelled ? &noise : nullptr);
       core::MonteCarloImage img = mcr.start();
       std::string why;
       if (bench::read_reference_cache(ref_path.string(), key, a.width, a.height, img, &why)) {

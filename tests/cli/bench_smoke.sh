@@ -51,4 +51,16 @@ test "$(tail -n +2 "$dir/timing/results.csv" | grep -c '^stratocumulus,')" -eq 2
 test ! -e "$dir/timing/quality_front.json" && test ! -e "$dir/timing/stratocumulus_pareto.png" || { echo "timing only wrote a front or a plot"; exit 1; }
 awk -F, '$2 == "default" && $13 == "nan" && $11 > 0 { f = 1 } END { exit !f }' "$dir/timing/results.csv" || { echo "timing only: the default row has an error or no time"; exit 1; }
 awk -F, '$2 == "path_2spp" && $25 > 0 && $25 < 1e300 { f = 1 } END { exit !f }' "$dir/timing/results.csv" || { echo "timing only: no noise estimate of the path tracer"; exit 1; }
+# --cloud-model both: each scene also as <scene>+modelled, against a reference of the modelled
+# density (its own cached file), its rows in the CSV and its scene in the front.
+"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --path-spp 1 --cloud-model both --out "$dir/models" --no-cache > "$dir/run5.txt"
+test "$(tail -n +2 "$dir/models/results.csv" | grep -c '^stratocumulus+modelled,')" -eq 21 || { echo "modelled: expected 21 rows"; exit 1; }
+test "$(tail -n +2 "$dir/models/results.csv" | grep -c '^stratocumulus,')" -eq 21 || { echo "both: expected 21 data rows"; exit 1; }
+test "$(ls "$dir/models"/ref_stratocumulus+modelled_24x14_*.cvref | wc -l)" -eq 1 || { echo "no reference of the modelled cloud"; exit 1; }
+test "$(ls "$dir/models"/ref_stratocumulus_24x14_*.cvref | wc -l)" -eq 1 || { echo "no reference of the data mode"; exit 1; }
+grep -q '"scene": "stratocumulus+modelled"' "$dir/models/quality_front.json" || { echo "the modelled scene is not in the front"; exit 1; }
+test -s "$dir/models/stratocumulus+modelled/err_default.png" || { echo "no error image of the modelled default"; exit 1; }
+# The modelled images differ from the data mode's (the default row's error is not the data row's).
+awk -F, '$2 == "default" { e[$1] = $13 } END { exit !(e["stratocumulus"] != e["stratocumulus+modelled"]) }' "$dir/models/results.csv" \
+  || { echo "the modelled rows are the data rows"; exit 1; }
 echo "bench smoke: $rows rows"
