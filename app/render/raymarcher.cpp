@@ -160,7 +160,10 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
   if (ms_[0]) glDeleteTextures(2, ms_);
   ms_[0] = ms_[1] = 0;
   ms_volume_ = nullptr;
-  fraction_volume_ = nullptr;  // the modelled cloud's cover: uploaded again when a march needs it
+  // The modelled cloud's cover: uploaded again when a march needs it, into a texture of this grid's size.
+  if (fraction_) glDeleteTextures(1, &fraction_);
+  fraction_ = 0;
+  fraction_volume_ = nullptr;
   modelled_pyramid_volume_ = nullptr;  // and its brick bounds
   // The pyramid for empty-space skipping and adapted steps, all levels in one buffer.
   std::vector<glm::vec2> packed = volume->pyramid_packed;

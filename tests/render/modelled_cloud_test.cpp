@@ -366,6 +366,31 @@ TEST_F(ModelledRender, DetailAmountZeroIsTheDataModeAndTheGpuMatchesTheCpu) {
 }
 
 
+// One raymarcher drawing the modelled cloud of two grids of different sizes in turn (the bench's
+// scenes, the viewer's views): the cover's texture follows the grid (it was kept at the first
+// grid's size: GL_INVALID_VALUE on the second upload).
+TEST_F(ModelledRender, GridsOfDifferentSizesInTurn) {
+  const core::ErosionNoise& noise = shared_noise();
+  render::GpuRaymarcher gpu(loader_);
+  gpu.upload_noise(noise);
+  for (const char* name : {"thin_cirrus", "stratocumulus", "thin_cirrus"}) {
+    const bench::StandardScene sc = bench::standard_scene(name, 16, 9);
+    const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
+    gpu.upload(sc.grid, medium);
+    core::MarchSettings m = sc.march;
+    m.medium.modelled = true;
+    m.medium.detail_scale_m = 4000.0;
+    std::vector<glm::vec4> img;
+    ASSERT_NO_THROW(img = gpu.render(sc.camera, sc.sun, m)) << name;
+    const core::ReferenceImage ref = core::render_reference(sc.grid, medium, sc.camera, sc.sun, m, &noise);
+    const double peak = std::max(largest(ref.radiance), 1e-30);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < img.size(); ++i)
+      for (int ch = 0; ch < 3; ++ch) worst = std::max(worst, std::abs(double(img[i][ch]) - ref.radiance[i][ch]) / peak);
+    EXPECT_LT(worst, 1e-3) << name << ": the GPU's modelled image is the CPU kernel's";
+  }
+}
+
 // Never NaN or Inf (issue 11's "never", for the modelled cloud too): the deck with NaN, fill values
 // and negatives in its extinction and fraction, an optical depth of 100 per metre in one node and a
 // fraction of 1e-9 beside cloud, marched on the GPU and the CPU, and path-traced on the CPU (there
