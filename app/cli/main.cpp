@@ -70,6 +70,7 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
        "  view INPUT [--size WxH] [--time ISO|N] [--play H] [--scale S] [--hide-ui] [--frame-budget MS]\n"
        "             [--compare FILE[@T] | @T ...] [--layout grid|swipe] [--unlinked] [--frames N --screenshot OUT.png]\n"
        "             [--section LAT,LON,LAT,LON[,FIELD]] [--series LAT,LON] [--quality reference [--spp N]]\n"
+       "             [--reproject] [--orbit PX]\n"
        "                           --time: an instant (UTC) or a step; --play H: start playing at H forecast\n"
        "                           hours per second (the timeline is in the data panel); with --frames it moves\n"
        "                           one instant per frame and waits for each, unless --realtime (wall time, no wait)\n"
@@ -86,7 +87,12 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
        "                           with that path or point, drawn as the section and series commands draw them\n"
        "                           --quality reference: the progressive path tracer (the Quality panel's switch):\n"
        "                           one sample per pixel per frame up to N (256), restarted by any change; clouds,\n"
-       "                           ground, sunlight through the air and the sky's light, no overlays\n"},
+       "                           ground, sunlight through the air and the sky's light, no overlays\n"
+       "                           --reproject: temporal reprojection (the Quality panel's switch): 1/16 of the\n"
+       "                           pixels marched per frame, the rest carried from the last image along the\n"
+       "                           camera's motion and clamped to the new samples after a move; a still view has\n"
+       "                           marched every pixel after 16 frames (not with overlays; no accumulation)\n"
+       "                           --orbit PX: drag the globe PX pixels to the right every frame (scripted orbit)\n"},
   };
 }
 

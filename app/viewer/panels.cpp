@@ -205,6 +205,8 @@ void quality_panel(ViewerState& s, const PanelContext& ctx) {
   // one sample per pixel per frame (no overlays, no haze in front of the clouds).
   ImGui::Checkbox("path tracer (progressive reference)", &s.path_trace);
   if (s.path_trace) ImGui::SliderInt("path samples per pixel", &s.path_spp, 1, 65536, "%d", ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
+  // Temporal reprojection: 1/16 of the pixels marched per frame, the rest carried from the last image.
+  ImGui::Checkbox("reprojection (1/16 of the pixels per frame)", &s.reproject);
   march_widgets(s.scene.render.march, core::SettingGroup::Quality);
   core::RenderSettings& r = s.scene.render;
   slider_double("resolution scale", &r.resolution_scale, 0.1, 1.0, "%.2f");
@@ -616,7 +618,11 @@ void draw_stats_overlay(const FrameStats& s, int target) {
       ImGui::End();
       return;
     }
-    ImGui::Text("frames %d / %d at %d x %d", s.accumulated, target, s.march_w, s.march_h);
+    if (s.reprojecting) {
+      ImGui::Text("reprojection: %d / 16 frames since the last change at %d x %d", std::min(s.accumulated, 16), s.march_w, s.march_h);
+    } else {
+      ImGui::Text("frames %d / %d at %d x %d", s.accumulated, target, s.march_w, s.march_h);
+    }
     ImGui::Text("%.1f FPS", s.fps);
     const core::MarchStats& m = s.march;
     ImGui::Text("view samples %llu, skipped %llu (%llu jumps)", static_cast<unsigned long long>(m.view_samples),

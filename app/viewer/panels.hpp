@@ -25,6 +25,7 @@ struct FrameStats {
   double fps = 0.0;         // window frames per second, averaged over ~0.5 s
   int accumulated = 0;      // frames in the current mean (the path tracer: samples per pixel)
   bool path_trace = false;  // the mean is the path tracer's
+  bool reprojecting = false;  // the view is reprojected (accumulated: frames since the last change)
   double path_error = 0.0;  // its mean relative standard error (MonteCarloImage), once 2 samples are in
   int march_w = 0, march_h = 0;
   core::MarchStats march;   // what the last marched frame sampled and left out

@@ -27,6 +27,7 @@
 #include "render/machine_id.hpp"
 #include "render/image_output.hpp"
 #include "render/presenter.hpp"
+#include "render/reprojector.hpp"
 #include "render/raymarcher.hpp"
 #include "viewer/camera_controller.hpp"
 #include "viewer/frame_budget.hpp"
@@ -155,6 +156,11 @@ struct ViewGpu {
   bool path_mode = false;
   double auto_exposure = render::kDefaultExposure;
   core::FrameSpec spec;
+  // Temporal reprojection (ViewerState::reproject): made when first used; the sparse frame's index,
+  // and whether the medium or the settings changed this frame (the camera's motion it finds itself).
+  std::unique_ptr<render::Reprojector> reprojector;
+  bool reprojecting = false, reproject_changed = false;
+  int reproject_index = 0;
 };
 
 // One more path-traced sample per pixel of the view's march camera into its sums, and their mean
@@ -409,6 +415,19 @@ int cmd_view(const std::vector<std::string>& args) {
         o.path_trace = true;
       } else if (a == "--spp") {
         o.path_spp = parse_int("--spp", next(), 1, 1000000);
+      } else if (a == "--reproject") {
+        o.reproject = true;
+      } else if (a == "--orbit") {
+        const std::string v = next();
+        std::size_t used = 0;
+        try {
+          o.orbit_px = std::stod(v, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != v.size() || !(std::abs(o.orbit_px) <= 1000.0)) {
+          throw ViewerInputError("cloudviewer view: --orbit: found '" + v + "', expected pixels of drag per frame in -1000..1000");
+        }
       } else if (a == "--section" || a == "--series") {
         (a == "--section" ? o.section : o.series) = next();
         SectionPanel sec;
@@ -532,6 +551,7 @@ int run_viewer(const ViewerOptions& o) {
   if (!o.scene || o.scale_given) s.scene.render.resolution_scale = o.scale;
   if (o.frame_budget_ms >= 0.0) s.scene.render.budget_ms = o.frame_budget_ms;
   s.path_trace = o.path_trace;
+  s.reproject = o.reproject;
   if (o.path_spp > 0) s.path_spp = o.path_spp;
 
   // More views (--compare, else the scene file's "views"): opened before the window, so bad input
@@ -637,6 +657,8 @@ int run_viewer(const ViewerOptions& o) {
       ctx.home = *s.scene.camera;
       ctx.goto_lat_deg = ctx.home.lat_deg, ctx.goto_lon_deg = ctx.home.lon_deg, ctx.goto_alt_m = ctx.home.alt_m;
     }
+    // --orbit: a scripted drag of the globe every frame after the first (the reprojection's figures).
+    if (o.orbit_px != 0.0 && frame > 0) orbit(*s.scene.camera, o.orbit_px, 0.0, g.earth_radius_m);
     for (ExtraView& v : extra) {
       if (!v.scene.camera) v.scene.camera = *s.scene.camera;  // a new view starts where view 0 looks
     }
@@ -904,13 +926,30 @@ int run_viewer(const ViewerOptions& o) {
       ViewGpu& v = *gpus[i];
       const core::Scene& sc = scene_of(static_cast<int>(i));
       const bool tracing = s.path_trace;
-      if (frame == 0 || !same_march(sc, v.previous) || v.path_mode != tracing) {
+      // Reprojection: not with the path tracer, overlays (their pass draws every pixel) or the
+      // camera path's track; it marches single frames at step middles (no jittered accumulation).
+      const bool reproject = s.reproject && !tracing && sc.overlays.empty() && !(i == 0 && s.keys.draw_path && s.scene.path);
+      if (reproject) {  // the march size in whole 4 x 4 blocks
+        v.spec.march_camera.width = render::Reprojector::whole_blocks(v.spec.march_camera.width);
+        v.spec.march_camera.height = render::Reprojector::whole_blocks(v.spec.march_camera.height);
+      }
+      const bool same = frame > 0 && same_march(sc, v.previous);
+      if (!same || v.path_mode != tracing || v.reprojecting != reproject) {
         v.accumulated = 0;
         v.paths = core::MonteCarloImage{};
       }
+      if (reproject) {
+        if (!v.reprojector) v.reprojector = std::make_unique<render::Reprojector>(loader);
+        if (!v.reprojecting) v.reprojector->reset();
+        // Anything but the camera changed (the reprojector finds the camera's motion itself).
+        core::Scene camera_only = v.previous;
+        camera_only.camera = sc.camera;
+        v.reproject_changed = frame > 0 && v.reprojecting && !same_march(sc, camera_only);
+      }
       v.path_mode = tracing;
+      v.reprojecting = reproject;
       v.previous = sc;
-      v.marching = v.accumulated < (tracing ? s.path_spp : sc.render.accumulate);
+      v.marching = reproject ? !same || !v.reprojector->complete() : v.accumulated < (tracing ? s.path_spp : sc.render.accumulate);
       any_march = any_march || v.marching;
       const int w = v.spec.march_camera.width, h = v.spec.march_camera.height;
       if (v.presenter.width() != w || v.presenter.height() != h) v.presenter.resize(w, h);
@@ -941,6 +980,14 @@ int run_viewer(const ViewerOptions& o) {
       if (!v->marching) continue;
       if (v->path_mode) {
         trace_into(*v);
+      } else if (v->reprojecting) {  // 1/16 of the pixels, the rest reprojected into the frame texture
+        core::FrameSpec sparse = v->spec;
+        sparse.accumulate = 1;
+        sparse.march_camera = render::Reprojector::sparse_camera(v->spec.march_camera, v->reproject_index);
+        v->renderer.march_into(v->reprojector->sparse_target(v->spec.march_camera), sparse, 0);
+        v->reprojector->resolve(v->renderer.raymarcher().cloud_depth_texture(), v->spec.march_camera, v->reproject_index,
+                                v->reproject_changed, g.earth_radius_m, v->presenter.frame_texture());
+        ++v->reproject_index;
       } else {
         v->renderer.march_into(v->presenter.frame_texture(), v->spec, v->accumulated);
       }
@@ -953,11 +1000,14 @@ int run_viewer(const ViewerOptions& o) {
       ViewGpu& v = *gpus[i];
       const core::Scene& sc = scene_of(static_cast<int>(i));
       if (v.marching) {
-        v.presenter.accumulate(v.path_mode ? 0 : v.accumulated);  // the path tracer's frame texture holds its mean
+        // The path tracer's frame texture holds its mean, the reprojector's the whole image.
+        v.presenter.accumulate(v.path_mode || v.reprojecting ? 0 : v.accumulated);
         ++v.accumulated;
         // The automatic exposure from the mean at the march size (as `render` takes it), when the mean
         // starts and when it is complete: not frame by frame, so the picture does not pulse.
-        const int target = v.path_mode ? s.path_spp : sc.render.accumulate;  // (as above)
+        // (Reprojecting: again once 16 frames have marched every pixel, so a still view ends on the
+        // exposure `render` takes from the whole image.)
+        const int target = v.path_mode ? s.path_spp : v.reprojecting ? render::Reprojector::kFramesToComplete : sc.render.accumulate;
         if (v.spec.auto_exposure && (v.accumulated == 1 || v.accumulated == target)) {
           std::vector<glm::vec4> mean(static_cast<std::size_t>(v.presenter.width()) * v.presenter.height());
           glGetTextureImage(v.presenter.mean_texture(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(mean.size() * sizeof(glm::vec4)),
@@ -988,6 +1038,7 @@ int run_viewer(const ViewerOptions& o) {
     if (show_ui) stats.march = renderer.last_stats();  // read back only when shown (it waits for the march)
     stats.accumulated = main_view.accumulated;
     stats.path_trace = main_view.path_mode;
+    stats.reprojecting = main_view.reprojecting;
     if (main_view.path_mode && main_view.paths.spp >= 2 && show_ui) stats.path_error = main_view.paths.mean_relative_standard_error();
     stats.march_w = mw;
     stats.march_h = mh;

@@ -31,6 +31,8 @@ struct ViewerOptions {
   std::string section, series;       // --section LAT,LON,LAT,LON[,FIELD], --series LAT,LON: open those panels, drawn
   bool path_trace = false;           // --quality reference: the progressive path tracer from the first frame
   int path_spp = 0;                  // --spp N: its samples per pixel (0: the state's default)
+  bool reproject = false;            // --reproject: temporal reprojection (ViewerState::reproject)
+  double orbit_px = 0.0;             // --orbit PX: the globe dragged PX pixels to the right every frame (a scripted orbit)
 };
 
 // Parses the `view` arguments and runs; returns the exit code (2 with one line for bad arguments).

@@ -59,6 +59,11 @@ struct ViewerState {
   // restarts the march's accumulation restarts it.
   bool path_trace = false;
   int path_spp = 256;
+  // Temporal reprojection (issue 18, item 4; render/reprojector.hpp): each view marches 1/16 of its
+  // pixels per frame and reprojects the rest from its last image, until 16 frames of a still scene
+  // have marched them all (single frames at step middles: no jittered accumulation). Views with
+  // overlays and the path tracer march every pixel.
+  bool reproject = false;
 };
 
 

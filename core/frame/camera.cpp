@@ -27,8 +27,8 @@ CameraFrame camera_frame(const Camera& cam) {
 
 glm::dvec3 camera_ray(const Camera& cam, int px, int py) {
   const CameraFrame c = camera_frame(cam);
-  const double x = (2.0 * (px + 0.5) / cam.width - 1.0) * c.tan_half;
-  const double y = (1.0 - 2.0 * (py + 0.5) / cam.height) * c.tan_half * cam.height / cam.width;
+  const double x = (2.0 * (px + 0.5 + cam.pixel_shift_x) / cam.width - 1.0) * c.tan_half;
+  const double y = (1.0 - 2.0 * (py + 0.5 + cam.pixel_shift_y) / cam.height) * c.tan_half * cam.height / cam.width;
   return glm::normalize(c.forward + x * c.right + y * c.up);
 }
 

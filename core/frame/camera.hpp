@@ -13,6 +13,10 @@ struct Camera {
   double lat_deg = 0.0, lon_deg = 0.0, alt_m = 0.0;
   double heading_deg = 0.0, pitch_deg = 0.0, fov_deg = 60.0;
   int width = 64, height = 36;
+  // Where in each pixel its ray passes, from the centre, in pixels (x right, y down): 0 everywhere
+  // but the viewer's sparse frames (render/reprojector), whose pixels stand for one pixel of a
+  // block of a larger image.
+  double pixel_shift_x = 0.0, pixel_shift_y = 0.0;
 };
 
 // A camera's orientation in Earth-centred coordinates, and its half-width: pixel (px, py) looks

@@ -449,8 +449,8 @@ CV_FN void tl_composite(ivec2 px, CV_INOUT(MarchState) s) {
 }
 
 CV_FN real3 pixel_direction(ivec2 px) {
-  real x = (real(2.0) * (real(px.x) + real(0.5)) / real(u_size.x) - real(1.0)) * u_tan_half;
-  real y = (real(1.0) - real(2.0) * (real(px.y) + real(0.5)) / real(u_size.y)) * u_tan_half * real(u_size.y) / real(u_size.x);
+  real x = (real(2.0) * (real(px.x) + real(0.5) + u_pixel_shift.x) / real(u_size.x) - real(1.0)) * u_tan_half;
+  real y = (real(1.0) - real(2.0) * (real(px.y) + real(0.5) + u_pixel_shift.y) / real(u_size.y)) * u_tan_half * real(u_size.y) / real(u_size.x);
   return normalize(u_forward + x * u_right + y * u_upv);
 }
 

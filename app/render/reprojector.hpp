@@ -1,0 +1,68 @@
+// Temporal reprojection for the viewer (issue 18, item 4; docs/physics.md "Temporal reprojection"):
+// each frame marches one pixel of every 4 x 4 block of the image (1/16 of the pixels, in a 4 x 4
+// Bayer order, so 16 frames of a still camera march every pixel once), and the other pixels take
+// the previous frame's image where the point they see stood in the previous camera (from the new
+// samples' cloud depth, else the Earth's surface, else the sky's direction), clamped to the range of
+// the nearby new samples for 16 frames after the camera moved or the medium changed (against
+// ghosting; a turn or a zoom of the lens reprojects exactly and is not clamped), or the new
+// samples' bilinear blend where the history never saw the point (disocclusion, the view's edges).
+// Offline renders never use it: `render` and `record` march every pixel.
+#pragma once
+
+#include <optional>
+
+#include <glm/vec2.hpp>
+
+#include "frame/camera.hpp"
+#include "render/shader_loader.hpp"
+
+namespace cv::render {
+
+class Reprojector {
+ public:
+  static constexpr int kBlock = 4;
+  static constexpr int kFramesToComplete = kBlock * kBlock;
+
+  // Needs a current OpenGL 4.5 context; compiles shaders/display/reproject.comp.
+  explicit Reprojector(const ShaderLoader& loader);
+  ~Reprojector();
+  Reprojector(const Reprojector&) = delete;
+  Reprojector& operator=(const Reprojector&) = delete;
+
+  // The pixel of each block that sparse frame `index` marches (the 4 x 4 Bayer order).
+  static glm::ivec2 offset_of(int index);
+  // The full image's size rounded up to whole blocks (the viewer's march size when reprojecting).
+  static int whole_blocks(int pixels) { return (pixels + kBlock - 1) / kBlock * kBlock; }
+  // The camera of sparse frame `index` for a full camera whose width and height are whole blocks:
+  // width/4 x height/4 pixels, pixel (i, j) on the ray of the full image's pixel (4 i + o.x, 4 j + o.y).
+  static core::Camera sparse_camera(const core::Camera& full, int index);
+
+  // An RGBA32F texture of the sparse size for `full` to march into (made again when the size changes).
+  unsigned sparse_target(const core::Camera& full);
+
+  // Makes the full image (into `out`, RGBA32F of full's size) from sparse frame `index` just marched
+  // into sparse_target() with its cloud depth in `sparse_depth` (R32F of the sparse size), and the
+  // history. `changed`: the medium or the settings changed since the last resolve (the camera's own
+  // motion is found here). The result becomes the next frame's history.
+  void resolve(unsigned sparse_depth, const core::Camera& full, int index, bool changed, double r0_m, unsigned out);
+
+  // Frames resolved since the last change (camera, medium or settings); the image holds only
+  // freshly marched pixels from kFramesToComplete on.
+  int frames_since_change() const { return frames_since_change_; }
+  bool complete() const { return frames_since_change_ >= kFramesToComplete; }
+  // Forgets the history: the next resolve blends the new samples alone.
+  void reset();
+  // The neighbourhood clamp (on; off only to measure what it does against ghosting).
+  void set_clamp(bool on) { clamp_ = on; }
+
+ private:
+  GlProgram program_;
+  unsigned history_ = 0, sparse_ = 0;
+  int width_ = 0, height_ = 0, sparse_w_ = 0, sparse_h_ = 0;
+  std::optional<core::Camera> previous_;
+  int frames_since_change_ = 0;
+  int frames_since_doubt_ = kFramesToComplete;  // since the camera moved or the medium changed
+  bool clamp_ = true;
+};
+
+}  // namespace cv::render
