@@ -50,6 +50,28 @@ const core::ErosionNoise& shared_noise() {
   return noise;
 }
 
+// The CPU kernel drawing the modelled cloud of prepared volume v with settings s, over the shared
+// noise; `shift` holds its u_detail_shift texels and must outlive it.
+kernel::f64::MarchKernel modelled_kernel(const core::PreparedVolume& v, const core::MarchSettings& s, std::vector<float>& shift) {
+  core::Camera cam;
+  cam.width = cam.height = 1;
+  kernel::f64::MarchKernel k;
+  static_cast<kernel::MarchParams&>(k) = core::march_params(v, cam, core::Sun{}, s, glm::ivec2(0));
+  const core::VolumeGrid& grid = v.grid;
+  const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
+  k.u_liquid = {v.extinction.liquid_per_m.data(), n};
+  k.u_ice = {v.extinction.ice_per_m.data(), n};
+  k.u_fraction = {v.extinction.fraction.data(), n};
+  const core::ErosionNoise& noise = shared_noise();
+  k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
+  k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
+  k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
+  shift = core::detail_shift_texels(v, k);
+  k.u_detail_shift = {shift.data(), {grid.alt_m.count, 1}, 2};
+  k.kModelled = true;
+  return k;
+}
+
 struct CellFigures {
   int cells = 0;                 // cells holding cloud that were measured
   double worst_mean = 0.0;       // largest |modelled mean / data mean - 1| over the cells
@@ -78,22 +100,9 @@ CellFigures measure_cells(const core::VolumeGrid& grid, const core::TimeStepData
   s.medium.modelled = true;
   s.medium.detail_amount = 1.0;
   s.medium.detail_scale_m = scale_m;
-  core::Camera cam;
-  cam.width = cam.height = 1;
-  core::Sun sun;
-  kernel::f64::MarchKernel k;
-  static_cast<kernel::MarchParams&>(k) = core::march_params(v, cam, sun, s, glm::ivec2(0));
+  std::vector<float> shift;
+  kernel::f64::MarchKernel k = modelled_kernel(v, s, shift);
   const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
-  k.u_liquid = {v.extinction.liquid_per_m.data(), n};
-  k.u_ice = {v.extinction.ice_per_m.data(), n};
-  k.u_fraction = {v.extinction.fraction.data(), n};
-  const core::ErosionNoise& noise = shared_noise();
-  k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
-  k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
-  k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
-  const std::vector<float> shift = core::detail_shift_texels(v, k);
-  k.u_detail_shift = {shift.data(), {grid.alt_m.count, 1}, 2};
-  k.kModelled = true;
   EXPECT_TRUE(k.u_has_fraction);
 
   // The cloudy cells: all 8 nodes with extinction and fraction.
@@ -246,20 +255,9 @@ TEST(ModelledCloud, BrickBoundsHoldTheModelledExtinction) {
     const std::vector<glm::vec2> bricks = core::medium_pyramid(v, s, noise.detail);
     ASSERT_EQ(bricks.size(), v.pyramid_packed.size());
     const double global = core::medium_majorant(v, s, noise.detail);
-    core::Camera cam;
-    cam.width = cam.height = 1;
-    kernel::f64::MarchKernel k;
-    static_cast<kernel::MarchParams&>(k) = core::march_params(v, cam, core::Sun{}, s, glm::ivec2(0));
+    std::vector<float> shift;
+    kernel::f64::MarchKernel k = modelled_kernel(v, s, shift);
     const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
-    k.u_liquid = {v.extinction.liquid_per_m.data(), n};
-    k.u_ice = {v.extinction.ice_per_m.data(), n};
-    k.u_fraction = {v.extinction.fraction.data(), n};
-    k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
-    k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
-    k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
-    const std::vector<float> shift = core::detail_shift_texels(v, k);
-    k.u_detail_shift = {shift.data(), {grid.alt_m.count, 1}, 2};
-    k.kModelled = true;
     const auto& l0 = v.pyramid.levels()[0];
     int cloudy = 0, tighter = 0;
     double worst_ratio = 0.0;  // largest sampled value / its brick's bound
