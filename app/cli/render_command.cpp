@@ -681,9 +681,13 @@ int cmd_render(const std::vector<std::string>& args) {
   // Resolve everything the scene left automatic, so the saved scene reproduces this image exactly.
   core::FrameSpec frame = render::resolve_frame(scene, vol);
   check_view_steps(frame.march.quality.view_step_m, g.earth_radius_m, prepared->layer.empty ? g.alt_m.last() : prepared->layer.top_m);
-  if (frame.march.medium.modelled && prepared->extinction.fraction.empty()) {
-    std::printf("note: %s has no cloud fraction: the modelled cloud takes a cover of 1 wherever there is water (its shapes only "
-                "thin and thicken it)\n", scene.data.path.c_str());
+  if (frame.march.medium.modelled) {
+    if (prepared->weather.cover_from_water) {
+      std::printf("note: %s has no cloud fraction: the modelled cloud takes the cover diagnosed from the water (in-cloud "
+                  "extinction of a typical cloud, shaped by the layer's type; docs/physics.md \"Weather textures\")\n",
+                  scene.data.path.c_str());
+    }
+    std::printf("%s\n", core::weather_textures_note(prepared->weather).c_str());
   }
   if (frame.march.medium.modelled) {
     if (!vol.has_field[static_cast<int>(core::Field::WindU)] || !vol.has_field[static_cast<int>(core::Field::WindV)]) {

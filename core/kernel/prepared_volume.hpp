@@ -16,6 +16,7 @@
 #include "volume/grid_mean.hpp"
 #include "volume/column_depth.hpp"
 #include "volume/extinction_pyramid.hpp"
+#include "kernel/weather_textures.hpp"
 
 namespace cv::core {
 
@@ -32,6 +33,10 @@ struct PreparedVolume {
   ExtinctionPyramid pyramid;
   std::vector<glm::vec2> pyramid_packed;  // every level's (min, max), finest first, as the GPU reads them
   std::array<int, ExtinctionPyramid::kMaxLevels> level_offset{};  // first brick of each level in pyramid_packed
+  // The 2-D weather textures of this medium (cover per layer, type, base, top; issue 18 item 1).
+  // Where the file gives no cloud fraction, extinction.fraction holds the cover diagnosed from the
+  // water (weather.cover_from_water), which the modelled cloud takes.
+  WeatherTextures weather;
 };
 
 PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinction);

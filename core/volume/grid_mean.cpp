@@ -2,6 +2,8 @@
 #include "volume/grid_mean.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "geo/geodesy.hpp"
 
@@ -14,6 +16,33 @@ double largest_extinction(const GridMeanExtinction& medium) {
                         (i < medium.ice_per_m.size() ? double(medium.ice_per_m[i]) : 0.0));
   }
   return m;
+}
+
+std::vector<float> lapse_rates(const VolumeGrid& grid, const TimeStepData& data) {
+  const auto& t = data[Field::Temperature];
+  if (t.size() != grid.points()) return {};
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<float> out(grid.columns(), nan);
+  for (int j = 0; j < grid.lat_deg.count; ++j) {
+    for (int i = 0; i < grid.lon_deg.count; ++i) {
+      const std::size_t col = grid.column(i, j);
+      const double ground = col < data.ground_m.size() && std::isfinite(data.ground_m[col]) ? data.ground_m[col] : 0.0;
+      // The lowest level at or above the ground with a temperature, then the first at least 3 km
+      // above it with one.
+      int k0 = -1;
+      for (int k = 0; k < grid.alt_m.count && k0 < 0; ++k) {
+        if (grid.alt_m.at(k) >= ground && std::isfinite(t[grid.index(i, j, k)])) k0 = k;
+      }
+      if (k0 < 0) continue;
+      for (int k = k0 + 1; k < grid.alt_m.count; ++k) {
+        const double dz = grid.alt_m.at(k) - grid.alt_m.at(k0);
+        if (dz < 3000.0 - 1e-6 || !std::isfinite(t[grid.index(i, j, k)])) continue;
+        out[col] = static_cast<float>((double(t[grid.index(i, j, k0)]) - double(t[grid.index(i, j, k)])) / dz * 1000.0);
+        break;
+      }
+    }
+  }
+  return out;
 }
 
 GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepData& data) {
@@ -37,6 +66,7 @@ GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepDa
     m.fraction.resize(cf.size());
     for (std::size_t p = 0; p < cf.size(); ++p) m.fraction[p] = cf[p] > 0.0f ? std::min(cf[p], 1.0f) : 0.0f;  // NaN -> 0
   }
+  m.lapse_k_per_km = lapse_rates(grid, data);
   return m;
 }
 

@@ -21,6 +21,10 @@ struct GridMeanExtinction {
   // The cloud fraction per node (0..1; NaN as 0), empty where the file has none: the modelled
   // cloud (cloud_model "modelled", march.glsl detail_factor) makes that share of each cell cloudy.
   std::vector<float> fraction{};
+  // Per column, the temperature lapse rate from the lowest level above the ground to 3 km above it
+  // (K/km; NaN where the column lacks temperatures), empty where the file has none: the weather
+  // textures' convective signal (core/kernel/weather_textures).
+  std::vector<float> lapse_k_per_km{};
   // The modelled cloud's detail displacement at this instant (grid cells along the longitude and
   // latitude indices, 2 per level; core/kernel/detail_drift), empty where nobody asked: it stays still.
   std::vector<double> detail_drift_cells{};
@@ -31,6 +35,8 @@ struct GridMeanExtinction {
 constexpr float kMaxGridMeanExtinctionPerM = 1e6f;
 // cloud fraction x in-cloud extinction per node; NaN, negative and >= kMaxGridMeanExtinctionPerM -> 0.
 GridMeanExtinction grid_mean_extinction(const VolumeGrid& grid, const TimeStepData& data);
+// The per-column lapse rates of GridMeanExtinction::lapse_k_per_km; empty without temperatures.
+std::vector<float> lapse_rates(const VolumeGrid& grid, const TimeStepData& data);
 
 // The altitudes between which a volume holds cloud: from the level below its lowest level with any
 // extinction to the level above its highest (trilinear sampling reads cloud between those), so the

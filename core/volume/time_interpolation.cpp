@@ -293,6 +293,12 @@ GridMeanExtinction interpolate_extinction(const VolumeGrid& grid, const GridMean
   }
   r.cost_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   out.ground_m = e0.ground_m.empty() ? e1.ground_m : e0.ground_m;  // the terrain does not move
+  // The columns' lapse rates (the weather textures' convective signal) linear in time in every
+  // mode but the nearest step's (a column property, not carried by the flow).
+  if (mode != TimeInterpolation::Nearest && fraction > 0.0 && fraction < 1.0 && e0.lapse_k_per_km.size() == e1.lapse_k_per_km.size() &&
+      !e0.lapse_k_per_km.empty()) {
+    out.lapse_k_per_km = blend(e0.lapse_k_per_km, e1.lapse_k_per_km, fraction);
+  }
   return out;
 }
 

@@ -225,6 +225,20 @@ TEST(ModelledCloud, CellsOfTheSampleKeepTheirCoverAndTogetherTheirMean) {
                                 measure_cells(vol.grid, vol.step(1), 20000.0, 8, 30, 1 << 17, true), 20, true);
 }
 
+// A file without cloud fraction: the sample's grid-mean water alone, whose cover the weather
+// textures diagnose from the water (core/kernel/weather_textures). The modelled cloud keeps that
+// cover and the water's mean as it keeps a file's own fraction.
+TEST(ModelledCloud, CellsKeepTheCoverDiagnosedFromTheWater) {
+  auto vol = importers::import_file(CV_SAMPLE_FILE);
+  core::TimeStepData step = vol.step(1);
+  const core::GridMeanExtinction m = core::grid_mean_extinction(vol.grid, step);
+  step[core::Field::ExtinctionLiquid] = m.liquid_per_m;
+  step[core::Field::ExtinctionIce] = m.ice_per_m;
+  step[core::Field::CloudFraction].clear();
+  expect_cells_keep_their_means("sample without its fraction (cover diagnosed from the water)",
+                                measure_cells(vol.grid, step, 20000.0, 8, 30, 1 << 17), 20, true);
+}
+
 TEST(ModelledCloud, CellsOfARealWrfFileKeepTheirCover) {
   REAL_FILE(path, "wrf_d01_allvars_cropped.nc");
   auto vol = importers::import_file(path);
