@@ -111,14 +111,14 @@ void GpuRaymarcher::upload_noise(const core::ErosionNoise& noise) {
     glTextureSubImage3D(noise_textures_[i], 0, 0, 0, 0, tex[i]->n, tex[i]->n, tex[i]->n, GL_RED, GL_FLOAT,
                         tex[i]->texels.data());
   }
-  // The modelled cloud's table over these tiles (threshold, ramp mean per cover).
+  // The modelled cloud's table over these tiles (threshold, ramp mean per cover and cloud type).
   if (detail_table_) glDeleteTextures(1, &detail_table_);
   detail_table_ = 0;
   detail_values_ = noise.detail;
-  if (noise.detail.size() == 2 * (CV_DETAIL_COVERS + 1)) {
+  if (noise.detail.size() == 2 * (CV_DETAIL_COVERS + 1) * CV_DETAIL_TYPES) {
     glCreateTextures(GL_TEXTURE_2D, 1, &detail_table_);
-    glTextureStorage2D(detail_table_, 1, GL_RG32F, CV_DETAIL_COVERS + 1, 1);
-    glTextureSubImage2D(detail_table_, 0, 0, 0, CV_DETAIL_COVERS + 1, 1, GL_RG, GL_FLOAT, noise.detail.data());
+    glTextureStorage2D(detail_table_, 1, GL_RG32F, CV_DETAIL_COVERS + 1, CV_DETAIL_TYPES);  // a row per cloud type
+    glTextureSubImage2D(detail_table_, 0, 0, 0, CV_DETAIL_COVERS + 1, CV_DETAIL_TYPES, GL_RG, GL_FLOAT, noise.detail.data());
   }
   check_gl("uploading the erosion noise textures");
 }
@@ -151,9 +151,11 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
   const core::ColumnDepth& columns = volume->columns;
   if (column_tau_) glDeleteTextures(1, &column_tau_);
   glCreateTextures(GL_TEXTURE_2D, 1, &column_tau_);
-  // Two channels: the optical depth and the ground's altitude (the layer masks).
-  glTextureStorage2D(column_tau_, 1, GL_RG32F, columns.nx, columns.ny);
-  glTextureSubImage2D(column_tau_, 0, 0, 0, columns.nx, columns.ny, GL_RG, GL_FLOAT, volume->column_maps.data());
+  // Four channels: the optical depth, the ground's altitude (the layer masks) and the modelled
+  // cloud's type memberships (cumuliform, cirriform).
+  static_assert(core::kColumnMapChannels == 4);
+  glTextureStorage2D(column_tau_, 1, GL_RGBA32F, columns.nx, columns.ny);
+  glTextureSubImage2D(column_tau_, 0, 0, 0, columns.nx, columns.ny, GL_RGBA, GL_FLOAT, volume->column_maps.data());
   check_gl("uploading the column optical depths");
   column_mask_ = core::MediumMask{};
   // The two-stream source belongs to a time step: built again, at this size, when a march needs it.
@@ -210,7 +212,7 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
   // The octave gate's column depths of what the march shows: made again when the mask changes.
   if (const core::MediumMask hidden = core::medium_mask(s); !(hidden == column_mask_)) {
     const std::vector<float> maps = core::column_maps_for(v, hidden);
-    glTextureSubImage2D(column_tau_, 0, 0, 0, v.columns.nx, v.columns.ny, GL_RG, GL_FLOAT, maps.data());
+    glTextureSubImage2D(column_tau_, 0, 0, 0, v.columns.nx, v.columns.ny, GL_RGBA, GL_FLOAT, maps.data());
     check_gl("uploading the masked column optical depths");
     column_mask_ = hidden;
   }

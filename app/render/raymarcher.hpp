@@ -185,12 +185,12 @@ class GpuRaymarcher {
   GLuint modelled_pyramid_ = 0;     // the modelled cloud's brick bounds (core::medium_pyramid) for modelled_pyramid_volume_
   const core::PreparedVolume* modelled_pyramid_volume_ = nullptr;
   double modelled_pyramid_amount_ = -1.0;
-  GLuint detail_table_ = 0;         // the modelled cloud's table (RG32F, CV_DETAIL_COVERS + 1 texels), with the noise
+  GLuint detail_table_ = 0;         // the modelled cloud's table (RG32F, CV_DETAIL_COVERS + 1 by CV_DETAIL_TYPES), with the noise
   std::vector<float> detail_values_;  // the same table on the CPU (the path tracer's majorant)
   core::MsSourceKey ms_key_;
   const core::PreparedVolume* ms_volume_ = nullptr;
   double ms_build_ms_ = 0.0;
-  GLuint column_tau_ = 0;           // vertical optical depth per column (R32F), for the octave gate
+  GLuint column_tau_ = 0;           // the column maps (RGBA32F): optical depth (the octave gate), ground, cloud type
   core::MediumMask column_mask_;    // the mask column_tau_'s depths were made for (none: the prepared map)
   GLuint jitter_mask_ = 0;          // the blue-noise mask (R32F), uploaded at construction
   GLuint ground_ = 0;               // land albedo and water fraction (RGBA32F), loaded from ground_path_

@@ -86,7 +86,7 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
       bool any = false;
       // The column's ground, as the march's band test reads it at a node (the column map's second channel).
       const std::size_t col = grid.column(i, j);
-      const double ground = 2 * col + 1 < v.column_maps.size() ? double(v.column_maps[2 * col + 1]) : 0.0;
+      const double ground = kColumnMapChannels * col + 1 < v.column_maps.size() ? double(v.column_maps[kColumnMapChannels * col + 1]) : 0.0;
       for (int k = 0; k < nz; ++k) {
         const std::size_t idx = grid.index(i, j, k);
         const bool shown = key.mask.shown(grid.alt_m.at(k), ground);

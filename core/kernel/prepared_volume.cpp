@@ -37,11 +37,14 @@ PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinct
   v.wraps = grid.wraps_lon();
   v.global_lat = VolumeSampler(grid, e.liquid_per_m).global_lat();
   v.columns = column_depth(grid, e.liquid_per_m, e.ice_per_m);
-  v.column_maps.assign(2 * v.columns.tau.size(), 0.0f);
+  v.column_maps.assign(kColumnMapChannels * v.columns.tau.size(), 0.0f);
+  const std::vector<float> types = detail_type_memberships(grid, v.weather);
   for (std::size_t c = 0; c < v.columns.tau.size(); ++c) {
-    v.column_maps[2 * c] = v.columns.tau[c];
+    v.column_maps[kColumnMapChannels * c] = v.columns.tau[c];
     const float ground = c < e.ground_m.size() ? e.ground_m[c] : 0.0f;
-    v.column_maps[2 * c + 1] = std::isfinite(ground) ? ground : 0.0f;  // unknown terrain: sea level
+    v.column_maps[kColumnMapChannels * c + 1] = std::isfinite(ground) ? ground : 0.0f;  // unknown terrain: sea level
+    v.column_maps[kColumnMapChannels * c + 2] = types[2 * c];
+    v.column_maps[kColumnMapChannels * c + 3] = types[2 * c + 1];
   }
   v.pyramid = ExtinctionPyramid(grid, e.liquid_per_m, e.ice_per_m);
   int offset = 0;
@@ -126,9 +129,11 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
 
 double medium_majorant(const PreparedVolume& v, const MarchSettings& s, const std::vector<float>& table) {
   if (!s.medium.modelled) return v.sigma_max_per_m;
-  double k = 1.0;  // c / m(c) = 1 at full cover
-  for (std::size_t e = 1; 2 * e + 1 < table.size(); ++e) {
-    const double c = (double(e) / CV_DETAIL_COVERS) * (double(e) / CV_DETAIL_COVERS), m = table[2 * e + 1];
+  double k = 1.0;  // c / m(c) = 1 at full cover; the types' blend is at most the largest row's
+  for (std::size_t e = 0; 2 * e + 1 < table.size(); ++e) {
+    const std::size_t entry = e % (CV_DETAIL_COVERS + 1);
+    if (entry == 0) continue;
+    const double c = (double(entry) / CV_DETAIL_COVERS) * (double(entry) / CV_DETAIL_COVERS), m = table[2 * e + 1];
     if (m > 0.0) k = std::max(k, c / m);
   }
   const GridMeanExtinction& x = v.extinction;
@@ -165,15 +170,20 @@ std::vector<glm::vec2> medium_pyramid(const PreparedVolume& v, const MarchSettin
   // Each brick's largest ratio, and its smallest and largest cover, over the same dilated nodes.
   const ExtinctionPyramid pr(v.grid, ratio, {}), pc(v.grid, cover, {});
   // K over table entries e0..e1: the largest c / m(c) (1 at full cover).
-  const int covers = int(table.size() / 2) - 1;
+  // Over every type's row: the blend of the types' factors is at most the largest.
+  constexpr int covers = CV_DETAIL_COVERS;
+  const int rows = int(table.size() / (2 * (covers + 1)));
   auto k_between = [&](double lo, double hi) {
-    if (covers < 1) return double(kHuge);
+    if (rows < 1) return double(kHuge);
     const int e0 = std::clamp(int(std::floor(std::sqrt(std::max(lo, 0.0)) * covers)), 0, covers);
     const int e1 = std::clamp(int(std::ceil(std::sqrt(std::min(hi, 1.0)) * covers)), e0, covers);
     double k = 1.0;
-    for (int e = std::max(e0, 1); e <= e1; ++e) {
-      const double c = (double(e) / covers) * (double(e) / covers), m = table[2 * std::size_t(e) + 1];
-      if (m > 0.0) k = std::max(k, c / m);
+    for (int row = 0; row < rows; ++row) {
+      for (int e = std::max(e0, 1); e <= e1; ++e) {
+        const double c = (double(e) / covers) * (double(e) / covers);
+        const double m = table[2 * (std::size_t(row) * (covers + 1) + std::size_t(e)) + 1];
+        if (m > 0.0) k = std::max(k, c / m);
+      }
     }
     return k;
   };
@@ -221,7 +231,7 @@ std::vector<float> column_maps_for(const PreparedVolume& v, const MediumMask& ma
   for (int y = 0; y < g.lat_deg.count; ++y) {
     for (int x = 0; x < g.lon_deg.count; ++x) {
       const std::size_t c = g.column(x, y);
-      const double ground = out[2 * c + 1];
+      const double ground = out[kColumnMapChannels * c + 1];
       double sum = 0.0;  // column_depth's trapezoid, in the same order
       for (int k = 0; k < nz; ++k) {
         const std::size_t i = g.index(x, y, k);
@@ -229,7 +239,7 @@ std::vector<float> column_maps_for(const PreparedVolume& v, const MediumMask& ma
         const double s = (liquid.empty() || mask.hide_liquid ? 0.0 : double(liquid[i])) + (ice.empty() || mask.hide_ice ? 0.0 : double(ice[i]));
         sum += k == 0 || k == nz - 1 ? 0.5 * s : s;
       }
-      out[2 * c] = nz > 1 ? static_cast<float>(sum * g.alt_m.step) : 0.0f;
+      out[kColumnMapChannels * c] = nz > 1 ? static_cast<float>(sum * g.alt_m.step) : 0.0f;
     }
   }
   return out;

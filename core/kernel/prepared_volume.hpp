@@ -20,6 +20,9 @@
 
 namespace cv::core {
 
+// Floats per column of PreparedVolume::column_maps.
+inline constexpr std::size_t kColumnMapChannels = 4;
+
 struct PreparedVolume {
   VolumeGrid grid;
   GridMeanExtinction extinction;
@@ -27,8 +30,10 @@ struct PreparedVolume {
   double sigma_max_per_m = 0.0;   // largest extinction (liquid + ice): sizes the sun marches' steps
   bool wraps = false, global_lat = false;
   ColumnDepth columns;            // vertical optical depth per column (the octave gate)
-  // Per column, (optical depth, ground altitude m, 0 without terrain) interleaved: the kernel's
-  // two-channel u_column_tau (the octave gate reads .r, the layer masks .g).
+  // Per column, (optical depth, ground altitude m (0 without terrain), cumuliform and cirriform
+  // memberships of the weather textures, spread into clear columns next to cloud) interleaved: the
+  // kernel's four-channel u_column_tau (the octave gate reads .r, the layer masks .g, the modelled
+  // cloud's type .b and .a).
   std::vector<float> column_maps;
   ExtinctionPyramid pyramid;
   std::vector<glm::vec2> pyramid_packed;  // every level's (min, max), finest first, as the GPU reads them
@@ -78,7 +83,7 @@ struct MediumMask {
 };
 MediumMask medium_mask(const MarchSettings& s);
 
-// The two-channel column map (optical depth, ground) the kernel reads as u_column_tau for a mask:
+// The column map (optical depth, ground, types) the kernel reads as u_column_tau for a mask:
 // the prepared one's ground, and the trapezoid over levels of what the mask shows (column_depth's
 // rule, a hidden node counting 0). Without a mask, the prepared map itself.
 std::vector<float> column_maps_for(const PreparedVolume& v, const MediumMask& mask);

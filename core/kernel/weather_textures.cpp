@@ -213,6 +213,53 @@ WeatherTextures weather_textures(const VolumeGrid& grid, const GridMeanExtinctio
   return w;
 }
 
+std::vector<float> detail_type_memberships(const VolumeGrid& grid, const WeatherTextures& w) {
+  const int nx = grid.lon_deg.count, ny = grid.lat_deg.count;
+  const std::size_t ncol = grid.columns();
+  std::vector<float> out(2 * ncol, 0.0f);
+  if (w.type.size() != ncol) return out;
+  std::vector<char> known(ncol, 0);
+  for (std::size_t c = 0; c < ncol; ++c) {
+    if (w.type[c] == CloudType::None) continue;
+    known[c] = 1;
+    out[2 * c] = w.memberships[3 * c + 1];
+    out[2 * c + 1] = w.memberships[3 * c + 2];
+  }
+  const bool wraps = grid.wraps_lon();
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<char> next = known;
+    std::vector<float> filled = out;
+    for (int j = 0; j < ny; ++j) {
+      for (int i = 0; i < nx; ++i) {
+        const std::size_t c = grid.column(i, j);
+        if (known[c]) continue;
+        double cu = 0.0, ci = 0.0;
+        int count = 0;
+        for (int dj = -1; dj <= 1; ++dj) {
+          for (int di = -1; di <= 1; ++di) {
+            int x = i + di;
+            const int y = j + dj;
+            if (y < 0 || y >= ny) continue;
+            if (x < 0 || x >= nx) {
+              if (!wraps) continue;
+              x = (x + nx) % nx;
+            }
+            const std::size_t n = grid.column(x, y);
+            if (!known[n]) continue;
+            cu += out[2 * n], ci += out[2 * n + 1], ++count;
+          }
+        }
+        if (count == 0) continue;
+        filled[2 * c] = float(cu / count), filled[2 * c + 1] = float(ci / count);
+        next[c] = 1;
+      }
+    }
+    out.swap(filled);
+    known.swap(next);
+  }
+  return out;
+}
+
 std::string weather_textures_note(const WeatherTextures& w) {
   const std::size_t cloudy = w.columns_of_type[1] + w.columns_of_type[2] + w.columns_of_type[3];
   char line[512];

@@ -72,6 +72,12 @@ std::vector<float> diagnosed_fraction(const VolumeGrid& grid, const GridMeanExti
 // The textures of a medium (its fraction, or the diagnosed one when `fraction_diagnosed`).
 WeatherTextures weather_textures(const VolumeGrid& grid, const GridMeanExtinction& medium, bool fraction_diagnosed);
 
+// The modelled cloud's type per column (2 floats per column: cumuliform and cirriform memberships;
+// stratiform is the rest): the textures' memberships, and in a clear column the mean of its cloudy
+// neighbours' (3 x 3, two passes, the longitudes wrapping where the grid does), so the cells at a
+// cloud's edge, whose corners reach clear columns, take the cloud's type. 0 (stratiform) far from cloud.
+std::vector<float> detail_type_memberships(const VolumeGrid& grid, const WeatherTextures& w);
+
 // One line for the reports: the cloudy columns' types and whence the cover came.
 std::string weather_textures_note(const WeatherTextures& w);
 

@@ -241,23 +241,26 @@ std::vector<float> detail_table(const NoiseTexture& low, const NoiseTexture& hig
   // Prefix sums of the sorted values: the mean of the ramp above any threshold in O(log N).
   std::vector<double> prefix(count + 1, 0.0);
   for (std::size_t i = 0; i < count; ++i) prefix[i + 1] = prefix[i] + v[i];
-  const double s = CV_DETAIL_SOFTNESS;
-  auto ramp_mean = [&](double t) {
+  auto ramp_mean = [&](double t, double s) {
     // Points in (t, t + s) contribute (n - t) / s, points from t + s up contribute 1.
     const std::size_t a = static_cast<std::size_t>(std::upper_bound(v.begin(), v.end(), t) - v.begin());
     const std::size_t b = static_cast<std::size_t>(std::lower_bound(v.begin(), v.end(), t + s) - v.begin());
     const double ramp = (prefix[b] - prefix[a] - t * double(b - a)) / s;
     return (ramp + double(count - b)) / double(count);
   };
-  std::vector<float> table(2 * (CV_DETAIL_COVERS + 1));
+  constexpr std::size_t row = CV_DETAIL_COVERS + 1;
+  std::vector<float> table(2 * row * CV_DETAIL_TYPES);
   for (int c = 0; c <= CV_DETAIL_COVERS; ++c) {
     // The share c of the points lies above t: t is the value at rank (1 - c) N (the largest for c = 0).
     const double share = (double(c) / CV_DETAIL_COVERS) * (double(c) / CV_DETAIL_COVERS);  // denser at low cover
     const double rank = (1.0 - share) * double(count);
     const std::size_t r = std::min(count - 1, static_cast<std::size_t>(std::max(0.0, rank)));
     const double t = c == 0 ? v.back() : c == CV_DETAIL_COVERS ? v.front() - 1e-9 : v[r];
-    table[2 * static_cast<std::size_t>(c)] = static_cast<float>(t);
-    table[2 * static_cast<std::size_t>(c) + 1] = static_cast<float>(ramp_mean(t));
+    for (int type = 0; type < CV_DETAIL_TYPES; ++type) {  // the same threshold, each type's ramp
+      const std::size_t e = 2 * (std::size_t(type) * row + static_cast<std::size_t>(c));
+      table[e] = static_cast<float>(t);
+      table[e + 1] = static_cast<float>(ramp_mean(t, p64::detail_softness(type)));
+    }
   }
   return table;
 }

@@ -32,10 +32,12 @@ struct ErosionNoise {
 
 // The modelled cloud's table (shaders/common/detail.glsl): for each cover c = (k / CV_DETAIL_COVERS)^2
 // (k = 0..CV_DETAIL_COVERS), the threshold t(c) of the noise n = detail_noise_mix(low, high) above
-// which a share c of the tile lies, and the tile's mean m(c) of detail_ramp(n, t(c)). The tile's
-// distribution of n is taken over `samples` uniform random points of the low-frequency tile (a fixed
-// sequence), interpolated as the kernel interpolates the textures. 2 (CV_DETAIL_COVERS + 1) floats,
-// (t, m) per cover; t(0) is the largest n (no cloud), t(1) the smallest.
+// which a share c of the tile lies, and the tile's mean m(c) of detail_ramp(n, t(c), s) for each
+// cloud type's softness s (detail_softness). The tile's distribution of n is taken over `samples`
+// uniform random points of the low-frequency tile (a fixed sequence), interpolated as the kernel
+// interpolates the textures. CV_DETAIL_TYPES rows (stratiform, cumuliform, cirriform) of
+// CV_DETAIL_COVERS + 1 entries, (t, m) per entry, rows one after the other (a texture of
+// CV_DETAIL_COVERS + 1 by CV_DETAIL_TYPES texels); t(0) is the largest n (no cloud), t(1) the smallest.
 std::vector<float> detail_table(const NoiseTexture& low, const NoiseTexture& high, std::size_t samples = std::size_t(1) << 22,
                                 unsigned threads = 0);
 // noise with its detail table made (once: an existing table is kept).

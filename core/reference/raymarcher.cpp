@@ -41,7 +41,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   // The octave gate's column depths of what the march shows (the prepared map when nothing is hidden).
   const MediumMask hidden = medium_mask(s);
   const std::vector<float> masked_columns = hidden.any() ? column_maps_for(v, hidden) : std::vector<float>{};
-  k.u_column_tau = {(hidden.any() ? masked_columns : v.column_maps).data(), {v.columns.nx, v.columns.ny}, 2};
+  k.u_column_tau = {(hidden.any() ? masked_columns : v.column_maps).data(), {v.columns.nx, v.columns.ny}, int(kColumnMapChannels)};
   MsSource ms;  // the two-stream source, built as the GPU's (core/kernel/ms_source)
   if (s.medium.ms_two_stream) {
     ms = build_ms_source(v, ms_source_key(s, k.u_to_sun));
@@ -54,7 +54,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   const std::vector<float> detail_shift = s.medium.modelled ? detail_shift_texels(v, k) : std::vector<float>{};
   if (s.medium.modelled) {  // the modelled cloud: the cover per node and the table over the noise tiles
     if (k.u_has_fraction) k.u_fraction = {v.extinction.fraction.data(), n};
-    k.u_detail_table = {noise->detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
+    k.u_detail_table = {noise->detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_TYPES}, 2};
     k.u_detail_shift = {detail_shift.data(), {g.alt_m.count, 1}, 2};
   }
   if (eroded || s.medium.modelled) {

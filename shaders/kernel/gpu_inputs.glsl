@@ -13,7 +13,7 @@ layout(std140, binding = CV_UBO_MARCH) uniform MarchParams {
 // The prepared volume and the other textures, fetched texel by texel (interpolated in the kernel).
 layout(binding = CV_TEX_LIQUID) uniform sampler3D u_liquid;  // grid-mean extinction, 1/m (cf x in-cloud)
 layout(binding = CV_TEX_ICE) uniform sampler3D u_ice;
-layout(binding = CV_TEX_COLUMN_TAU) uniform sampler2D u_column_tau;  // per column: vertical optical depth (r), ground altitude m (g)
+layout(binding = CV_TEX_COLUMN_TAU) uniform sampler2D u_column_tau;  // per column: vertical optical depth (r), ground altitude m (g), cumuliform (b) and cirriform (a) memberships
 layout(binding = CV_TEX_JITTER_MASK) uniform sampler2D u_jitter_mask;  // blue-noise rank / n^2, tiled
 layout(binding = CV_TEX_GROUND) uniform sampler2D u_ground;  // linear albedo, equirectangular
 layout(binding = CV_TEX_NOISE_LOW) uniform sampler3D u_noise_low;    // Perlin-Worley, periodic, [0, 1]
@@ -28,7 +28,7 @@ layout(binding = CV_TEX_TL_COLOR) uniform sampler2D u_tl_color;
 layout(binding = CV_TEX_MS_I0) uniform sampler3D u_ms_i0;  // two-stream diffuse radiance per unit irradiance
 layout(binding = CV_TEX_MS_I1) uniform sampler3D u_ms_i1;  // its first moment (upward)
 layout(binding = CV_TEX_FRACTION) uniform sampler3D u_fraction;  // cloud fraction per node (the modelled cloud's cover)
-layout(binding = CV_TEX_DETAIL_TABLE) uniform sampler2D u_detail_table;  // (threshold, ramp mean) by cover (core/kernel/detail)
+layout(binding = CV_TEX_DETAIL_TABLE) uniform sampler2D u_detail_table;  // (threshold, ramp mean) by cover (x) and cloud type (y) (core/noise detail_table)
 layout(binding = CV_TEX_DETAIL_SHIFT) uniform sampler2D u_detail_shift;  // the detail's wind displacement per level, in tiles (core/kernel/detail_drift)
 // The extinction pyramid: (min, max) per brick, levels one after the other, x fastest.
 layout(std430, binding = CV_SSBO_PYRAMID) readonly buffer Pyramid { vec2 u_min_max[]; };

@@ -71,41 +71,11 @@ CV_FN void erode_at(real3 p, CV_INOUT(real) sl, CV_INOUT(real) si) {
   si = erode_extinction(si, e, feature_m);
 }
 
-// The modelled cloud (kModelled; shaders/common/detail.glsl, docs/physics.md "The modelled cloud"):
-// the factor by which the data's grid-mean extinction at grid index f is redistributed inside its
-// cell. The noise lies in whole tiles per cell (u_detail_tiles along lon, lat and altitude), so a
-// cell holds the tile's distribution of it; the cover c is the data's cloud fraction at f (1 without
-// one); the table gives the threshold t(c) above which a share c of the tile lies and the tile's
-// mean m(c) of the ramp above it. So (1 - a) + a h / m keeps the cell's mean extinction for any
-// amount a, and with a = 1 the cloudy share of the cell is its cover. The tiles are displaced along
-// the level-mean wind (u_detail_shift, per level in tiles, linear between levels: a shift constant
-// over each horizontal slice of a cell keeps the slice's share of the periodic tile), so the detail
-// travels with the cloud and every cell keeps its cover and mean at every instant.
-CV_FN real detail_factor(real3 f) {
-  real c = u_has_fraction ? clamp(fetch(u_fraction, f), real(0.0), real(1.0)) : real(1.0);
-  real x = sqrt(c) * real(CV_DETAIL_COVERS);  // the table's covers are (k / N)^2
-  int i = min(int(x), CV_DETAIL_COVERS - 1);
-  real w = x - real(i);
-  real4 e0 = real4(texelFetch(u_detail_table, ivec2(i, 0), 0));
-  real4 e1 = real4(texelFetch(u_detail_table, ivec2(i + 1, 0), 0));
-  real t = mix(e0.x, e1.x, w);
-  real m = mix(e0.y, e1.y, w);
-  real wz;
-  int k0 = volume_fetch_index(f.z, int(u_grid_count.z), wz);
-  int k1 = min(k0 + 1, int(u_grid_count.z) - 1);
-  real4 s0 = real4(texelFetch(u_detail_shift, ivec2(k0, 0), 0));
-  real4 s1 = real4(texelFetch(u_detail_shift, ivec2(k1, 0), 0));
-  real3 tc = fract(f * u_detail_tiles - real3(mix(s0.x, s1.x, wz), mix(s0.y, s1.y, wz), real(0.0)));
-  tc.z = real(1.0) - abs(real(2.0) * tc.z - real(1.0));  // mirrored about each tile's middle height
-  real n = detail_noise_mix(fetch_noise(u_noise_low, tc), fetch_noise(u_noise_high, noise_high_coords(tc)));
-  real g = m > real(0.0) ? detail_ramp(n, t) / m : real(0.0);
-  return real(1.0) - u_detail_amount + u_detail_amount * g;
-}
-
-// The column map at grid index f: the column's vertical optical depth (x) and the ground's
-// altitude in metres (y), bilinear with the 3-D fetch's horizontal rules (wrap, pole clamp,
-// regional border 0), from the prepared volume's column map (u_column_tau, two channels).
-CV_FN real2 column_map(real3 f) {
+// The column map at grid index f, bilinear with the 3-D fetch's horizontal rules (wrap, pole clamp,
+// regional border 0), from the prepared volume's column map (u_column_tau, four channels): the
+// column's vertical optical depth (x), the ground's altitude in metres (y), and the weather
+// textures' cumuliform (z) and cirriform (w) memberships (core/kernel/weather_textures).
+CV_FN real4 column_texel(real3 f) {
   ivec2 n = ivec2(u_grid_count);
   real wx;
   real wy;
@@ -117,11 +87,55 @@ CV_FN real2 column_map(real3 f) {
   real4 t10 = x1 < 0 || x1 >= n.x || y0 < 0 || y0 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec2(x1, y0), 0));
   real4 t01 = x0 < 0 || x0 >= n.x || y1 < 0 || y1 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec2(x0, y1), 0));
   real4 t11 = x1 < 0 || x1 >= n.x || y1 < 0 || y1 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec2(x1, y1), 0));
-  real2 c00 = real2(t00.x, t00.y);
-  real2 c10 = real2(t10.x, t10.y);
-  real2 c01 = real2(t01.x, t01.y);
-  real2 c11 = real2(t11.x, t11.y);
-  return mix(mix(c00, c10, wx), mix(c01, c11, wx), wy);
+  return mix(mix(t00, t10, wx), mix(t01, t11, wx), wy);
+}
+
+// The column's optical depth (x) and ground altitude (y) at grid index f.
+CV_FN real2 column_map(real3 f) {
+  real4 t = column_texel(f);
+  return real2(t.x, t.y);
+}
+
+// The modelled cloud (kModelled; shaders/common/detail.glsl, docs/physics.md "The modelled cloud"):
+// the factor by which the data's grid-mean extinction at grid index f is redistributed inside its
+// cell. The noise lies in whole tiles per cell (u_detail_tiles along lon, lat and altitude), so a
+// cell holds the tile's distribution of it; the cover c is the data's cloud fraction at f (1 without
+// one); the table gives the threshold t(c) above which a share c of the tile lies and the tile's
+// mean m(c) of the ramp above it. So (1 - a) + a h / m keeps the cell's mean extinction for any
+// amount a, and with a = 1 the cloudy share of the cell is its cover. The tiles are displaced along
+// the level-mean wind (u_detail_shift, per level in tiles, linear between levels: a shift constant
+// over each horizontal slice of a cell keeps the slice's share of the periodic tile), so the detail
+// travels with the cloud and every cell keeps its cover and mean at every instant. The ramp's
+// softness is the cloud type's (the weather textures' memberships, bilinear from the columns: the
+// table's rows); the types' factors, each of mean 1 over a cell, are blended by the memberships, and
+// all share the threshold, so the cloudy share stays c.
+CV_FN real detail_factor(real3 f) {
+  real c = u_has_fraction ? clamp(fetch(u_fraction, f), real(0.0), real(1.0)) : real(1.0);
+  real x = sqrt(c) * real(CV_DETAIL_COVERS);  // the table's covers are (k / N)^2
+  int i = min(int(x), CV_DETAIL_COVERS - 1);
+  real w = x - real(i);
+  real4 e0 = real4(texelFetch(u_detail_table, ivec2(i, 0), 0));
+  real4 e1 = real4(texelFetch(u_detail_table, ivec2(i + 1, 0), 0));
+  real t = mix(e0.x, e1.x, w);  // the same in every row
+  real m0 = mix(e0.y, e1.y, w);
+  real m1 = mix(real(texelFetch(u_detail_table, ivec2(i, 1), 0).y), real(texelFetch(u_detail_table, ivec2(i + 1, 1), 0).y), w);
+  real m2 = mix(real(texelFetch(u_detail_table, ivec2(i, 2), 0).y), real(texelFetch(u_detail_table, ivec2(i + 1, 2), 0).y), w);
+  real4 col = column_texel(f);
+  real w_cu = clamp(col.z, real(0.0), real(1.0));
+  real w_ci = clamp(col.w, real(0.0), real(1.0) - w_cu);
+  real w_st = real(1.0) - w_cu - w_ci;
+  real wz;
+  int k0 = volume_fetch_index(f.z, int(u_grid_count.z), wz);
+  int k1 = min(k0 + 1, int(u_grid_count.z) - 1);
+  real4 s0 = real4(texelFetch(u_detail_shift, ivec2(k0, 0), 0));
+  real4 s1 = real4(texelFetch(u_detail_shift, ivec2(k1, 0), 0));
+  real3 tc = fract(f * u_detail_tiles - real3(mix(s0.x, s1.x, wz), mix(s0.y, s1.y, wz), real(0.0)));
+  tc.z = real(1.0) - abs(real(2.0) * tc.z - real(1.0));  // mirrored about each tile's middle height
+  real n = detail_noise_mix(fetch_noise(u_noise_low, tc), fetch_noise(u_noise_high, noise_high_coords(tc)));
+  real g = (m0 > real(0.0) ? w_st * detail_ramp(n, t, detail_softness(0)) / m0 : real(0.0)) +
+           (m1 > real(0.0) ? w_cu * detail_ramp(n, t, detail_softness(1)) / m1 : real(0.0)) +
+           (m2 > real(0.0) ? w_ci * detail_ramp(n, t, detail_softness(2)) / m2 : real(0.0));
+  return real(1.0) - u_detail_amount + u_detail_amount * g;
 }
 
 // The column's vertical optical depth at p (the column map's x).

@@ -338,7 +338,7 @@ class LayerMask : public ::testing::Test {
     const glm::ivec3 n(g.lon_deg.count, g.lat_deg.count, g.alt_m.count);
     k.u_liquid = {prep_.extinction.liquid_per_m.data(), n};
     k.u_ice = {prep_.extinction.ice_per_m.data(), n};
-    k.u_column_tau = {prep_.column_maps.data(), {prep_.columns.nx, prep_.columns.ny}, 2};
+    k.u_column_tau = {prep_.column_maps.data(), {prep_.columns.nx, prep_.columns.ny}, int(core::kColumnMapChannels)};
     return k;
   }
   static core::MarchSettings band(const std::string& name, bool sea_level = false) {

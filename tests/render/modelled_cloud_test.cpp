@@ -62,10 +62,11 @@ kernel::f64::MarchKernel modelled_kernel(const core::PreparedVolume& v, const co
   k.u_liquid = {v.extinction.liquid_per_m.data(), n};
   k.u_ice = {v.extinction.ice_per_m.data(), n};
   k.u_fraction = {v.extinction.fraction.data(), n};
+  k.u_column_tau = {v.column_maps.data(), {v.columns.nx, v.columns.ny}, int(core::kColumnMapChannels)};
   const core::ErosionNoise& noise = shared_noise();
   k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
   k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
-  k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
+  k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_TYPES}, 2};
   shift = core::detail_shift_texels(v, k);
   k.u_detail_shift = {shift.data(), {grid.alt_m.count, 1}, 2};
   k.kModelled = true;
@@ -166,17 +167,27 @@ void expect_cells_keep_their_means(const char* what, const CellFigures& f, int m
 
 TEST(ModelledCloud, TheTableLeavesTheCoverAboveItsThreshold) {
   const core::ErosionNoise& noise = shared_noise();
-  ASSERT_EQ(noise.detail.size(), 2u * (CV_DETAIL_COVERS + 1));
-  // Thresholds fall as the cover rises, the ramp's mean rises with it, and is at most the cover.
-  for (int c = 1; c <= CV_DETAIL_COVERS; ++c) {
-    const double t0 = noise.detail[2 * (c - 1)], t1 = noise.detail[2 * c];
-    const double m0 = noise.detail[2 * (c - 1) + 1], m1 = noise.detail[2 * c + 1];
-    EXPECT_LE(t1, t0) << c;
-    EXPECT_GE(m1, m0) << c;
-    EXPECT_LE(m1, (double(c) / CV_DETAIL_COVERS) * (double(c) / CV_DETAIL_COVERS) + 1e-6) << c;
-    EXPECT_GT(m1, 0.0) << c;
+  constexpr int row = CV_DETAIL_COVERS + 1;
+  ASSERT_EQ(noise.detail.size(), 2u * row * CV_DETAIL_TYPES);
+  const auto t = [&](int type, int c) { return double(noise.detail[2 * std::size_t(type * row + c)]); };
+  const auto m = [&](int type, int c) { return double(noise.detail[2 * std::size_t(type * row + c) + 1]); };
+  // Per type: thresholds fall as the cover rises, the ramp's mean rises with it, and is at most the
+  // cover. Every type has the same thresholds (the cover does not depend on the ramp), and a softer
+  // ramp has a smaller mean (stratiform 0.25 < cirriform 0.15 < cumuliform 0.05 in softness).
+  for (int type = 0; type < CV_DETAIL_TYPES; ++type) {
+    for (int c = 1; c <= CV_DETAIL_COVERS; ++c) {
+      EXPECT_LE(t(type, c), t(type, c - 1)) << c;
+      EXPECT_GE(m(type, c), m(type, c - 1)) << c;
+      EXPECT_LE(m(type, c), (double(c) / CV_DETAIL_COVERS) * (double(c) / CV_DETAIL_COVERS) + 1e-6) << c;
+      EXPECT_GT(m(type, c), 0.0) << c;
+      EXPECT_EQ(t(type, c), t(0, c)) << type << " " << c;
+    }
+    EXPECT_EQ(m(type, 0), 0.0) << "no cover, no cloud";
   }
-  EXPECT_EQ(noise.detail[1], 0.0f) << "no cover, no cloud";
+  for (int c : {16, 128, 200}) {
+    EXPECT_LT(m(0, c), m(2, c)) << c;
+    EXPECT_LT(m(2, c), m(1, c)) << c;
+  }
 }
 
 // The construction itself: at a constant cover c, over whole tiles, the factor's mean is 1 and the
@@ -191,14 +202,21 @@ TEST(ModelledCloud, AtAConstantCoverATileKeepsTheMeanAndTheCover) {
   k.u_has_fraction = true;
   k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
   k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
-  k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, 1}, 2};
+  k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_TYPES}, 2};
   k.u_detail_tiles = {2, 3, 1};
   k.u_detail_amount = 1.0;
+  // The cloud type per column (cumuliform, cirriform memberships): each type alone, and a blend.
+  std::vector<float> columns(4 * 16, 0.0f);
+  k.u_column_tau = {columns.data(), {4, 4}, 4};
+  const glm::vec2 types[4] = {{0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}, {0.3f, 0.2f}};
+  const char* type_names[4] = {"stratiform", "cumuliform", "cirriform", "blend"};
   const std::vector<float> still(8, 0.0f), drifted = {0.0f, 0.0f, 0.31f, -0.77f, 1.58f, 0.23f, 0.0f, 0.0f};
   const double covers[6] = {0.02, 0.1, 0.3, 0.6, 0.9, 1.0};
   for (int run = 0; run < 12; ++run) {
     const int d = run / 6;
     const double c = covers[run % 6];
+    const int type = run % 4;
+    for (int col = 0; col < 16; ++col) columns[4 * col + 2] = types[type].x, columns[4 * col + 3] = types[type].y;
     k.u_detail_shift = {(d ? drifted : still).data(), {4, 1}, 2};
     std::fill(frac.begin(), frac.end(), float(c));
     const int n = 1 << 19;
@@ -211,7 +229,8 @@ TEST(ModelledCloud, AtAConstantCoverATileKeepsTheMeanAndTheCover) {
     }
     const double mean = sum / n, se = std::sqrt(std::max(sum2 / n - mean * mean, 0.0) / n);
     const double share = cover / n, se_share = std::sqrt(c * (1.0 - c) / n) + 1e-9;
-    std::printf("%s, cover %.2f: mean factor %.4f +- %.4f, cloudy share %.4f\n", d ? "drifted" : "still", c, mean, se, share);
+    std::printf("%s, %s, cover %.2f: mean factor %.4f +- %.4f, cloudy share %.4f\n", d ? "drifted" : "still", type_names[type], c, mean, se,
+                share);
     EXPECT_LT(std::abs(mean - 1.0), 4.5 * se + 0.005) << "cover " << c;
     EXPECT_LT(std::abs(share - c), 4.5 * se_share + 0.002) << "cover " << c;
   }
