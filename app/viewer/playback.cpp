@@ -184,7 +184,7 @@ void Prefetcher::run() {
         e0 = core::interpolate_extinction(volume_.grid, e0, e1, w0, w1, at.gap_s, at.fraction, mode, &r.report);
       }
       e0.detail_drift_cells = std::move(d);
-      r.volume = std::make_shared<const core::PreparedVolume>(core::prepare_volume(volume_.grid, std::move(e0)));
+      r.volume = std::make_shared<const core::PreparedVolume>(core::prepare_volume(volume_.grid, std::move(e0), drift));  // the weather textures for the modelled cloud only
     } catch (const std::exception& e) {
       error = e.what();
     }

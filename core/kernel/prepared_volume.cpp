@@ -17,7 +17,7 @@
 
 namespace cv::core {
 
-PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinction) {
+PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinction, bool weather) {
   PreparedVolume v;
   v.grid = grid;
   v.extinction = std::move(extinction);
@@ -26,11 +26,13 @@ PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinct
     if (f->empty()) f->assign(grid.points(), 0.0f);
   }
   // The weather textures, and the cover diagnosed from the water where the file gives none.
-  const auto t0 = std::chrono::steady_clock::now();
-  const bool diagnose = v.extinction.fraction.size() != grid.points();
-  if (diagnose) v.extinction.fraction = diagnosed_fraction(grid, v.extinction);
-  v.weather = weather_textures(grid, v.extinction, diagnose);
-  v.weather.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (weather) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const bool diagnose = v.extinction.fraction.size() != grid.points();
+    if (diagnose) v.extinction.fraction = diagnosed_fraction(grid, v.extinction);
+    v.weather = weather_textures(grid, v.extinction, diagnose);
+    v.weather.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
   const GridMeanExtinction& e = v.extinction;
   v.layer = cloud_layer(grid, e);
   v.sigma_max_per_m = largest_extinction(e);

@@ -44,7 +44,10 @@ struct PreparedVolume {
   WeatherTextures weather;
 };
 
-PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinction);
+// With `weather` false the weather textures are left out (weather.nx == 0, the column maps' type
+// channels 0, no cover diagnosed): only the modelled cloud reads them, and on a global 0.25 degree
+// step they cost about half a second, so the data mode's time steps skip them.
+PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinction, bool weather = true);
 
 // The largest extinction the march kernel's medium can take with these settings, the tracking's
 // majorant (1/m): the volume's largest node sum for the data's field; for the modelled cloud

@@ -21,8 +21,9 @@ class PreparedVolumeCache {
   static constexpr std::size_t kResident = 2;
   // The prepared time step `step` of `volume`, whose data are named by `source` (a file path):
   // from the cache, or prepared now (evicting the least recently used beyond kResident). With
-  // `detail_drift` (the modelled cloud), the medium carries the detail's wind displacement at the
-  // step (DetailDrift: the winds of the steps before it are read once).
+  // `detail_drift` (the modelled cloud), the volume has its weather textures and the medium carries
+  // the detail's wind displacement at the step (DetailDrift: the winds of the steps before it are
+  // read once).
   std::shared_ptr<const PreparedVolume> get(const std::string& source, CloudVolume& volume, std::size_t step,
                                             bool detail_drift = false);
   // The medium at an instant: the step itself at a step, else the two neighbouring steps'

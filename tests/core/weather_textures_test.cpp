@@ -215,5 +215,22 @@ TEST(WeatherTextures, CoverDiagnosedFromTheWaterWhereTheFileHasNone) {
   EXPECT_NE(weather_textures_note(v.weather).find("diagnosed from the water"), std::string::npos);
 }
 
+// The data mode's volumes leave the textures out (only the modelled cloud reads them).
+TEST(WeatherTextures, LeftOutWhereNothingReadsThem) {
+  const VolumeGrid g = grid();
+  TimeStepData d = empty_step(g, 5.0);
+  put(g, d, {1, 0}, 1, 3, 0.3, 0.02, false);
+  set_lapse(g, d, {1, 0}, 8.5);
+  const PreparedVolume with = prepare_volume(g, grid_mean_extinction(g, d), true);
+  const PreparedVolume without = prepare_volume(g, grid_mean_extinction(g, d), false);
+  EXPECT_EQ(with.weather.nx, 4);
+  EXPECT_EQ(without.weather.nx, 0);
+  EXPECT_TRUE(without.weather.type.empty());
+  EXPECT_GT(with.column_maps[kColumnMapChannels * g.column(1, 0) + 2], 0.5f) << "the cumulus column's type reaches the kernel";
+  EXPECT_EQ(without.column_maps[kColumnMapChannels * g.column(1, 0) + 2], 0.0f);
+  d[Field::CloudFraction].clear();
+  EXPECT_TRUE(prepare_volume(g, grid_mean_extinction(g, d), false).extinction.fraction.empty()) << "no cover diagnosed";
+}
+
 }  // namespace
 }  // namespace cv::core
