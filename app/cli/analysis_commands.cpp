@@ -33,7 +33,8 @@ const char* probe_usage() {
          "                           the column at a point, per grid level: altitude, height above the ground, cloud\n"
          "                           fraction, in-cloud liquid and ice extinction, the grid-mean extinction the march\n"
          "                           samples, temperature, wind and pressure where the volume has them (the march's trilinear\n"
-         "                           sampler); its cover, base, top and optical depth; with --camera, where along the view\n"
+         "                           sampler); its cover, base, top and optical depth; the weather textures at the nearest grid\n"
+         "                           column (the modelled cloud's type and covers, docs/physics.md); with --camera, where along the view\n"
          "                           ray from there to the point's ground the light came from (the first cloud, and where\n"
          "                           the transmittance fell to 0.5: the CPU march kernel's own record of that ray);\n"
          "                           --time: one of the file's valid times or a step (default the first); pressure is\n"
@@ -101,6 +102,8 @@ int cmd_probe(const std::vector<std::string>& args) {
                         ", top " + (std::isfinite(p.top_m) ? num(p.top_m, "%.1f") + " m" : "none") + ", optical depth " +
                         num(p.optical_depth, "%.6g");
   std::printf("column: %s\n", summary.c_str());
+  const std::string weather = core::weather_at_text(vol.grid, prepared.weather, lat, lon);
+  if (!weather.empty()) std::printf("%s\n", weather.c_str());
   if (have_camera) {
     std::printf("view ray from %.6g,%.6g,%.6g m to the point's ground (%.6g km): first cloud %s, transmittance 0.5 at %s, "
                 "transmittance %.4g (view step %.4g m)\n",

@@ -260,6 +260,32 @@ std::vector<float> detail_type_memberships(const VolumeGrid& grid, const Weather
   return out;
 }
 
+std::string weather_at_text(const VolumeGrid& grid, const WeatherTextures& w, double lat_deg, double lon_deg) {
+  if (w.nx != grid.lon_deg.count || w.ny != grid.lat_deg.count || w.type.size() != grid.columns()) return {};
+  // The longitude east of the grid's first by 0..360, then the nearest column (a point just west of
+  // the first column is nearest to it: taken 360 lower).
+  const double east = std::fmod(std::fmod(lon_deg - grid.lon_deg.start, 360.0) + 360.0, 360.0);
+  long ii = std::lround(east / grid.lon_deg.step);
+  if (ii >= w.nx) ii = grid.wraps_lon() || east - 360.0 >= -0.5 * grid.lon_deg.step ? (grid.wraps_lon() ? ii % w.nx : 0) : -1;
+  const long j = std::lround((lat_deg - grid.lat_deg.start) / grid.lat_deg.step);
+  if (ii < 0 || ii >= w.nx || j < 0 || j >= w.ny) return {};
+  const std::size_t c = grid.column(int(ii), int(j));
+  char line[512];
+  if (w.type[c] == CloudType::None) {
+    std::snprintf(line, sizeof line, "weather textures at the nearest column (lat %.6g, lon %.6g): no cloud", grid.lat_deg.at(int(j)),
+                  grid.lon_deg.at(int(ii)));
+    return line;
+  }
+  std::snprintf(line, sizeof line,
+                "weather textures at the nearest column (lat %.6g, lon %.6g): %s (stratiform %.2f, cumuliform %.2f, cirriform %.2f), "
+                "cover %.3f (low %.3f, mid %.3f, high %.3f above %s)%s, base %.1f m, top %.1f m, ice share %.3f",
+                grid.lat_deg.at(int(j)), grid.lon_deg.at(int(ii)), cloud_type_name(w.type[c]), w.memberships[3 * c], w.memberships[3 * c + 1],
+                w.memberships[3 * c + 2], w.cover[c], w.cover_low[c], w.cover_mid[c], w.cover_high[c],
+                w.heights_above_ground ? "the ground" : "sea level", w.cover_from_water ? " diagnosed from the water" : "", w.base_m[c],
+                w.top_m[c], w.ice_share[c]);
+  return line;
+}
+
 std::string weather_textures_note(const WeatherTextures& w) {
   const std::size_t cloudy = w.columns_of_type[1] + w.columns_of_type[2] + w.columns_of_type[3];
   char line[512];

@@ -78,6 +78,11 @@ WeatherTextures weather_textures(const VolumeGrid& grid, const GridMeanExtinctio
 // cloud's edge, whose corners reach clear columns, take the cloud's type. 0 (stratiform) far from cloud.
 std::vector<float> detail_type_memberships(const VolumeGrid& grid, const WeatherTextures& w);
 
+// The textures at the grid column nearest (lat, lon) (longitude taken modulo 360), as one line for
+// `probe`: the type and its memberships, the covers, base, top and ice share. Empty when the
+// textures were left out or the point is outside the grid.
+std::string weather_at_text(const VolumeGrid& grid, const WeatherTextures& w, double lat_deg, double lon_deg);
+
 // One line for the reports: the cloudy columns' types and whence the cover came.
 std::string weather_textures_note(const WeatherTextures& w);
 
