@@ -76,14 +76,21 @@ kernel::f64::MarchKernel modelled_kernel(const core::PreparedVolume& v, const co
 struct CellFigures {
   int cells = 0;                 // cells holding cloud that were measured
   double worst_mean = 0.0;       // largest |modelled mean / data mean - 1| over the cells
+  double worst_mean_se = 0.0;    // that cell's standard error of the estimate
+  double worst_beyond = 0.0;     // largest |error| - 3 standard errors: the bias no cell is shown to exceed
+  double worst_beyond_counted = 0.0;  // the same over the cells the maps count as cloud (mean cover >= 0.01)
+  int thin_cells = 0;            // cells of mean cover below 0.01
   double worst_cover = 0.0;      // largest |modelled cover - data cover| (absolute share)
   double total_mean = 0.0;       // modelled / data over all measured cells together, - 1
   double p95_mean = 0.0;         // the 95th percentile of |mean error|
+  double p95_se = 0.0;           // the 95th percentile of the cells' standard errors
 };
 
 // Measures up to `max_cells` cloudy cells of `data` (cells with at least `min_nodes` of their 8
-// nodes holding cloud, spread over the grid) at `points` uniform random points each, with detail tiles of `scale_m`. (A regular
-// lattice aliases with the noise textures' texels.)
+// nodes holding cloud, spread over the grid) at `points` uniform random points each (more at low
+// cover, where few points fall in the cloud: points x min(16, 0.25 / cover)), with detail tiles of
+// `scale_m`. (A regular lattice aliases with the noise textures' texels.) Each cell's error comes
+// with the estimate's standard error (of the mean of modelled - data over the points).
 // With `drifted`, the detail is displaced by the wind (core/kernel/detail_drift) by a different
 // number of cells, not whole tiles, at every level.
 CellFigures measure_cells(const core::VolumeGrid& grid, const core::TimeStepData& data, double scale_m, int min_nodes, int max_cells,
@@ -122,42 +129,63 @@ CellFigures measure_cells(const core::VolumeGrid& grid, const core::TimeStepData
   CellFigures out;
   if (cloudy.empty()) return out;
   const std::size_t stride = std::max<std::size_t>(1, cloudy.size() / static_cast<std::size_t>(max_cells));
-  std::vector<double> errors;
+  std::vector<double> errors, ses;
   double sum_data = 0.0, sum_model = 0.0;
   for (std::size_t c = 0; c < cloudy.size(); c += stride) {
     const glm::ivec3 cell = cloudy[c];
-    double data_sum = 0.0, model_sum = 0.0, cover_data = 0.0, cover_model = 0.0;
+    double data_sum = 0.0, model_sum = 0.0, diff2 = 0.0, cover_data = 0.0, cover_model = 0.0;
+    double node_cover = 0.0;  // the cell's mean cover: its 8 nodes' mean (trilinear)
+    for (int q = 0; q < 8; ++q) {
+      node_cover += std::clamp(double(v.extinction.fraction[grid.index(cell.x + (q & 1), cell.y + ((q >> 1) & 1), cell.z + ((q >> 2) & 1))]), 0.0, 1.0) / 8.0;
+    }
+    const int count = static_cast<int>(points * std::clamp(0.25 / std::max(node_cover, 1e-6), 1.0, 16.0));
     Uniform u(c + 1);
-    for (int q = 0; q < points; ++q) {
+    for (int q = 0; q < count; ++q) {
       const glm::dvec3 f(cell.x + u(), cell.y + u(), cell.z + u());
       const double base = k.fetch(k.u_liquid, f) + k.fetch(k.u_ice, f);
       const double modelled = base * k.detail_factor(f);
       data_sum += base;
       model_sum += modelled;
+      diff2 += (modelled - base) * (modelled - base);
       cover_data += std::clamp(k.fetch(k.u_fraction, f), 0.0, 1.0);
       cover_model += modelled > 0.0 ? 1.0 : 0.0;
     }
     const double err = model_sum / data_sum - 1.0;
+    const double mean_diff = (model_sum - data_sum) / count;
+    const double se = std::sqrt(std::max(diff2 / count - mean_diff * mean_diff, 0.0) / count) / (data_sum / count);
     errors.push_back(std::abs(err));
-    out.worst_mean = std::max(out.worst_mean, std::abs(err));
-    out.worst_cover = std::max(out.worst_cover, std::abs(cover_model - cover_data) / double(points));
+    ses.push_back(se);
+    if (std::abs(err) > out.worst_mean) out.worst_mean = std::abs(err), out.worst_mean_se = se;
+    out.worst_beyond = std::max(out.worst_beyond, std::abs(err) - 3.0 * se);
+    if (node_cover >= core::MapOptions{}.min_cloud_fraction) {
+      out.worst_beyond_counted = std::max(out.worst_beyond_counted, std::abs(err) - 3.0 * se);
+    } else {
+      ++out.thin_cells;
+    }
+    out.worst_cover = std::max(out.worst_cover, std::abs(cover_model - cover_data) / double(count));
     sum_data += data_sum, sum_model += model_sum;
     ++out.cells;
   }
   std::sort(errors.begin(), errors.end());
   out.p95_mean = errors[std::min(errors.size() - 1, static_cast<std::size_t>(0.95 * double(errors.size())))];
+  std::sort(ses.begin(), ses.end());
+  out.p95_se = ses[std::min(ses.size() - 1, static_cast<std::size_t>(0.95 * double(ses.size())))];
   out.total_mean = sum_model / sum_data - 1.0;
   return out;
 }
 
 // The issue's 2 %: asserted for every cell's cover (absolute share) and, where `mean_too`, for the
-// mean extinction over the measured cells together. Each cell's own mean is printed, not asserted:
-// within a cell the data's extinction and fraction vary (trilinearly) across the noise pattern,
-// which the construction does not cancel (docs/physics.md, "The modelled cloud": not met, 2-4 %).
+// mean extinction over the measured cells together. Each cell's own mean is printed with its
+// standard error, not asserted: within a cell the data's extinction and fraction vary (trilinearly)
+// across the noise pattern, which the construction does not cancel (docs/physics.md, "The
+// modelled cloud": not met; "largest beyond 3 standard errors" is a lower bound on the worst cell's
+// bias, so a figure above 0 shows a bias, not noise).
 void expect_cells_keep_their_means(const char* what, const CellFigures& f, int min_cells, bool mean_too) {
-  std::printf("%s: %d cloudy cells: mean extinction worst %.2f %%, 95th percentile %.2f %%, all cells together %+.3f %%; "
-              "cover worst %.3f (absolute share)\n",
-              what, f.cells, 100.0 * f.worst_mean, 100.0 * f.p95_mean, 100.0 * f.total_mean, f.worst_cover);
+  std::printf("%s: %d cloudy cells: mean extinction worst %.2f %% (+- %.2f %%), 95th percentile %.2f %% (standard errors up to "
+              "%.2f %% at the 95th percentile), largest beyond 3 standard errors %.2f %% (%.2f %% over the %d cells of mean "
+              "cover from 0.01), all cells together %+.3f %%; cover worst %.3f (absolute share)\n",
+              what, f.cells, 100.0 * f.worst_mean, 100.0 * f.worst_mean_se, 100.0 * f.p95_mean, 100.0 * f.p95_se, 100.0 * f.worst_beyond,
+              100.0 * f.worst_beyond_counted, f.cells - f.thin_cells, 100.0 * f.total_mean, f.worst_cover);
   ASSERT_GE(f.cells, min_cells);
   if (mean_too) {
     EXPECT_LT(std::abs(f.total_mean), 0.02);
