@@ -115,10 +115,10 @@ void GpuRaymarcher::upload_noise(const core::ErosionNoise& noise) {
   if (detail_table_) glDeleteTextures(1, &detail_table_);
   detail_table_ = 0;
   detail_values_ = noise.detail;
-  if (noise.detail.size() == 2 * (CV_DETAIL_COVERS + 1) * CV_DETAIL_TYPES) {
+  if (noise.detail.size() == 2 * (CV_DETAIL_COVERS + 1) * CV_DETAIL_ROWS) {
     glCreateTextures(GL_TEXTURE_2D, 1, &detail_table_);
-    glTextureStorage2D(detail_table_, 1, GL_RG32F, CV_DETAIL_COVERS + 1, CV_DETAIL_TYPES);  // a row per cloud type
-    glTextureSubImage2D(detail_table_, 0, 0, 0, CV_DETAIL_COVERS + 1, CV_DETAIL_TYPES, GL_RG, GL_FLOAT, noise.detail.data());
+    glTextureStorage2D(detail_table_, 1, GL_RG32F, CV_DETAIL_COVERS + 1, CV_DETAIL_ROWS);  // rows per cloud type, then its moments
+    glTextureSubImage2D(detail_table_, 0, 0, 0, CV_DETAIL_COVERS + 1, CV_DETAIL_ROWS, GL_RG, GL_FLOAT, noise.detail.data());
   }
   check_gl("uploading the erosion noise textures");
 }

@@ -132,7 +132,7 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
 double medium_majorant(const PreparedVolume& v, const MarchSettings& s, const std::vector<float>& table) {
   if (!s.medium.modelled) return v.sigma_max_per_m;
   double k = 1.0;  // c / m(c) = 1 at full cover; the types' blend is at most the largest row's
-  for (std::size_t e = 0; 2 * e + 1 < table.size(); ++e) {
+  for (std::size_t e = 0; 2 * e + 1 < table.size() && e < std::size_t(CV_DETAIL_TYPES) * (CV_DETAIL_COVERS + 1); ++e) {
     const std::size_t entry = e % (CV_DETAIL_COVERS + 1);
     if (entry == 0) continue;
     const double c = (double(entry) / CV_DETAIL_COVERS) * (double(entry) / CV_DETAIL_COVERS), m = table[2 * e + 1];
@@ -151,7 +151,8 @@ double medium_majorant(const PreparedVolume& v, const MarchSettings& s, const st
     }
   }
   const double a = std::clamp(s.medium.detail_amount, 0.0, 1.0);
-  return (1.0 - a) * v.sigma_max_per_m + a * k * in_cloud;
+  // The cell-mean correction multiplies the factor by at most CV_DETAIL_CORRECTION_MAX.
+  return CV_DETAIL_CORRECTION_MAX * ((1.0 - a) * v.sigma_max_per_m + a * k * in_cloud);
 }
 
 std::vector<glm::vec2> medium_pyramid(const PreparedVolume& v, const MarchSettings& s, const std::vector<float>& table) {
@@ -174,7 +175,7 @@ std::vector<glm::vec2> medium_pyramid(const PreparedVolume& v, const MarchSettin
   // K over table entries e0..e1: the largest c / m(c) (1 at full cover).
   // Over every type's row: the blend of the types' factors is at most the largest.
   constexpr int covers = CV_DETAIL_COVERS;
-  const int rows = int(table.size() / (2 * (covers + 1)));
+  const int rows = std::min(int(table.size() / (2 * (covers + 1))), CV_DETAIL_TYPES);  // the types' (t, m) rows
   auto k_between = [&](double lo, double hi) {
     if (rows < 1) return double(kHuge);
     const int e0 = std::clamp(int(std::floor(std::sqrt(std::max(lo, 0.0)) * covers)), 0, covers);
@@ -202,7 +203,7 @@ std::vector<glm::vec2> medium_pyramid(const PreparedVolume& v, const MarchSettin
       if (R[b].y > 0.0f) {
         const double c_lo = C[b].x, c_hi = C[b].y;
         const double r = double(R[b].y) >= double(kHuge) ? double(kHuge) : double(R[b].y) * k_between(c_lo, c_hi);
-        bound = std::min((1.0 - a) * double(S[b].y) + a * r, double(kHuge));
+        bound = std::min(CV_DETAIL_CORRECTION_MAX * ((1.0 - a) * double(S[b].y) + a * r), double(kHuge));  // with the cell-mean correction
       }
       out.emplace_back(0.0f, static_cast<float>(bound * (1.0 + 1e-6)));
     }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <thread>
 
 #include <glm/glm.hpp>
@@ -215,6 +216,9 @@ std::vector<float> detail_table(const NoiseTexture& low, const NoiseTexture& hig
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   const std::size_t count = std::max<std::size_t>(samples, 1024);
   std::vector<double> v(count);
+  // The first points' tile coordinates along longitude and latitude, for the first moments.
+  const std::size_t moment_count = std::min<std::size_t>(count, std::size_t(1) << 20);
+  std::vector<float> tx(moment_count), ty(moment_count);
   // The kernel's noise (march.glsl detail_factor) at uniform random points of the tile, point i's
   // coordinates from a hash of i: the same points whatever the threads. A regular lattice would
   // alias with the textures' texels (a 64^3 lattice gave a mean ramp 7 % off at 5 % cover).
@@ -233,10 +237,18 @@ std::vector<float> detail_table(const NoiseTexture& low, const NoiseTexture& hig
         const glm::dvec3 t(next(), next(), next());
         const glm::dvec3 th(p64::noise_high_coords(t));
         v[i] = p64::detail_noise_mix(low.sample(t), high.sample(th));
+        if (i < moment_count) tx[i] = static_cast<float>(t.x), ty[i] = static_cast<float>(t.y);
       }
     });
   }
   for (std::thread& t : pool) t.join();
+  // The moment points sorted by their noise (before v is sorted in place).
+  std::vector<std::uint32_t> order(moment_count);
+  for (std::size_t i = 0; i < moment_count; ++i) order[i] = static_cast<std::uint32_t>(i);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return v[a] < v[b]; });
+  std::vector<double> mn(moment_count);
+  std::vector<float> mx(moment_count), my(moment_count);
+  for (std::size_t i = 0; i < moment_count; ++i) mn[i] = v[order[i]], mx[i] = tx[order[i]], my[i] = ty[order[i]];
   std::sort(v.begin(), v.end());
   // Prefix sums of the sorted values: the mean of the ramp above any threshold in O(log N).
   std::vector<double> prefix(count + 1, 0.0);
@@ -249,7 +261,7 @@ std::vector<float> detail_table(const NoiseTexture& low, const NoiseTexture& hig
     return (ramp + double(count - b)) / double(count);
   };
   constexpr std::size_t row = CV_DETAIL_COVERS + 1;
-  std::vector<float> table(2 * row * CV_DETAIL_TYPES);
+  std::vector<float> table(2 * row * CV_DETAIL_ROWS);
   for (int c = 0; c <= CV_DETAIL_COVERS; ++c) {
     // The share c of the points lies above t: t is the value at rank (1 - c) N (the largest for c = 0).
     const double share = (double(c) / CV_DETAIL_COVERS) * (double(c) / CV_DETAIL_COVERS);  // denser at low cover
@@ -262,6 +274,43 @@ std::vector<float> detail_table(const NoiseTexture& low, const NoiseTexture& hig
       table[e + 1] = static_cast<float>(ramp_mean(t, p64::detail_softness(type)));
     }
   }
+  // The first moments (detail.glsl detail_first_moment): for each type, phase phi = p / PHASES and
+  // cover, M = E[(fract(u - phi) - 1/2) h(n; t(c), s) / m(c)] along longitude (x) and latitude (y),
+  // from the moment points sorted by n: prefix sums of g = fract(u - phi) - 1/2 and of g n give the
+  // ramp's share above any threshold, as ramp_mean does.
+  const std::size_t mc = moment_count;
+  std::vector<std::thread> workers;
+  for (unsigned w = 0; w < threads; ++w) {
+    workers.emplace_back([&, w] {
+      std::vector<double> pg(mc + 1), pgn(mc + 1);
+      for (int job = int(w); job < 2 * CV_DETAIL_PHASES; job += int(threads)) {
+        const int axis = job % 2, p = job / 2;
+        const double phi = double(p) / CV_DETAIL_PHASES;
+        const std::vector<float>& u = axis == 0 ? mx : my;
+        pg[0] = pgn[0] = 0.0;
+        for (std::size_t i = 0; i < mc; ++i) {
+          double g = double(u[i]) - phi;
+          g -= std::floor(g);
+          g -= 0.5;
+          pg[i + 1] = pg[i] + g, pgn[i + 1] = pgn[i] + g * mn[i];
+        }
+        for (int c = 0; c <= CV_DETAIL_COVERS; ++c) {
+          const double t = table[2 * static_cast<std::size_t>(c)];  // the threshold (every type's row has it)
+          const std::size_t a = static_cast<std::size_t>(std::upper_bound(mn.begin(), mn.end(), t) - mn.begin());
+          for (int type = 0; type < CV_DETAIL_TYPES; ++type) {
+            const double sft = p64::detail_softness(type);
+            const double m = table[2 * (std::size_t(type) * row + static_cast<std::size_t>(c)) + 1];
+            const std::size_t b = static_cast<std::size_t>(std::lower_bound(mn.begin(), mn.end(), t + sft) - mn.begin());
+            const double sum = (pgn[b] - pgn[a] - t * (pg[b] - pg[a])) / sft + (pg[mc] - pg[b]);
+            const double moment = m > 0.0 ? sum / double(mc) / m : 0.0;
+            const std::size_t r = CV_DETAIL_TYPES + std::size_t(type) * CV_DETAIL_PHASES + std::size_t(p);
+            table[2 * (r * row + static_cast<std::size_t>(c)) + std::size_t(axis)] = static_cast<float>(moment);
+          }
+        }
+      }
+    });
+  }
+  for (std::thread& t : workers) t.join();
   return table;
 }
 

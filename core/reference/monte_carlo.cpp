@@ -125,7 +125,7 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
   k.u_column_tau = {volume_->column_maps.data(), {volume_->columns.nx, volume_->columns.ny}, int(kColumnMapChannels)};
   if (k.kModelled) {  // the modelled cloud: the cover per node and the table over the noise tiles
     if (k.u_has_fraction) k.u_fraction = {volume_->extinction.fraction.data(), n};
-    k.u_detail_table = {noise->detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_TYPES}, 2};
+    k.u_detail_table = {noise->detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_ROWS}, 2};
     detail_shift_ = std::make_shared<const std::vector<float>>(detail_shift_texels(*volume_, k));
     k.u_detail_shift = {detail_shift_->data(), {grid.alt_m.count, 1}, 2};
   }

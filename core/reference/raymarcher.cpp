@@ -54,7 +54,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   const std::vector<float> detail_shift = s.medium.modelled ? detail_shift_texels(v, k) : std::vector<float>{};
   if (s.medium.modelled) {  // the modelled cloud: the cover per node and the table over the noise tiles
     if (k.u_has_fraction) k.u_fraction = {v.extinction.fraction.data(), n};
-    k.u_detail_table = {noise->detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_TYPES}, 2};
+    k.u_detail_table = {noise->detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_ROWS}, 2};
     k.u_detail_shift = {detail_shift.data(), {g.alt_m.count, 1}, 2};
   }
   if (eroded || s.medium.modelled) {

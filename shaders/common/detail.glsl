@@ -11,13 +11,22 @@
 // where the threshold moves fastest: the noise's thin upper tail).
 #define CV_DETAIL_COVERS 256
 // The table's rows: one per cloud type of the weather textures (core/kernel/weather_textures), in
-// the order stratiform, cumuliform, cirriform.
+// the order stratiform, cumuliform, cirriform; then, per type, CV_DETAIL_PHASES rows of the tile's
+// first moments along longitude (x) and latitude (y) at the phases p / CV_DETAIL_PHASES
+// (detail_first_moment: the cell-mean correction of march.glsl detail_factor).
 #define CV_DETAIL_TYPES 3
+#define CV_DETAIL_PHASES 64
+#define CV_DETAIL_ROWS (CV_DETAIL_TYPES * (1 + CV_DETAIL_PHASES))
+// The correction's bounds: it multiplies the modelled extinction by 1 / 1.1 to 1.1 (the majorants
+// take the upper one).
+#define CV_DETAIL_CORRECTION_MAX 1.1
 
 // The ramp's width in noise units for a type (row): the cloud's water grows over this much of n
-// above the threshold. A deck's water varies softly through it (stratiform 0.25), a cumulus has
-// crisp edges (0.05), a cirrus sheet is wispy (0.15).
-CV_FN real detail_softness(int type) { return type == 0 ? real(0.25) : type == 1 ? real(0.05) : real(0.15); }
+// above the threshold. A deck's water varies softly through it (stratiform 0.12), a cumulus has
+// crisp edges (0.05), a cirrus sheet is wispy (0.10). A softer ramp has a smaller mean m(c) at low
+// cover, so a larger peak c / m(c) (the tracking's majorant: about 176 x the softness at the
+// smallest cover; 0.25 made the path tracer's null collisions 2.6 times as many as 0.08 did).
+CV_FN real detail_softness(int type) { return type == 0 ? real(0.12) : type == 1 ? real(0.05) : real(0.10); }
 
 CV_FN real detail_ramp(real n, real t, real softness) { return clamp((n - t) / softness, real(0.0), real(1.0)); }
 

@@ -46,6 +46,35 @@ CV_FN real fetch(sampler3D tex, real3 f) {
   return mix(mix(c00, c10, wy), mix(c01, c11, wy), wz);
 }
 
+// The trilinear value at f (x) with its cell's shape from the same 8 nodes: their mean (y, the
+// cell's mean of the trilinear field) and the differences between the cell's faces along the
+// longitude (z) and latitude (w) indices (face means, upper minus lower).
+CV_FN real4 fetch_cell(sampler3D tex, real3 f) {
+  ivec3 n = ivec3(u_grid_count);
+  real wx;
+  real wy;
+  real wz;
+  int x0 = volume_fetch_index(f.x, n.x, wx);
+  int y0 = volume_fetch_index(f.y, n.y, wy);
+  int z0 = volume_fetch_index(f.z, n.z, wz);
+  int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
+  int y1 = y0 + 1;
+  int z1 = min(z0 + 1, n.z - 1);
+  real n000 = node(tex, x0, y0, z0);
+  real n100 = node(tex, x1, y0, z0);
+  real n010 = node(tex, x0, y1, z0);
+  real n110 = node(tex, x1, y1, z0);
+  real n001 = node(tex, x0, y0, z1);
+  real n101 = node(tex, x1, y0, z1);
+  real n011 = node(tex, x0, y1, z1);
+  real n111 = node(tex, x1, y1, z1);
+  real v = mix(mix(mix(n000, n100, wx), mix(n010, n110, wx), wy), mix(mix(n001, n101, wx), mix(n011, n111, wx), wy), wz);
+  real mean = (n000 + n100 + n010 + n110 + n001 + n101 + n011 + n111) * real(0.125);
+  real dx = (n100 + n110 + n101 + n111 - n000 - n010 - n001 - n011) * real(0.25);
+  real dy = (n010 + n110 + n011 + n111 - n000 - n100 - n001 - n101) * real(0.25);
+  return real4(v, mean, dx, dy);
+}
+
 // Trilinear with wrap-around over a periodic noise tile (x, then y, then z).
 CV_FN real fetch_noise(sampler3D tex, real3 t) {
   int n = textureSize(tex, 0).x;
@@ -96,6 +125,20 @@ CV_FN real2 column_map(real3 f) {
   return real2(t.x, t.y);
 }
 
+// One type's first-order cell-mean error (detail_factor_of): the tile's first moments along the
+// longitude and latitude indices at the cover entry im (weight wm towards im + 1, entries dc apart
+// in cover) and the phase rows px, py, against the extinction's relative face differences gx, gy
+// and the cover's gcx, gcy, over the tiles per cell.
+CV_FN real detail_moment_term(int type, int im, real wm, real dc, int px, int py, real gx, real gy, real gcx, real gcy) {
+  int rx = CV_DETAIL_TYPES + type * CV_DETAIL_PHASES + px;
+  int ry = CV_DETAIL_TYPES + type * CV_DETAIL_PHASES + py;
+  real mx0 = real(texelFetch(u_detail_table, ivec2(im, rx), 0).x);
+  real mx1 = real(texelFetch(u_detail_table, ivec2(im + 1, rx), 0).x);
+  real my0 = real(texelFetch(u_detail_table, ivec2(im, ry), 0).y);
+  real my1 = real(texelFetch(u_detail_table, ivec2(im + 1, ry), 0).y);
+  return (gx * mix(mx0, mx1, wm) + gcx * (mx1 - mx0) / dc) / u_detail_tiles.x + (gy * mix(my0, my1, wm) + gcy * (my1 - my0) / dc) / u_detail_tiles.y;
+}
+
 // The modelled cloud (kModelled; shaders/common/detail.glsl, docs/physics.md "The modelled cloud"):
 // the factor by which the data's grid-mean extinction at grid index f is redistributed inside its
 // cell. The noise lies in whole tiles per cell (u_detail_tiles along lon, lat and altitude), so a
@@ -109,8 +152,17 @@ CV_FN real2 column_map(real3 f) {
 // softness is the cloud type's (the weather textures' memberships, bilinear from the columns: the
 // table's rows); the types' factors, each of mean 1 over a cell, are blended by the memberships, and
 // all share the threshold, so the cloudy share stays c.
-CV_FN real detail_factor(real3 f) {
-  real c = u_has_fraction ? clamp(fetch(u_fraction, f), real(0.0), real(1.0)) : real(1.0);
+//
+// The cell-mean correction: where the extinction and the cover vary across a cell, they meet the
+// pattern's first moments along it, and the cell's mean is off by (g M(c, phi) + gamma dM/dc) / T
+// per horizontal axis to first order (g: the extinction's relative difference between the cell's
+// faces, gamma: the cover's, T: tiles per cell, M: the tile's first moment of the factor at the
+// phase phi where the cell starts in its tile; the table's moment rows). Dividing by 1 plus that
+// sum, bounded to 1/1.1..1.1, takes it out; the vertical mirror leaves no moment in height.
+// `s` is fetch_cell of the extinction shown (liquid + ice).
+CV_FN real detail_factor_of(real3 f, real4 s) {
+  real4 cc = u_has_fraction ? fetch_cell(u_fraction, f) : real4(1.0, 1.0, 0.0, 0.0);
+  real c = clamp(cc.x, real(0.0), real(1.0));
   real x = sqrt(c) * real(CV_DETAIL_COVERS);  // the table's covers are (k / N)^2
   int i = min(int(x), CV_DETAIL_COVERS - 1);
   real w = x - real(i);
@@ -135,7 +187,30 @@ CV_FN real detail_factor(real3 f) {
   real g = (m0 > real(0.0) ? w_st * detail_ramp(n, t, detail_softness(0)) / m0 : real(0.0)) +
            (m1 > real(0.0) ? w_cu * detail_ramp(n, t, detail_softness(1)) / m1 : real(0.0)) +
            (m2 > real(0.0) ? w_ci * detail_ramp(n, t, detail_softness(2)) / m2 : real(0.0));
-  return real(1.0) - u_detail_amount + u_detail_amount * g;
+  // The correction, at the cell's mean cover and the phases where the cell starts in its tiles.
+  real cm = clamp(cc.y, real(0.0), real(1.0));
+  real xm = sqrt(cm) * real(CV_DETAIL_COVERS);
+  int im = min(int(xm), CV_DETAIL_COVERS - 1);
+  real wm = xm - real(im);
+  real dc = (real(im + 1) * real(im + 1) - real(im) * real(im)) / real(CV_DETAIL_COVERS * CV_DETAIL_COVERS);
+  real2 phase = fract(-real2(mix(s0.x, s1.x, wz), mix(s0.y, s1.y, wz)));
+  int px = int(floor(phase.x * real(CV_DETAIL_PHASES) + real(0.5))) % CV_DETAIL_PHASES;
+  int py = int(floor(phase.y * real(CV_DETAIL_PHASES) + real(0.5))) % CV_DETAIL_PHASES;
+  real gx = s.y > real(0.0) ? s.z / s.y : real(0.0);
+  real gy = s.y > real(0.0) ? s.w / s.y : real(0.0);
+  // Written out per type, not looped (llvmpipe's loop budget is shared by the whole march).
+  real corr = w_st * detail_moment_term(0, im, wm, dc, px, py, gx, gy, cc.z, cc.w) +
+              w_cu * detail_moment_term(1, im, wm, dc, px, py, gx, gy, cc.z, cc.w) +
+              w_ci * detail_moment_term(2, im, wm, dc, px, py, gx, gy, cc.z, cc.w);
+  real kappa = clamp(real(1.0) / max(real(1.0) + u_detail_amount * corr, real(1e-6)), real(1.0) / real(CV_DETAIL_CORRECTION_MAX),
+                     real(CV_DETAIL_CORRECTION_MAX));
+  return (real(1.0) - u_detail_amount + u_detail_amount * g) * kappa;
+}
+
+// The factor at f, fetching the extinction's cell itself (for callers outside the march).
+CV_FN real detail_factor(real3 f) {
+  real4 s = fetch_cell(u_liquid, f) * (u_hide_liquid ? real(0.0) : real(1.0)) + fetch_cell(u_ice, f) * (u_hide_ice ? real(0.0) : real(1.0));
+  return detail_factor_of(f, s);
 }
 
 // The column's vertical optical depth at p (the column map's x).
@@ -192,12 +267,19 @@ CV_FN void medium_in(real3 p, real3 g, real alt_m, CV_OUT(real) sl, CV_OUT(real)
   if (!layer_shown(f, alt_m)) return;
   // Hidden phases as factors, not branches: the GLSL compiler puts a fetch under `hide ? 0 :
   // fetch` in a branch of its own, which llvmpipe runs under a mask at every view and sun sample.
-  sl = fetch(u_liquid, f) * (u_hide_liquid ? real(0.0) : real(1.0));
-  si = fetch(u_ice, f) * (u_hide_ice ? real(0.0) : real(1.0));
-  if (kModelled && sl + si > real(0.0)) {
-    real k = detail_factor(f);
-    sl *= k;
-    si *= k;
+  if (kModelled) {  // the cells' shapes too, from the same texels (detail_factor_of's correction)
+    real4 cl = fetch_cell(u_liquid, f) * (u_hide_liquid ? real(0.0) : real(1.0));
+    real4 ci = fetch_cell(u_ice, f) * (u_hide_ice ? real(0.0) : real(1.0));
+    sl = cl.x;
+    si = ci.x;
+    if (sl + si > real(0.0)) {
+      real k = detail_factor_of(f, cl + ci);
+      sl *= k;
+      si *= k;
+    }
+  } else {
+    sl = fetch(u_liquid, f) * (u_hide_liquid ? real(0.0) : real(1.0));
+    si = fetch(u_ice, f) * (u_hide_ice ? real(0.0) : real(1.0));
   }
   if (kNoise && sl + si > real(0.0)) erode_at(p, sl, si);
 }

@@ -167,7 +167,7 @@ struct DetailField {
     k.u_column_tau = {v->column_maps.data(), {v->columns.nx, v->columns.ny}, int(kColumnMapChannels)};
     k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
     k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
-    k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_TYPES}, 2};
+    k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_ROWS}, 2};
     shift = detail_shift_texels(*v, k);
     k.u_detail_shift = {shift.data(), {g.alt_m.count, 1}, 2};
     k.kModelled = true;

@@ -66,7 +66,7 @@ kernel::f64::MarchKernel modelled_kernel(const core::PreparedVolume& v, const co
   const core::ErosionNoise& noise = shared_noise();
   k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
   k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
-  k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_TYPES}, 2};
+  k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_ROWS}, 2};
   shift = core::detail_shift_texels(v, k);
   k.u_detail_shift = {shift.data(), {grid.alt_m.count, 1}, 2};
   k.kModelled = true;
@@ -196,12 +196,12 @@ void expect_cells_keep_their_means(const char* what, const CellFigures& f, int m
 TEST(ModelledCloud, TheTableLeavesTheCoverAboveItsThreshold) {
   const core::ErosionNoise& noise = shared_noise();
   constexpr int row = CV_DETAIL_COVERS + 1;
-  ASSERT_EQ(noise.detail.size(), 2u * row * CV_DETAIL_TYPES);
+  ASSERT_EQ(noise.detail.size(), 2u * row * CV_DETAIL_ROWS);
   const auto t = [&](int type, int c) { return double(noise.detail[2 * std::size_t(type * row + c)]); };
   const auto m = [&](int type, int c) { return double(noise.detail[2 * std::size_t(type * row + c) + 1]); };
   // Per type: thresholds fall as the cover rises, the ramp's mean rises with it, and is at most the
   // cover. Every type has the same thresholds (the cover does not depend on the ramp), and a softer
-  // ramp has a smaller mean (stratiform 0.25 < cirriform 0.15 < cumuliform 0.05 in softness).
+  // ramp has a smaller mean (stratiform 0.12, cirriform 0.10, cumuliform 0.05 in softness).
   for (int type = 0; type < CV_DETAIL_TYPES; ++type) {
     for (int c = 1; c <= CV_DETAIL_COVERS; ++c) {
       EXPECT_LE(t(type, c), t(type, c - 1)) << c;
@@ -225,12 +225,14 @@ TEST(ModelledCloud, AtAConstantCoverATileKeepsTheMeanAndTheCover) {
   const core::ErosionNoise& noise = shared_noise();
   kernel::f64::MarchKernel k;
   k.u_grid_count = {4, 4, 4};
-  std::vector<float> frac(64, 0.0f);
+  std::vector<float> frac(64, 0.0f), water(64, 1e-3f), none(64, 0.0f);
   k.u_fraction = {frac.data(), glm::ivec3(4)};
   k.u_has_fraction = true;
+  k.u_liquid = {water.data(), glm::ivec3(4)};  // uniform: no slopes for the cell-mean correction to take out
+  k.u_ice = {none.data(), glm::ivec3(4)};
   k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
   k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
-  k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_TYPES}, 2};
+  k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_ROWS}, 2};
   k.u_detail_tiles = {2, 3, 1};
   k.u_detail_amount = 1.0;
   // The cloud type per column (cumuliform, cirriform memberships): each type alone, and a blend.
