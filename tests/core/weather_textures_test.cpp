@@ -106,9 +106,15 @@ TEST(WeatherTextures, ProfilesAreBoundedAndShapedByType) {
       if (p > best) best = p, at = eta;
     }
     std::printf("%s: densest at eta %.3f (%.3f)\n", cloud_type_name(t), at, best);
-    if (t == CloudType::Stratiform) EXPECT_GT(at, 0.6) << "a deck's water grows with height to near its top";
-    if (t == CloudType::Cumuliform) EXPECT_LT(at, 0.5) << "a cumulus is densest low, over its flat base";
-    if (t == CloudType::Cirriform) EXPECT_NEAR(at, 0.5, 0.01) << "a cirrus sheet is densest in its middle";
+    if (t == CloudType::Stratiform) {
+      EXPECT_GT(at, 0.6) << "a deck's water grows with height to near its top";
+    }
+    if (t == CloudType::Cumuliform) {
+      EXPECT_LT(at, 0.5) << "a cumulus is densest low, over its flat base";
+    }
+    if (t == CloudType::Cirriform) {
+      EXPECT_NEAR(at, 0.5, 0.01) << "a cirrus sheet is densest in its middle";
+    }
     EXPECT_LT(type_profile(t, 0.0), 0.05 * best + 1e-12) << "the edges are thin";
   }
 }
