@@ -172,23 +172,32 @@ std::vector<glm::vec2> medium_pyramid(const PreparedVolume& v, const MarchSettin
   }
   // Each brick's largest ratio, and its smallest and largest cover, over the same dilated nodes.
   const ExtinctionPyramid pr(v.grid, ratio, {}), pc(v.grid, cover, {});
-  // K over table entries e0..e1: the largest c / m(c) (1 at full cover).
-  // Over every type's row: the blend of the types' factors is at most the largest.
+  // K of one type's row over table entries e0..e1: the largest c / m(c) (1 at full cover).
   constexpr int covers = CV_DETAIL_COVERS;
   const int rows = std::min(int(table.size() / (2 * (covers + 1))), CV_DETAIL_TYPES);  // the types' (t, m) rows
-  auto k_between = [&](double lo, double hi) {
-    if (rows < 1) return double(kHuge);
+  auto k_row = [&](int row, double lo, double hi) {
     const int e0 = std::clamp(int(std::floor(std::sqrt(std::max(lo, 0.0)) * covers)), 0, covers);
     const int e1 = std::clamp(int(std::ceil(std::sqrt(std::min(hi, 1.0)) * covers)), e0, covers);
     double k = 1.0;
-    for (int row = 0; row < rows; ++row) {
-      for (int e = std::max(e0, 1); e <= e1; ++e) {
-        const double c = (double(e) / covers) * (double(e) / covers);
-        const double m = table[2 * (std::size_t(row) * (covers + 1) + std::size_t(e)) + 1];
-        if (m > 0.0) k = std::max(k, c / m);
-      }
+    for (int e = std::max(e0, 1); e <= e1; ++e) {
+      const double c = (double(e) / covers) * (double(e) / covers);
+      const double m = table[2 * (std::size_t(row) * (covers + 1) + std::size_t(e)) + 1];
+      if (m > 0.0) k = std::max(k, c / m);
     }
     return k;
+  };
+  // The types a brick's samples can blend (march.glsl detail_factor_of: the memberships bilinear
+  // from the columns, so those of the brick's dilated columns): the factor is at most
+  // sum_k w_k / m_k, so c x factor at most min(max_k K_k, sum_k (largest w_k) K_k) over the types
+  // present. Per level, per column of bricks.
+  const VolumeGrid& g = v.grid;
+  const int gx = g.lon_deg.count, gy = g.lat_deg.count;
+  const bool wraps = g.wraps_lon();
+  auto weights = [&](std::size_t col) {
+    const std::size_t at = kColumnMapChannels * col;
+    const double cu = at + 3 < v.column_maps.size() ? std::clamp(double(v.column_maps[at + 2]), 0.0, 1.0) : 0.0;
+    const double ci = at + 3 < v.column_maps.size() ? std::clamp(double(v.column_maps[at + 3]), 0.0, 1.0 - cu) : 0.0;
+    return glm::dvec3(1.0 - cu - ci, cu, ci);
   };
   const double a = std::clamp(s.medium.detail_amount, 0.0, 1.0);
   std::vector<glm::vec2> out;
@@ -198,11 +207,34 @@ std::vector<glm::vec2> medium_pyramid(const PreparedVolume& v, const MarchSettin
     const auto& S = ls[l].min_max;
     const auto& R = pr.levels()[l].min_max;
     const auto& C = pc.levels()[l].min_max;
+    const ExtinctionPyramid::Level& lv = ls[l];
+    std::vector<glm::dvec3> wmax(std::size_t(lv.nx) * std::size_t(lv.ny), glm::dvec3(0.0));
+    for (int by = 0; by < lv.ny; ++by) {
+      for (int bx = 0; bx < lv.nx; ++bx) {
+        glm::dvec3& w = wmax[std::size_t(by) * std::size_t(lv.nx) + std::size_t(bx)];
+        for (int j = by * lv.nodes - 1; j <= by * lv.nodes + lv.nodes; ++j) {
+          for (int i = bx * lv.nodes - 1; i <= bx * lv.nodes + lv.nodes; ++i) {
+            int ii = i;
+            if (ii < 0 || ii >= gx) ii = wraps ? (ii + gx) % gx : -1;
+            // Beyond a regional grid's border the column map reads 0: all stratiform.
+            w = glm::max(w, ii < 0 || j < 0 || j >= gy ? glm::dvec3(1.0, 0.0, 0.0) : weights(g.column(ii, j)));
+          }
+        }
+      }
+    }
     for (std::size_t b = 0; b < S.size(); ++b) {
       double bound = 0.0;
       if (R[b].y > 0.0f) {
         const double c_lo = C[b].x, c_hi = C[b].y;
-        const double r = double(R[b].y) >= double(kHuge) ? double(kHuge) : double(R[b].y) * k_between(c_lo, c_hi);
+        const glm::dvec3 w = wmax[b % (std::size_t(lv.nx) * std::size_t(lv.ny))];
+        double k_max = rows < 1 ? double(kHuge) : 1.0, k_sum = 0.0;
+        for (int row = 0; row < rows; ++row) {
+          if (!(w[row] > 0.0)) continue;
+          const double k = k_row(row, c_lo, c_hi);
+          k_max = std::max(k_max, k), k_sum += w[row] * k;
+        }
+        const double k = rows < 1 ? double(kHuge) : std::min(k_max, std::max(k_sum, 1.0));
+        const double r = double(R[b].y) >= double(kHuge) ? double(kHuge) : double(R[b].y) * k;
         bound = std::min(CV_DETAIL_CORRECTION_MAX * ((1.0 - a) * double(S[b].y) + a * r), double(kHuge));  // with the cell-mean correction
       }
       out.emplace_back(0.0f, static_cast<float>(bound * (1.0 + 1e-6)));
