@@ -44,6 +44,8 @@ class FrameRenderer {
 
   // Makes `volume` the time step marched, uploading it when it is not the one on the GPU already.
   void use_volume(std::shared_ptr<const core::PreparedVolume> volume);
+  // The volume marched now (null before use_volume).
+  const core::PreparedVolume* volume() const { return volume_.get(); }
 
   // The settings of frame `index` of an accumulation of `count`: a single frame keeps the settings'
   // own (step middles unless it names one), else the index's jitter.

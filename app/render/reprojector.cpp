@@ -1,6 +1,8 @@
 // The viewer's temporal reprojection.
 #include "render/reprojector.hpp"
 
+#include <cmath>
+
 #include "render/gl.hpp"
 
 namespace cv::render {
@@ -25,6 +27,30 @@ Reprojector::Reprojector(const ShaderLoader& loader)
 Reprojector::~Reprojector() {
   if (history_) glDeleteTextures(1, &history_);
   if (sparse_) glDeleteTextures(1, &sparse_);
+  if (motion_) glDeleteTextures(1, &motion_);
+}
+
+std::vector<float> Reprojector::wind_motion_deg(const core::VolumeGrid& then_grid, const std::vector<double>& then_drift,
+                                                const core::VolumeGrid& now_grid, const std::vector<double>& now_drift) {
+  const std::size_t levels = static_cast<std::size_t>(now_grid.alt_m.count);
+  const auto same_axis = [](const core::RegularAxis& a, const core::RegularAxis& b) {
+    return a.start == b.start && a.step == b.step && a.count == b.count;
+  };
+  if (now_drift.size() != 2 * levels || then_drift.size() != now_drift.size() || !same_axis(then_grid.lon_deg, now_grid.lon_deg) ||
+      !same_axis(then_grid.lat_deg, now_grid.lat_deg) || !same_axis(then_grid.alt_m, now_grid.alt_m)) {
+    return {};
+  }
+  std::vector<float> out(2 * levels);
+  bool moved = false;
+  for (std::size_t k = 0; k < levels; ++k) {
+    const double dlon = (now_drift[2 * k] - then_drift[2 * k]) * now_grid.lon_deg.step;
+    const double dlat = (now_drift[2 * k + 1] - then_drift[2 * k + 1]) * now_grid.lat_deg.step;
+    if (!std::isfinite(dlon) || !std::isfinite(dlat)) return {};
+    out[2 * k] = static_cast<float>(dlon);
+    out[2 * k + 1] = static_cast<float>(dlat);
+    moved = moved || dlon != 0.0 || dlat != 0.0;
+  }
+  return moved ? out : std::vector<float>{};
 }
 
 glm::ivec2 Reprojector::offset_of(int index) {
@@ -66,11 +92,14 @@ unsigned Reprojector::sparse_target(const core::Camera& full) {
 
 void Reprojector::reset() {
   previous_.reset();
+  previous_grid_.reset();
+  previous_drift_.clear();
   frames_since_change_ = 0;
   frames_since_doubt_ = kFramesToComplete;
 }
 
-void Reprojector::resolve(unsigned sparse_depth, const core::Camera& full, int index, bool changed, double r0_m, unsigned out) {
+void Reprojector::resolve(unsigned sparse_depth, const core::Camera& full, int index, bool changed, double r0_m, unsigned out,
+                          const core::PreparedVolume* volume) {
   if (!sparse_ || full.width / kBlock != sparse_w_ || full.height / kBlock != sparse_h_) {
     throw GlError("reprojection: march the sparse frame into sparse_target() first");
   }
@@ -114,7 +143,27 @@ void Reprojector::resolve(unsigned sparse_depth, const core::Camera& full, int i
   set3(p, "u_prev_right", then.right);
   set3(p, "u_prev_up", then.up);
   glProgramUniform1f(p, loc(p, "u_prev_tan_half"), static_cast<float>(then.tan_half));
+  // The wind's motion since the history's medium (the modelled cloud's detail drift, per level).
+  std::vector<float> motion;
+  if (wind_ && has_history && volume && previous_grid_) {
+    motion = wind_motion_deg(*previous_grid_, previous_drift_, volume->grid, volume->extinction.detail_drift_cells);
+  }
+  wind_moved_ = !motion.empty();
+  if (wind_moved_) {
+    const int levels = static_cast<int>(motion.size() / 2);
+    if (!motion_ || levels != motion_levels_) {
+      if (motion_) glDeleteTextures(1, &motion_);
+      glCreateTextures(GL_TEXTURE_2D, 1, &motion_);
+      glTextureStorage2D(motion_, 1, GL_RG32F, levels, 1);
+      motion_levels_ = levels;
+    }
+    glTextureSubImage2D(motion_, 0, 0, 0, levels, 1, GL_RG, GL_FLOAT, motion.data());
+    glProgramUniform3f(p, loc(p, "u_alt_axis"), static_cast<float>(volume->grid.alt_m.start), static_cast<float>(volume->grid.alt_m.step),
+                       static_cast<float>(levels));
+  }
+  glProgramUniform1i(p, loc(p, "u_wind"), wind_moved_ ? 1 : 0);
   glBindImageTexture(0, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  if (wind_moved_) glBindTextureUnit(3, motion_);
   glBindTextureUnit(0, history_);
   glBindTextureUnit(1, sparse_);
   glBindTextureUnit(2, sparse_depth);
@@ -126,6 +175,13 @@ void Reprojector::resolve(unsigned sparse_depth, const core::Camera& full, int i
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
   check_gl("reprojecting the viewer's frame");
   previous_ = full;
+  if (volume) {
+    previous_grid_ = volume->grid;
+    previous_drift_ = volume->extinction.detail_drift_cells;
+  } else {
+    previous_grid_.reset();
+    previous_drift_.clear();
+  }
   ++frames_since_change_;
   ++frames_since_doubt_;
 }

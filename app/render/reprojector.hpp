@@ -6,14 +6,19 @@
 // the nearby new samples for 16 frames after the camera moved or the medium changed (against
 // ghosting; a turn or a zoom of the lens reprojects exactly and is not clamped), or the new
 // samples' bilinear blend where the history never saw the point (disocclusion, the view's edges).
+// Where the medium carries the modelled cloud's wind displacement (core::DetailDrift, one per level)
+// and time moved between two frames, a point in cloud is looked up where the wind held it in the
+// previous frame: the camera's motion and the wind's both reproject.
 // Offline renders never use it: `render` and `record` march every pixel.
 #pragma once
 
 #include <optional>
+#include <vector>
 
 #include <glm/vec2.hpp>
 
 #include "frame/camera.hpp"
+#include "kernel/prepared_volume.hpp"
 #include "render/shader_loader.hpp"
 
 namespace cv::render {
@@ -43,8 +48,17 @@ class Reprojector {
   // Makes the full image (into `out`, RGBA32F of full's size) from sparse frame `index` just marched
   // into sparse_target() with its cloud depth in `sparse_depth` (R32F of the sparse size), and the
   // history. `changed`: the medium or the settings changed since the last resolve (the camera's own
-  // motion is found here). The result becomes the next frame's history.
-  void resolve(unsigned sparse_depth, const core::Camera& full, int index, bool changed, double r0_m, unsigned out);
+  // motion is found here). `volume`: the medium marched (its detail drift gives the wind's motion
+  // since the previous resolve; null or without a drift: no wind motion). The result becomes the
+  // next frame's history.
+  void resolve(unsigned sparse_depth, const core::Camera& full, int index, bool changed, double r0_m, unsigned out,
+               const core::PreparedVolume* volume = nullptr);
+
+  // The wind's motion between two media, per level (longitude and latitude, degrees): the
+  // difference of their detail drifts times the grid's steps. Empty when either has no drift, the
+  // grids differ, or nothing moved.
+  static std::vector<float> wind_motion_deg(const core::VolumeGrid& then_grid, const std::vector<double>& then_drift,
+                                            const core::VolumeGrid& now_grid, const std::vector<double>& now_drift);
 
   // Frames resolved since the last change (camera, medium or settings); the image holds only
   // freshly marched pixels from kFramesToComplete on.
@@ -54,15 +68,23 @@ class Reprojector {
   void reset();
   // The neighbourhood clamp (on; off only to measure what it does against ghosting).
   void set_clamp(bool on) { clamp_ = on; }
+  // The wind's motion of the history (on; off only to measure what it does).
+  void set_wind_motion(bool on) { wind_ = on; }
+  // Whether the last resolve moved the history with the wind.
+  bool wind_moved() const { return wind_moved_; }
 
  private:
   GlProgram program_;
-  unsigned history_ = 0, sparse_ = 0;
+  unsigned history_ = 0, sparse_ = 0, motion_ = 0;
+  int motion_levels_ = 0;
   int width_ = 0, height_ = 0, sparse_w_ = 0, sparse_h_ = 0;
   std::optional<core::Camera> previous_;
   int frames_since_change_ = 0;
   int frames_since_doubt_ = kFramesToComplete;  // since the camera moved or the medium changed
-  bool clamp_ = true;
+  bool clamp_ = true, wind_ = true, wind_moved_ = false;
+  // The previous resolve's medium: its grid and detail drift (cells, 2 per level).
+  std::optional<core::VolumeGrid> previous_grid_;
+  std::vector<double> previous_drift_;
 };
 
 }  // namespace cv::render

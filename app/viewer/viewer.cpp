@@ -986,7 +986,7 @@ int run_viewer(const ViewerOptions& o) {
         sparse.march_camera = render::Reprojector::sparse_camera(v->spec.march_camera, v->reproject_index);
         v->renderer.march_into(v->reprojector->sparse_target(v->spec.march_camera), sparse, 0);
         v->reprojector->resolve(v->renderer.raymarcher().cloud_depth_texture(), v->spec.march_camera, v->reproject_index,
-                                v->reproject_changed, g.earth_radius_m, v->presenter.frame_texture());
+                                v->reproject_changed, g.earth_radius_m, v->presenter.frame_texture(), v->renderer.volume());
         ++v->reproject_index;
       } else {
         v->renderer.march_into(v->presenter.frame_texture(), v->spec, v->accumulated);

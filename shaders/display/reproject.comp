@@ -2,12 +2,17 @@
 // pixel of every 4 x 4 block (the sparse frame); the other pixels take the previous full image
 // (the history) where the point they see stood in the previous camera, clamped to the range of the
 // new samples around them when anything moved, or the new samples' bilinear blend where the history
-// has nothing (out of the previous view, behind it, or no history yet).
+// has nothing (out of the previous view, behind it, or no history yet). A point in cloud is looked
+// up where the wind held it in the previous frame when the medium carries the wind's displacement
+// (the modelled cloud's detail drift, per level) and time moved.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(rgba32f, binding = 0) writeonly uniform image2D u_out;  // the full image (rgb radiance, a transmittance)
-layout(binding = 0) uniform sampler2D u_history;       // the previous full image (linear filtering, clamped to the edge)
+layout(binding = 0) uniform sampler2D u_history;       // the previous full image (read texel by texel)
 layout(binding = 1) uniform sampler2D u_sparse;        // this frame's samples, one per block
 layout(binding = 2) uniform sampler2D u_sparse_depth;  // the distance at which their view transmittance fell to 0.5 (3e38: never)
+layout(binding = 3) uniform sampler2D u_wind_motion;   // per level (x): the wind's motion since the history (longitude, latitude; degrees)
+uniform bool u_wind;        // u_wind_motion holds a motion
+uniform vec3 u_alt_axis;    // the grid's levels: first altitude (m), spacing (m), count
 uniform ivec2 u_full;        // the full image's size (a multiple of the block in each axis)
 uniform ivec2 u_offset;      // this frame's pixel within each block
 uniform bool u_has_history;  // false: the spatial blend everywhere but the new samples
@@ -45,6 +50,54 @@ float earth_hit(vec3 o, vec3 d, float r0) {
   return t > 0.0 ? t : -1.0;
 }
 
+// Where the wind held the Earth-centred point x at the history's instant, as an offset from x: the
+// point turned back by its level's motion in longitude (about the polar axis) and latitude (along
+// its meridian), at the same height. Between levels the motion is linear, as the detail's shift.
+vec3 wind_back(vec3 x) {
+  float r = length(x);
+  float n = u_alt_axis.z;
+  float kf = clamp((r - u_r0 - u_alt_axis.x) / u_alt_axis.y, 0.0, n - 1.0);
+  int k0 = int(floor(kf));
+  int k1 = min(k0 + 1, int(n) - 1);
+  vec2 m = radians(mix(texelFetch(u_wind_motion, ivec2(k0, 0), 0).xy, texelFetch(u_wind_motion, ivec2(k1, 0), 0).xy, kf - float(k0)));
+  float lat = asin(clamp(x.z / r, -1.0, 1.0));
+  float lon = atan(x.y, x.x);
+  float lat1 = lat - m.y, lon1 = lon - m.x;
+  vec3 u1 = vec3(cos(lat1) * cos(lon1), cos(lat1) * sin(lon1), sin(lat1));
+  return r * u1 - x;
+}
+
+// The history at pixel position x (pixel units, centres at half-integers) by Catmull-Rom
+// interpolation over the 4 x 4 texels around it: a bilinear lookup would blur the history a little
+// more at every frame that reprojects it by a fraction of a pixel; this keeps its detail. Its
+// overshoot is taken off (radiance and transmittance stay within the taps' range).
+vec4 history_at(vec2 x) {
+  vec2 c = x - 0.5;
+  vec2 i0 = floor(c);
+  vec2 t = c - i0;
+  vec2 t2 = t * t, t3 = t2 * t;
+  vec2 w[4];
+  w[0] = 0.5 * (-t3 + 2.0 * t2 - t);
+  w[1] = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0);
+  w[2] = 0.5 * (-3.0 * t3 + 4.0 * t2 + t);
+  w[3] = 0.5 * (t3 - t2);
+  vec4 sum = vec4(0.0), lo = vec4(3.0e38), hi = vec4(-3.0e38);
+  for (int j = 0; j < 4; ++j) {
+    for (int i = 0; i < 4; ++i) {
+      ivec2 q = clamp(ivec2(i0) + ivec2(i - 1, j - 1), ivec2(0), u_full - 1);
+      vec4 h = texelFetch(u_history, q, 0);
+      sum += w[i].x * w[j].y * h;
+      if (i == 1 || i == 2) {
+        if (j == 1 || j == 2) {
+          lo = min(lo, h);
+          hi = max(hi, h);
+        }
+      }
+    }
+  }
+  return clamp(sum, lo, hi);
+}
+
 vec4 sparse_at(ivec2 b, ivec2 n) { return texelFetch(u_sparse, clamp(b, ivec2(0), n - 1), 0); }
 
 void main() {
@@ -71,10 +124,19 @@ void main() {
   // the Earth, else a direction (the sky: only the camera's turn moves it).
   ivec2 nearest = clamp(ivec2(floor(f + 0.5)), ivec2(0), n - 1);
   float t = texelFetch(u_sparse_depth, nearest, 0).r;
+  if (u_wind) {
+    // With the wind, the closest cloud among the four new samples around: a gap in the cloud (the
+    // ground seen through it) moves with the cloud around it, and an edge with the cloud in front.
+    t = min(min(t, texelFetch(u_sparse_depth, clamp(b0, ivec2(0), n - 1), 0).r),
+            min(texelFetch(u_sparse_depth, clamp(b0 + ivec2(1, 0), ivec2(0), n - 1), 0).r,
+                min(texelFetch(u_sparse_depth, clamp(b0 + ivec2(0, 1), ivec2(0), n - 1), 0).r,
+                    texelFetch(u_sparse_depth, clamp(b0 + ivec2(1, 1), ivec2(0), n - 1), 0).r)));
+  }
   vec3 d = pixel_ray(vec2(p) + 0.5);
   vec3 q;
   if (t < 1.0e37) {
     q = u_delta + d * t;
+    if (u_wind) q += wind_back(u_cam + d * t);
   } else {
     float te = earth_hit(u_cam, d, u_r0);
     q = te > 0.0 ? u_delta + d * te : d;
@@ -90,7 +152,7 @@ void main() {
     imageStore(u_out, p, spatial);  // disoccluded: the history never saw it
     return;
   }
-  vec4 h = texture(u_history, prev / vec2(u_full));
+  vec4 h = history_at(prev);
   if (u_clamp) {
     // The range of the four new samples around this pixel: the history may not leave it, so what
     // moved or changed (or shines differently from the new viewpoint) does not linger as a ghost.

@@ -39,7 +39,7 @@ struct Errors {
   }
 };
 
-enum class Mode { Reproject, NoClamp, SpatialOnly };
+enum class Mode { Reproject, NoClamp, SpatialOnly, NoWind };
 
 // Runs `frames` frames of the scene with the camera moved by `step` before each (frame 0 as it is),
 // reprojected as `mode` says, and measures each frame from `skip` on against the full march, in
@@ -58,6 +58,7 @@ inline Errors run_sequence(render::FrameRenderer& fr, render::Reprojector& rp, c
   glTextureStorage2D(out, 1, GL_RGBA32F, w, h);
   rp.reset();
   rp.set_clamp(mode != Mode::NoClamp);
+  rp.set_wind_motion(mode != Mode::NoWind);
   Errors e;
   double peak = 0.0;
   for (int k = 0; k < frames; ++k) {
@@ -70,7 +71,7 @@ inline Errors run_sequence(render::FrameRenderer& fr, render::Reprojector& rp, c
     sparse.march_camera = render::Reprojector::sparse_camera(full.camera, k);
     fr.march_into(rp.sparse_target(full.camera), sparse, 0);
     if (mode == Mode::SpatialOnly) rp.reset();
-    rp.resolve(fr.raymarcher().cloud_depth_texture(), full.camera, k, changed, r0_m, out);
+    rp.resolve(fr.raymarcher().cloud_depth_texture(), full.camera, k, changed, r0_m, out, fr.volume());
     if (times) {  // the sparse march and the resolve, as the viewer pays them per frame
       glFinish();
       times->push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
