@@ -185,7 +185,7 @@ class GpuRaymarcher {
   GLuint modelled_pyramid_ = 0;     // the modelled cloud's brick bounds (core::medium_pyramid) for modelled_pyramid_volume_
   const core::PreparedVolume* modelled_pyramid_volume_ = nullptr;
   double modelled_pyramid_amount_ = -1.0;
-  GLuint detail_table_ = 0;         // the modelled cloud's table (RG32F, CV_DETAIL_COVERS + 1 by CV_DETAIL_TYPES), with the noise
+  GLuint detail_table_ = 0;         // the modelled cloud's table (RG32F, CV_DETAIL_COVERS + 1 by CV_DETAIL_ROWS), with the noise
   std::vector<float> detail_values_;  // the same table on the CPU (the path tracer's majorant)
   core::MsSourceKey ms_key_;
   const core::PreparedVolume* ms_volume_ = nullptr;

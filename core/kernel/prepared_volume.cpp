@@ -129,14 +129,30 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
   return p;
 }
 
+double detail_least_mean(const std::vector<float>& table, int type, int entry) {
+  constexpr std::size_t row = CV_DETAIL_COVERS + 1;
+  auto mean_at = [&](std::size_t r) {
+    const std::size_t i = 2 * (r * row + static_cast<std::size_t>(entry)) + 1;
+    return i < table.size() ? double(table[i]) : std::numeric_limits<double>::infinity();
+  };
+  double m = mean_at(static_cast<std::size_t>(type));
+  for (int j = 0; j < CV_DETAIL_SLICES; ++j) {
+    m = std::min(m, mean_at(std::size_t(CV_DETAIL_SLICE_ROW0) + std::size_t(j) * CV_DETAIL_TYPES + static_cast<std::size_t>(type)));
+  }
+  return std::isfinite(m) ? m : 0.0;
+}
+
 double medium_majorant(const PreparedVolume& v, const MarchSettings& s, const std::vector<float>& table) {
   if (!s.medium.modelled) return v.sigma_max_per_m;
-  double k = 1.0;  // c / m(c) = 1 at full cover; the types' blend is at most the largest row's
-  for (std::size_t e = 0; 2 * e + 1 < table.size() && e < std::size_t(CV_DETAIL_TYPES) * (CV_DETAIL_COVERS + 1); ++e) {
-    const std::size_t entry = e % (CV_DETAIL_COVERS + 1);
-    if (entry == 0) continue;
-    const double c = (double(entry) / CV_DETAIL_COVERS) * (double(entry) / CV_DETAIL_COVERS), m = table[2 * e + 1];
-    if (m > 0.0) k = std::max(k, c / m);
+  // c / m(c) = 1 at full cover; the types' blend is at most the largest row's, and a blend of two
+  // slices' rows at most the larger of theirs: every (threshold, mean) row, the whole tile's and
+  // each slice's.
+  double k = 1.0;
+  for (int type = 0; type < CV_DETAIL_TYPES; ++type) {
+    for (int e = 1; e <= CV_DETAIL_COVERS; ++e) {
+      const double c = (double(e) / CV_DETAIL_COVERS) * (double(e) / CV_DETAIL_COVERS), m = detail_least_mean(table, type, e);
+      if (m > 0.0) k = std::max(k, c / m);
+    }
   }
   const GridMeanExtinction& x = v.extinction;
   double in_cloud = 0.0;
@@ -181,7 +197,7 @@ std::vector<glm::vec2> medium_pyramid(const PreparedVolume& v, const MarchSettin
     double k = 1.0;
     for (int e = std::max(e0, 1); e <= e1; ++e) {
       const double c = (double(e) / covers) * (double(e) / covers);
-      const double m = table[2 * (std::size_t(row) * (covers + 1) + std::size_t(e)) + 1];
+      const double m = detail_least_mean(table, row, e);
       if (m > 0.0) k = std::max(k, c / m);
     }
     return k;

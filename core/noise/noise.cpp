@@ -216,6 +216,7 @@ std::vector<float> detail_table(const NoiseTexture& low, const NoiseTexture& hig
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   const std::size_t count = std::max<std::size_t>(samples, 1024);
   std::vector<double> v(count);
+  std::vector<std::uint8_t> slice_of(count);  // the point's horizontal slice, by its height in the tile
   // The first points' tile coordinates along longitude and latitude, for the first moments.
   const std::size_t moment_count = std::min<std::size_t>(count, std::size_t(1) << 20);
   std::vector<float> tx(moment_count), ty(moment_count);
@@ -237,6 +238,7 @@ std::vector<float> detail_table(const NoiseTexture& low, const NoiseTexture& hig
         const glm::dvec3 t(next(), next(), next());
         const glm::dvec3 th(p64::noise_high_coords(t));
         v[i] = p64::detail_noise_mix(low.sample(t), high.sample(th));
+        slice_of[i] = static_cast<std::uint8_t>(std::min(CV_DETAIL_SLICES - 1, static_cast<int>(t.z * CV_DETAIL_SLICES)));
         if (i < moment_count) tx[i] = static_cast<float>(t.x), ty[i] = static_cast<float>(t.y);
       }
     });
@@ -246,33 +248,69 @@ std::vector<float> detail_table(const NoiseTexture& low, const NoiseTexture& hig
   std::vector<std::uint32_t> order(moment_count);
   for (std::size_t i = 0; i < moment_count; ++i) order[i] = static_cast<std::uint32_t>(i);
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return v[a] < v[b]; });
+  // Each slice's values, sorted (before v is sorted in place).
+  std::vector<std::vector<double>> slices(CV_DETAIL_SLICES);
+  for (auto& sl : slices) sl.reserve(count / CV_DETAIL_SLICES + count / (4 * CV_DETAIL_SLICES));
+  for (std::size_t i = 0; i < count; ++i) slices[slice_of[i]].push_back(v[i]);
   std::vector<double> mn(moment_count);
   std::vector<float> mx(moment_count), my(moment_count);
   for (std::size_t i = 0; i < moment_count; ++i) mn[i] = v[order[i]], mx[i] = tx[order[i]], my[i] = ty[order[i]];
   std::sort(v.begin(), v.end());
-  // Prefix sums of the sorted values: the mean of the ramp above any threshold in O(log N).
-  std::vector<double> prefix(count + 1, 0.0);
-  for (std::size_t i = 0; i < count; ++i) prefix[i + 1] = prefix[i] + v[i];
-  auto ramp_mean = [&](double t, double s) {
-    // Points in (t, t + s) contribute (n - t) / s, points from t + s up contribute 1.
-    const std::size_t a = static_cast<std::size_t>(std::upper_bound(v.begin(), v.end(), t) - v.begin());
-    const std::size_t b = static_cast<std::size_t>(std::lower_bound(v.begin(), v.end(), t + s) - v.begin());
-    const double ramp = (prefix[b] - prefix[a] - t * double(b - a)) / s;
-    return (ramp + double(count - b)) / double(count);
-  };
   constexpr std::size_t row = CV_DETAIL_COVERS + 1;
   std::vector<float> table(2 * row * CV_DETAIL_ROWS);
-  for (int c = 0; c <= CV_DETAIL_COVERS; ++c) {
-    // The share c of the points lies above t: t is the value at rank (1 - c) N (the largest for c = 0).
-    const double share = (double(c) / CV_DETAIL_COVERS) * (double(c) / CV_DETAIL_COVERS);  // denser at low cover
-    const double rank = (1.0 - share) * double(count);
-    const std::size_t r = std::min(count - 1, static_cast<std::size_t>(std::max(0.0, rank)));
-    const double t = c == 0 ? v.back() : c == CV_DETAIL_COVERS ? v.front() - 1e-9 : v[r];
-    for (int type = 0; type < CV_DETAIL_TYPES; ++type) {  // the same threshold, each type's ramp
-      const std::size_t e = 2 * (std::size_t(type) * row + static_cast<std::size_t>(c));
-      table[e] = static_cast<float>(t);
-      table[e + 1] = static_cast<float>(ramp_mean(t, p64::detail_softness(type)));
+  // One set of rows (the types' threshold and ramp mean per cover) from sorted values w: the whole
+  // tile's at row0 = 0, each slice's at its own rows.
+  auto fill_rows = [&](const std::vector<double>& w, std::size_t row0) {
+    const std::size_t n = w.size();
+    if (n == 0) return;
+    // Prefix sums of the sorted values: the mean of the ramp above any threshold in O(log N).
+    std::vector<double> prefix(n + 1, 0.0);
+    for (std::size_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + w[i];
+    auto ramp_mean = [&](double t, double s) {
+      // Points in (t, t + s) contribute (n - t) / s, points from t + s up contribute 1.
+      const std::size_t a = static_cast<std::size_t>(std::upper_bound(w.begin(), w.end(), t) - w.begin());
+      const std::size_t b = static_cast<std::size_t>(std::lower_bound(w.begin(), w.end(), t + s) - w.begin());
+      const double ramp = (prefix[b] - prefix[a] - t * double(b - a)) / s;
+      return (ramp + double(n - b)) / double(n);
+    };
+    for (int c = 0; c <= CV_DETAIL_COVERS; ++c) {
+      // The share c of the points lies above t: t is the value at rank (1 - c) N (the largest for c = 0).
+      const double share = (double(c) / CV_DETAIL_COVERS) * (double(c) / CV_DETAIL_COVERS);  // denser at low cover
+      const double rank = (1.0 - share) * double(n);
+      const std::size_t r = std::min(n - 1, static_cast<std::size_t>(std::max(0.0, rank)));
+      const double t = c == 0 ? w.back() : c == CV_DETAIL_COVERS ? w.front() - 1e-9 : w[r];
+      // A slice's covers with fewer than kSliceTail of its points above the threshold take the whole
+      // tile's entries: from a handful of points the slice's ramp mean m is noise, and c / m (the
+      // tracking's majorant, medium_majorant) came out 40 times the tile's.
+      constexpr double kSliceTail = 256.0;
+      if (row0 != 0 && (share * double(n) < kSliceTail)) {
+        for (int type = 0; type < CV_DETAIL_TYPES; ++type) {
+          const std::size_t e = 2 * ((row0 + std::size_t(type)) * row + static_cast<std::size_t>(c));
+          const std::size_t g = 2 * (std::size_t(type) * row + static_cast<std::size_t>(c));
+          table[e] = table[g];
+          table[e + 1] = table[g + 1];
+        }
+        continue;
+      }
+      for (int type = 0; type < CV_DETAIL_TYPES; ++type) {  // the same threshold, each type's ramp
+        const std::size_t e = 2 * ((row0 + std::size_t(type)) * row + static_cast<std::size_t>(c));
+        table[e] = static_cast<float>(t);
+        table[e + 1] = static_cast<float>(ramp_mean(t, p64::detail_softness(type)));
+      }
     }
+  };
+  fill_rows(v, 0);
+  {
+    std::vector<std::thread> sorters;
+    for (unsigned w = 0; w < threads; ++w) {
+      sorters.emplace_back([&, w] {
+        for (int j = int(w); j < CV_DETAIL_SLICES; j += int(threads)) {
+          std::sort(slices[std::size_t(j)].begin(), slices[std::size_t(j)].end());
+          fill_rows(slices[std::size_t(j)], std::size_t(CV_DETAIL_SLICE_ROW0) + std::size_t(j) * CV_DETAIL_TYPES);
+        }
+      });
+    }
+    for (std::thread& t : sorters) t.join();
   }
   // The first moments (detail.glsl detail_first_moment): for each type, phase phi = p / PHASES and
   // cover, M = E[(fract(u - phi) - 1/2) h(n; t(c), s) / m(c)] along longitude (x) and latitude (y),

@@ -36,8 +36,11 @@ struct ErosionNoise {
 // cloud type's softness s (detail_softness). The tile's distribution of n is taken over `samples`
 // uniform random points of the low-frequency tile (a fixed sequence), interpolated as the kernel
 // interpolates the textures. CV_DETAIL_TYPES rows (stratiform, cumuliform, cirriform) of
-// CV_DETAIL_COVERS + 1 entries, (t, m) per entry, rows one after the other (a texture of
-// CV_DETAIL_COVERS + 1 by CV_DETAIL_TYPES texels); t(0) is the largest n (no cloud), t(1) the smallest.
+// CV_DETAIL_COVERS + 1 entries, (t, m) per entry, rows one after the other; then the types' first
+// moments per phase (the cell-mean correction), then the same (t, m) rows for each of the
+// CV_DETAIL_SLICES horizontal slices of the tile's height, from the points in that slice (the
+// tile's entries where fewer than 256 of them lie above the threshold): a texture of
+// CV_DETAIL_COVERS + 1 by CV_DETAIL_ROWS texels. t(0) is the largest n (no cloud), t(1) the smallest.
 std::vector<float> detail_table(const NoiseTexture& low, const NoiseTexture& high, std::size_t samples = std::size_t(1) << 22,
                                 unsigned threads = 0);
 // noise with its detail table made (once: an existing table is kept).

@@ -14,9 +14,18 @@
 // the order stratiform, cumuliform, cirriform; then, per type, CV_DETAIL_PHASES rows of the tile's
 // first moments along longitude (x) and latitude (y) at the phases p / CV_DETAIL_PHASES
 // (detail_first_moment: the cell-mean correction of march.glsl detail_factor).
+// Then, per horizontal slice of the tile (CV_DETAIL_SLICES of them, by the tile's height, which the
+// kernel mirrors so that each level holds it once going up and once coming down), a row per type
+// of the slice's own threshold and ramp mean: a slice of the tile does not hold the whole tile's
+// distribution (at a cover of 0.3 the share above the tile's threshold ranged 0.20-0.38 over 16
+// slices), so a cover or an extinction that changes with height within a level would meet that
+// difference; with each slice's own threshold every horizontal slice of a cell keeps its cover and
+// mean (docs/physics.md, "The modelled cloud").
 #define CV_DETAIL_TYPES 3
 #define CV_DETAIL_PHASES 64
-#define CV_DETAIL_ROWS (CV_DETAIL_TYPES * (1 + CV_DETAIL_PHASES))
+#define CV_DETAIL_SLICES 32
+#define CV_DETAIL_SLICE_ROW0 (CV_DETAIL_TYPES * (1 + CV_DETAIL_PHASES))
+#define CV_DETAIL_ROWS (CV_DETAIL_SLICE_ROW0 + CV_DETAIL_SLICES * CV_DETAIL_TYPES)
 // The correction's bounds: it multiplies the modelled extinction by 1 / 1.1 to 1.1 (the majorants
 // take the upper one).
 #define CV_DETAIL_CORRECTION_MAX 1.1

@@ -151,12 +151,6 @@ CV_FN real detail_factor_of(real3 f, real4 s) {
   real x = sqrt(c) * real(CV_DETAIL_COVERS);  // the table's covers are (k / N)^2
   int i = min(int(x), CV_DETAIL_COVERS - 1);
   real w = x - real(i);
-  real4 e0 = real4(texelFetch(u_detail_table, ivec2(i, 0), 0));
-  real4 e1 = real4(texelFetch(u_detail_table, ivec2(i + 1, 0), 0));
-  real t = mix(e0.x, e1.x, w);  // the same in every row
-  real m0 = mix(e0.y, e1.y, w);
-  real m1 = mix(real(texelFetch(u_detail_table, ivec2(i, 1), 0).y), real(texelFetch(u_detail_table, ivec2(i + 1, 1), 0).y), w);
-  real m2 = mix(real(texelFetch(u_detail_table, ivec2(i, 2), 0).y), real(texelFetch(u_detail_table, ivec2(i + 1, 2), 0).y), w);
   real4 col = column_texel(f);
   real w_cu = clamp(col.z, real(0.0), real(1.0));
   real w_ci = clamp(col.w, real(0.0), real(1.0) - w_cu);
@@ -168,6 +162,21 @@ CV_FN real detail_factor_of(real3 f, real4 s) {
   real4 s1 = real4(texelFetch(u_detail_shift, ivec2(k1, 0), 0));
   real3 tc = fract(f * u_detail_tiles - real3(mix(s0.x, s1.x, wz), mix(s0.y, s1.y, wz), real(0.0)));
   tc.z = real(1.0) - abs(real(2.0) * tc.z - real(1.0));  // mirrored about each tile's middle height
+  // The threshold and the types' ramp means of the horizontal slice at the tile height tc.z: linear
+  // between the two nearest slices' rows (centres at (j + 1/2) / SLICES), and between covers.
+  real zs = clamp(tc.z * real(CV_DETAIL_SLICES) - real(0.5), real(0.0), real(CV_DETAIL_SLICES - 1));
+  int j0 = min(int(floor(zs)), CV_DETAIL_SLICES - 2);
+  real wj = zs - real(j0);
+  int r0 = CV_DETAIL_SLICE_ROW0 + j0 * CV_DETAIL_TYPES;
+  int r1 = r0 + CV_DETAIL_TYPES;
+  real2 a0 = mix(real2(texelFetch(u_detail_table, ivec2(i, r0), 0)), real2(texelFetch(u_detail_table, ivec2(i + 1, r0), 0)), w);
+  real2 b0 = mix(real2(texelFetch(u_detail_table, ivec2(i, r1), 0)), real2(texelFetch(u_detail_table, ivec2(i + 1, r1), 0)), w);
+  real t = mix(a0.x, b0.x, wj);  // the same in every type's row
+  real m0 = mix(a0.y, b0.y, wj);
+  real m1 = mix(mix(real(texelFetch(u_detail_table, ivec2(i, r0 + 1), 0).y), real(texelFetch(u_detail_table, ivec2(i + 1, r0 + 1), 0).y), w),
+                mix(real(texelFetch(u_detail_table, ivec2(i, r1 + 1), 0).y), real(texelFetch(u_detail_table, ivec2(i + 1, r1 + 1), 0).y), w), wj);
+  real m2 = mix(mix(real(texelFetch(u_detail_table, ivec2(i, r0 + 2), 0).y), real(texelFetch(u_detail_table, ivec2(i + 1, r0 + 2), 0).y), w),
+                mix(real(texelFetch(u_detail_table, ivec2(i, r1 + 2), 0).y), real(texelFetch(u_detail_table, ivec2(i + 1, r1 + 2), 0).y), w), wj);
   real n = detail_noise_mix(fetch_noise(u_noise_low, tc), fetch_noise(u_noise_high, noise_high_coords(tc)));
   real g = (m0 > real(0.0) ? w_st * detail_ramp(n, t, detail_softness(0)) / m0 : real(0.0)) +
            (m1 > real(0.0) ? w_cu * detail_ramp(n, t, detail_softness(1)) / m1 : real(0.0)) +

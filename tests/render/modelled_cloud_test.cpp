@@ -174,12 +174,12 @@ CellFigures measure_cells(const core::VolumeGrid& grid, const core::TimeStepData
   return out;
 }
 
-// The issue's 2 %: asserted for every cell's cover (absolute share) and, where `mean_too`, for the
-// mean extinction over the measured cells together. Each cell's own mean is printed with its
-// standard error, not asserted: within a cell the data's extinction and fraction vary (trilinearly)
-// across the noise pattern, which the construction does not cancel (docs/physics.md, "The
-// modelled cloud": not met; "largest beyond 3 standard errors" is a lower bound on the worst cell's
-// bias, so a figure above 0 shows a bias, not noise).
+// The issue's 2 %: asserted for every cell's cover (absolute share), for every cell's mean
+// extinction as far as the estimate resolves it (no cell's |error| - 3 standard errors, a lower
+// bound on its bias, reaches 2 %), and, where `mean_too`, for the mean over the measured cells
+// together. Each cell's own estimate carries sampling noise (its standard error is printed): the
+// 95th percentile and the worst of the estimates are printed, not asserted (docs/physics.md, "The
+// modelled cloud").
 void expect_cells_keep_their_means(const char* what, const CellFigures& f, int min_cells, bool mean_too) {
   std::printf("%s: %d cloudy cells: mean extinction worst %.2f %% (+- %.2f %%), 95th percentile %.2f %% (standard errors up to "
               "%.2f %% at the 95th percentile), largest beyond 3 standard errors %.2f %% (%.2f %% over the %d cells of mean "
@@ -190,6 +190,7 @@ void expect_cells_keep_their_means(const char* what, const CellFigures& f, int m
   if (mean_too) {
     EXPECT_LT(std::abs(f.total_mean), 0.02);
   }
+  EXPECT_LT(f.worst_beyond, 0.02) << "a cell's mean is off by more than 2 % beyond 3 standard errors of its estimate";
   EXPECT_LT(f.worst_cover, 0.02);
 }
 
@@ -216,6 +217,28 @@ TEST(ModelledCloud, TheTableLeavesTheCoverAboveItsThreshold) {
     EXPECT_LT(m(0, c), m(2, c)) << c;
     EXPECT_LT(m(2, c), m(1, c)) << c;
   }
+  // Each horizontal slice's rows: the same rules over the covers the slice resolves (at the lowest
+  // covers, where too few of its points lie above the threshold, it takes the whole tile's entries),
+  // and they differ from the whole tile's: a slice does not hold the tile's distribution.
+  int differ = 0;
+  for (int j = 0; j < CV_DETAIL_SLICES; ++j) {
+    const int r0 = CV_DETAIL_SLICE_ROW0 + j * CV_DETAIL_TYPES;
+    for (int type = 0; type < CV_DETAIL_TYPES; ++type) {
+      const int r = r0 + type;
+      for (int c = 1; c <= CV_DETAIL_COVERS; ++c) {
+        const bool own = t(r, c) != t(type, c) || m(r, c) != m(type, c), own_before = t(r, c - 1) != t(type, c - 1);
+        EXPECT_EQ(t(r, c), t(r0, c)) << "slice " << j << " type " << type << " cover entry " << c;
+        EXPECT_LE(m(r, c), (double(c) / CV_DETAIL_COVERS) * (double(c) / CV_DETAIL_COVERS) + 1e-6) << "slice " << j << " entry " << c;
+        EXPECT_GT(m(r, c), 0.0) << "slice " << j << " entry " << c;
+        if (own && own_before) {
+          EXPECT_LE(t(r, c), t(r, c - 1)) << "slice " << j << " entry " << c;
+          EXPECT_GE(m(r, c), m(r, c - 1)) << "slice " << j << " entry " << c;
+        }
+        differ += own && c == 128;
+      }
+    }
+  }
+  EXPECT_EQ(differ, CV_DETAIL_SLICES * CV_DETAIL_TYPES) << "every slice has its own entries at a cover of 1/4";
 }
 
 // The construction itself: at a constant cover c, over whole tiles, the factor's mean is 1 and the
@@ -250,17 +273,37 @@ TEST(ModelledCloud, AtAConstantCoverATileKeepsTheMeanAndTheCover) {
     k.u_detail_shift = {(d ? drifted : still).data(), {4, 1}, 2};
     std::fill(frac.begin(), frac.end(), float(c));
     const int n = 1 << 19;
+    constexpr int kLayers = 8;  // horizontal layers of the level, by height
     Uniform u(7);
     double sum = 0.0, sum2 = 0.0, cover = 0.0;
+    double layer_sum[kLayers] = {}, layer_sum2[kLayers] = {}, layer_cover[kLayers] = {}, layer_n[kLayers] = {};
     for (int q = 0; q < n; ++q) {
       const glm::dvec3 f(1.0 + u(), 1.0 + u(), 1.0 + u());
       const double g = k.detail_factor(f);
       sum += g, sum2 += g * g, cover += g > 0.0 ? 1.0 : 0.0;
+      const int l = std::min(kLayers - 1, int((f.z - 1.0) * kLayers));
+      layer_sum[l] += g, layer_sum2[l] += g * g, layer_cover[l] += g > 0.0 ? 1.0 : 0.0, layer_n[l] += 1.0;
     }
     const double mean = sum / n, se = std::sqrt(std::max(sum2 / n - mean * mean, 0.0) / n);
     const double share = cover / n, se_share = std::sqrt(c * (1.0 - c) / n) + 1e-9;
-    std::printf("%s, %s, cover %.2f: mean factor %.4f +- %.4f, cloudy share %.4f\n", d ? "drifted" : "still", type_names[type], c, mean, se,
-                share);
+    // Each horizontal layer of the level on its own (the slices' rows): its cover and mean too, so
+    // a cover or an extinction that changes with height inside a level meets no bias.
+    double worst_layer_share = 0.0, worst_layer_mean = 0.0, worst_layer_share_z = 0.0, worst_layer_mean_z = 0.0;
+    for (int l = 0; l < kLayers; ++l) {
+      const double ln = layer_n[l], lm = layer_sum[l] / ln;
+      const double lse = std::sqrt(std::max(layer_sum2[l] / ln - lm * lm, 0.0) / ln) + 1e-12;
+      const double lshare = layer_cover[l] / ln, lse_share = std::sqrt(c * (1.0 - c) / ln) + 1e-12;
+      worst_layer_share = std::max(worst_layer_share, std::abs(lshare - c));
+      worst_layer_mean = std::max(worst_layer_mean, std::abs(lm - 1.0));
+      worst_layer_share_z = std::max(worst_layer_share_z, std::abs(lshare - c) / lse_share);
+      worst_layer_mean_z = std::max(worst_layer_mean_z, std::abs(lm - 1.0) / lse);
+      EXPECT_LT(std::abs(lshare - c), 4.5 * lse_share + 0.01 * c + 0.002) << "cover " << c << ", layer " << l;
+      EXPECT_LT(std::abs(lm - 1.0), 4.5 * lse + 0.01) << "cover " << c << ", layer " << l;
+    }
+    std::printf("%s, %s, cover %.2f: mean factor %.4f +- %.4f, cloudy share %.4f; of the level's %d layers, the worst: share off by "
+                "%.4f (%.1f standard errors), mean off by %.4f (%.1f)\n",
+                d ? "drifted" : "still", type_names[type], c, mean, se, share, kLayers, worst_layer_share, worst_layer_share_z,
+                worst_layer_mean, worst_layer_mean_z);
     EXPECT_LT(std::abs(mean - 1.0), 4.5 * se + 0.005) << "cover " << c;
     EXPECT_LT(std::abs(share - c), 4.5 * se_share + 0.002) << "cover " << c;
   }
@@ -288,12 +331,13 @@ TEST(ModelledCloud, CellsKeepTheCoverDiagnosedFromTheWater) {
                                 measure_cells(vol.grid, step, 20000.0, 8, 30, 1 << 17), 20, true);
 }
 
-TEST(ModelledCloud, CellsOfARealWrfFileKeepTheirCover) {
+TEST(ModelledCloud, CellsOfARealWrfFileKeepTheirCoverAndTheirMean) {
   REAL_FILE(path, "wrf_d01_allvars_cropped.nc");
   auto vol = importers::import_file(path);
   // The cropped WRF file holds little cloud: no cell with all 8 nodes cloudy; the cells with half
-  // of them are cloud edges, whose mean comes out 2-3 % low together (not asserted; see above).
-  expect_cells_keep_their_means("WRF", measure_cells(vol.grid, vol.step(0), 5000.0, 4, 30, 1 << 17), 5, false);
+  // of them or more are cloud edges (2.9 % low together before each slice of the tile had its own
+  // threshold, 0.7 % after).
+  expect_cells_keep_their_means("WRF", measure_cells(vol.grid, vol.step(0), 5000.0, 4, 30, 1 << 17), 5, true);
 }
 
 TEST(ModelledCloud, CellsOfARealEra5FileKeepTheirCoverAndTogetherTheirMean) {
