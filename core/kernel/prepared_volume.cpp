@@ -129,17 +129,23 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
   return p;
 }
 
-double detail_least_mean(const std::vector<float>& table, int type, int entry) {
+std::vector<double> detail_least_means(const std::vector<float>& table) {
   constexpr std::size_t row = CV_DETAIL_COVERS + 1;
-  auto mean_at = [&](std::size_t r) {
-    const std::size_t i = 2 * (r * row + static_cast<std::size_t>(entry)) + 1;
-    return i < table.size() ? double(table[i]) : std::numeric_limits<double>::infinity();
-  };
-  double m = mean_at(static_cast<std::size_t>(type));
-  for (int j = 0; j < CV_DETAIL_SLICES; ++j) {
-    m = std::min(m, mean_at(std::size_t(CV_DETAIL_SLICE_ROW0) + std::size_t(j) * CV_DETAIL_TYPES + static_cast<std::size_t>(type)));
+  std::vector<double> out(std::size_t(CV_DETAIL_TYPES) * row, 0.0);
+  for (int type = 0; type < CV_DETAIL_TYPES; ++type) {
+    for (std::size_t e = 0; e < row; ++e) {
+      auto mean_at = [&](std::size_t r) {
+        const std::size_t i = 2 * (r * row + e) + 1;
+        return i < table.size() ? double(table[i]) : std::numeric_limits<double>::infinity();
+      };
+      double m = mean_at(static_cast<std::size_t>(type));
+      for (int j = 0; j < CV_DETAIL_SLICES; ++j) {
+        m = std::min(m, mean_at(std::size_t(CV_DETAIL_SLICE_ROW0) + std::size_t(j) * CV_DETAIL_TYPES + static_cast<std::size_t>(type)));
+      }
+      out[std::size_t(type) * row + e] = std::isfinite(m) ? m : 0.0;
+    }
   }
-  return std::isfinite(m) ? m : 0.0;
+  return out;
 }
 
 double medium_majorant(const PreparedVolume& v, const MarchSettings& s, const std::vector<float>& table) {
@@ -148,9 +154,11 @@ double medium_majorant(const PreparedVolume& v, const MarchSettings& s, const st
   // slices' rows at most the larger of theirs: every (threshold, mean) row, the whole tile's and
   // each slice's.
   double k = 1.0;
+  const std::vector<double> least = detail_least_means(table);
   for (int type = 0; type < CV_DETAIL_TYPES; ++type) {
     for (int e = 1; e <= CV_DETAIL_COVERS; ++e) {
-      const double c = (double(e) / CV_DETAIL_COVERS) * (double(e) / CV_DETAIL_COVERS), m = detail_least_mean(table, type, e);
+      const double c = (double(e) / CV_DETAIL_COVERS) * (double(e) / CV_DETAIL_COVERS);
+      const double m = least[std::size_t(type) * (CV_DETAIL_COVERS + 1) + std::size_t(e)];
       if (m > 0.0) k = std::max(k, c / m);
     }
   }
@@ -191,13 +199,14 @@ std::vector<glm::vec2> medium_pyramid(const PreparedVolume& v, const MarchSettin
   // K of one type's row over table entries e0..e1: the largest c / m(c) (1 at full cover).
   constexpr int covers = CV_DETAIL_COVERS;
   const int rows = std::min(int(table.size() / (2 * (covers + 1))), CV_DETAIL_TYPES);  // the types' (t, m) rows
+  const std::vector<double> least = detail_least_means(table);
   auto k_row = [&](int row, double lo, double hi) {
     const int e0 = std::clamp(int(std::floor(std::sqrt(std::max(lo, 0.0)) * covers)), 0, covers);
     const int e1 = std::clamp(int(std::ceil(std::sqrt(std::min(hi, 1.0)) * covers)), e0, covers);
     double k = 1.0;
     for (int e = std::max(e0, 1); e <= e1; ++e) {
       const double c = (double(e) / covers) * (double(e) / covers);
-      const double m = detail_least_mean(table, row, e);
+      const double m = least[std::size_t(row) * (covers + 1) + std::size_t(e)];
       if (m > 0.0) k = std::max(k, c / m);
     }
     return k;

@@ -49,10 +49,11 @@ struct PreparedVolume {
 // step they cost about half a second, so the data mode's time steps skip them.
 PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinction, bool weather = true);
 
-// The smallest ramp mean m(c) of cloud type `type` at the table's cover entry `entry` over the whole
-// tile's row and every horizontal slice's row (shaders/common/detail.glsl): the kernel blends two
-// slices' rows, so c / m(c) at any point is at most c over this. 0 where the table has no such row.
-double detail_least_mean(const std::vector<float>& table, int type, int entry);
+// Per cloud type and cover entry of the table (CV_DETAIL_TYPES rows of CV_DETAIL_COVERS + 1), the
+// smallest ramp mean m(c) over the whole tile's row and every horizontal slice's row
+// (shaders/common/detail.glsl): the kernel blends two slices' rows, so c / m(c) at any point is at
+// most c over this. 0 where the table has no such row.
+std::vector<double> detail_least_means(const std::vector<float>& table);
 
 // The largest extinction the march kernel's medium can take with these settings, the tracking's
 // majorant (1/m): the volume's largest node sum for the data's field; for the modelled cloud

@@ -283,7 +283,7 @@ std::vector<float> detail_table(const NoiseTexture& low, const NoiseTexture& hig
       // tile's entries: from a handful of points the slice's ramp mean m is noise, and c / m (the
       // tracking's majorant, medium_majorant) came out 40 times the tile's.
       constexpr double kSliceTail = 256.0;
-      if (row0 != 0 && (share * double(n) < kSliceTail)) {
+      if (row0 != 0 && share * double(n) < kSliceTail) {
         for (int type = 0; type < CV_DETAIL_TYPES; ++type) {
           const std::size_t e = 2 * ((row0 + std::size_t(type)) * row + static_cast<std::size_t>(c));
           const std::size_t g = 2 * (std::size_t(type) * row + static_cast<std::size_t>(c));
