@@ -2,6 +2,7 @@
 #include "render/reprojector.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "render/gl.hpp"
 
@@ -19,7 +20,31 @@ bool same_camera(const core::Camera& a, const core::Camera& b) {
          a.pitch_deg == b.pitch_deg && a.fov_deg == b.fov_deg && a.width == b.width && a.height == b.height;
 }
 
+bool same_volume_grid(const core::VolumeGrid& a, const core::VolumeGrid& b) {
+  const auto same_axis = [](const core::RegularAxis& x, const core::RegularAxis& y) {
+    return x.start == y.start && x.step == y.step && x.count == y.count;
+  };
+  return same_axis(a.lon_deg, b.lon_deg) && same_axis(a.lat_deg, b.lat_deg) && same_axis(a.alt_m, b.alt_m) &&
+         a.earth_radius_m == b.earth_radius_m;
+}
+
 }  // namespace
+
+void Reprojector::upload_motion(int nx, int ny, int levels, const float* rg) {
+  if (!motion_ || nx != motion_size_[0] || ny != motion_size_[1] || levels != motion_size_[2]) {
+    if (motion_) glDeleteTextures(1, &motion_);
+    glCreateTextures(GL_TEXTURE_3D, 1, &motion_);
+    glTextureStorage3D(motion_, 1, GL_RG32F, nx, ny, levels);
+    glTextureParameteri(motion_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(motion_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(motion_, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(motion_, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(motion_, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    motion_size_ = {nx, ny, levels};
+  }
+  glTextureSubImage3D(motion_, 0, 0, 0, 0, nx, ny, levels, GL_RG, GL_FLOAT, rg);
+  check_gl("uploading the wind's motion");
+}
 
 Reprojector::Reprojector(const ShaderLoader& loader)
     : program_(load_compute(loader, ShaderLoader::default_shader_dir() / "display" / "reproject.comp")) {}
@@ -94,6 +119,8 @@ void Reprojector::reset() {
   previous_.reset();
   previous_grid_.reset();
   previous_drift_.clear();
+  previous_time_s_ = std::numeric_limits<double>::quiet_NaN();
+  previous_flowed_ = false;
   frames_since_change_ = 0;
   frames_since_doubt_ = kFramesToComplete;
 }
@@ -143,23 +170,41 @@ void Reprojector::resolve(unsigned sparse_depth, const core::Camera& full, int i
   set3(p, "u_prev_right", then.right);
   set3(p, "u_prev_up", then.up);
   glProgramUniform1f(p, loc(p, "u_prev_tan_half"), static_cast<float>(then.tan_half));
-  // The wind's motion since the history's medium (the modelled cloud's detail drift, per level).
-  std::vector<float> motion;
+  // The wind's motion since the history's medium: the modelled cloud's detail drift (per level),
+  // else the advected medium's flow (per coarse node) times the time between the two media.
+  wind_moved_ = false;
   if (wind_ && has_history && volume && previous_grid_) {
-    motion = wind_motion_deg(*previous_grid_, previous_drift_, volume->grid, volume->extinction.detail_drift_cells);
-  }
-  wind_moved_ = !motion.empty();
-  if (wind_moved_) {
-    const int levels = static_cast<int>(motion.size() / 2);
-    if (!motion_ || levels != motion_levels_) {
-      if (motion_) glDeleteTextures(1, &motion_);
-      glCreateTextures(GL_TEXTURE_2D, 1, &motion_);
-      glTextureStorage2D(motion_, 1, GL_RG32F, levels, 1);
-      motion_levels_ = levels;
+    const std::vector<float> per_level =
+        wind_motion_deg(*previous_grid_, previous_drift_, volume->grid, volume->extinction.detail_drift_cells);
+    const double dt_s = volume->time_s - previous_time_s_;
+    const bool same_grid = same_volume_grid(*previous_grid_, volume->grid);
+    if (!per_level.empty()) {
+      const int levels = static_cast<int>(per_level.size() / 2);
+      upload_motion(1, 1, levels, per_level.data());
+      motion_axes_ = {0.0f, 1.0f, 0.0f, 1.0f};
+      motion_scale_ = 1.0f;
+      motion_is_flow_ = false;
+      wind_moved_ = true;
+    } else if (same_grid && std::isfinite(dt_s) && dt_s != 0.0 && !volume->flow.empty() &&
+               volume->flow.levels == volume->grid.alt_m.count) {
+      const core::AngularFlow& f = volume->flow;
+      upload_motion(f.lon_deg.count, f.lat_deg.count, f.levels, f.deg_per_s.data());
+      motion_axes_ = {static_cast<float>(f.lon_deg.start), static_cast<float>(f.lon_deg.step), static_cast<float>(f.lat_deg.start),
+                      static_cast<float>(f.lat_deg.step)};
+      motion_scale_ = static_cast<float>(dt_s);
+      motion_is_flow_ = true;
+      wind_moved_ = true;
+    } else if (same_grid && std::isfinite(dt_s) && dt_s != 0.0 && motion_is_flow_ && previous_flowed_) {
+      // A medium at a step itself carries no flow: the previous instant's flow, still uploaded, moves it.
+      motion_scale_ = static_cast<float>(dt_s);
+      wind_moved_ = true;
     }
-    glTextureSubImage2D(motion_, 0, 0, 0, levels, 1, GL_RG, GL_FLOAT, motion.data());
+  }
+  if (wind_moved_) {
+    glProgramUniform4f(p, loc(p, "u_motion_axes"), motion_axes_[0], motion_axes_[1], motion_axes_[2], motion_axes_[3]);
+    glProgramUniform1f(p, loc(p, "u_motion_scale"), motion_scale_);
     glProgramUniform3f(p, loc(p, "u_alt_axis"), static_cast<float>(volume->grid.alt_m.start), static_cast<float>(volume->grid.alt_m.step),
-                       static_cast<float>(levels));
+                       static_cast<float>(volume->grid.alt_m.count));
   }
   glProgramUniform1i(p, loc(p, "u_wind"), wind_moved_ ? 1 : 0);
   glBindImageTexture(0, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
@@ -178,9 +223,13 @@ void Reprojector::resolve(unsigned sparse_depth, const core::Camera& full, int i
   if (volume) {
     previous_grid_ = volume->grid;
     previous_drift_ = volume->extinction.detail_drift_cells;
+    previous_time_s_ = volume->time_s;
+    previous_flowed_ = !volume->flow.empty() && motion_is_flow_ && wind_moved_;
   } else {
     previous_grid_.reset();
     previous_drift_.clear();
+    previous_time_s_ = std::numeric_limits<double>::quiet_NaN();
+    previous_flowed_ = false;
   }
   ++frames_since_change_;
   ++frames_since_doubt_;

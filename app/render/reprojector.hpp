@@ -6,12 +6,15 @@
 // the nearby new samples for 16 frames after the camera moved or the medium changed (against
 // ghosting; a turn or a zoom of the lens reprojects exactly and is not clamped), or the new
 // samples' bilinear blend where the history never saw the point (disocclusion, the view's edges).
-// Where the medium carries the modelled cloud's wind displacement (core::DetailDrift, one per level)
-// and time moved between two frames, a point in cloud is looked up where the wind held it in the
-// previous frame: the camera's motion and the wind's both reproject.
+// Where time moved between two frames and the medium carries the wind (the modelled cloud's
+// displacement, core::DetailDrift, one per level; or, for an advected medium, the winds' angular
+// flow, core::angular_flow, per coarse node), a point in cloud is looked up where the wind held it
+// in the previous frame: the camera's motion and the wind's both reproject.
 // Offline renders never use it: `render` and `record` march every pixel.
 #pragma once
 
+#include <array>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -48,9 +51,9 @@ class Reprojector {
   // Makes the full image (into `out`, RGBA32F of full's size) from sparse frame `index` just marched
   // into sparse_target() with its cloud depth in `sparse_depth` (R32F of the sparse size), and the
   // history. `changed`: the medium or the settings changed since the last resolve (the camera's own
-  // motion is found here). `volume`: the medium marched (its detail drift gives the wind's motion
-  // since the previous resolve; null or without a drift: no wind motion). The result becomes the
-  // next frame's history.
+  // motion is found here). `volume`: the medium marched (its detail drift, else its flow times the
+  // time since the previous resolve's medium, gives the wind's motion; null, or neither: no wind
+  // motion). The result becomes the next frame's history.
   void resolve(unsigned sparse_depth, const core::Camera& full, int index, bool changed, double r0_m, unsigned out,
                const core::PreparedVolume* volume = nullptr);
 
@@ -74,9 +77,18 @@ class Reprojector {
   bool wind_moved() const { return wind_moved_; }
 
  private:
+  // The motion texture (RG32F, 3-D: longitude, latitude, level) made again when its size changes.
+  void upload_motion(int nx, int ny, int levels, const float* rg);
+
   GlProgram program_;
   unsigned history_ = 0, sparse_ = 0, motion_ = 0;
-  int motion_levels_ = 0;
+  std::array<int, 3> motion_size_{};
+  // What the motion texture holds: its nodes' first longitude, longitude step, first latitude and
+  // latitude step (degrees; 1 x 1 per level for a drift), and the factor its values take (the
+  // seconds between two media for a flow, 1 for a drift's degrees).
+  std::array<float, 4> motion_axes_{};
+  float motion_scale_ = 1.0f;
+  bool motion_is_flow_ = false;
   int width_ = 0, height_ = 0, sparse_w_ = 0, sparse_h_ = 0;
   std::optional<core::Camera> previous_;
   int frames_since_change_ = 0;
@@ -85,6 +97,8 @@ class Reprojector {
   // The previous resolve's medium: its grid and detail drift (cells, 2 per level).
   std::optional<core::VolumeGrid> previous_grid_;
   std::vector<double> previous_drift_;
+  double previous_time_s_ = std::numeric_limits<double>::quiet_NaN();
+  bool previous_flowed_ = false;  // the last resolve moved the history by its medium's flow, still uploaded
 };
 
 }  // namespace cv::render

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "settings/march_settings.hpp"
 #include "volume/grid_mean.hpp"
 #include "volume/column_depth.hpp"
+#include "volume/time_interpolation.hpp"
 #include "volume/extinction_pyramid.hpp"
 #include "kernel/weather_textures.hpp"
 
@@ -42,6 +44,13 @@ struct PreparedVolume {
   // Where the file gives no cloud fraction, extinction.fraction holds the cover diagnosed from the
   // water (weather.cover_from_water), which the modelled cloud takes.
   WeatherTextures weather;
+  // The instant this medium stands for (seconds since 1970-01-01 UTC, from the file's valid times;
+  // NaN where the cache did not set it), and, where it was advected between two steps, the winds'
+  // angular motion at that instant (core::angular_flow): the viewer's reprojection moves its history
+  // by the flow times the time between two frames' media. Empty otherwise (a step itself, a linear
+  // blend: nothing moves).
+  double time_s = std::numeric_limits<double>::quiet_NaN();
+  AngularFlow flow;
 };
 
 // With `weather` false the weather textures are left out (weather.nx == 0, the column maps' type

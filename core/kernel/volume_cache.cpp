@@ -34,7 +34,10 @@ std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string
   e.source = source, e.step = at.step0, e.step1 = at.step1, e.fraction = at.fraction, e.mode = mode, e.drift = detail_drift;
   GridMeanExtinction mixed = interpolate_extinction(volume.grid, e0, e1, w0, w1, at.gap_s, at.fraction, mode, &e.report);
   mixed.detail_drift_cells = std::move(drift);
-  e.volume = std::make_shared<const PreparedVolume>(prepare_volume(volume.grid, std::move(mixed), detail_drift));
+  PreparedVolume prepared = prepare_volume(volume.grid, std::move(mixed), detail_drift);
+  if (at.step0 < volume.times.size()) prepared.time_s = double(volume.times[at.step0].unix_s) + at.fraction * at.gap_s;
+  if (e.report.used == TimeInterpolation::Advected) prepared.flow = angular_flow(volume.grid, w0, w1, at.fraction);
+  e.volume = std::make_shared<const PreparedVolume>(std::move(prepared));
   ++prepared_;
   entries_.push_back(e);
   if (entries_.size() > kResident) entries_.erase(entries_.begin());
@@ -61,7 +64,9 @@ std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string
   }
   GridMeanExtinction medium = grid_mean_extinction(volume.grid, volume.step(step));
   medium.detail_drift_cells = std::move(drift);
-  auto v = std::make_shared<const PreparedVolume>(prepare_volume(volume.grid, std::move(medium), detail_drift));
+  PreparedVolume prepared = prepare_volume(volume.grid, std::move(medium), detail_drift);
+  if (step < volume.times.size()) prepared.time_s = double(volume.times[step].unix_s);
+  auto v = std::make_shared<const PreparedVolume>(std::move(prepared));
   ++prepared_;
   Entry e;
   e.source = source, e.step = e.step1 = step, e.drift = detail_drift, e.volume = v;

@@ -302,4 +302,53 @@ GridMeanExtinction interpolate_extinction(const VolumeGrid& grid, const GridMean
   return out;
 }
 
+AngularFlow angular_flow(const VolumeGrid& grid, const StepWinds& w0, const StepWinds& w1, double fraction, int max_nodes) {
+  AngularFlow f;
+  const std::size_t n = grid.points();
+  if (!w0.horizontal() || !w1.horizontal() || w0.u.size() != n || w0.v.size() != n || w1.u.size() != n || w1.v.size() != n ||
+      n == 0) {
+    return f;
+  }
+  max_nodes = std::max(max_nodes, 2);
+  const int nx = grid.lon_deg.count, ny = grid.lat_deg.count, nz = grid.alt_m.count;
+  const auto stride = [&](int count) { return count <= max_nodes ? 1 : (count - 1 + max_nodes - 2) / (max_nodes - 1); };
+  const int sx = stride(nx), sy = stride(ny);
+  const int cx = (nx - 1) / sx + 1, cy = (ny - 1) / sy + 1;
+  f.lon_deg = {grid.lon_deg.start, grid.lon_deg.step * sx, cx};
+  f.lat_deg = {grid.lat_deg.start, grid.lat_deg.step * sy, cy};
+  f.levels = nz;
+  const std::size_t plane = std::size_t(cx) * std::size_t(cy);
+  std::vector<double> su(plane * std::size_t(nz), 0.0), sv(su.size(), 0.0), count(su.size(), 0.0);
+  const double t = std::clamp(fraction, 0.0, 1.0);
+  const auto calm = [](float v) { return std::isfinite(v) ? double(v) : 0.0; };
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j) {
+      // Each fine node counts towards its nearest coarse node: a box of one stride around each.
+      const int cj = std::min((j + sy / 2) / sy, cy - 1);
+      for (int i = 0; i < nx; ++i) {
+        const int ci = std::min((i + sx / 2) / sx, cx - 1);
+        const std::size_t p = grid.index(i, j, k);
+        const std::size_t q = std::size_t(k) * plane + std::size_t(cj) * std::size_t(cx) + std::size_t(ci);
+        su[q] += (1.0 - t) * calm(w0.u[p]) + t * calm(w1.u[p]);
+        sv[q] += (1.0 - t) * calm(w0.v[p]) + t * calm(w1.v[p]);
+        count[q] += 1.0;
+      }
+    }
+  f.deg_per_s.assign(2 * su.size(), 0.0f);
+  for (int k = 0; k < nz; ++k) {
+    const double r = grid.earth_radius_m + grid.alt_m.at(k);
+    for (int j = 0; j < cy; ++j) {
+      // Near a pole the meridians converge: bounded as the advection bounds it.
+      const double coslat = std::max(std::cos(f.lat_deg.at(j) * kRadPerDeg), 1e-3);
+      for (int i = 0; i < cx; ++i) {
+        const std::size_t q = std::size_t(k) * plane + std::size_t(j) * std::size_t(cx) + std::size_t(i);
+        if (count[q] == 0.0) continue;
+        f.deg_per_s[2 * q] = static_cast<float>(su[q] / count[q] / (r * coslat) / kRadPerDeg);
+        f.deg_per_s[2 * q + 1] = static_cast<float>(sv[q] / count[q] / r / kRadPerDeg);
+      }
+    }
+  }
+  return f;
+}
+
 }  // namespace cv::core

@@ -54,4 +54,21 @@ std::vector<float> advect_field(const VolumeGrid& grid, const std::vector<float>
                                 const StepWinds& w1, double gap_s, double fraction, int from, int* substeps = nullptr,
                                 double* max_courant = nullptr);
 
+// The winds at an instant as the angular motion they give a point, in degrees of longitude and
+// latitude per second (u / ((R + z) cos lat), v / (R + z)), box-averaged onto every `stride`-th
+// node of each horizontal axis so that at most `max_nodes` remain per axis (every level is kept).
+// While an advected forecast plays, the field between two instants moves by about this times their
+// gap: the viewer's reprojection moves its history with it (docs/physics.md, "Temporal
+// reprojection"). Linear in time between the steps; NaN counts as calm (as in the advection).
+struct AngularFlow {
+  RegularAxis lon_deg, lat_deg;  // the coarse nodes (every stride-th node of the grid's axes)
+  int levels = 0;                // the grid's levels
+  // (longitude, latitude) rate per coarse node: longitude fastest, then latitude, then level.
+  std::vector<float> deg_per_s;
+  bool empty() const { return deg_per_s.empty(); }
+};
+// Empty unless both steps have horizontal winds of the grid's size.
+AngularFlow angular_flow(const VolumeGrid& grid, const StepWinds& w0, const StepWinds& w1, double fraction,
+                         int max_nodes = 128);
+
 }  // namespace cv::core

@@ -4,15 +4,20 @@
 // new samples around them when anything moved, or the new samples' bilinear blend where the history
 // has nothing (out of the previous view, behind it, or no history yet). A point in cloud is looked
 // up where the wind held it in the previous frame when the medium carries the wind's displacement
-// (the modelled cloud's detail drift, per level) and time moved.
+// (the modelled cloud's detail drift, per level; or an advected medium's angular flow, per coarse
+// node) and time moved.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(rgba32f, binding = 0) writeonly uniform image2D u_out;  // the full image (rgb radiance, a transmittance)
 layout(binding = 0) uniform sampler2D u_history;       // the previous full image (read texel by texel)
 layout(binding = 1) uniform sampler2D u_sparse;        // this frame's samples, one per block
 layout(binding = 2) uniform sampler2D u_sparse_depth;  // the distance at which their view transmittance fell to 0.5 (3e38: never)
-layout(binding = 3) uniform sampler2D u_wind_motion;   // per level (x): the wind's motion since the history (longitude, latitude; degrees)
-uniform bool u_wind;        // u_wind_motion holds a motion
-uniform vec3 u_alt_axis;    // the grid's levels: first altitude (m), spacing (m), count
+// The wind's motion since the history (longitude, latitude; degrees, after u_motion_scale), per node
+// of (longitude, latitude, level): 1 x 1 per level for the modelled cloud's drift.
+layout(binding = 3) uniform sampler3D u_wind_motion;
+uniform bool u_wind;          // u_wind_motion holds a motion
+uniform vec4 u_motion_axes;   // its nodes: first longitude, longitude step, first latitude, latitude step (degrees)
+uniform float u_motion_scale; // what its values are multiplied by (seconds for a flow in degrees per second)
+uniform vec3 u_alt_axis;      // the grid's levels: first altitude (m), spacing (m), count
 uniform ivec2 u_full;        // the full image's size (a multiple of the block in each axis)
 uniform ivec2 u_offset;      // this frame's pixel within each block
 uniform bool u_has_history;  // false: the spatial blend everywhere but the new samples
@@ -51,17 +56,22 @@ float earth_hit(vec3 o, vec3 d, float r0) {
 }
 
 // Where the wind held the Earth-centred point x at the history's instant, as an offset from x: the
-// point turned back by its level's motion in longitude (about the polar axis) and latitude (along
-// its meridian), at the same height. Between levels the motion is linear, as the detail's shift.
+// point turned back by the motion at its place in longitude (about the polar axis) and latitude
+// (along its meridian), at the same height. Between nodes and levels the motion is linear.
 vec3 wind_back(vec3 x) {
   float r = length(x);
-  float n = u_alt_axis.z;
-  float kf = clamp((r - u_r0 - u_alt_axis.x) / u_alt_axis.y, 0.0, n - 1.0);
-  int k0 = int(floor(kf));
-  int k1 = min(k0 + 1, int(n) - 1);
-  vec2 m = radians(mix(texelFetch(u_wind_motion, ivec2(k0, 0), 0).xy, texelFetch(u_wind_motion, ivec2(k1, 0), 0).xy, kf - float(k0)));
   float lat = asin(clamp(x.z / r, -1.0, 1.0));
   float lon = atan(x.y, x.x);
+  vec3 size = vec3(textureSize(u_wind_motion, 0));
+  // The longitude taken within half a turn of the nodes' middle, so a grid across the date line
+  // (or a global one) finds its nodes.
+  float middle = u_motion_axes.x + 0.5 * u_motion_axes.y * (size.x - 1.0);
+  float rel = degrees(lon) - middle;
+  rel -= 360.0 * floor((rel + 180.0) / 360.0);
+  vec3 tc = vec3(((middle + rel - u_motion_axes.x) / u_motion_axes.y + 0.5) / size.x,
+                 ((degrees(lat) - u_motion_axes.z) / u_motion_axes.w + 0.5) / size.y,
+                 ((r - u_r0 - u_alt_axis.x) / u_alt_axis.y + 0.5) / size.z);
+  vec2 m = radians(texture(u_wind_motion, tc).xy * u_motion_scale);
   float lat1 = lat - m.y, lon1 = lon - m.x;
   vec3 u1 = vec3(cos(lat1) * cos(lon1), cos(lat1) * sin(lon1), sin(lat1));
   return r * u1 - x;

@@ -4,7 +4,8 @@
 // 99th percentile of |dL| / the first frame's brightest), with the clamp, without it and without the
 // history. With --play MIN, time advances MIN minutes a frame from the first step (the volumes
 // as the viewer prepares them), and the history moved with the wind is measured against the history
-// that stays where it is; --modelled draws the modelled cloud, whose detail the wind carries;
+// that stays where it is (the modelled cloud's detail drift, or in the data mode the advected
+// medium's flow); --modelled draws the modelled cloud, whose detail the wind carries;
 // --above M looks straight down on the grid's centre from M metres instead of the automatic camera.
 // Not a test: docs/BENCHMARKS.md records what it prints.
 //   bench_reprojection FILE [WxH] [FRAMES] [PX] [QUALITY] [--modelled] [--play MIN] [--above M]
@@ -94,8 +95,17 @@ int main(int argc, char** argv) {
                                                                       v1->extinction.detail_drift_cells);
     double most = 0.0;
     for (std::size_t k = 0; k + 1 < m.size(); k += 2) most = std::max(most, std::hypot(double(m[k]), double(m[k + 1])));
-    std::printf("  the wind's motion a frame: up to %.4f degrees (%zu levels%s)\n", most, m.size() / 2,
-                m.empty() ? ": none, the media carry no drift" : "");
+    if (!m.empty()) {
+      std::printf("  the wind's motion a frame: up to %.4f degrees (the detail's drift, %zu levels)\n", most, m.size() / 2);
+    } else if (!v1->flow.empty()) {  // the data mode, advected: the flow times the time between the media
+      const double dt = v1->time_s - v0->time_s;
+      for (std::size_t k = 0; k + 1 < v1->flow.deg_per_s.size(); k += 2)
+        most = std::max(most, std::hypot(double(v1->flow.deg_per_s[k]), double(v1->flow.deg_per_s[k + 1])) * std::abs(dt));
+      std::printf("  the wind's motion a frame: up to %.4f degrees (the advected medium's flow, %d x %d x %d nodes)\n", most,
+                  v1->flow.lon_deg.count, v1->flow.lat_deg.count, v1->flow.levels);
+    } else {
+      std::printf("  the wind's motion a frame: none (the media carry neither a drift nor an advected flow)\n");
+    }
   }
   scene.time_step = static_cast<int>(first);
   core::FrameSpec base = render::resolve_frame(scene, vol);

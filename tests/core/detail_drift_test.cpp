@@ -137,6 +137,27 @@ TEST(DetailDrift, TheDisplacementIsTheIntegralOfTheInterpolatedRate) {
   for (int k = 0; k < 5; ++k) EXPECT_EQ(d[2 * k + 1], 0.0);
 }
 
+// The prepared media the viewer's cache makes carry their instant, and an advected one the winds'
+// angular flow at it (the data mode's reprojection moves its history by it); a linear blend, which
+// moves nothing, carries none.
+TEST(DetailDrift, TheCachesMediaCarryTheirInstantAndAnAdvectedOneItsFlow) {
+  ThreeSteps t;
+  PreparedVolumeCache cache;
+  const Instant at = t.at("2024-01-01T01:30:00Z");  // half-way between 10 and 20 m/s
+  const auto advected = cache.get("three steps", t.vol, at, TimeInterpolation::Advected);
+  EXPECT_DOUBLE_EQ(advected->time_s, 1704067200.0 + 5400.0);
+  ASSERT_FALSE(advected->flow.empty());
+  const std::size_t q = (std::size_t(2) * 13 + 6) * 21 + 10;  // level 2, 43 N, every node kept
+  EXPECT_NEAR(advected->flow.deg_per_s[2 * q] * ((kR + 2000.0) * std::cos(43.0 * kDeg)) * kDeg, 15.0, 15.0 * 1e-6);  // float
+  EXPECT_EQ(advected->flow.deg_per_s[2 * q + 1], 0.0f);
+  const auto linear = cache.get("three steps", t.vol, at, TimeInterpolation::Linear);
+  EXPECT_DOUBLE_EQ(linear->time_s, 1704067200.0 + 5400.0);
+  EXPECT_TRUE(linear->flow.empty());
+  const auto step = cache.get("three steps", t.vol, std::size_t(1));
+  EXPECT_DOUBLE_EQ(step->time_s, 1704067200.0 + 3 * 3600.0);
+  EXPECT_TRUE(step->flow.empty());
+}
+
 TEST(DetailDrift, AFileWithoutTimesStaysStill) {
   ThreeSteps t;
   t.vol.times = {{0, "0"}, {1, "1"}, {2, "2"}};  // step labels, no UTC valid times

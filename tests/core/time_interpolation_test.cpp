@@ -178,6 +178,43 @@ std::vector<ValidTime> three_hourly(int n) {
   return t;
 }
 
+// The winds' angular flow (for the viewer's reprojection): a uniform wind's rates are u / ((R + z)
+// cos lat) and v / (R + z) in degrees per second, linear in time between the steps, averaged onto a
+// coarser grid where the grid is large, with no data as calm; no flow without both steps' winds.
+TEST(AngularFlow, GivesTheWindsRatesOnACoarseGridLinearInTime) {
+  const VolumeGrid g = strip();
+  const StepWinds w0 = uniform(g, 10.0, 4.0), w1 = uniform(g, 30.0, -4.0);
+  const AngularFlow f = angular_flow(g, w0, w1, 0.25);
+  ASSERT_FALSE(f.empty());
+  EXPECT_EQ(f.lon_deg.count, 64);  // small enough: every node kept
+  EXPECT_EQ(f.lat_deg.count, 9);
+  EXPECT_EQ(f.levels, 3);
+  const double u = 0.75 * 10.0 + 0.25 * 30.0, v = 0.75 * 4.0 + 0.25 * -4.0;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 9; ++j) {
+      const double r = g.earth_radius_m + g.alt_m.at(k), lat = g.lat_deg.at(j) * kPi / 180.0;
+      const std::size_t q = (std::size_t(k) * 9 + std::size_t(j)) * 64 + 17;
+      EXPECT_NEAR(f.deg_per_s[2 * q], u / (r * std::cos(lat)) * 180.0 / kPi, 1e-9) << j << " " << k;
+      EXPECT_NEAR(f.deg_per_s[2 * q + 1], v / r * 180.0 / kPi, 1e-10);
+    }
+
+  // At most 16 nodes per axis: every 5th of 64 (0, 5, ..., 60: 13 nodes) and every 1st of 9.
+  StepWinds holes = w0;
+  holes.u[g.index(20, 4, 1)] = std::numeric_limits<float>::quiet_NaN();  // counts as calm
+  const AngularFlow c = angular_flow(g, holes, holes, 0.0, 16);
+  ASSERT_EQ(c.lon_deg.count, 13);
+  EXPECT_DOUBLE_EQ(c.lon_deg.step, 2.5);
+  EXPECT_DOUBLE_EQ(c.lon_deg.start, 0.0);
+  EXPECT_EQ(c.lat_deg.count, 9);
+  const double r1 = g.earth_radius_m + g.alt_m.at(1);
+  const std::size_t q4 = (std::size_t(1) * 9 + 4) * 13 + 4;  // coarse node 4 = fine node 20: fine nodes 18..22
+  EXPECT_NEAR(c.deg_per_s[2 * q4], 0.8 * 10.0 / r1 * 180.0 / kPi, 1e-10) << "one of the five nodes averaged is calm";
+  EXPECT_NEAR(c.deg_per_s[2 * (q4 + 1)], 10.0 / r1 * 180.0 / kPi, 1e-10);
+
+  EXPECT_TRUE(angular_flow(g, w0, StepWinds{}, 0.5).empty());
+  EXPECT_TRUE(angular_flow(g, StepWinds{}, w1, 0.5).empty());
+}
+
 TEST(Instant, FallsBetweenStepsAndNamesTheRangeWhenOutside) {
   const auto times = three_hourly(6);
   EXPECT_EQ(times[1].iso_utc, "2024-01-15T03:00:00Z");
