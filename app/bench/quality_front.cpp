@@ -91,12 +91,32 @@ bool usable(const FrontScene& s) {
 
 }  // namespace
 
-void rank_front(QualityFront& front) {
+bool modelled_scene(const std::string& scene) {
+  const std::string tag = "+modelled";
+  return scene.size() > tag.size() && scene.compare(scene.size() - tag.size(), tag.size(), tag) == 0;
+}
+
+namespace {
+bool of_model(const std::string& scene, FrontModel model) {
+  return model == FrontModel::All || modelled_scene(scene) == (model == FrontModel::Modelled);
+}
+}  // namespace
+
+bool front_measures(const QualityFront& front, FrontModel model) {
+  for (const FrontConfig& c : front.configs)
+    for (const FrontScene& s : c.scenes)
+      if (of_model(s.scene, model)) return true;
+  return false;
+}
+
+void rank_front(QualityFront& front, FrontModel model) {
+  if (!front_measures(front, model)) model = FrontModel::All;
   for (FrontConfig& c : front.configs) {
     double log_e = 0.0, log_t = 0.0;
     int n = 0;
     bool on_a_front = false;
     for (const FrontScene& s : c.scenes) {
+      if (!of_model(s.scene, model)) continue;
       on_a_front = on_a_front || s.pareto;
       if (!usable(s)) continue;
       log_e += std::log(std::max(s.rel_rmse, 1e-12));
@@ -285,17 +305,24 @@ std::string front_cache_path() {
   return {};
 }
 
-CandidateSource budget_candidates(const std::string& front_file, const std::string& machine) {
+CandidateSource budget_candidates(const std::string& front_file, const std::string& machine, FrontModel model) {
   CandidateSource out;
   auto from = [&](const std::string& path) {
     QualityFront f = load_front(path);
     check_machine(f, machine, path);
-    rank_front(f);  // the file's order and flags are recomputed, not trusted
+    rank_front(f, model);  // the file's order and flags are recomputed, not trusted
     out.candidates = front_candidates(f);
     if (out.candidates.empty())
       throw FrontError(
           path + ": configs: found no candidate, expected at least one configuration on a scene's front");
-    out.source = "the measured front " + path + " (" + std::to_string(out.candidates.size()) + " candidates)";
+    std::string on;
+    if (model != FrontModel::All) {
+      const bool own = front_measures(f, model);
+      const char* name = model == FrontModel::Modelled ? "modelled" : "data";
+      on = own ? std::string(", ranked on its ") + name + " scenes"
+               : std::string(", ranked on all its scenes: it measured no ") + name + " scene";
+    }
+    out.source = "the measured front " + path + " (" + std::to_string(out.candidates.size()) + " candidates" + on + ")";
   };
   if (!front_file.empty()) {
     from(front_file);

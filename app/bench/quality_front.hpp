@@ -64,7 +64,18 @@ struct QualityFront {
 // not dominated across scenes by another such configuration (another one at most as slow and at
 // most as wrong in the geometric means, better in one): a dominated configuration would only cost a
 // calibration frame in the budget choice and never be picked over the one that dominates it.
-void rank_front(QualityFront& front);
+//
+// `model` ranks on one cloud model's own measurements: the modelled cloud's scenes (named
+// "<scene>+modelled", `bench --cloud-model modelled|both`) or the data mode's (the others), when the
+// front measured any scene of that model; else on all of them (front_measures says which). The two
+// models cost differently (the modelled cloud's table lookups) and err differently, so a budget
+// chooses for the model the frame draws from the figures of that model.
+enum class FrontModel { All, Data, Modelled };
+void rank_front(QualityFront& front, FrontModel model = FrontModel::All);
+// Whether a scene of the front is the modelled cloud's ("<scene>+modelled").
+bool modelled_scene(const std::string& scene);
+// Whether the front measured any scene of that model (All: any scene at all).
+bool front_measures(const QualityFront& front, FrontModel model);
 
 // The candidates in order of error, most accurate first.
 std::vector<FrontConfig> front_candidates(const QualityFront& front);
@@ -97,7 +108,10 @@ struct CandidateSource {
   std::vector<FrontConfig> candidates;  // most accurate first
   std::string source, warning;
 };
-CandidateSource budget_candidates(const std::string& front_file, const std::string& machine);
+// `model`: the cloud model the frames draw (rank_front); a front that never measured it ranks on all
+// its scenes, and `source` says so.
+CandidateSource budget_candidates(const std::string& front_file, const std::string& machine,
+                                  FrontModel model = FrontModel::All);
 
 // The budget choice. Candidates are ordered most accurate first; measure_ms(i) renders candidate i
 // and returns its time; the most accurate whose time fits (ms <= budget_ms) is chosen.

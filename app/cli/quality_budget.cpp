@@ -93,7 +93,9 @@ void choose_by_budget(render::GpuRaymarcher& gpu, const core::Camera& cam, const
                       core::RenderSettings& render) {
   bench::CandidateSource src;
   try {
-    src = bench::budget_candidates(front_file, machine);
+    // Ranked on the measurements of the cloud model this frame draws, where the front has them.
+    src = bench::budget_candidates(front_file, machine,
+                                   base.medium.modelled ? bench::FrontModel::Modelled : bench::FrontModel::Data);
   } catch (const bench::FrontError& e) {
     throw UsageError{std::string("cloudviewer render: --front: ") + e.what()};
   }

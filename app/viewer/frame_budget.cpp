@@ -9,7 +9,8 @@
 namespace cv::viewer {
 
 FrameBudget::FrameBudget(const std::string& machine)
-    : source_(bench::budget_candidates("", machine)),
+    : machine_(machine),
+      source_(bench::budget_candidates("", machine, model_)),
       stepper_(source_.candidates.size(), source_.candidates.size() - 1) {}
 
 bool FrameBudget::update(core::RenderSettings& render, double dz_m, double last_frame_ms, bool marched) {
@@ -17,6 +18,12 @@ bool FrameBudget::update(core::RenderSettings& render, double dz_m, double last_
   if (!want) {
     on_ = false;
     return false;
+  }
+  const bench::FrontModel model = render.march.medium.modelled ? bench::FrontModel::Modelled : bench::FrontModel::Data;
+  if (model != model_) {  // the other cloud model: its own figures rank the candidates, from the start
+    model_ = model;
+    source_ = bench::budget_candidates("", machine_, model_);
+    on_ = false;
   }
   bool apply = false;
   if (!on_) {  // just switched on: from the fastest, with nothing known

@@ -24,6 +24,8 @@ class FrameBudget {
   // octaves, adaptive stepping and resolution scale are written into `render` (the accumulation
   // target stays the viewer's: it refines a still image, it does not slow a frame). dz_m: the
   // grid's vertical spacing. Returns true when `render` was changed.
+  // The candidates are ranked on the measurements of the cloud model `render` draws
+  // (bench::FrontModel); when the model changes, they are ranked again and the stepper starts over.
   bool update(core::RenderSettings& render, double dz_m, double last_frame_ms, bool marched);
 
   bool on() const { return on_; }
@@ -35,6 +37,8 @@ class FrameBudget {
   const std::string& warning() const { return source_.warning; }
 
  private:
+  std::string machine_;
+  bench::FrontModel model_ = bench::FrontModel::Data;
   bench::CandidateSource source_;
   bench::BudgetStepper stepper_;
   bool on_ = false;

@@ -75,6 +75,42 @@ TEST(QualityFront, DominatedAcrossScenesIsNoCandidate) {
   EXPECT_EQ(c[0].name, "a");
 }
 
+// A front measured on both cloud models ranks for one model on that model's scenes: "careful" is
+// more accurate on the data but slower and worse on the modelled cloud, so a budget for the modelled
+// cloud never chooses it; a front with no modelled scene ranks on all of its scenes for either.
+TEST(QualityFront, EachCloudModelIsRankedOnItsOwnScenes) {
+  QualityFront f;
+  f.configs.push_back(config("fast", "sweep", {{"a", 1, 10, 0.02, true}, {"b", 1, 10, 0.02, true},
+                                               {"a+modelled", 1, 20, 0.05, true}, {"b+modelled", 1, 20, 0.05, true}}));
+  f.configs.push_back(config("careful", "sweep", {{"a", 1, 40, 0.01, true}, {"b", 1, 40, 0.01, true},
+                                                  {"a+modelled", 1, 80, 0.06, false}, {"b+modelled", 1, 80, 0.06, false}}));
+  EXPECT_TRUE(modelled_scene("a+modelled"));
+  EXPECT_FALSE(modelled_scene("a"));
+  EXPECT_FALSE(modelled_scene("+modelled"));
+  QualityFront data = f, modelled = f, all = f;
+  rank_front(data, FrontModel::Data);
+  rank_front(modelled, FrontModel::Modelled);
+  rank_front(all);
+  auto names = [](const QualityFront& q) {
+    std::string out;
+    for (const FrontConfig& c : front_candidates(q)) out += c.name + " ";
+    return out;
+  };
+  EXPECT_EQ(names(data), "careful fast ");
+  EXPECT_EQ(names(modelled), "fast ");
+  EXPECT_DOUBLE_EQ(modelled.configs[0].ms, 20.0);
+  EXPECT_DOUBLE_EQ(modelled.configs[0].error, 0.05);
+  EXPECT_DOUBLE_EQ(data.configs[1].ms, 10.0);  // "fast", second by error
+  EXPECT_NEAR(all.configs[1].ms, std::sqrt(10.0 * 20.0), 1e-12);
+  // Without modelled scenes, the modelled ranking is the whole front's.
+  QualityFront plain = sample_front(), plain_modelled = sample_front();
+  EXPECT_FALSE(front_measures(plain, FrontModel::Modelled));
+  EXPECT_TRUE(front_measures(plain, FrontModel::Data));
+  rank_front(plain);
+  rank_front(plain_modelled, FrontModel::Modelled);
+  EXPECT_EQ(names(plain), names(plain_modelled));
+}
+
 TEST(QualityFront, UnmeasurableErrorsAreLeftOutOfTheMeans) {
   QualityFront f;
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -194,6 +230,11 @@ TEST(QualityFront, CandidatesFromFileCacheOrLadder) {
   ASSERT_EQ(s.candidates.size(), 3u);
   EXPECT_EQ(s.candidates[0].name, "fine");
   EXPECT_TRUE(s.warning.empty());
+  s = budget_candidates("", f.machine, FrontModel::Modelled);  // it measured no modelled scene
+  ASSERT_EQ(s.candidates.size(), 3u);
+  EXPECT_NE(s.source.find("ranked on all its scenes: it measured no modelled scene"), std::string::npos) << s.source;
+  s = budget_candidates("", f.machine, FrontModel::Data);
+  EXPECT_NE(s.source.find("ranked on its data scenes"), std::string::npos) << s.source;
   s = budget_candidates("", "another GPU");
   EXPECT_EQ(s.candidates[0].name, "high");
   EXPECT_EQ(s.warning.rfind(front_cache_path() + ": machine: found", 0), 0u) << s.warning;
