@@ -351,6 +351,9 @@ int cmd_bench(const std::vector<std::string>& args) {
     base.medium.ms_two_stream = core::scene_march_defaults().medium.ms_two_stream;  // the model the product renders with
     base.features.atmosphere = base.features.globe = false;
     base.medium.ambient = 0.0, base.medium.noise_amount = 0.0;
+    // The reference samples pixel centres: accumulated configurations march them too, so their
+    // error is the transport's, not the difference between a filtered image and a point-sampled one.
+    base.quality.anti_alias = false;
     if (!(base.medium.droplet_diameter_um > 0.0)) base.medium.droplet_diameter_um = 20.0;
     core::MonteCarloSettings mc;
     // The modelled cloud's one majorant is the densest shape anywhere (about 14x the in-cloud

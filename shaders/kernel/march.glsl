@@ -538,15 +538,34 @@ CV_FN void tl_composite(ivec2 px, CV_INOUT(MarchState) s) {
   s.tl_next += 1;
 }
 
-CV_FN real3 pixel_direction(ivec2 px) {
-  real x = (real(2.0) * (real(px.x) + real(0.5) + u_pixel_shift.x) / real(u_size.x) - real(1.0)) * u_tan_half;
-  real y = (real(1.0) - real(2.0) * (real(px.y) + real(0.5) + u_pixel_shift.y) / real(u_size.y)) * u_tan_half * real(u_size.y) / real(u_size.x);
+// The view ray through pixel px, `jitter` pixels from where u_pixel_shift puts it.
+CV_FN real3 pixel_direction_jittered(ivec2 px, real2 jitter) {
+  real x = (real(2.0) * (real(px.x) + real(0.5) + u_pixel_shift.x + jitter.x) / real(u_size.x) - real(1.0)) * u_tan_half;
+  real y = (real(1.0) - real(2.0) * (real(px.y) + real(0.5) + u_pixel_shift.y + jitter.y) / real(u_size.y)) * u_tan_half *
+           real(u_size.y) / real(u_size.x);
   return normalize(u_forward + x * u_right + y * u_upv);
+}
+
+CV_FN real3 pixel_direction(ivec2 px) { return pixel_direction_jittered(px, real2(real(0.0), real(0.0))); }
+
+// Where frame u_frame of an accumulation passes its view rays within their pixels, from the
+// centre (pixels, each in [-0.5, 0.5)): the R2 sequence (Roberts' generalised golden ratio,
+// 1/phi2 and 1/phi2^2 with phi2^3 = phi2 + 1) started at the centre, so frame 0 and single frames
+// (u_frame -1) are the centres and any N consecutive frames spread evenly over the pixel. Summed in
+// 24-bit fixed point with integer wrap-around (as blue_noise_jitter), so float on the GPU and double
+// on the CPU give the same offsets bit for bit at any frame. Only the march takes it; the Monte
+// Carlo and the path tracer sample the centres.
+CV_FN real2 pixel_jitter() {
+  if (!u_anti_alias || u_frame <= 0) return real2(real(0.0), real(0.0));
+  uint k = uint(u_frame);
+  uint x24 = (8388608u + k * 12664746u) & 16777215u;  // 0.7548776662466927 * 2^24
+  uint y24 = (8388608u + k * 9560334u) & 16777215u;   // 0.5698402909980532 * 2^24
+  return real2(real(x24), real(y24)) * real(5.9604644775390625e-8) - real2(real(0.5), real(0.5));
 }
 
 CV_FN MarchRay march_ray(ivec2 px) {
   MarchRay r;
-  r.d = pixel_direction(px);
+  r.d = pixel_direction_jittered(px, pixel_jitter());
   real ht = u_layer.y;
   r.origin = u_cam_ecef;
   r.h = u_cam_alt;

@@ -55,6 +55,7 @@ CV_PARAM(bool, u_sun_down)           // the whole cloud layer is in the Earth's 
 CV_PARAM(bool, u_octave_gate)        // weight octave i >= 1 by w^i from the column's optical depth
 CV_PARAM(bool, u_liquid_phase_hg)    // Henyey-Greenstein with the Mie fit's mean cosine instead of the fit
 CV_PARAM(bool, u_blue_noise)         // the jitter from the blue-noise mask, else the hash
+CV_PARAM(bool, u_anti_alias)         // accumulation frames >= 1 spread their rays over the pixel (pixel_jitter)
 CV_PARAM(bool, u_has_depth)          // u_depth holds the distance to opaque geometry per pixel
 CV_PARAM(bool, u_has_opaque_color)   // u_opaque holds that geometry's radiance, composited behind
 CV_PARAM(real, u_mask_bottom)        // layer mask: the lowest height shown, m (march_settings.def layer_bottom_m)

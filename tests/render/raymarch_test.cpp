@@ -110,6 +110,72 @@ TEST(Raymarch, GpuMatchesTheCpuReference) {
   EXPECT_GT(differs, 1e-4);
 }
 
+// Anti-aliasing (march.anti_alias, march.glsl pixel_jitter): accumulated frames spread their rays
+// over the pixel, so their mean tends to the pixel's box-filtered radiance. The truth: the same view
+// marched at 4 x 4 times the pixels (at their centres) and averaged over each 4 x 4 block. The
+// anti-aliased mean of 64 frames must be much closer to it than the mean of 64 frames at the
+// centres, which keeps the centres' stairs at the bubble's edges; the CPU kernel jitters the same
+// way; frame 0 stays at the centres.
+TEST(Raymarch, AccumulatedFramesConvergeToThePixelsBoxFilteredRadiance) {
+  BubbleOnGpu g;
+  auto& [ctx, loader, gpu, sc, medium] = g;
+  const core::Camera cam = bubble_camera(48, 27);
+  const core::Sun sun = low_eastern_sun();
+  core::MarchSettings s = bubble_march();
+  auto mean_of = [&](const core::Camera& c, bool aa, int frames) {
+    core::MarchSettings m = s;
+    m.quality.anti_alias = aa;
+    std::vector<glm::dvec4> sum(static_cast<std::size_t>(c.width * c.height), glm::dvec4(0.0));
+    for (int k = 0; k < frames; ++k) {
+      m.per_frame.frame = k;
+      const auto img = gpu.render(c, sun, m);
+      for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += glm::dvec4(img[i]) / double(frames);
+    }
+    return sum;
+  };
+  core::Camera fine = cam;
+  fine.width *= 4, fine.height *= 4;
+  const auto super = mean_of(fine, false, 4);
+  std::vector<glm::dvec4> truth(static_cast<std::size_t>(cam.width * cam.height), glm::dvec4(0.0));
+  for (int y = 0; y < fine.height; ++y)
+    for (int x = 0; x < fine.width; ++x)
+      truth[static_cast<std::size_t>((y / 4) * cam.width + x / 4)] += super[static_cast<std::size_t>(y * fine.width + x)] / 16.0;
+  const auto aa = mean_of(cam, true, 64), centres = mean_of(cam, false, 64);
+  double max_l = 0.0;
+  for (const auto& t : truth) max_l = std::max(max_l, t.x);
+  ASSERT_GT(max_l, 0.0);
+  double err_aa = 0.0, err_centres = 0.0, worst_aa = 0.0, worst_centres = 0.0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const double a = std::abs(aa[i].x - truth[i].x) / max_l, c = std::abs(centres[i].x - truth[i].x) / max_l;
+    err_aa += a / double(truth.size()), err_centres += c / double(truth.size());
+    worst_aa = std::max(worst_aa, a), worst_centres = std::max(worst_centres, c);
+  }
+  std::printf("against the 4x4 box-filtered image, %dx%d, 64 frames: anti-aliased mean %.4f worst %.4f; pixel centres mean %.4f "
+              "worst %.4f (|dL| / brightest)\n", cam.width, cam.height, err_aa, worst_aa, err_centres, worst_centres);
+  EXPECT_LT(err_aa, 0.5 * err_centres);
+  EXPECT_LT(worst_aa, 0.5 * worst_centres);
+
+  // The CPU kernel jitters as the GPU does (frame 5), and frame 0 is the centres' image.
+  core::MarchSettings m = s;
+  m.per_frame.frame = 5;
+  const auto cpu = core::render_reference(sc.grid, medium, cam, sun, m);
+  const auto gpu5 = gpu.render(cam, sun, m);
+  m.quality.anti_alias = false;
+  const auto cpu_centres = core::render_reference(sc.grid, medium, cam, sun, m);
+  double worst = 0.0, moved = 0.0;
+  for (std::size_t i = 0; i < gpu5.size(); ++i) {
+    worst = std::max(worst, std::abs(gpu5[i].x - cpu.radiance[i].x) / max_l);
+    moved = std::max(moved, std::abs(cpu.radiance[i].x - cpu_centres.radiance[i].x) / max_l);
+  }
+  EXPECT_LT(worst, 1e-3) << "the GPU and the CPU kernel pass the same jittered rays";
+  EXPECT_GT(moved, 1e-2) << "the jitter moves the rays within the pixel";
+  m.per_frame.frame = 0;
+  const auto f0 = gpu.render(cam, sun, m);
+  m.quality.anti_alias = true;
+  const auto f0_aa = gpu.render(cam, sun, m);
+  for (std::size_t i = 0; i < f0.size(); ++i) ASSERT_EQ(f0[i], f0_aa[i]) << "frame 0 marches the centres: " << i;
+}
+
 // An image wider and taller than the 64 x 64 blue-noise mask: pixels past it take the mask again
 // (texelFetch at px mod 64 on the GPU, BlueNoiseMask::at on the CPU), the same on both.
 TEST(Raymarch, BlueNoiseJitterTilesPastTheMaskOnGpuAsOnCpu) {
