@@ -90,8 +90,10 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
        "                           ground, sunlight through the air and the sky's light, no overlays\n"
        "                           --reproject: temporal reprojection (the Quality panel's switch): 1/16 of the\n"
        "                           pixels marched per frame, the rest carried from the last image along the\n"
-       "                           camera's motion and clamped to the new samples after a move; a still view has\n"
-       "                           marched every pixel after 16 frames (not with overlays; no accumulation)\n"
+       "                           camera's motion (and the wind's while a forecast plays) and clamped to the\n"
+       "                           new samples after a move; a still view has marched every pixel after 16\n"
+       "                           frames, then refines 16 frames per accumulated frame, as --frames sets (not\n"
+       "                           with overlays)\n"
        "                           --orbit PX: drag the globe PX pixels to the right every frame (scripted orbit)\n"},
   };
 }

@@ -97,6 +97,7 @@ core::Camera Reprojector::sparse_camera(const core::Camera& full, int index) {
   // Pixel (i, j)'s ray passes at (4 i + o + 1/2) / 4 of a sparse pixel: its centre plus (2 o - 3) / 8.
   c.pixel_shift_x = (2.0 * o.x - 3.0) / (2.0 * kBlock);
   c.pixel_shift_y = (2.0 * o.y - 3.0) / (2.0 * kBlock);
+  c.pixel_block = kBlock, c.block_x = o.x, c.block_y = o.y;  // its jitters are the full pixel's
   return c;
 }
 
@@ -113,6 +114,11 @@ unsigned Reprojector::sparse_target(const core::Camera& full) {
     check_gl("allocating the sparse frame");
   }
   return sparse_;
+}
+
+int Reprojector::next_cycle(const core::Camera& full, bool changed) const {
+  if (changed || !previous_ || !history_ || full.width != width_ || full.height != height_ || !same_camera(*previous_, full)) return 0;
+  return frames_since_change_ / kFramesToComplete;
 }
 
 void Reprojector::reset() {
@@ -150,6 +156,9 @@ void Reprojector::resolve(unsigned sparse_depth, const core::Camera& full, int i
   const bool translated = has_history && (previous_->lat_deg != full.lat_deg || previous_->lon_deg != full.lon_deg ||
                                           previous_->alt_m != full.alt_m);
   if (!has_history || moved || changed) frames_since_change_ = 0;
+  // The pass over every pixel this frame belongs to: from the second on (a still view), each pixel
+  // marched adds its new sample to its running mean instead of replacing it.
+  const int cycle = frames_since_change_ / kFramesToComplete;
   if (translated || changed) frames_since_doubt_ = 0;
   const core::Camera prev = has_history ? *previous_ : full;
   const core::CameraFrame now = core::camera_frame(full), then = core::camera_frame(prev);
@@ -158,6 +167,7 @@ void Reprojector::resolve(unsigned sparse_depth, const core::Camera& full, int i
   const glm::ivec2 o = offset_of(index);
   glProgramUniform2i(p, loc(p, "u_offset"), o.x, o.y);
   glProgramUniform1i(p, loc(p, "u_has_history"), has_history ? 1 : 0);
+  glProgramUniform1i(p, loc(p, "u_cycle"), cycle);
   glProgramUniform1i(p, loc(p, "u_clamp"), clamp_ && frames_since_doubt_ < kFramesToComplete ? 1 : 0);
   set3(p, "u_delta", core::camera_ecef(full, r0_m) - core::camera_ecef(prev, r0_m));  // in double, then float
   set3(p, "u_forward", now.forward);

@@ -10,6 +10,9 @@
 // displacement, core::DetailDrift, one per level; or, for an advected medium, the winds' angular
 // flow, core::angular_flow, per coarse node), a point in cloud is looked up where the wind held it
 // in the previous frame: the camera's motion and the wind's both reproject.
+// A still view keeps refining after its first 16 frames: pass c marches each pixel once more as
+// accumulation frame c and averages it in (next_cycle), which gives the still image the
+// accumulation's step jitter and anti-aliasing.
 // Offline renders never use it: `render` and `record` march every pixel.
 #pragma once
 
@@ -63,6 +66,13 @@ class Reprojector {
   static std::vector<float> wind_motion_deg(const core::VolumeGrid& then_grid, const std::vector<double>& then_drift,
                                             const core::VolumeGrid& now_grid, const std::vector<double>& now_drift);
 
+  // The pass over every pixel (16 frames each) that the next frame of `full` belongs to, with
+  // `changed` as resolve will be told: 0 after any change, then 1, 2, ... while the view stays. From
+  // the second pass on, a marched pixel's sample joins its running mean (the mean of passes 0..c):
+  // the caller marches pass c as accumulation frame c (jittered steps, and with
+  // march.anti_alias its rays spread over the pixel), so a still view converges as `render
+  // --accumulate` does.
+  int next_cycle(const core::Camera& full, bool changed) const;
   // Frames resolved since the last change (camera, medium or settings); the image holds only
   // freshly marched pixels from kFramesToComplete on.
   int frames_since_change() const { return frames_since_change_; }

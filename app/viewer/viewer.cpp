@@ -927,7 +927,9 @@ int run_viewer(const ViewerOptions& o) {
       const core::Scene& sc = scene_of(static_cast<int>(i));
       const bool tracing = s.path_trace;
       // Reprojection: not with the path tracer, overlays (their pass draws every pixel) or the
-      // camera path's track; it marches single frames at step middles (no jittered accumulation).
+      // camera path's track. A still view goes on after its first 16 frames: each further pass of
+      // 16 marches every pixel once more as the next accumulation frame, up to render.accumulate
+      // passes (Reprojector::next_cycle), so it converges as the accumulation without it does.
       const bool reproject = s.reproject && !tracing && sc.overlays.empty() && !(i == 0 && s.keys.draw_path && s.scene.path);
       if (reproject) {  // the march size in whole 4 x 4 blocks
         v.spec.march_camera.width = render::Reprojector::whole_blocks(v.spec.march_camera.width);
@@ -949,7 +951,9 @@ int run_viewer(const ViewerOptions& o) {
       v.path_mode = tracing;
       v.reprojecting = reproject;
       v.previous = sc;
-      v.marching = reproject ? !same || !v.reprojector->complete() : v.accumulated < (tracing ? s.path_spp : sc.render.accumulate);
+      v.marching = reproject ? !same || v.reprojector->frames_since_change() <
+                                            render::Reprojector::kFramesToComplete * std::max(1, sc.render.accumulate)
+                             : v.accumulated < (tracing ? s.path_spp : sc.render.accumulate);
       any_march = any_march || v.marching;
       const int w = v.spec.march_camera.width, h = v.spec.march_camera.height;
       if (v.presenter.width() != w || v.presenter.height() != h) v.presenter.resize(w, h);
@@ -982,6 +986,11 @@ int run_viewer(const ViewerOptions& o) {
         trace_into(*v);
       } else if (v->reprojecting) {  // 1/16 of the pixels, the rest reprojected into the frame texture
         core::FrameSpec sparse = v->spec;
+        // Pass c of a still view is accumulation frame c (jittered steps and rays); a single frame
+        // (accumulate 1) keeps the scene's own frame, as `render` does.
+        if (v->spec.accumulate > 1) {
+          sparse.march.per_frame.frame = v->reprojector->next_cycle(v->spec.march_camera, v->reproject_changed);
+        }
         sparse.accumulate = 1;
         sparse.march_camera = render::Reprojector::sparse_camera(v->spec.march_camera, v->reproject_index);
         v->renderer.march_into(v->reprojector->sparse_target(v->spec.march_camera), sparse, 0);
@@ -1005,10 +1014,11 @@ int run_viewer(const ViewerOptions& o) {
         ++v.accumulated;
         // The automatic exposure from the mean at the march size (as `render` takes it), when the mean
         // starts and when it is complete: not frame by frame, so the picture does not pulse.
-        // (Reprojecting: again once 16 frames have marched every pixel, so a still view ends on the
-        // exposure `render` takes from the whole image.)
-        const int target = v.path_mode ? s.path_spp : v.reprojecting ? render::Reprojector::kFramesToComplete : sc.render.accumulate;
-        if (v.spec.auto_exposure && (v.accumulated == 1 || v.accumulated == target)) {
+        // (Reprojecting: again once 16 frames have marched every pixel, and once the last pass is
+        // done, so a still view ends on the exposure `render --accumulate` takes from its mean.)
+        const int pass = render::Reprojector::kFramesToComplete;
+        const int target = v.path_mode ? s.path_spp : v.reprojecting ? pass * std::max(1, sc.render.accumulate) : sc.render.accumulate;
+        if (v.spec.auto_exposure && (v.accumulated == 1 || v.accumulated == target || (v.reprojecting && v.accumulated == pass))) {
           std::vector<glm::vec4> mean(static_cast<std::size_t>(v.presenter.width()) * v.presenter.height());
           glGetTextureImage(v.presenter.mean_texture(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(mean.size() * sizeof(glm::vec4)),
                             mean.data());

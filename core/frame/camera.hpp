@@ -17,6 +17,11 @@ struct Camera {
   // but the viewer's sparse frames (render/reprojector), whose pixels stand for one pixel of a
   // block of a larger image.
   double pixel_shift_x = 0.0, pixel_shift_y = 0.0;
+  // Pixel (px, py) stands for pixel (block px + block_x, block py + block_y) of an image `block`
+  // times larger (the reprojection's sparse frames: 4): an accumulation frame's jitters, of the
+  // steps and of the rays within the pixel (march.glsl step_offset, pixel_jitter), are that pixel's,
+  // so a sparse frame marches what the full frame marches there. 1, 0, 0 everywhere else.
+  int pixel_block = 1, block_x = 0, block_y = 0;
 };
 
 // A camera's orientation in Earth-centred coordinates, and its half-width: pixel (px, py) looks

@@ -74,6 +74,8 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
 #undef CV_MARCH_SETTING
   p.u_size = {cam.width, cam.height};
   p.u_pixel_shift = {cam.pixel_shift_x, cam.pixel_shift_y};
+  p.u_pixel_block = cam.pixel_block;
+  p.u_block_origin = {cam.block_x, cam.block_y};
   p.u_cam_ecef = geo::sphere_to_ecef({cam.lat_deg, cam.lon_deg, cam.alt_m}, r0);
   p.u_cam_alt = cam.alt_m;
   p.u_cam_up = geo::sphere_enu(cam.lat_deg, cam.lon_deg).up;

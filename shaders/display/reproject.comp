@@ -21,6 +21,7 @@ uniform vec3 u_alt_axis;      // the grid's levels: first altitude (m), spacing 
 uniform ivec2 u_full;        // the full image's size (a multiple of the block in each axis)
 uniform ivec2 u_offset;      // this frame's pixel within each block
 uniform bool u_has_history;  // false: the spatial blend everywhere but the new samples
+uniform int u_cycle;         // the pass over every pixel (a still view from the second on: running means)
 uniform bool u_clamp;        // the camera or the medium changed since the history was made
 // The current camera: its position from the previous camera's (m, from double), its axes and the
 // tangent of half its horizontal field of view; its position from the Earth's centre for the ground.
@@ -115,8 +116,10 @@ void main() {
   if (p.x >= u_full.x || p.y >= u_full.y) return;
   ivec2 n = textureSize(u_sparse, 0);
   ivec2 block = p / kBlock;
-  if (p - block * kBlock == u_offset) {  // marched this frame: exact
-    imageStore(u_out, p, sparse_at(block, n));
+  if (p - block * kBlock == u_offset) {  // marched this frame: exact, or its pass's share of the mean
+    vec4 s = sparse_at(block, n);
+    if (u_has_history && u_cycle > 0) s = mix(texelFetch(u_history, p, 0), s, 1.0 / float(u_cycle + 1));
+    imageStore(u_out, p, s);
     return;
   }
   // The new samples stand at the centres of pixels block * 4 + offset: this pixel's place among them.

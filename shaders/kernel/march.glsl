@@ -491,11 +491,14 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
 
 // Where in its step a pixel's view samples lie (0..1): step middles without a frame, else the
 // frame's jitter from the blue-noise mask (or the white-noise hash).
+// The jitter is that of the pixel px stands for (u_pixel_block): a sparse frame's samples are the
+// full frame's.
 CV_FN real step_offset(ivec2 px) {
   if (u_frame < 0) return real(0.5);
-  if (!u_blue_noise) return step_jitter(uint(px.x), uint(px.y), uint(u_frame));
+  ivec2 q = px * u_pixel_block + u_block_origin;
+  if (!u_blue_noise) return step_jitter(uint(q.x), uint(q.y), uint(u_frame));
   ivec2 n = textureSize(u_jitter_mask, 0);
-  return blue_noise_jitter(real(texelFetch(u_jitter_mask, px % n, 0).r), uint(u_frame));
+  return blue_noise_jitter(real(texelFetch(u_jitter_mask, q % n, 0).r), uint(u_frame));
 }
 
 // A pixel's view ray, from the camera or, for a camera above the cloud shell, from where the ray
@@ -553,14 +556,15 @@ CV_FN real3 pixel_direction(ivec2 px) { return pixel_direction_jittered(px, real
 // 1/phi2 and 1/phi2^2 with phi2^3 = phi2 + 1) started at the centre, so frame 0 and single frames
 // (u_frame -1) are the centres and any N consecutive frames spread evenly over the pixel. Summed in
 // 24-bit fixed point with integer wrap-around (as blue_noise_jitter), so float on the GPU and double
-// on the CPU give the same offsets bit for bit at any frame. Only the march takes it; the Monte
-// Carlo and the path tracer sample the centres.
+// on the CPU give the same offsets bit for bit at any frame; in the pixels of the image this one's
+// pixels stand for (u_pixel_block: a sparse frame's pixel is 4 of the image's). Only the march takes
+// it; the Monte Carlo and the path tracer sample the centres.
 CV_FN real2 pixel_jitter() {
   if (!u_anti_alias || u_frame <= 0) return real2(real(0.0), real(0.0));
   uint k = uint(u_frame);
   uint x24 = (8388608u + k * 12664746u) & 16777215u;  // 0.7548776662466927 * 2^24
   uint y24 = (8388608u + k * 9560334u) & 16777215u;   // 0.5698402909980532 * 2^24
-  return real2(real(x24), real(y24)) * real(5.9604644775390625e-8) - real2(real(0.5), real(0.5));
+  return (real2(real(x24), real(y24)) * real(5.9604644775390625e-8) - real2(real(0.5), real(0.5))) / real(u_pixel_block);
 }
 
 CV_FN MarchRay march_ray(ivec2 px) {

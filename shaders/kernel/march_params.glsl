@@ -35,6 +35,8 @@ CV_PARAM(real, u_noise_amount)
 CV_PARAM(real2, u_layer)             // altitudes (m) between which the data holds cloud (CloudLayer)
 CV_PARAM(ivec2, u_size)              // image size, pixels
 CV_PARAM(real2, u_pixel_shift)       // where each pixel's ray passes, from its centre, pixels (Camera::pixel_shift_x, _y)
+CV_PARAM(int, u_pixel_block)         // pixel px stands for pixel px * this + u_block_origin of a larger image (Camera::pixel_block)
+CV_PARAM(ivec2, u_block_origin)      // (Camera::block_x, _y)
 CV_PARAM(ivec2, u_ground_size)       // of the albedo texture; (0, 0): constant albedo
 CV_PARAM(real3, u_tint_liquid)       // false colour (hue) of the liquid's light (march_settings.def tint_liquid)
 CV_PARAM(bool, u_tint)               // a tint is set: each sample's light takes the hue of its tints

@@ -63,6 +63,53 @@ TEST_F(Reprojection, AStillCameraConvergesToTheFullMarchIn16Frames) {
   EXPECT_TRUE(rp.complete());
 }
 
+// A still view after its first pass: pass c marches each pixel once more as accumulation frame c
+// (jittered steps, rays spread over the pixel by anti-aliasing) and averages it in, so after C passes
+// the image is `render --accumulate C`'s. Passes start again at 0 when the camera moves.
+TEST_F(Reprojection, AStillViewRefinesToTheAntiAliasedAccumulation) {
+  const bench::StandardScene sc = bench::standard_scene("cumulus_field", 64, 36);
+  render::FrameRenderer fr(loader_);
+  fr.use_volume(std::make_shared<const core::PreparedVolume>(core::prepare_volume(sc.grid, sc.data)));
+  render::Reprojector rp(loader_);
+  core::FrameSpec full = base_of(sc);
+  full.accumulate = 1;
+  const int w = full.camera.width, h = full.camera.height, passes = 4;
+  GLuint out = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &out);
+  glTextureStorage2D(out, 1, GL_RGBA32F, w, h);
+  for (int k = 0; k < 16 * passes; ++k) {
+    const int cycle = rp.next_cycle(full.march_camera, false);
+    ASSERT_EQ(cycle, k / 16) << k;
+    core::FrameSpec sparse = full;
+    sparse.march.per_frame.frame = cycle;
+    sparse.march_camera = render::Reprojector::sparse_camera(full.march_camera, k);
+    fr.march_into(rp.sparse_target(full.march_camera), sparse, 0);
+    rp.resolve(fr.raymarcher().cloud_depth_texture(), full.march_camera, k, false, sc.grid.earth_radius_m, out, fr.volume());
+  }
+  const std::vector<glm::vec4> got = test_support::read_rgba(out, w, h);
+  glDeleteTextures(1, &out);
+  core::FrameSpec acc = full;
+  acc.accumulate = passes;
+  const std::vector<glm::vec4> want = fr.render(acc);
+  const std::vector<glm::vec4> first = fr.render(full);
+  double peak = 0.0, worst = 0.0, moved = 0.0;
+  for (const glm::vec4& c : want) peak = std::max(peak, test_support::luminance(c));
+  ASSERT_GT(peak, 0.0);
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    worst = std::max(worst, std::abs(test_support::luminance(got[i]) - test_support::luminance(want[i])) / peak);
+    moved = std::max(moved, std::abs(test_support::luminance(first[i]) - test_support::luminance(want[i])) / peak);
+  }
+  std::printf("a still view after %d passes against render --accumulate %d: worst |dL| %.2e of the brightest (one frame "
+              "differs by up to %.2e)\n", passes, passes, worst, moved);
+  EXPECT_LT(worst, 1e-3);
+  EXPECT_GT(moved, 1e-2) << "the passes after the first add what a single frame lacks";
+  core::Camera turned = full.march_camera;
+  turned.heading_deg += 1.0;
+  EXPECT_EQ(rp.next_cycle(turned, false), 0) << "a moved camera starts again";
+  EXPECT_EQ(rp.next_cycle(full.march_camera, true), 0) << "so does a changed medium";
+  EXPECT_EQ(rp.next_cycle(full.march_camera, false), passes);
+}
+
 TEST_F(Reprojection, MovingCameraErrorsAgainstFullFrames) {
   const bench::StandardScene sc = bench::standard_scene("cumulus_field", 96, 56);
   render::FrameRenderer fr(loader_);
