@@ -1,6 +1,7 @@
 // Scene files (round trip, and each class of bad input named in one line), quality presets,
 // automatic framing and the scene's sun.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -113,7 +114,7 @@ TEST(SceneJson, FullyPopulatedSceneRoundTripsExactly) {
   expect_equal(scene_from_json(text), s);
   // And through a file: save, load (an absolute data path stays as it is; a relative ground
   // texture is taken from the scene file's folder, as the data path is).
-  const fs::path file = fs::temp_directory_path() / "cv_scene_roundtrip.json";
+  const fs::path file = fs::temp_directory_path() / ("cv_scene_roundtrip_" + std::to_string(::getpid()) + ".json");
   save_scene(s, file.string());
   Scene expected = s;
   if (fs::path(s.render.march.medium.ground_texture).is_relative()) {
@@ -148,7 +149,7 @@ TEST(SceneJson, MissingKeysTakeTheDefaultsAndTheDefaultPreset) {
 }
 
 TEST(SceneJson, RelativeDataPathIsTakenFromTheSceneFilesFolder) {
-  const fs::path dir = fs::temp_directory_path() / "cv_scene_rel" / "scenes";
+  const fs::path dir = fs::temp_directory_path() / ("cv_scene_rel_" + std::to_string(::getpid())) / "scenes";
   fs::create_directories(dir);
   std::ofstream(dir / "s.json") << R"({"version": 1, "data": {"path": "../data/c.nc"}})";
   EXPECT_EQ(load_scene((dir / "s.json").string()).data.path, (dir.parent_path() / "data" / "c.nc").string());
@@ -353,7 +354,7 @@ TEST(SceneJson, ViewsRoundTripAndTheirPathsAreTakenFromTheSceneFilesFolder) {
   const Scene w = scene_from_json(R"({"version": 1, "views": {"layout": "swipe", "divider": 0.3, "compare": [{"time": 1}]}})", "w.json");
   EXPECT_EQ(w.views->divider, 0.3);
 
-  const fs::path dir = fs::temp_directory_path() / "cv_scene_views" / "scenes";
+  const fs::path dir = fs::temp_directory_path() / ("cv_scene_views_" + std::to_string(::getpid())) / "scenes";
   fs::create_directories(dir);
   std::ofstream(dir / "s.json") << R"({"version": 1, "views": {"compare": [{"path": "../data/b.nc"}, {"time": 1}]}})";
   const Scene l = load_scene((dir / "s.json").string());

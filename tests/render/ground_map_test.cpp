@@ -3,6 +3,7 @@
 // the rasteriser's coverage fractions and nesting, the fallback without GSHHS, the "map" model, and
 // a bad image as one clear error.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -151,7 +152,7 @@ TEST(GroundMap, TheMapModelTakesTheImagesColoursAsAlbedoWithoutWater) {
 }
 
 TEST(GroundMap, AGroundTextureThatIsNoImageIsOneClearError) {
-  const std::string path = (std::filesystem::temp_directory_path() / "cv_not_an_image.png").string();
+  const std::string path = (std::filesystem::temp_directory_path() / ("cv_not_an_image_" + std::to_string(::getpid()) + ".png")).string();
   std::ofstream(path) << "not an image\n";
   try {
     render::load_albedo_map(path);

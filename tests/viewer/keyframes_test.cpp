@@ -2,6 +2,8 @@
 // reordered, retimed (refused out of order), previewed through the path, drawn on the globe, kept
 // by the scene file, and the record command shown.
 #include <gtest/gtest.h>
+#include <string>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -129,7 +131,7 @@ TEST(KeyframePanel, ThePathIsDrawnWhereTheCameraGoesAndKeptByTheSceneFile) {
             "cloudviewer record scenes/flyover.json -o scenes/flyover.mp4 --fps 30 --size 640x360");
 
   // Saved with the scene file and loaded back, keyframe for keyframe.
-  const std::filesystem::path file = std::filesystem::temp_directory_path() / "keyframe_panel_scene.json";
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / ("keyframe_panel_scene_" + std::to_string(::getpid()) + ".json");
   core::save_scene(scene, file.string());
   const core::Scene back = core::load_scene(file.string());
   std::filesystem::remove(file);
