@@ -225,23 +225,36 @@ void MonteCarloRenderer::add_samples(MonteCarloImage& img, int spp) const {
     for (int py = next_row++; py < cam_.height; py = next_row++) {
       for (int px = 0; px < cam_.width; ++px) {
         // The kernel's start of a path (path_camera_origin): a camera above the grid starts where the
-        // ray enters it, on the exact sphere.
-        const glm::dvec3 d = kernel_->pixel_direction(glm::ivec2(px, py));
-        bool misses = false;
-        const glm::dvec3 o = kernel_->path_camera_origin(d, misses);
+        // ray enters it, on the exact sphere. With anti-aliasing each sample's ray passes through a
+        // uniform point of the pixel (the box filter the march's accumulated frames tend to), drawn
+        // first from the sample's own stream; else every sample takes the centre's ray.
+        const bool area = kernel_->u_anti_alias;
+        const glm::ivec2 pixel(px, py);
+        auto start = [&](const glm::dvec3& d, glm::dvec3& o, glm::dvec3& sky) {
+          bool misses = false;
+          o = kernel_->path_camera_origin(d, misses);
+          sky = glm::dvec3(0.0);  // a ray that misses the shell sees the sky (none without air)
+          if (misses) {
+            kernel::f64::TrackKernel::TrackCounts c = kernel_->track_counts();
+            sky = kernel_->path_miss(d, c);
+          }
+          return misses;
+        };
+        const glm::dvec3 d_centre = kernel_->pixel_direction(pixel);
+        glm::dvec3 o_centre(0.0), sky_centre(0.0);
+        const bool misses_centre = area ? false : start(d_centre, o_centre, sky_centre);
         const std::size_t idx = static_cast<std::size_t>(py) * cam_.width + px;
-        glm::dvec3 sky(0.0);  // a ray that misses the shell sees the sky (none without air)
-        if (misses) {
-          kernel::f64::TrackKernel::TrackCounts c = kernel_->track_counts();
-          sky = kernel_->path_miss(d, c);
-        }
         // Samples in index order into this pixel's sums: the same sums whichever thread does it.
         for (std::uint64_t s = first; s < first + static_cast<std::uint64_t>(spp); ++s) {
-          glm::dvec3 v = sky;
-          if (!misses) {
-            PathRng rng(mc_.seed, idx, s);
-            v = trace(o, d, rng, stats[w]).radiance;
+          PathRng rng(mc_.seed, idx, s);
+          glm::dvec3 d = d_centre, o = o_centre, v = sky_centre;
+          bool misses = misses_centre;
+          if (area) {
+            const double jx = rng.uniform() - 0.5, jy = rng.uniform() - 0.5;
+            d = kernel_->pixel_direction_jittered(pixel, glm::dvec2(jx, jy) / double(kernel_->u_pixel_block));
+            misses = start(d, o, v);
           }
+          if (!misses) v = trace(o, d, rng, stats[w]).radiance;
           const double l = glm::dot(v, kLumWeights);
           img.sum[idx] += v;
           img.sum_sq[idx] += v * v;

@@ -96,7 +96,11 @@ void main() {
   if (u_pass == 0) {  // a new sample: the pixel's view ray and its own random stream
     // A counter-based stream per (seed, pixel, sample), as the CPU's PathRng is (another hash).
     rng = pcg_hash(u_seed * 0x9E3779B9u ^ pcg_hash(idx * 0x85EBCA6Bu + 0x632BE5ABu) ^ pcg_hash(u_sample * 0xC2B2AE35u + 0x27D4EB2Fu));
-    vec3 d = pixel_direction(px);
+    // With anti-aliasing, each sample's ray passes through a uniform point of its pixel (a box
+    // filter: what the march's accumulated frames tend to); else through the centre.
+    vec2 j = vec2(0.0);
+    if (u_anti_alias) j = (vec2(rng_next(rng), rng_next(rng)) - 0.5) / float(u_pixel_block);
+    vec3 d = pixel_direction_jittered(px, j);
     bool misses;
     vec3 o = path_camera_origin(d, misses);
     s = path_begin(o, d);

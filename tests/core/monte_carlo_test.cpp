@@ -172,6 +172,7 @@ TEST(MonteCarlo, SingleScatteringAgreesWithTheRaymarcher) {
   m.quality.octaves = 1;
   m.quality.view_step_m = 10.0;
   m.quality.sun_steps = 128;
+  m.quality.anti_alias = false;  // one march through each pixel's centre: the paths start there too
   auto t0 = std::chrono::steady_clock::now();
   const ReferenceImage ref = render_reference(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m);
   const double t_ref = seconds_since(t0);
@@ -212,6 +213,53 @@ TEST(MonteCarlo, SingleScatteringAgreesWithTheRaymarcher) {
   EXPECT_NEAR(z2 / lit, 1.0, 0.4);
   EXPECT_LT(std::abs(bias), kSigmas * bias_se);
   EXPECT_EQ(img.stats.majorant_exceeded, 0u);
+}
+
+// Anti-aliasing (march.anti_alias): each path starts through a uniform point of its pixel, so the
+// Monte Carlo estimates the pixel's box-filtered radiance, which the march's accumulated frames
+// (the R2 sequence over the pixel) tend to. The deck in single scattering: 128 jittered march frames
+// against 512 paths per pixel, each pixel within the paths' noise, and the centres' single march
+// visibly out of it (so the check can fail). (With 32 frames the R2 points' own quadrature error
+// over the deck's edges was about as large as the paths' noise: mean z^2 3.0.)
+TEST(MonteCarlo, AntiAliasedPathsAgreeWithTheAntiAliasedMarch) {
+  const SceneCase c("stratocumulus", 24, 14);
+  MarchSettings m = c.scene.march;
+  m.quality.octaves = 1;
+  m.quality.view_step_m = 10.0;
+  m.quality.sun_steps = 128;
+  m.quality.anti_alias = true;
+  const int frames = 128;
+  std::vector<double> march(static_cast<std::size_t>(24 * 14), 0.0);
+  for (int k = 0; k < frames; ++k) {
+    m.per_frame.frame = k;
+    const ReferenceImage f = render_reference(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m);
+    for (std::size_t i = 0; i < march.size(); ++i) march[i] += f.radiance[i].y / frames;
+  }
+  m.per_frame.frame = -1;
+  MarchSettings centre = m;
+  centre.quality.anti_alias = false;
+  const ReferenceImage one = render_reference(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, centre);
+  MonteCarloSettings mc;
+  mc.max_bounces = 1;
+  mc.seed = 5;
+  const MonteCarloImage img = render_monte_carlo(c.scene.grid, c.ext, c.scene.camera, c.scene.sun, m, mc, 512);
+  double z2 = 0.0, z_max = 0.0, z2_centre = 0.0;
+  int lit = 0;
+  for (std::size_t i = 0; i < march.size(); ++i) {
+    const double mean = img.mean(i).y, se = img.standard_error(i).y;
+    if (!(se > 0.0)) continue;
+    const double z = (mean - march[i]) / se, zc = (mean - one.radiance[i].y) / se;
+    z2 += z * z, z2_centre += zc * zc;
+    z_max = std::max(z_max, std::abs(z));
+    ++lit;
+  }
+  std::printf("anti-aliased single scattering, stratocumulus 24x14: %d frames of the march against 512 paths (mean rel. s.e. "
+              "%.4f): %d pixels, mean z^2 %.3f, max |z| %.2f; the centres' single march: mean z^2 %.3f\n",
+              frames, img.mean_relative_standard_error(), lit, z2 / std::max(lit, 1), z_max, z2_centre / std::max(lit, 1));
+  ASSERT_GT(lit, 50);
+  EXPECT_LT(z_max, kSigmas + 0.5);
+  EXPECT_NEAR(z2 / lit, 1.0, 0.4);
+  EXPECT_GT(z2_centre / lit, 2.0) << "the centres are not the pixels' mean";
 }
 
 TEST(MonteCarlo, TheSameSeedGivesTheSameImageOnAnyThreadCountAndInSteps) {
