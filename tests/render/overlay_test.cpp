@@ -14,6 +14,7 @@
 
 #include <glm/glm.hpp>
 
+#include "support/scratch_dir.hpp"
 #include "geo/geodesy.hpp"
 #include "geometry/overlay_mesh.hpp"
 #include "importer.hpp"
@@ -983,7 +984,7 @@ TEST(Section, AnIsobaricSurfaceStandsWhereThePressureIs) {
 // temperature), imported, and the isobaric section built by the overlay builder from a scene's
 // entry; and the same entry refused, with the key named, for a volume without pressure.
 TEST(Section, AnIsobaricSectionOfAFileOnPressureLevels) {
-  const std::string path = ::testing::TempDir() + "isobaric_section.nc";
+  const std::string path = cv::test_support::scratch_dir() + "isobaric_section.nc";
   constexpr double kR = 6371000.0;
   const std::vector<double> levels_pa = {100000.0, 92500.0, 85000.0, 77500.0, 70000.0, 62500.0, 55000.0};
   const int nx = 9, ny = 3, nz = static_cast<int>(levels_pa.size());

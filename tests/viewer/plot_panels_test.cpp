@@ -11,6 +11,7 @@
 
 #include <sys/wait.h>
 
+#include "support/scratch_dir.hpp"
 #include "importer.hpp"
 #include "plots/drape.hpp"
 #include "scene/framing.hpp"
@@ -30,7 +31,7 @@ std::string read_all(const std::string& path) {
 int run_cli(const std::string& args, std::string& err) {
   // One file per test: ctest runs the tests of this file in parallel.
   const std::string err_path =
-      ::testing::TempDir() + "/plot_panels_" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".err";
+      cv::test_support::scratch_dir() + "/plot_panels_" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".err";
   const std::string cmd = std::string("\"") + CV_CLOUDVIEWER + "\" " + args + " > /dev/null 2> \"" + err_path + "\"";
   const int status = std::system(cmd.c_str());
   err = read_all(err_path);
@@ -56,7 +57,7 @@ TEST(PlotPanels, TheSectionIsTheSectionCommandsDownToThePngAndCsv) {
   EXPECT_GT(cloudy, 0);  // the path crosses the cyclone's cloud: the comparison reads values
   EXPECT_GT(p.figure.hi, p.figure.lo);
 
-  const std::string dir = ::testing::TempDir();
+  const std::string dir = cv::test_support::scratch_dir();
   std::string err;
   ASSERT_EQ(run_cli("section " + quoted(CV_SAMPLE_FILE) + " --from 35,170 --to 55,200 --field cloud_fraction --time 1 -o " +
                         quoted(dir + "/section_cli.png") + " --csv " + quoted(dir + "/section_cli.csv"),
@@ -105,7 +106,7 @@ TEST(PlotPanels, BadSectionInputsGiveTheCommandsLineAndKeepTheLastFigure) {
     char args[200];
     std::snprintf(args, sizeof args, " --from %.6g,%.6g --to %.6g,%.6g --field %s -o ", b.lat1, b.lon1, b.lat2, b.lon2, b.field);
     std::string err;
-    EXPECT_EQ(run_cli("section " + quoted(CV_SAMPLE_FILE) + args + quoted(::testing::TempDir() + "/bad.png"), err), 2);
+    EXPECT_EQ(run_cli("section " + quoted(CV_SAMPLE_FILE) + args + quoted(cv::test_support::scratch_dir() + "/bad.png"), err), 2);
     EXPECT_EQ("cloudviewer section: " + q.message + "\n", err);  // the same one line
     EXPECT_EQ(q.version, version);  // the last figure stays
     EXPECT_TRUE(q.figure.csv == csv);
@@ -133,7 +134,7 @@ TEST(PlotPanels, TheSeriesIsTheSeriesCommandsWithAMarkerAtTheTimeShown) {
   EXPECT_EQ(p.figure.columns[1].optical_depth, probe.column.optical_depth);
   EXPECT_GT(probe.column.cover, 0.0);
 
-  const std::string dir = ::testing::TempDir();
+  const std::string dir = cv::test_support::scratch_dir();
   std::string err;
   ASSERT_EQ(run_cli("series " + quoted(CV_SAMPLE_FILE) + " --at 45,185 -o " + quoted(dir + "/series_cli.png") + " --csv " +
                         quoted(dir + "/series_cli.csv"),

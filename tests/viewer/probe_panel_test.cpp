@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "support/scratch_dir.hpp"
 #include "importer.hpp"
 #include "viewer/playback.hpp"
 #include "viewer/probe_panel.hpp"
@@ -70,7 +71,7 @@ TEST(ProbePanel, ReadsTheColumnTheProbeCommandReadsDownToTheCsv) {
   ASSERT_FALSE(p.column.levels.empty());
   EXPECT_GT(p.column.cover, 0.0);  // the sample's cyclone has cloud there: the comparison reads values
 
-  const std::string dir = ::testing::TempDir();
+  const std::string dir = cv::test_support::scratch_dir();
   const std::string cli_csv = dir + "/probe_cli.csv", panel_csv = dir + "/probe_panel.csv";
   const std::string cmd = std::string("\"") + CV_CLOUDVIEWER + "\" probe \"" + CV_SAMPLE_FILE + "\" --at 45,185 --time 1 --csv \"" + cli_csv +
                           "\" > /dev/null";
@@ -105,7 +106,7 @@ TEST(ProbePanel, RecordsTheViewRayAsTheProbeCommandWithACamera) {
   EXPECT_LT(p.ray->transmittance, 1.0);
   EXPECT_EQ(p.ray->view_step_m, 200.0);
 
-  const std::string dir = ::testing::TempDir();
+  const std::string dir = cv::test_support::scratch_dir();
   const std::string cli_csv = dir + "/probe_ray_cli.csv", panel_csv = dir + "/probe_ray_panel.csv";
   const std::string cmd = std::string("\"") + CV_CLOUDVIEWER + "\" probe \"" + CV_SAMPLE_FILE +
                           "\" --at 45,185 --time 1 --camera 40,180,300000 --view-step 200 --csv \"" + cli_csv + "\" > /dev/null";
