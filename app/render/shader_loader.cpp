@@ -78,13 +78,24 @@ fs::path ShaderLoader::resolve(const std::string& name, const fs::path& from_dir
 
 void ShaderLoader::append(const fs::path& file, ShaderSource& out, std::vector<std::string>& stack) const {
   const std::string key = file.string();
-  for (const auto& f : out.files) {
-    if (f == key) return;  // each file once per program, like #pragma once
-  }
   std::ifstream in(file);
   if (!in) throw ShaderError(key + ": cannot read shader file");
-  const int index = static_cast<int>(out.files.size());
-  out.files.push_back(key);
+  // Each file once per program, like #pragma once, except an X-macro table (its first line begins
+  // "// X-macro table"), which is expanded again at each include under the includer's macros.
+  std::string first;
+  std::getline(in, first);
+  const bool table = first.rfind("// X-macro table", 0) == 0;
+  in.clear();
+  in.seekg(0);
+  int index = -1;
+  for (std::size_t i = 0; i < out.files.size(); ++i) {
+    if (out.files[i] == key) index = static_cast<int>(i);
+  }
+  if (index >= 0 && !table) return;
+  if (index < 0) {
+    index = static_cast<int>(out.files.size());
+    out.files.push_back(key);
+  }
   stack.push_back(key);
 
   static const std::regex include_re(R"(^\s*#\s*include\s*[<"]([^">]+)[">]\s*(//.*)?$)");

@@ -1,4 +1,4 @@
-// Loads GLSL with `#include "file"` (each file once per program), a prelude that defines the
+// Loads GLSL with `#include "file"` (each file once per program, an X-macro table at each include), a prelude that defines the
 // physics dialect and the feature macros, and `#line` directives so compiler messages name the
 // right file and line; compiles compute programs and rewrites their logs with file names.
 #pragma once

@@ -1,6 +1,8 @@
-// The march kernel's parameters, one line each: CV_PARAM(type, name) in the shared dialect's types.
-// Included three times: as the members of the GLSL uniform block (shaders/render/raymarch.comp), as
-// the double-precision members of the C++ kernel (core/kernel/march_kernel.hpp), and as the float
+// X-macro table: the march kernel's parameters, one line each: CV_PARAM(type, name) in the shared
+// dialect's types. Expanded at each include (app/render/shader_loader repeats it there; the first
+// line's words say so): in GLSL as the members of the uniform block, as the per-invocation copies
+// the kernel reads and as their loading (shaders/kernel/gpu_inputs.glsl); in C++ as the
+// double-precision members of the C++ kernel (core/kernel/march_kernel.hpp) and as the float
 // std140 struct the host uploads (core/kernel/march_params.hpp, its layout checked there). The
 // order is the std140 packing: each vec3 is followed by a scalar that fills its fourth slot.
 // Everything here is per frame; nothing per dispatch (the driver's own uniforms hold that).

@@ -88,6 +88,7 @@ PathState load_state(uint idx, out uint rng) {
 }
 
 void main() {
+  load_march_params();
   ivec2 px = ivec2(gl_GlobalInvocationID.xy) + ivec2(0, u_row_offset);
   if (px.x >= u_size.x || px.y >= u_size.y) return;
   uint idx = uint(px.y) * uint(u_size.x) + uint(px.x);

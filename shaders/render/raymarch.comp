@@ -38,6 +38,7 @@ void flush_stats() {
 }
 
 void main() {
+  load_march_params();
   ivec2 px = ivec2(gl_GlobalInvocationID.xy) + ivec2(0, u_row_offset);
   if (px.x >= u_size.x || px.y >= u_size.y) return;
   bool first = u_pass == 0 && u_step_begin == 0;

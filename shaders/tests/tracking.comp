@@ -29,6 +29,7 @@ real track_uniform(inout TrackRng r) { return rng_next(r.state); }
 #include "../kernel/tracking.glsl"
 
 void main() {
+  load_march_params();
   uint i = gl_GlobalInvocationID.x;
   if (i >= u_count) return;
   TrackRng rng;

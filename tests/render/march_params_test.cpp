@@ -31,10 +31,10 @@ TEST(MarchParams, Std140StructMatchesTheCompiledBlock) {
         render::load_compute(loader, render::ShaderLoader::default_shader_dir() / "render" / "raymarch.comp", {}, v.defines());
     int members = 0;
 #define CV_PARAM(T, name)                                                                                  \
-  EXPECT_EQ(member_offset(p.id(), #name), static_cast<GLint>(offsetof(kernel::MarchParamsStd140, name))) << #name; \
+  EXPECT_EQ(member_offset(p.id(), "MarchParams." #name), static_cast<GLint>(offsetof(kernel::MarchParamsStd140, name))) << #name; \
   ++members;
 #define CV_PARAM_ARRAY(T, name, N)                                                                            \
-  EXPECT_EQ(member_offset(p.id(), #name "[0]"), static_cast<GLint>(offsetof(kernel::MarchParamsStd140, name))) << #name; \
+  EXPECT_EQ(member_offset(p.id(), "MarchParams." #name "[0]"), static_cast<GLint>(offsetof(kernel::MarchParamsStd140, name))) << #name; \
   ++members;
 #include "kernel/march_params.glsl"
 #undef CV_PARAM

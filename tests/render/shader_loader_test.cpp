@@ -57,6 +57,34 @@ TEST_F(ShaderLoaderTest, IncludesResolveOnceEachWithLineDirectives) {
   EXPECT_NE(src.text.find("#line 100002 1"), std::string::npos);  // back in top.comp at its line 2
 }
 
+// An X-macro table (first line "// X-macro table") expands at each include under the includer's
+// macros, keeping one file index; an ordinary file still comes once. The program compiles and
+// reads the copies the second expansion made of the block's members.
+TEST_F(ShaderLoaderTest, XMacroTablesExpandAtEachInclude) {
+  auto ctx = make_headless_context();
+  write("lib/table.glsl", "// X-macro table: two rows\nROW(float, v_a)\nROW(float, v_b)\n");
+  write("lib/a.glsl", "float a() { return 1.0; }\n");
+  const auto top = write("top.comp",
+                         "#include \"lib/a.glsl\"\n"
+                         "#define ROW(T, n) T n;\n"
+                         "layout(std140, binding = 0) uniform Block {\n#include \"lib/table.glsl\"\n} blk;\n"
+                         "#include \"lib/table.glsl\"\n"
+                         "#undef ROW\n#define ROW(T, n) n = blk.n;\n"
+                         "void load() {\n#include \"lib/table.glsl\"\n}\n"
+                         "#include \"lib/a.glsl\"\n"
+                         "layout(std430, binding = 1) buffer Out { float o[]; };\n"
+                         "layout(local_size_x = 1) in;\nvoid main() { load(); o[0] = v_a + v_b + a(); }\n");
+  ShaderLoader loader({dir_});
+  const ShaderSource src = loader.load(top);
+  ASSERT_EQ(src.files.size(), 4u);  // prelude, top, a, table: the table keeps one index
+  std::size_t rows = 0;
+  for (std::size_t at = src.text.find("ROW(float, v_a)"); at != std::string::npos; at = src.text.find("ROW(float, v_a)", at + 1)) ++rows;
+  EXPECT_EQ(rows, 3u);
+  const size_t first = src.text.find("float a()");
+  EXPECT_EQ(src.text.find("float a()", first + 1), std::string::npos);  // a.glsl only once
+  EXPECT_EQ(compile_error(top), "");
+}
+
 TEST_F(ShaderLoaderTest, MissingIncludeNamesFileLineAndWhatWasSought) {
   const auto top = write("top.comp", std::string(kMain) + "#include \"nowhere.glsl\"\n");
   ShaderLoader loader({dir_});
