@@ -16,6 +16,7 @@
 #include "diagnosed_cloud.hpp"
 #include "wrf_import.hpp"
 #include "importer.hpp"
+#include "io/input_file.hpp"
 #include "physics/physics.hpp"
 
 namespace cv::importers {
@@ -285,7 +286,7 @@ void read_slab_into(Slab& s, const Era5Source& S, const NcVar& v, int time_index
   }
   if (as_double) {
     s.f.clear();
-    s.d = f.read(v, start, count, info);
+    f.read_into(s.d, v, start, count, info);
   } else {
     s.d.clear();
     f.read_float_into(s.f, v, start, count, info);
@@ -387,7 +388,10 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   const int nx = grid.lon_deg.count, ny = grid.lat_deg.count;
   const bool has_cf = have[static_cast<int>(Role::CloudFraction)];
   auto alloc = [&](core::Field f, bool on) {
-    if (on) out[f].assign(grid.points(), std::numeric_limits<float>::quiet_NaN());
+    if (on) {
+      core::reserve_huge(out[f], grid.points());
+      out[f].assign(grid.points(), std::numeric_limits<float>::quiet_NaN());
+    }
     else out[f].clear();
   };
   alloc(core::Field::ExtinctionLiquid, have[static_cast<int>(Role::Liquid)] || diagnose);

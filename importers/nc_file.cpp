@@ -1,6 +1,8 @@
 // NcFile: netCDF-C behind one-line errors, unpacking and missing-value handling.
 #include "nc_file.hpp"
 
+#include "io/input_file.hpp"
+
 #include <netcdf.h>
 
 #include <poll.h>
@@ -661,6 +663,13 @@ void NcFile::whole_if_empty(const NcVar& v, std::vector<std::size_t>& start, std
 
 std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start, std::vector<std::size_t> count,
                                  UnpackInfo* info) const {
+  std::vector<double> out;
+  read_into(out, v, std::move(start), std::move(count), info);
+  return out;
+}
+
+void NcFile::read_into(std::vector<double>& out, const NcVar& v, std::vector<std::size_t> start,
+                       std::vector<std::size_t> count, UnpackInfo* info) const {
   const std::size_t nd = v.dims.size();
   whole_if_empty(v, start, count);
   if (start.size() != nd || count.size() != nd) {
@@ -688,8 +697,10 @@ std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start,
   } catch (const core::InputError& e) {
     throw ImportError(e.what());
   }
-  std::vector<double> out(n);
-  if (n == 0) return out;
+  // Every value is written by get_doubles: a buffer of the right size is not cleared first.
+  core::reserve_huge(out, n);
+  if (out.size() != n) out.resize(n);
+  if (n == 0) return;
   get_doubles(v, start, count, out.data(), n);
   // Fill and missing values are compared in the packed (raw) domain, as CF says.
   std::vector<double> missing;
@@ -734,7 +745,6 @@ std::vector<double> NcFile::read(const NcVar& v, std::vector<std::size_t> start,
     }
   }
   if (info) *info = {scale, offset, packed, nmissing};
-  return out;
 }
 
 std::vector<float> NcFile::read_float(const NcVar& v, std::vector<std::size_t> start, std::vector<std::size_t> count,
@@ -751,9 +761,12 @@ void NcFile::read_float_into(std::vector<float>& out, const NcVar& v, std::vecto
   // Split along the first axis with more than one index; each chunk goes through read().
   std::size_t axis = 0;
   while (axis + 1 < nd && count[axis] == 1) ++axis;
-  out.clear();
   UnpackInfo total;
   const std::size_t chunks = nd ? count[axis] : 1;
+  // One chunk's doubles, reused from chunk to chunk (and call to call on this thread), written into
+  // `out` in place: `out` keeps its memory when the caller reuses it.
+  thread_local std::vector<double> d;
+  std::size_t filled = 0;
   for (std::size_t c = 0; c < chunks; ++c) {
     std::vector<std::size_t> s = start, n = count;
     if (nd) {
@@ -761,12 +774,18 @@ void NcFile::read_float_into(std::vector<float>& out, const NcVar& v, std::vecto
       n[axis] = 1;
     }
     UnpackInfo part;
-    const std::vector<double> d = read(v, s, n, &part);
-    if (c == 0) out.reserve(d.size() * chunks);
-    for (double x : d) out.push_back(static_cast<float>(x));
+    read_into(d, v, s, n, &part);
+    if (c == 0 && out.size() != d.size() * chunks) {
+      core::reserve_huge(out, d.size() * chunks);
+      out.resize(d.size() * chunks);
+    }
+    float* o = out.data() + filled;
+    for (std::size_t i = 0; i < d.size(); ++i) o[i] = static_cast<float>(d[i]);
+    filled += d.size();
     total.scale = part.scale, total.offset = part.offset, total.packed = part.packed;
     total.missing += part.missing;
   }
+  out.resize(filled);
   if (info) *info = total;
 }
 

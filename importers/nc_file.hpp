@@ -81,6 +81,10 @@ class NcFile {
   // entry per dimension (empty: the whole variable).
   std::vector<double> read(const NcVar& v, std::vector<std::size_t> start = {}, std::vector<std::size_t> count = {},
                            UnpackInfo* info = nullptr) const;
+  // The same into `out`, reusing its memory (a global step's slab is hundreds of megabytes: fresh
+  // memory for it each step cost page faults and a clearing pass).
+  void read_into(std::vector<double>& out, const NcVar& v, std::vector<std::size_t> start = {},
+                 std::vector<std::size_t> count = {}, UnpackInfo* info = nullptr) const;
   // The same read into float, unpacked in double a chunk at a time, so a large slab never exists in
   // double (half the memory of read()).
   std::vector<float> read_float(const NcVar& v, std::vector<std::size_t> start = {}, std::vector<std::size_t> count = {},

@@ -3,7 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace cv::core {
 
@@ -18,13 +23,14 @@ void ValueStats::add(double v) {
 }
 
 namespace {
+// Adds a range's finite values (a value that is not finite, |x| <= max being false for NaN and
+// infinity, is counted as missing). A global step holds 10^8 values per field, and the compiler
+// does not vectorise a floating-point min/max reduction without fast-math (which would let it drop
+// the finiteness test), so the x86-64 loops are written with SSE2, four floats or two doubles at a
+// time; other processors take the scalar loop.
 template <typename T>
-void add_range(ValueStats& s, const T* v, std::size_t n) {
-  // Branch-free so the compiler vectorises it (a global step is 10^8 values): a value that is not
-  // finite (|x| <= max is false for NaN and infinity) leaves lo and hi alone and is not counted.
+void add_scalar(const T* v, std::size_t n, T& lo, T& hi, std::size_t& finite) {
   const T inf = std::numeric_limits<T>::infinity(), big = std::numeric_limits<T>::max();
-  T lo = inf, hi = -inf;
-  std::size_t finite = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const T x = v[i];
     const bool ok = std::abs(x) <= big;
@@ -32,6 +38,71 @@ void add_range(ValueStats& s, const T* v, std::size_t n) {
     hi = std::max(hi, ok ? x : -inf);
     finite += ok ? 1 : 0;
   }
+}
+
+#if defined(__SSE2__)
+void add_simd(const float* v, std::size_t n, float& lo, float& hi, std::size_t& finite) {
+  const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity()), ninf = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+  const __m128 big = _mm_set1_ps(std::numeric_limits<float>::max());
+  const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+  __m128 vlo = inf, vhi = ninf;
+  std::size_t i = 0;
+  // The count in 32-bit lanes, flushed to the total every 2^24 values (well before a lane overflows).
+  while (n - i >= 4) {
+    __m128i count = _mm_setzero_si128();
+    const std::size_t end = i + std::min<std::size_t>((n - i) / 4 * 4, std::size_t(1) << 24);
+    for (; i < end; i += 4) {
+      const __m128 x = _mm_loadu_ps(v + i);
+      const __m128 ok = _mm_cmple_ps(_mm_and_ps(x, abs_mask), big);  // false for NaN and infinity
+      vlo = _mm_min_ps(vlo, _mm_or_ps(_mm_and_ps(ok, x), _mm_andnot_ps(ok, inf)));
+      vhi = _mm_max_ps(vhi, _mm_or_ps(_mm_and_ps(ok, x), _mm_andnot_ps(ok, ninf)));
+      count = _mm_sub_epi32(count, _mm_castps_si128(ok));  // ok lanes are -1
+    }
+    alignas(16) std::uint32_t c[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(c), count);
+    finite += std::size_t(c[0]) + c[1] + c[2] + c[3];
+  }
+  alignas(16) float l[4], h[4];
+  _mm_store_ps(l, vlo);
+  _mm_store_ps(h, vhi);
+  for (int k = 0; k < 4; ++k) lo = std::min(lo, l[k]), hi = std::max(hi, h[k]);
+  add_scalar(v + i, n - i, lo, hi, finite);
+}
+
+void add_simd(const double* v, std::size_t n, double& lo, double& hi, std::size_t& finite) {
+  const __m128d inf = _mm_set1_pd(std::numeric_limits<double>::infinity()), ninf = _mm_set1_pd(-std::numeric_limits<double>::infinity());
+  const __m128d big = _mm_set1_pd(std::numeric_limits<double>::max());
+  const __m128d abs_mask = _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffffLL));
+  __m128d vlo = inf, vhi = ninf;
+  __m128i count = _mm_setzero_si128();
+  std::size_t i = 0;
+  for (; n - i >= 2; i += 2) {
+    const __m128d x = _mm_loadu_pd(v + i);
+    const __m128d ok = _mm_cmple_pd(_mm_and_pd(x, abs_mask), big);
+    vlo = _mm_min_pd(vlo, _mm_or_pd(_mm_and_pd(ok, x), _mm_andnot_pd(ok, inf)));
+    vhi = _mm_max_pd(vhi, _mm_or_pd(_mm_and_pd(ok, x), _mm_andnot_pd(ok, ninf)));
+    count = _mm_sub_epi64(count, _mm_castpd_si128(ok));
+  }
+  alignas(16) std::uint64_t c[2];
+  _mm_store_si128(reinterpret_cast<__m128i*>(c), count);
+  finite += c[0] + c[1];
+  alignas(16) double l[2], h[2];
+  _mm_store_pd(l, vlo);
+  _mm_store_pd(h, vhi);
+  for (int k = 0; k < 2; ++k) lo = std::min(lo, l[k]), hi = std::max(hi, h[k]);
+  add_scalar(v + i, n - i, lo, hi, finite);
+}
+#endif
+
+template <typename T>
+void add_range(ValueStats& s, const T* v, std::size_t n) {
+  T lo = std::numeric_limits<T>::infinity(), hi = -std::numeric_limits<T>::infinity();
+  std::size_t finite = 0;
+#if defined(__SSE2__)
+  add_simd(v, n, lo, hi, finite);
+#else
+  add_scalar(v, n, lo, hi, finite);
+#endif
   if (finite) {
     s.min = std::min(s.min, static_cast<double>(lo));
     s.max = std::max(s.max, static_cast<double>(hi));

@@ -31,6 +31,9 @@ void write_cvvol(OutputGroup& group, const std::string& path, CloudVolume& volum
 // IEEE 754 binary16 conversions (round to nearest even; NaN kept; overflow to infinity).
 std::uint16_t float_to_half(float f);
 float half_to_float(std::uint16_t h);
+// out[i] = float_to_half(in[i] * scale) for i < n, bit for bit; with the processor's F16C
+// instructions where it has them (eight at a time), else value by value.
+void floats_to_halves(const float* in, float scale, std::uint16_t* out, std::size_t n);
 // A .cvvol that cannot be read: missing, of another kind, truncated or corrupt (bad input).
 class VolumeFileError : public InputError {
  public:

@@ -2,11 +2,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <random>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 
 #include "support/nc_builder.hpp"
+#include "volume/import_report.hpp"
 #include "volume/cloud_volume.hpp"
 #include "volume/volume_io.hpp"
 
@@ -26,6 +29,44 @@ TimeStepData column(const VolumeGrid& g, const std::vector<float>& cf, float ext
   d[Field::CloudFraction] = cf;
   d[Field::ExtinctionLiquid].assign(g.points(), ext);
   return d;
+}
+
+// The report's range over an array (vectorised on x86-64) equals value-by-value adding, for floats
+// and doubles with NaN and infinities among them, at every length around the vector widths and the
+// block size, and keeps the extremes wherever they fall.
+TEST(ValueStats, AddAllEqualsAddingEachValue) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-5.0, 5.0);
+  const double special[] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                            -std::numeric_limits<double>::infinity(), 1e300, -1e300};
+  for (std::size_t n : {std::size_t(0), std::size_t(1), std::size_t(3), std::size_t(4), std::size_t(5), std::size_t(7),
+                        std::size_t(64), std::size_t(1001), (std::size_t(1) << 24) + 5}) {
+    std::vector<double> d(n);
+    for (auto& x : d) x = u(rng);
+    for (std::size_t k = 0; k < n; k += 97) d[k] = special[(k / 97) % 5];
+    if (n > 2) d[n - 1] = -7.5, d[n / 2] = 9.25;  // the extremes in the tail and the middle
+    std::vector<float> f(d.begin(), d.end());
+    ValueStats want_d, want_f, got_d, got_f;
+    for (double x : d) want_d.add(x);
+    for (float x : f) want_f.add(x);
+    got_d.add_all(d.data(), d.size());
+    got_f.add_all(f.data(), f.size());
+    for (const auto& [got, want] : {std::pair{got_d, want_d}, std::pair{got_f, want_f}}) {
+      EXPECT_EQ(got.count, want.count) << n;
+      EXPECT_EQ(got.missing, want.missing) << n;
+      EXPECT_EQ(got.min, want.min) << n;
+      EXPECT_EQ(got.max, want.max) << n;
+    }
+  }
+  // Only values that are not finite: counted as missing, the range left empty.
+  const float bad[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                       -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN(),
+                       std::numeric_limits<float>::infinity()};
+  ValueStats none;
+  none.add_all(bad, 5);
+  EXPECT_EQ(none.count, 0u);
+  EXPECT_EQ(none.missing, 5u);
+  EXPECT_TRUE(none.empty());
 }
 
 TEST(Maps, MaximumRandomOverlap) {
