@@ -22,6 +22,10 @@
 #include <limits>
 #include <stdexcept>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace cv::importers {
 namespace {
 
@@ -733,15 +737,50 @@ void NcFile::read_into(std::vector<double>& out, const NcVar& v, std::vector<std
   }
   const double lo = vmin.value_or(-std::numeric_limits<double>::infinity());
   const double hi = vmax.value_or(std::numeric_limits<double>::infinity());
-  for (double& x : out) {
-    bool miss = std::isnan(x) || x < lo || x > hi;
-    for (double m : exact) miss |= x == m;
-    for (double m : approx) miss |= std::abs(x - m) <= 1e-6 * std::abs(m);
-    if (miss) {
-      x = nan;
-      ++nmissing;
-    } else {
-      x = x * scale + offset;
+  if (approx.empty() && exact.size() <= 2) {
+    // The usual case (integer packing with a fill value and perhaps a missing value), without
+    // branches so the compiler vectorises it: an unused marker is NaN, which equals nothing.
+    const double m0 = exact.empty() ? nan : exact[0], m1 = exact.size() < 2 ? nan : exact[1];
+    const double lo_ = lo, hi_ = hi, scale_ = scale, offset_ = offset;
+    double* p = out.data();
+    const std::size_t count_ = out.size();
+    std::uint64_t missed = 0;
+    std::size_t i = 0;
+#if defined(__SSE2__)
+    // Two at a time (GCC keeps the scalar loop below branchy and unvectorised).
+    const __m128d vlo = _mm_set1_pd(lo_), vhi = _mm_set1_pd(hi_), vm0 = _mm_set1_pd(m0), vm1 = _mm_set1_pd(m1);
+    const __m128d vscale = _mm_set1_pd(scale_), voffset = _mm_set1_pd(offset_), vnan = _mm_set1_pd(nan);
+    __m128i vmissed = _mm_setzero_si128();
+    for (; i + 2 <= count_; i += 2) {
+      const __m128d x = _mm_loadu_pd(p + i);
+      const __m128d miss = _mm_or_pd(_mm_or_pd(_mm_cmpunord_pd(x, x), _mm_or_pd(_mm_cmplt_pd(x, vlo), _mm_cmpgt_pd(x, vhi))),
+                                     _mm_or_pd(_mm_cmpeq_pd(x, vm0), _mm_cmpeq_pd(x, vm1)));
+      const __m128d y = _mm_add_pd(_mm_mul_pd(x, vscale), voffset);
+      _mm_storeu_pd(p + i, _mm_or_pd(_mm_and_pd(miss, vnan), _mm_andnot_pd(miss, y)));
+      vmissed = _mm_sub_epi64(vmissed, _mm_castpd_si128(miss));  // a miss lane is all ones: -1
+    }
+    alignas(16) std::uint64_t lanes[2];
+    _mm_store_si128(reinterpret_cast<__m128i*>(lanes), vmissed);
+    missed += lanes[0] + lanes[1];
+#endif
+    for (; i < count_; ++i) {
+      const double x = p[i];
+      const bool miss = (x != x) | (x < lo_) | (x > hi_) | (x == m0) | (x == m1);
+      missed += miss ? 1 : 0;
+      p[i] = miss ? nan : x * scale_ + offset_;
+    }
+    nmissing += missed;
+  } else {
+    for (double& x : out) {
+      bool miss = std::isnan(x) || x < lo || x > hi;
+      for (double m : exact) miss |= x == m;
+      for (double m : approx) miss |= std::abs(x - m) <= 1e-6 * std::abs(m);
+      if (miss) {
+        x = nan;
+        ++nmissing;
+      } else {
+        x = x * scale + offset;
+      }
     }
   }
   if (info) *info = {scale, offset, packed, nmissing};
