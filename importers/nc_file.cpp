@@ -739,7 +739,7 @@ void NcFile::read_into(std::vector<double>& out, const NcVar& v, std::vector<std
   const double hi = vmax.value_or(std::numeric_limits<double>::infinity());
   if (approx.empty() && exact.size() <= 2) {
     // The usual case (integer packing with a fill value and perhaps a missing value), without
-    // branches so the compiler vectorises it: an unused marker is NaN, which equals nothing.
+    // branches: an unused marker is NaN, which equals nothing.
     const double m0 = exact.empty() ? nan : exact[0], m1 = exact.size() < 2 ? nan : exact[1];
     const double lo_ = lo, hi_ = hi, scale_ = scale, offset_ = offset;
     double* p = out.data();
@@ -797,7 +797,7 @@ void NcFile::read_float_into(std::vector<float>& out, const NcVar& v, std::vecto
                              std::vector<std::size_t> count, UnpackInfo* info) const {
   const std::size_t nd = v.dims.size();
   whole_if_empty(v, start, count);
-  // Split along the first axis with more than one index; each chunk goes through read().
+  // Split along the first axis with more than one index; each chunk goes through read_into().
   std::size_t axis = 0;
   while (axis + 1 < nd && count[axis] == 1) ++axis;
   UnpackInfo total;
