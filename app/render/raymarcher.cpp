@@ -80,7 +80,7 @@ GpuRaymarcher::~GpuRaymarcher() {
   if (path_state_) glDeleteBuffers(1, &path_state_);
   if (path_stats_) glDeleteBuffers(1, &path_stats_);
   if (textures_[0]) glDeleteTextures(2, textures_);
-  if (state_[0]) glDeleteTextures(3, state_);
+  if (state_[0]) glDeleteTextures(4, state_);
   if (ground_) glDeleteTextures(1, &ground_);
   if (jitter_mask_) glDeleteTextures(1, &jitter_mask_);
   if (column_tau_) glDeleteTextures(1, &column_tau_);
@@ -324,11 +324,12 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   const double r0 = grid.earth_radius_m;
   const glm::dvec3 to_sun = params.u_to_sun;
   if (!state_[0] || state_w_ != cam.width || state_h_ != cam.height) {
-    if (state_[0]) glDeleteTextures(3, state_);
-    glCreateTextures(GL_TEXTURE_2D, 3, state_);
+    if (state_[0]) glDeleteTextures(4, state_);
+    glCreateTextures(GL_TEXTURE_2D, 4, state_);
     glTextureStorage2D(state_[0], 1, GL_RGBA32F, cam.width, cam.height);
     glTextureStorage2D(state_[1], 1, GL_RGBA32F, cam.width, cam.height);
     glTextureStorage2D(state_[2], 1, GL_R32F, cam.width, cam.height);  // the cloud depth, kept after the frame
+    glTextureStorage2D(state_[3], 1, GL_R32F, cam.width, cam.height);  // the two-stream's scaled view transmittance
     state_w_ = cam.width;
     state_h_ = cam.height;
   }
@@ -336,6 +337,7 @@ void GpuRaymarcher::render_into(GLuint out, const core::Camera& cam, const core:
   glBindImageTexture(CV_IMAGE_STATE_L, state_[0], 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(CV_IMAGE_STATE_DEPTH, state_[1], 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(CV_IMAGE_CLOUD_DEPTH, state_[2], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glBindImageTexture(CV_IMAGE_STATE_MS, state_[3], 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
   glUseProgram(p);
   const int tile = dispatch.rows_per_tile > 0 ? (dispatch.rows_per_tile + 7) / 8 * 8 : cam.height;
   GLuint query = 0;

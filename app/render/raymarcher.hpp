@@ -195,7 +195,7 @@ class GpuRaymarcher {
   GLuint jitter_mask_ = 0;          // the blue-noise mask (R32F), uploaded at construction
   GLuint ground_ = 0;               // land albedo and water fraction (RGBA32F), loaded from ground_path_
   // The march's state between dispatches (image-sized, two RGBA32F) and the cloud depth it writes (R32F).
-  GLuint state_[3] = {0, 0, 0};
+  GLuint state_[4] = {0, 0, 0, 0};  // march state (radiance, depths), cloud depth, two-stream transmittance
   int state_w_ = 0, state_h_ = 0;
   int ground_w_ = 0, ground_h_ = 0;
   std::string ground_path_;

@@ -7,8 +7,10 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "kernel/prepared_volume.hpp"
@@ -52,5 +54,18 @@ struct MsSourceKey {
 MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun);
 
 MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key);
+
+// The level c (1/sr) at which the forward peak of a phase function p(mu) (normalised over the
+// sphere, mu the cosine of the scattering angle) holding the share f of its scattering is cut: the
+// integral of max(p - c, 0) over the sphere is f times that of p. The two-stream march sends the
+// light the sun's beam scatters toward the camera with the phase above c along the true extinction,
+// the rest along the delta-scaled one (docs/physics.md, "the view path"). f <= 0 gives p's largest
+// value (no peak), f >= 1 gives 0 (all peak).
+double ms_peak_cut(const std::function<double(double)>& phase, double f);
+
+// The cuts of the march's liquid and ice phases at f = g^2 (the kernel's u_ms_peak_liquid and
+// u_ms_peak_ice): the approximate Mie fit at the droplet diameter (or HG with its mean cosine with
+// liquid_phase_hg) and ice's Henyey-Greenstein. Remembers the last settings it was asked for.
+glm::dvec2 ms_peak_cuts(const MarchSettings& s);
 
 }  // namespace cv::core

@@ -10,6 +10,7 @@
 
 #include "geo/geodesy.hpp"
 #include "kernel/march_limits.hpp"
+#include "kernel/ms_source.hpp"
 #include "noise/noise.hpp"
 #include "physics/physics.hpp"
 #include "reference/earth_shadow.hpp"
@@ -100,6 +101,11 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
   p.u_sigma_max = v.sigma_max_per_m;
   p.u_sun_step_max = sun_step_limit_m(grid, v.layer, s);
   p.u_octave_abc = {s.medium.octave_a, s.medium.octave_b, s.medium.octave_c};
+  if (s.medium.ms_two_stream) {
+    const glm::dvec2 cuts = ms_peak_cuts(s);
+    p.u_ms_peak_liquid = cuts.x;
+    p.u_ms_peak_ice = cuts.y;
+  }
   if (s.medium.noise_amount > 0.0) {
     const NoiseAnchor a = noise_anchor(grid_centre_ecef(grid), s.medium.noise_scale_m);
     p.u_noise_anchor = a.ecef_m;  // float-exact by construction

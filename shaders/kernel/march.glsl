@@ -391,6 +391,10 @@ CV_FN real cloud_sun_depth(real3 p, real alt_p, real mu_sun, real nu_sun) {
 struct MarchState {
   real3 radiance;
   real t_view;
+  // kTwoStream: the view transmittance through the delta-scaled extinction (1 - g^2) sigma, along
+  // which the scattered light travels to the camera (march_sample); the march goes on while either
+  // transmittance is above u_min_t.
+  real t_ms;
   real depth_w;
   real depth_t;
   bool ended;
@@ -442,22 +446,36 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
   // The octave sums of both phases (clouds do not absorb), only where the sun shines (llvmpipe runs
   // masked code: a ternary would not save them).
   real scatter = real(0.0);
-  real3 diffuse = real3(0.0);
+  real3 scaled_source = real3(0.0);  // kTwoStream: the light that reaches the camera through t_ms
+  real sigma_ms = sigma;
   if (kTwoStream) {
-    // The two-stream model (docs/physics.md): the sun's light scattered once, exactly, with the full
-    // phase, through exp(-(1 - f) tau_sun) (f = g^2 of delta-Eddington: the light the forward peak
-    // keeps in the beam), plus the column's diffuse light scattered toward the camera,
-    // sigma (I0 + g I1 mu_out), mu_out the cosine of the outgoing direction -d to the vertical.
+    // The two-stream model (docs/physics.md). Delta-Eddington takes the share f = g^2 of each
+    // scattering as no scattering at all (the forward peak): the sun's beam is exp(-(1 - f) tau_sun)
+    // and light on its way to the camera meets the scaled extinction sigma' = (1 - g^2) sigma. Along
+    // that path travel the sun's beam scattered toward the camera with the phase below the peak's cut
+    // (u_ms_peak_*), and the column's diffuse light I0 + I1 mu scattered by the truncated phase
+    // (mean cosine g' = g / (1 + g)): sigma' I0 + sigma' g' I1 mu_out, sigma' g' = g (1 - g) sigma,
+    // mu_out the cosine of the outgoing direction -d to the vertical. The peak above the cut, where
+    // the phase changes faster than the scaling's pass-through can follow (toward the sun), takes
+    // the true extinction.
     real g_liquid = mie_mean_cosine(mie);
-    real g_mix = (sl * g_liquid + si * u_ice_g) / sigma;
+    real g_ice = u_ice_g;
+    real g_mix = (sl * g_liquid + si * g_ice) / sigma;
     if (lit) {
       real p_liquid = u_liquid_phase_hg ? phase_hg(mu, g_liquid) : phase_mie(mu, mie);
-      scatter = (sl * p_liquid + si * phase_hg(mu, u_ice_g)) * transmittance((real(1.0) - g_mix * g_mix) * tau_sun);
+      real p_ice = phase_hg(mu, g_ice);
+      real c_liquid = min(p_liquid, u_ms_peak_liquid);
+      real c_ice = min(p_ice, u_ms_peak_ice);
+      real beam = transmittance((real(1.0) - g_mix * g_mix) * tau_sun);
+      scatter = (sl * (p_liquid - c_liquid) + si * (p_ice - c_ice)) * beam;
+      scaled_source = sun_air * ((sl * c_liquid + si * c_ice) * beam);
     }
+    sigma_ms = sl * (real(1.0) - g_liquid * g_liquid) + si * (real(1.0) - g_ice * g_ice);
+    real first = sl * g_liquid * (real(1.0) - g_liquid) + si * g_ice * (real(1.0) - g_ice);
     real i0;
     real i1;
     ms_source_at(p, alt_p, i0, i1);
-    diffuse = sun_air * (sigma * max(i0 - g_mix * i1 * dot(d, up_p), real(0.0)));
+    scaled_source += sun_air * max(sigma_ms * i0 - first * i1 * dot(d, up_p), real(0.0));
   } else if (lit) {
     // The octave gate (octaves.glsl): w from the column's optical depth; off, the classic sum.
     bool gate = u_octave_gate && u_octaves > 1;
@@ -470,9 +488,15 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
                                     : ms_octaves_mie_gated(sl, mu, mie, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
     scatter = liquid + ms_octaves_hg_gated(si, mu, u_ice_g, tau_sun, u_octaves, abc.x, abc.y, abc.z, w, tol);
   }
-  real3 source = u_irradiance * (sun_air * scatter + diffuse + ambient);
+  real3 source = u_irradiance * (sun_air * scatter + ambient);
   if (kTint && u_tint) source *= tint_hue(sl, si, sigma);
   s.radiance += s.t_view * segment_integral(source, sigma, ds);
+  if (kTwoStream) {
+    real3 source_ms = u_irradiance * scaled_source;
+    if (kTint && u_tint) source_ms *= tint_hue(sl, si, sigma);
+    s.radiance += s.t_ms * segment_integral(source_ms, sigma_ms, ds);
+    s.t_ms *= transmittance(sigma_ms * ds);
+  }
   // The light the step takes out of the view, t_view (1 - exp(-sigma ds)), without the cancellation
   // of t_view - t_next: in float that is a multiple of 6e-8, which left faint cloud with a mean
   // depth tens of kilometres off.
@@ -538,6 +562,7 @@ CV_FN void tl_composite(ivec2 px, CV_INOUT(MarchState) s) {
   real4 c = real4(texelFetch(u_tl_color, ivec2(px.x + s.tl_next * u_size.x, px.y), 0));
   s.radiance += s.t_view * c.w * real3(c.x, c.y, c.z);
   s.t_view *= real(1.0) - c.w;
+  s.t_ms *= real(1.0) - c.w;
   s.tl_next += 1;
 }
 
@@ -602,10 +627,15 @@ CV_FN MarchRay march_ray(ivec2 px) {
   return r;
 }
 
+// Whether light from further along the ray can still reach the camera: through the true extinction
+// and, with the two-stream source, through the scaled one too.
+CV_FN bool march_goes_on(CV_IN(MarchState) s) { return (kTwoStream ? max(s.t_view, s.t_ms) : s.t_view) > u_min_t; }
+
 CV_FN MarchState march_start() {
   MarchState s;
   s.radiance = real3(0.0);
   s.t_view = real(1.0);
+  s.t_ms = real(1.0);
   s.depth_w = real(0.0);
   s.depth_t = real(0.0);
   s.ended = false;
@@ -642,7 +672,7 @@ CV_FN void march_advance(MarchRay r, ivec2 px, int step_begin, int step_count, C
   int range_end = step_begin + step_count;
   int base = 0;  // steps of the segments before segment k
   bool crossed = false;
-  for (int k = 0; k < (s.ended ? 0 : r.n) && s.t_view > u_min_t; ++k) {
+  for (int k = 0; k < (s.ended ? 0 : r.n) && march_goes_on(s); ++k) {
     real t_start = k == 0 ? r.seg.x : r.seg.z;
     real t_end = min(k == 0 ? r.seg.y : r.seg.w, r.t_ground);
     if (!(t_end > t_start)) continue;
@@ -660,7 +690,7 @@ CV_FN void march_advance(MarchRay r, ivec2 px, int step_begin, int step_count, C
     // One loop iteration per sample, substeps included: sample j of the substeps of step i.
     int j = 0;
     int substeps = 1;
-    while (i < i_end && s.t_view > u_min_t) {
+    while (i < i_end && march_goes_on(s)) {
       if (j == 0) {
         real t_rel = (real(i) + offset) * dt;
         if ((kSkipEmpty || kAdaptive) && !(t_rel < known_end)) {
@@ -717,7 +747,7 @@ CV_FN void march_advance(MarchRay r, ivec2 px, int step_begin, int step_count, C
   }
   if (step_begin == 0) g_stats[CV_STAT_RAYS_MISSED] += crossed ? 0u : 1u;
   march_half_settle(s);
-  s.ended = !(s.t_view > u_min_t) || s.ended || range_end >= base;
+  s.ended = !march_goes_on(s) || s.ended || range_end >= base;
   s.next_step = next_step;
 }
 

@@ -19,6 +19,8 @@ layout(rgba32f, binding = CV_IMAGE_STATE_L) uniform image2D u_state_l;          
 // depth_w, depth_t, t_half, and the next step (n) while the march goes on or -(n + 1) once it has ended;
 // with translucent geometry n is next_step * 8 + the next translucent fragment
 layout(rgba32f, binding = CV_IMAGE_STATE_DEPTH) uniform image2D u_state_depth;
+// The two-stream march's second view transmittance (MarchState.t_ms) between dispatches.
+layout(r32f, binding = CV_IMAGE_STATE_MS) uniform image2D u_state_ms;
 layout(r32f, binding = CV_IMAGE_CLOUD_DEPTH) writeonly uniform image2D u_cloud_depth;  // pass 1 writes it there
 uniform int u_pass;        // 0: march a range of steps; 1: air and ground, then u_out
 uniform int u_step_begin;  // pass 0: the first view step (counted over both shell segments)
@@ -51,6 +53,7 @@ void main() {
   MarchState s;
   s.radiance = state_l.rgb;
   s.t_view = state_l.a;
+  s.t_ms = kTwoStream ? (first ? 1.0 : imageLoad(u_state_ms, px).r) : 1.0;
   s.depth_w = state_depth.x;
   s.depth_t = state_depth.y;
   s.t_half = state_depth.z;
@@ -66,6 +69,7 @@ void main() {
     march_advance(r, px, u_step_begin, u_step_count, s);
     flush_stats();
     imageStore(u_state_l, px, vec4(s.radiance, s.t_view));
+    if (kTwoStream) imageStore(u_state_ms, px, vec4(s.t_ms));
     int out_code = kTranslucent ? s.next_step * 8 + s.tl_next : s.next_step;
     imageStore(u_state_depth, px, vec4(s.depth_w, s.depth_t, s.t_half, float(s.ended ? -1 - out_code : out_code)));
     return;

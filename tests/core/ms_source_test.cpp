@@ -3,10 +3,13 @@
 // everything, and no NaN or Inf at extreme optical depths and grazing suns.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <vector>
 
 #include "kernel/ms_source.hpp"
+#include "physics/physics.hpp"
 #include "settings/march_settings.hpp"
 #include "support/bubble_scene.hpp"
 #include "volume/grid_mean.hpp"
@@ -182,6 +185,60 @@ TEST(MediumMask, TheColumnDepthsAreThoseOfWhatIsShown) {
   EXPECT_EQ(depth_and_ground(masked), depth_and_ground(prepare_volume(with_ice.grid, cut).column_maps));
   EXPECT_NE(depth_and_ground(masked), depth_and_ground(whole.column_maps));  // the ice's depth is gone from every column
   EXPECT_EQ(types_of(masked), types_of(whole.column_maps));
+}
+
+// The forward peak's cut (ms_peak_cut) for Henyey-Greenstein against its closed form: the share of
+// scattering at cosines above mu_c is (1 - g^2)/(2g) (1/(1 - g) - 1/sqrt(1 + g^2 - 2 g mu_c)), and
+// the phase falls monotonically, so the cut c = p(mu_c) where that share less c 2 pi (1 - mu_c) is f.
+TEST(TwoStream, PeakCutOfHenyeyGreensteinMatchesItsClosedForm) {
+  constexpr double kPi = 3.14159265358979323846;
+  auto hg = [](double mu, double g) { return (1.0 - g * g) / (4.0 * kPi * std::pow(1.0 + g * g - 2.0 * g * mu, 1.5)); };
+  for (double g : {0.3, 0.75, 0.85, 0.95}) {
+    const double f = g * g;
+    double lo = -1.0, hi = 1.0;
+    for (int i = 0; i < 200; ++i) {
+      const double m = 0.5 * (lo + hi);
+      const double share = (1.0 - g * g) / (2.0 * g) * (1.0 / (1.0 - g) - 1.0 / std::sqrt(1.0 + g * g - 2.0 * g * m));
+      (share - hg(m, g) * 2.0 * kPi * (1.0 - m) > f ? lo : hi) = m;
+    }
+    const double expected = hg(0.5 * (lo + hi), g);
+    const double cut = ms_peak_cut([&](double mu) { return hg(mu, g); }, f);
+    EXPECT_NEAR(cut / expected, 1.0, 1e-3) << "g " << g << ": cut " << cut << ", closed form " << expected;
+  }
+  // g = 0.85: the peak is the scattering within about 41 degrees of forward.
+  EXPECT_NEAR(ms_peak_cut([&](double mu) { return hg(mu, 0.85); }, 0.85 * 0.85), 0.07756, 1e-4);
+  // No peak and all peak.
+  EXPECT_DOUBLE_EQ(ms_peak_cut([&](double mu) { return hg(mu, 0.85); }, 0.0), hg(1.0, 0.85));
+  EXPECT_EQ(ms_peak_cut([&](double mu) { return hg(mu, 0.85); }, 1.0), 0.0);
+}
+
+// The approximate Mie phase (a droplet's diffraction peak, about 5e3 per sr): the share above the cut
+// is g^2, counted by an independent quadrature (Simpson's rule in the scattering angle, panels
+// packed geometrically toward forward).
+TEST(TwoStream, PeakCutOfTheMiePhaseHoldsTheShareGSquared) {
+  constexpr double kPi = 3.14159265358979323846;
+  for (double d : {5.0, 20.0, 40.0}) {
+    const physics::f64::MieParams mie = physics::f64::mie_params(d);
+    const double g = physics::f64::mie_mean_cosine(mie);
+    auto p = [&](double mu) { return physics::f64::phase_mie(mu, mie); };
+    const double cut = ms_peak_cut(p, g * g);
+    ASSERT_TRUE(std::isfinite(cut) && cut > 0.0) << d;
+    // Integrals over theta of 2 pi sin(theta) x(theta): [1e-6, pi] in 400 geometric panels.
+    auto integral = [&](const std::function<double(double)>& x) {
+      double sum = 0.0, a = 1e-6;
+      const double r = std::pow(kPi / 1e-6, 1.0 / 400.0);
+      for (int k = 0; k < 400; ++k) {
+        const double b = k == 399 ? kPi : a * r, m = 0.5 * (a + b);
+        auto y = [&](double t) { return 2.0 * kPi * std::sin(t) * x(std::cos(t)); };
+        sum += (b - a) / 6.0 * (y(a) + 4.0 * y(m) + y(b));
+        a = b;
+      }
+      return sum;
+    };
+    const double whole = integral(p);
+    const double above = integral([&](double mu) { return std::max(p(mu) - cut, 0.0); });
+    EXPECT_NEAR(above / whole, g * g, 2e-3) << "droplet " << d << " um: cut " << cut;
+  }
 }
 
 }  // namespace cv::core
