@@ -241,4 +241,23 @@ TEST(TwoStream, PeakCutOfTheMiePhaseHoldsTheShareGSquared) {
   }
 }
 
+// The cuts the march gets, over the settings' whole ranges (a droplet diameter of 0 means "from the
+// data"; ice g from -0.999 to 0.999): finite, and between 0 and the phase's largest value.
+TEST(TwoStream, PeakCutsAreFiniteOverTheSettingsRanges) {
+  for (double d : {0.0, 0.01, 1.0, 20.0, 50.0}) {
+    for (double ice_g : {-0.999, -0.5, 0.0, 0.75, 0.999}) {
+      for (bool hg : {false, true}) {
+        MarchSettings s;
+        s.medium.droplet_diameter_um = d;
+        s.medium.ice_g = ice_g;
+        s.medium.liquid_phase_hg = hg;
+        const glm::dvec2 c = ms_peak_cuts(s);
+        EXPECT_TRUE(std::isfinite(c.x) && c.x >= 0.0) << "droplet " << d << " hg " << hg << ": " << c.x;
+        EXPECT_TRUE(std::isfinite(c.y) && c.y >= 0.0) << "ice g " << ice_g << ": " << c.y;
+        EXPECT_LE(c.y, physics::f64::phase_hg(ice_g >= 0.0 ? 1.0 : -1.0, ice_g) * (1.0 + 1e-12)) << ice_g;
+      }
+    }
+  }
+}
+
 }  // namespace cv::core
