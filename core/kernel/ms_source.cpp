@@ -108,7 +108,7 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
   return out;
 }
 
-double ms_peak_cut(const std::function<double(double)>& phase, double f) {
+MsPeak ms_peak(const std::function<double(double)>& phase, double f) {
   // The phase on cosines packed geometrically toward the forward direction (a droplet's peak is
   // narrower than a degree: 1 - mu down to 1e-10), integrated by the trapezoid in mu.
   constexpr int kNodes = 4001;
@@ -119,43 +119,59 @@ double ms_peak_cut(const std::function<double(double)>& phase, double f) {
     const double v = phase(1.0 - s);
     p[static_cast<std::size_t>(i)] = std::isfinite(v) ? std::max(v, 0.0) : 0.0;
   }
-  auto above = [&](double c) {
-    double sum = 0.0;
+  // The integrals of max(p - c, 0) and of max(p - c, 0) mu over the sphere.
+  auto above = [&](double c, double* first_moment) {
+    double sum = 0.0, moment = 0.0;
     for (std::size_t i = 0; i + 1 < mu.size(); ++i) {
-      sum += 0.5 * (std::max(p[i] - c, 0.0) + std::max(p[i + 1] - c, 0.0)) * (mu[i] - mu[i + 1]);
+      const double a = std::max(p[i] - c, 0.0), b = std::max(p[i + 1] - c, 0.0), w = 0.5 * (mu[i] - mu[i + 1]);
+      sum += (a + b) * w;
+      moment += (a * mu[i] + b * mu[i + 1]) * w;
     }
+    if (first_moment) *first_moment = 2.0 * kPi * moment;
     return 2.0 * kPi * sum;
   };
+  MsPeak out;
   const double peak = *std::max_element(p.begin(), p.end());
-  if (!(f > 0.0) || !(peak > 0.0)) return peak;
-  if (f >= 1.0) return 0.0;
-  const double target = f * above(0.0);
-  // above(c) falls from the whole integral at c = 0 to 0 at the peak's value: bisection.
-  double lo = 0.0, hi = peak;
-  for (int it = 0; it < 200 && hi - lo > 1e-12 * hi; ++it) {
-    const double c = 0.5 * (lo + hi);
-    (above(c) > target ? lo : hi) = c;
+  if (!(f > 0.0) || !(peak > 0.0)) {
+    out.cut = peak;
+    return out;
   }
-  return 0.5 * (lo + hi);
+  double c = 0.0;
+  if (f < 1.0) {
+    const double target = f * above(0.0, nullptr);
+    // above(c) falls from the whole integral at c = 0 to 0 at the peak's value: bisection.
+    double lo = 0.0, hi = peak;
+    for (int it = 0; it < 200 && hi - lo > 1e-12 * hi; ++it) {
+      const double m = 0.5 * (lo + hi);
+      (above(m, nullptr) > target ? lo : hi) = m;
+    }
+    c = 0.5 * (lo + hi);
+  }
+  double moment = 0.0;
+  const double share = above(c, &moment);
+  out.cut = c;
+  out.g = share > 0.0 ? std::clamp(moment / share, -1.0, 1.0) : 1.0;
+  return out;
 }
 
-glm::dvec2 ms_peak_cuts(const MarchSettings& s) {
+MsPeaks ms_peaks(const MarchSettings& s) {
   struct Memo {
     double droplet_um = -1.0, ice_g = -2.0;
     bool liquid_hg = false;
-    glm::dvec2 cuts{0.0};
+    MsPeaks peaks;
   };
   thread_local Memo memo;
   const double d = s.medium.droplet_diameter_um, ice_g = s.medium.ice_g;
   const bool hg = s.medium.liquid_phase_hg;
-  if (memo.droplet_um == d && memo.ice_g == ice_g && memo.liquid_hg == hg) return memo.cuts;
+  if (memo.droplet_um == d && memo.ice_g == ice_g && memo.liquid_hg == hg) return memo.peaks;
   const physics::f64::MieParams mie = physics::f64::mie_params(d);
   const double gl = physics::f64::mie_mean_cosine(mie);
-  const double liquid = hg ? ms_peak_cut([gl](double m) { return physics::f64::phase_hg(m, gl); }, gl * gl)
-                           : ms_peak_cut([&mie](double m) { return physics::f64::phase_mie(m, mie); }, gl * gl);
-  const double ice = ms_peak_cut([ice_g](double m) { return physics::f64::phase_hg(m, ice_g); }, ice_g * ice_g);
-  memo = Memo{d, ice_g, hg, glm::dvec2(liquid, ice)};
-  return memo.cuts;
+  MsPeaks out;
+  out.liquid = hg ? ms_peak([gl](double m) { return physics::f64::phase_hg(m, gl); }, gl * gl)
+                  : ms_peak([&mie](double m) { return physics::f64::phase_mie(m, mie); }, gl * gl);
+  out.ice = ms_peak([ice_g](double m) { return physics::f64::phase_hg(m, ice_g); }, ice_g * ice_g);
+  memo = Memo{d, ice_g, hg, out};
+  return out;
 }
 
 }  // namespace cv::core

@@ -10,7 +10,6 @@
 #include <functional>
 #include <vector>
 
-#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "kernel/prepared_volume.hpp"
@@ -55,17 +54,26 @@ MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun);
 
 MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key);
 
-// The level c (1/sr) at which the forward peak of a phase function p(mu) (normalised over the
-// sphere, mu the cosine of the scattering angle) holding the share f of its scattering is cut: the
-// integral of max(p - c, 0) over the sphere is f times that of p. The two-stream march sends the
-// light the sun's beam scatters toward the camera with the phase above c along the true extinction,
-// the rest along the delta-scaled one (docs/physics.md, "the view path"). f <= 0 gives p's largest
-// value (no peak), f >= 1 gives 0 (all peak).
-double ms_peak_cut(const std::function<double(double)>& phase, double f);
+// The forward peak of a phase function p(mu) (normalised over the sphere, mu the cosine of the
+// scattering angle) that holds the share f of its scattering, cut at the level c (1/sr): the
+// integral of max(p - c, 0) over the sphere is f times that of p; g is the mean cosine of that
+// peak, max(p - c, 0) / f. The two-stream march sends the light the sun's beam scatters toward the
+// camera with the phase above c along the true extinction, the rest along the delta-scaled one, and
+// spreads the beam's peak-scattered light by g per peak scattering (docs/physics.md, "the view
+// path"). f <= 0 gives c = p's largest value (no peak), f >= 1 gives c = 0 (all peak).
+struct MsPeak {
+  double cut = 0.0;
+  double g = 1.0;
+};
+MsPeak ms_peak(const std::function<double(double)>& phase, double f);
+inline double ms_peak_cut(const std::function<double(double)>& phase, double f) { return ms_peak(phase, f).cut; }
 
-// The cuts of the march's liquid and ice phases at f = g^2 (the kernel's u_ms_peak_liquid and
-// u_ms_peak_ice): the approximate Mie fit at the droplet diameter (or HG with its mean cosine with
+// The peaks of the march's liquid and ice phases at f = g^2 (the kernel's u_ms_peak_* parameters):
+// the approximate Mie fit at the droplet diameter (or HG with its mean cosine with
 // liquid_phase_hg) and ice's Henyey-Greenstein. Remembers the last settings it was asked for.
-glm::dvec2 ms_peak_cuts(const MarchSettings& s);
+struct MsPeaks {
+  MsPeak liquid, ice;
+};
+MsPeaks ms_peaks(const MarchSettings& s);
 
 }  // namespace cv::core

@@ -102,9 +102,11 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
   p.u_sun_step_max = sun_step_limit_m(grid, v.layer, s);
   p.u_octave_abc = {s.medium.octave_a, s.medium.octave_b, s.medium.octave_c};
   if (s.medium.ms_two_stream) {
-    const glm::dvec2 cuts = ms_peak_cuts(s);
-    p.u_ms_peak_liquid = cuts.x;
-    p.u_ms_peak_ice = cuts.y;
+    const MsPeaks peaks = ms_peaks(s);
+    p.u_ms_peak_liquid = peaks.liquid.cut;
+    p.u_ms_peak_ice = peaks.ice.cut;
+    p.u_ms_peak_g_liquid = peaks.liquid.g;
+    p.u_ms_peak_g_ice = peaks.ice.g;
   }
   if (s.medium.noise_amount > 0.0) {
     const NoiseAnchor a = noise_anchor(grid_centre_ecef(grid), s.medium.noise_scale_m);

@@ -424,6 +424,33 @@ CV_FN real3 tint_hue(real sl, real si, real sigma) {
   return lum > real(0.0) ? mixed / lum : real3(0.0);
 }
 
+// The phase with which the delta-scaled beam exp(-(1 - f) tau_sun) scatters toward the camera. Its
+// light has met a Poisson number k of forward-peak scatterings (mean lambda = f tau_sun: the beam
+// without them is exp(-tau_sun)), each of which spreads it about the sun's direction like a
+// Henyey-Greenstein kernel of the peak's mean cosine g_pk (ms_peak). Kernels compose by
+// multiplying their mean cosines: HG(g) spread by k of them is HG(g g_pk^k). The phase p0 (the Mie
+// fit, or HG) spread by them is taken as p0 + HG(g g_pk^k) - HG(g): exact for HG, and for a phase
+// whose narrow diffraction peak and broad back lobes a narrow kernel moves little, the change is
+// that of its HG part, near forward. CV_MS_PEAK_TERMS terms, the rest of the weight at
+// k = max(terms, lambda).
+#define CV_MS_PEAK_TERMS 8
+CV_FN real ms_beam_phase(real mu, real p0, real g, real g_pk, real lambda) {
+  real l = clamp(lambda, real(0.0), real(1.0e4));
+  real w = exp(-l);
+  real sum = real(0.0);  // sum over k >= 1 of w_k HG(g g_pk^k)
+  real mass = w;
+  real gk = g;
+  for (int k = 1; k < CV_MS_PEAK_TERMS; ++k) {
+    w *= l / real(k);
+    gk *= g_pk;
+    sum += w * phase_hg(mu, gk);
+    mass += w;
+  }
+  real tail = max(real(1.0) - mass, real(0.0));
+  sum += tail * phase_hg(mu, g * pow(max(g_pk, real(0.0)), max(real(CV_MS_PEAK_TERMS), l)));
+  return max(p0 + sum - (real(1.0) - exp(-l)) * phase_hg(mu, g), real(0.0));
+}
+
 CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real3 d, real mu, MieParams mie, CV_INOUT(MarchState) s) {
   real sl;
   real si;
@@ -462,8 +489,9 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
     real g_ice = u_ice_g;
     real g_mix = (sl * g_liquid + si * g_ice) / sigma;
     if (lit) {
-      real p_liquid = u_liquid_phase_hg ? phase_hg(mu, g_liquid) : phase_mie(mu, mie);
-      real p_ice = phase_hg(mu, g_ice);
+      real lambda = g_mix * g_mix * tau_sun;  // forward-peak scatterings the beam has met, on average
+      real p_liquid = ms_beam_phase(mu, u_liquid_phase_hg ? phase_hg(mu, g_liquid) : phase_mie(mu, mie), g_liquid, u_ms_peak_g_liquid, lambda);
+      real p_ice = ms_beam_phase(mu, phase_hg(mu, g_ice), g_ice, u_ms_peak_g_ice, lambda);
       real c_liquid = min(p_liquid, u_ms_peak_liquid);
       real c_ice = min(p_ice, u_ms_peak_ice);
       real beam = transmittance((real(1.0) - g_mix * g_mix) * tau_sun);

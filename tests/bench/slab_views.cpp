@@ -5,7 +5,7 @@
 // error from the 3-D effects of the standard scenes: a deck seen at a grazing angle toward the sun
 // (stratocumulus) and a view from inside a cloud are oblique views of a nearly plane-parallel cloud.
 //   bench_slab_views [--phase hg|mie|both] [--tau 1,2,...] [--zenith SUN,...] [--view V,...]
-//                    [--azimuth A,...] [--spp N] [--seed S]
+//                    [--azimuth A,...] [--spp N] [--seed S] [--max-bounces N]
 // --view: view zenith angles at the cloud top (degrees); --azimuth: the camera's heading from the
 // sun's azimuth (0: looking toward the sun, the light it sees scattered forward; 180: away).
 // Camera 10 km up over (0, 0), the slab 1-2 km up and 666 km across: every ray meets its top far
@@ -39,15 +39,16 @@ cv::core::Camera oblique(double view_zenith_deg, double azimuth_deg) {
 int main(int argc, char** argv) {
   std::string phases = "mie";
   std::vector<double> taus{2, 5, 20}, zeniths{30}, views{0, 45, 70, 85}, azimuths{0, 90, 180};
-  int spp = 20000;
+  int spp = 20000, max_bounces = 1000000;
   std::uint64_t seed = 5;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h") {
       std::printf("usage: bench_slab_views [--phase hg|mie|both] [--tau 1,2,...] [--zenith SUN,...] [--view V,...]\n"
-                  "                        [--azimuth A,...] [--spp N] [--seed S]\n"
+                  "                        [--azimuth A,...] [--spp N] [--seed S] [--max-bounces N]\n"
                   "  the octave sum and the two-stream source against the Monte Carlo on a slab seen obliquely\n"
-                  "  (view zenith V at the cloud top, heading A from the sun's azimuth: 0 toward the sun)\n");
+                  "  (view zenith V at the cloud top, heading A from the sun's azimuth: 0 toward the sun);\n"
+                  "  --max-bounces cuts the Monte Carlo's paths (the light of the first N orders of scattering)\n");
       return 0;
     }
     if (i + 1 >= argc) {
@@ -61,6 +62,7 @@ int main(int argc, char** argv) {
     else if (a == "--view") views = number_list(v);
     else if (a == "--azimuth") azimuths = number_list(v);
     else if (a == "--spp" && std::atoi(v.c_str()) > 0) spp = std::atoi(v.c_str());
+    else if (a == "--max-bounces" && std::atoi(v.c_str()) > 0) max_bounces = std::atoi(v.c_str());
     else if (a == "--seed") seed = std::strtoull(v.c_str(), nullptr, 10);
     else {
       std::fprintf(stderr, "bench_slab_views: %s %s: unknown option or bad value (see --help)\n", a.c_str(), v.c_str());
@@ -88,7 +90,7 @@ int main(int argc, char** argv) {
             const cv::core::Camera cam = oblique(v, az);
             cv::core::MonteCarloSettings mc;
             mc.seed = seed;
-            mc.max_bounces = 1000000;
+            mc.max_bounces = max_bounces;
             mc.threads = 2;
             cv::core::MarchSettings mm = m;
             mm.quality.anti_alias = false;

@@ -251,10 +251,11 @@ TEST(TwoStream, PeakCutsAreFiniteOverTheSettingsRanges) {
         s.medium.droplet_diameter_um = d;
         s.medium.ice_g = ice_g;
         s.medium.liquid_phase_hg = hg;
-        const glm::dvec2 c = ms_peak_cuts(s);
-        EXPECT_TRUE(std::isfinite(c.x) && c.x >= 0.0) << "droplet " << d << " hg " << hg << ": " << c.x;
-        EXPECT_TRUE(std::isfinite(c.y) && c.y >= 0.0) << "ice g " << ice_g << ": " << c.y;
-        EXPECT_LE(c.y, physics::f64::phase_hg(ice_g >= 0.0 ? 1.0 : -1.0, ice_g) * (1.0 + 1e-12)) << ice_g;
+        const MsPeaks c = ms_peaks(s);
+        EXPECT_TRUE(std::isfinite(c.liquid.cut) && c.liquid.cut >= 0.0) << "droplet " << d << " hg " << hg << ": " << c.liquid.cut;
+        EXPECT_TRUE(std::isfinite(c.ice.cut) && c.ice.cut >= 0.0) << "ice g " << ice_g << ": " << c.ice.cut;
+        EXPECT_LE(c.ice.cut, physics::f64::phase_hg(ice_g >= 0.0 ? 1.0 : -1.0, ice_g) * (1.0 + 1e-12)) << ice_g;
+        for (double pg : {c.liquid.g, c.ice.g}) EXPECT_TRUE(pg >= -1.0 && pg <= 1.0) << "droplet " << d << " ice g " << ice_g << ": " << pg;
       }
     }
   }
