@@ -207,6 +207,25 @@ TEST(TwoStream, PeakCutOfHenyeyGreensteinMatchesItsClosedForm) {
   }
   // g = 0.85: the peak is the scattering within about 41 degrees of forward.
   EXPECT_NEAR(ms_peak_cut([&](double mu) { return hg(mu, 0.85); }, 0.85 * 0.85), 0.07756, 1e-4);
+  // The peak's mean cosine, against a midpoint rule in mu over the closed-form cut's cap.
+  for (double g : {0.75, 0.85}) {
+    const MsPeak pk = ms_peak([&](double mu) { return hg(mu, g); }, g * g);
+    double lo = -1.0, hi = 1.0;
+    for (int i = 0; i < 200; ++i) {
+      const double m = 0.5 * (lo + hi);
+      const double share = (1.0 - g * g) / (2.0 * g) * (1.0 / (1.0 - g) - 1.0 / std::sqrt(1.0 + g * g - 2.0 * g * m));
+      (share - hg(m, g) * 2.0 * kPi * (1.0 - m) > g * g ? lo : hi) = m;
+    }
+    const double mu_c = 0.5 * (lo + hi), c = hg(mu_c, g);
+    double s0 = 0.0, s1 = 0.0;
+    const int n = 200000;
+    for (int i = 0; i < n; ++i) {
+      const double mu = mu_c + (1.0 - mu_c) * (i + 0.5) / n, w = std::max(hg(mu, g) - c, 0.0) * (1.0 - mu_c) / n;
+      s0 += w;
+      s1 += w * mu;
+    }
+    EXPECT_NEAR(pk.g, s1 / s0, 1e-3) << "g " << g;
+  }
   // No peak and all peak.
   EXPECT_DOUBLE_EQ(ms_peak_cut([&](double mu) { return hg(mu, 0.85); }, 0.0), hg(1.0, 0.85));
   EXPECT_EQ(ms_peak_cut([&](double mu) { return hg(mu, 0.85); }, 1.0), 0.0);
