@@ -60,7 +60,9 @@ test "$(ls "$dir/models"/ref_stratocumulus+modelled_24x14_*.cvref | wc -l)" -eq 
 test "$(ls "$dir/models"/ref_stratocumulus_24x14_*.cvref | wc -l)" -eq 1 || { echo "no reference of the data mode"; exit 1; }
 grep -q '"scene": "stratocumulus+modelled"' "$dir/models/quality_front.json" || { echo "the modelled scene is not in the front"; exit 1; }
 test -s "$dir/models/stratocumulus+modelled/err_default.png" || { echo "no error image of the modelled default"; exit 1; }
-# The modelled images differ from the data mode's (the default row's error is not the data row's).
-awk -F, '$2 == "default" { e[$1] = $13 } END { exit !(e["stratocumulus"] != e["stratocumulus+modelled"]) }' "$dir/models/results.csv" \
+# The modelled images differ from the data mode's (the default row's raw error, with the noise left
+# in, is not the data row's: the noise-corrected error of both can be clamped to 0 against a reference
+# of 2 spp once the model is close to it).
+awk -F, '$2 == "default" { e[$1] = $14 } END { exit !(e["stratocumulus"] != e["stratocumulus+modelled"]) }' "$dir/models/results.csv" \
   || { echo "the modelled rows are the data rows"; exit 1; }
 echo "bench smoke: $rows rows"
