@@ -479,8 +479,9 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
     // The two-stream model (docs/physics.md). Delta-Eddington takes the share f = g^2 of each
     // scattering as no scattering at all (the forward peak): the sun's beam is exp(-(1 - f) tau_sun)
     // and light on its way to the camera meets the scaled extinction sigma' = (1 - g^2) sigma. Along
-    // that path travel the sun's beam scattered toward the camera with the phase below the peak's cut
-    // (u_ms_peak_*), and the column's diffuse light I0 + I1 mu scattered by the truncated phase
+    // that path travel the sun's beam scattered toward the camera (its peak-scattered light spread,
+    // ms_beam_phase) with the phase below the peak's cut (u_ms_peak_*), and the column's diffuse
+    // light I0 + I1 mu scattered by the truncated phase
     // (mean cosine g' = g / (1 + g)): sigma' I0 + sigma' g' I1 mu_out, sigma' g' = g (1 - g) sigma,
     // mu_out the cosine of the outgoing direction -d to the vertical. The peak above the cut, where
     // the phase changes faster than the scaling's pass-through can follow (toward the sun), takes
@@ -490,8 +491,10 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
     real g_mix = (sl * g_liquid + si * g_ice) / sigma;
     if (lit) {
       real lambda = g_mix * g_mix * tau_sun;  // forward-peak scatterings the beam has met, on average
-      real p_liquid = ms_beam_phase(mu, u_liquid_phase_hg ? phase_hg(mu, g_liquid) : phase_mie(mu, mie), g_liquid, u_ms_peak_g_liquid, lambda);
-      real p_ice = ms_beam_phase(mu, phase_hg(mu, g_ice), g_ice, u_ms_peak_g_ice, lambda);
+      real p_liquid = real(0.0);
+      real p_ice = real(0.0);
+      if (sl > real(0.0)) p_liquid = ms_beam_phase(mu, u_liquid_phase_hg ? phase_hg(mu, g_liquid) : phase_mie(mu, mie), g_liquid, u_ms_peak_g_liquid, lambda);
+      if (si > real(0.0)) p_ice = ms_beam_phase(mu, phase_hg(mu, g_ice), g_ice, u_ms_peak_g_ice, lambda);
       real c_liquid = min(p_liquid, u_ms_peak_liquid);
       real c_ice = min(p_ice, u_ms_peak_ice);
       real beam = transmittance((real(1.0) - g_mix * g_mix) * tau_sun);
