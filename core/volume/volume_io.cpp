@@ -13,6 +13,9 @@
 #include <stdexcept>
 #include <unistd.h>
 
+#include "io/background_writer.hpp"
+#include "io/parallel.hpp"
+
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <cpuid.h>
 #include <immintrin.h>
@@ -38,6 +41,9 @@ MapArrays map_arrays(const Maps2D& m) {
            {"optical_depth", &m.optical_depth}, {"low_cover", &m.low_cover}, {"mid_cover", &m.mid_cover},
            {"high_cover", &m.high_cover}}};
 }
+// Outputs of at least this many field bytes are written with direct I/O (below it, the page cache's
+// copy is cheap and keeps the file cached for the render that usually follows).
+constexpr double kDirectWriteBytes = 64.0 * (1 << 20);
 // Stored value = SI value x this, for the float16 encoding (pressure in hPa: Pa would pass 65504).
 float half_scale(int field) {
   if (field == static_cast<int>(Field::Pressure)) return 0.01f;
@@ -148,7 +154,7 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
     times += std::string(t ? ", " : "") + "{\"iso_utc\": " + json_quote(v.times[t].iso_utc) +
              ", \"unix_s\": " + std::to_string(v.times[t].unix_s) + "}";
   }
-  const std::string header = "{\"format\": \"cvvol\", \"version\": 1,\n \"grid\": {\"lon_deg\": " + axis_json(v.grid.lon_deg) +
+  std::string header = "{\"format\": \"cvvol\", \"version\": 1,\n \"grid\": {\"lon_deg\": " + axis_json(v.grid.lon_deg) +
                              ", \"lat_deg\": " + axis_json(v.grid.lat_deg) + ", \"alt_m\": " + axis_json(v.grid.alt_m) +
                              ", \"earth_radius_m\": " + std::to_string(v.grid.earth_radius_m) + "},\n \"liquid_r_eff_um\": " +
                              std::to_string(v.liquid_r_eff_um) + ",\n" +
@@ -159,11 +165,25 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
                              "],\n \"layout\": \"" + (half ? "fields float16, maps float32" : "float32") +
                              " little-endian; per time step, each field (lon fastest, then lat, "
                              "then alt) then each map (lon fastest, then lat); NaN = no data\"}\n";
+  // Padded so the data starts 8-byte aligned (magic 8 + length 8 + header): the half floats are
+  // then converted in place in the write queue.
+  header.pop_back();  // the closing newline, put back after the spaces
+  header.append((8 - (16 + header.size() + 1) % 8) % 8, ' ');
+  header.push_back('\n');
   writer(path, [&](std::FILE* f) {
-    put(f, "CVVOL01\n");
+    // Through a writer thread: the disk writes a step while the next one is loaded, with direct
+    // I/O for outputs large enough that the page cache's copy costs more than it saves.
+    std::size_t fields_per_step = 0;
+    for (int i = 0; i < kFieldCount; ++i) fields_per_step += v.has_field[static_cast<std::size_t>(i)] ? 1 : 0;
+    const double bytes = static_cast<double>(v.grid.points()) * static_cast<double>(fields_per_step) *
+                         static_cast<double>(v.times.size()) * (half ? 2.0 : 4.0);
+    BackgroundWriter::Options wo;
+    wo.direct = bytes >= kDirectWriteBytes;
+    BackgroundWriter out(f, wo);
+    out.write("CVVOL01\n", 8);
     const std::uint64_t len = header.size();
-    put(f, &len, sizeof len);
-    put(f, header);
+    out.write(&len, sizeof len);
+    out.write(header.data(), header.size());
     for (std::size_t t = 0; t < v.times.size(); ++t) {
       if (progress) progress(t, v.times.size());
       const TimeStepData& d = v.step(t);
@@ -172,28 +192,44 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
         const auto& a = d.fields[static_cast<std::size_t>(i)];
         if (a.size() != v.grid.points()) throw std::runtime_error(std::string("field ") + field_name(static_cast<Field>(i)) + " has the wrong size");
         if (half) {
-          // Converted a slice at a time, so no second copy of the volume exists.
+          // Converted straight into the write queue's chunks, so no second copy of the volume exists.
           const float k = half_scale(i);
-          std::vector<std::uint16_t> buf(std::min<std::size_t>(a.size(), std::size_t(1) << 20));
-          for (std::size_t at = 0; at < a.size(); at += buf.size()) {
-            const std::size_t n = std::min(buf.size(), a.size() - at);
-            floats_to_halves(a.data() + at, k, buf.data(), n);
-            put(f, buf.data(), n * sizeof(std::uint16_t));
+          for (std::size_t at = 0; at < a.size();) {
+            const std::span<std::byte> r = out.room();
+            const std::size_t n = std::min(a.size() - at, r.size() / sizeof(std::uint16_t));
+            if (n == 0 || reinterpret_cast<std::uintptr_t>(r.data()) % alignof(std::uint16_t)) {
+              // Not at a half's alignment (cannot happen with the padded header; kept for safety):
+              // through a small buffer instead.
+              std::uint16_t h[256];
+              const std::size_t m = std::min<std::size_t>(a.size() - at, 256);
+              floats_to_halves(a.data() + at, k, h, m);
+              out.write(h, m * sizeof(std::uint16_t));
+              at += m;
+              continue;
+            }
+            std::uint16_t* dst = reinterpret_cast<std::uint16_t*>(r.data());
+            const float* src = a.data() + at;
+            parallel_ranges(n, std::size_t(1) << 20, [&](std::size_t b, std::size_t e, unsigned) {
+              floats_to_halves(src + b, k, dst + b, e - b);
+            });
+            out.commit(n * sizeof(std::uint16_t));
+            at += n;
           }
         } else {
-          put(f, a.data(), a.size() * sizeof(float));
+          out.write(a.data(), a.size() * sizeof(float));
         }
       }
-      for (const auto& [name, arr] : map_arrays(d.maps)) put(f, arr->data(), arr->size() * sizeof(float));
+      for (const auto& [name, arr] : map_arrays(d.maps)) out.write(arr->data(), arr->size() * sizeof(float));
       if (v.has_ground) {
         if (d.ground_m.size() == v.grid.columns()) {
-          put(f, d.ground_m.data(), d.ground_m.size() * sizeof(float));
+          out.write(d.ground_m.data(), d.ground_m.size() * sizeof(float));
         } else {
           const std::vector<float> unknown(v.grid.columns(), std::numeric_limits<float>::quiet_NaN());
-          put(f, unknown.data(), unknown.size() * sizeof(float));
+          out.write(unknown.data(), unknown.size() * sizeof(float));
         }
       }
     }
+    out.finish();
   });
 }
 }  // namespace
