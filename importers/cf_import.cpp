@@ -8,6 +8,7 @@
 #include <memory>
 #include <exception>
 #include <numeric>
+#include <optional>
 #include <thread>
 
 #include "checks.hpp"
@@ -17,6 +18,7 @@
 #include "wrf_import.hpp"
 #include "importer.hpp"
 #include "io/input_file.hpp"
+#include "io/parallel.hpp"
 #include "physics/physics.hpp"
 
 namespace cv::importers {
@@ -365,8 +367,14 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     }
     // Units to the conversion's: % to 0..1, g/kg to kg/kg.
     if (const double k = L.role_scale[r]; k != 1.0) {
-      for (float& x : slab[r].f) x = static_cast<float>(x * k);
-      for (double& x : slab[r].d) x *= k;
+      float* fv = slab[r].f.data();
+      double* dv = slab[r].d.data();
+      core::parallel_ranges(slab[r].f.size(), std::size_t(1) << 22, [&](std::size_t b, std::size_t e, unsigned) {
+        for (std::size_t i = b; i < e; ++i) fv[i] = static_cast<float>(fv[i] * k);
+      });
+      core::parallel_ranges(slab[r].d.size(), std::size_t(1) << 22, [&](std::size_t b, std::size_t e, unsigned) {
+        for (std::size_t i = b; i < e; ++i) dv[i] *= k;
+      });
       const std::string what = "x " + fmt(k) + " (units '" + use.units + "'); ";
       if (use.conversion.find(what) == std::string::npos) use.conversion += what;
     }
@@ -389,8 +397,13 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   const bool has_cf = have[static_cast<int>(Role::CloudFraction)];
   auto alloc = [&](core::Field f, bool on) {
     if (on) {
+      // Filled on every core: a fresh global field is 190 MB of pages to touch.
       core::reserve_huge(out[f], grid.points());
-      out[f].assign(grid.points(), std::numeric_limits<float>::quiet_NaN());
+      out[f].resize(grid.points());
+      float* d = out[f].data();
+      core::parallel_ranges(grid.points(), std::size_t(1) << 22, [&](std::size_t b, std::size_t e, unsigned) {
+        std::fill(d + b, d + e, std::numeric_limits<float>::quiet_NaN());
+      });
     }
     else out[f].clear();
   };
@@ -808,27 +821,58 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
     const NcVar* zv = L.roles[static_cast<int>(Role::Geopotential)];
     const NcVar* ghv = L.roles[static_cast<int>(Role::GeopotentialHeight)];
     std::vector<double> thick;
+    std::optional<double> median_thickness;
     if (zv || ghv) {
-      const Slab s = read_slab(*S, zv ? *zv : *ghv, S->steps.front(), nullptr, true);
-      for (int y = 0; y < probe.lat_deg.count; ++y) {
-        for (int x = 0; x < probe.lon_deg.count; ++x) {
-          double prev = kNaN;
-          for (std::size_t l = 0; l < S->levels.size(); ++l) {
-            const std::size_t yy = static_cast<std::size_t>(y);
-            const int row = S->lat.w[yy] == 1.0 ? S->lat.j1[yy] : S->lat.j0[yy];  // a row the read holds
-            const double raw = s.at(S->lon.src[static_cast<std::size_t>(x)], row, S->levels[l]);
-            const double zz = physics::f64::geopotential_to_height_m(zv ? raw : kG0 * raw, vol.grid.earth_radius_m);
-            if (std::isnan(zz)) continue;
-            if (zz < -1000.0 || zz > 1.0e5) {
-              throw ImportError(path + ": variable '" + (zv ? zv : ghv)->name + "' has value " + fmt(raw) +
-                                " (a height of " + fmt(zz) + " m), expected a height between -1 km and 100 km");
+      // Read into the step loader's slab, whose memory the first step then reuses (fresh pages
+      // cost more than the reading).
+      const Role zr = zv ? Role::Geopotential : Role::GeopotentialHeight;
+      Slab& s = S->scratch[static_cast<std::size_t>(zr)];
+      read_slab_into(s, *S, zv ? *zv : *ghv, S->steps.front(), nullptr, true);
+      // Each column's level heights, bottom up, to `visit(raw value, height, thickness below or NaN)`.
+      auto heights = [&](auto&& visit) {
+        for (int y = 0; y < probe.lat_deg.count; ++y) {
+          for (int x = 0; x < probe.lon_deg.count; ++x) {
+            double prev = kNaN;
+            for (std::size_t l = 0; l < S->levels.size(); ++l) {
+              const std::size_t yy = static_cast<std::size_t>(y);
+              const int row = S->lat.w[yy] == 1.0 ? S->lat.j1[yy] : S->lat.j0[yy];  // a row the read holds
+              const double raw = s.at(S->lon.src[static_cast<std::size_t>(x)], row, S->levels[l]);
+              const double zz = physics::f64::geopotential_to_height_m(zv ? raw : kG0 * raw, vol.grid.earth_radius_m);
+              if (std::isnan(zz)) continue;
+              visit(raw, zz, !std::isnan(prev) && zz > prev ? zz - prev : kNaN);
+              prev = zz;
             }
-            zmin = std::min(zmin, zz);
-            zmax = std::max(zmax, zz);
-            if (!std::isnan(prev) && zz > prev) thick.push_back(zz - prev);
-            prev = zz;
           }
         }
+      };
+      // The median thickness exactly (the element a full sort would put in the middle) without
+      // storing 10^7 thicknesses: a first pass counts them in 1 m bins, a second keeps only the
+      // median's bin.
+      constexpr double kBinM = 1.0;
+      constexpr std::size_t kBins = 200000;  // thicknesses up to 200 km: the heights are checked to 100 km
+      std::vector<std::size_t> bins(kBins, 0);
+      std::size_t n_thick = 0;
+      heights([&](double raw, double zz, double t) {
+        if (zz < -1000.0 || zz > 1.0e5) {
+          throw ImportError(path + ": variable '" + (zv ? zv : ghv)->name + "' has value " + fmt(raw) + " (a height of " +
+                            fmt(zz) + " m), expected a height between -1 km and 100 km");
+        }
+        zmin = std::min(zmin, zz);
+        zmax = std::max(zmax, zz);
+        if (!std::isnan(t)) ++bins[std::min(kBins - 1, static_cast<std::size_t>(t / kBinM))], ++n_thick;
+      });
+      if (n_thick) {
+        const std::size_t mid = n_thick / 2;  // the index of the median in sorted order
+        std::size_t below = 0, bin = 0;
+        while (below + bins[bin] <= mid) below += bins[bin++];
+        std::vector<double> in_bin;
+        in_bin.reserve(bins[bin]);
+        heights([&](double, double, double t) {
+          if (!std::isnan(t) && std::min(kBins - 1, static_cast<std::size_t>(t / kBinM)) == bin) in_bin.push_back(t);
+        });
+        const auto at = in_bin.begin() + static_cast<std::ptrdiff_t>(mid - below);
+        std::nth_element(in_bin.begin(), at, in_bin.end());
+        median_thickness = *at;
       }
     } else {
       // Height levels are their own heights; pressure and hybrid levels take the standard
@@ -862,9 +906,12 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
     if (!(zmax > zmin)) throw ImportError(path + ": the levels' heights span no altitude range");
     double dz = options.dz_m;
     if (dz <= 0.0) {
-      // The median (the element a full sort would put in the middle), without sorting 10^7 values.
-      if (!thick.empty()) std::nth_element(thick.begin(), thick.begin() + static_cast<std::ptrdiff_t>(thick.size() / 2), thick.end());
-      const double median = thick.empty() ? 500.0 : thick[thick.size() / 2];
+      // The median (the element a full sort would put in the middle), without sorting.
+      if (!median_thickness && !thick.empty()) {
+        std::nth_element(thick.begin(), thick.begin() + static_cast<std::ptrdiff_t>(thick.size() / 2), thick.end());
+        median_thickness = thick[thick.size() / 2];
+      }
+      const double median = median_thickness.value_or(500.0);
       dz = std::clamp(median / 2.0, 50.0, 500.0);
     }
     zmin = std::max(zmin, -500.0);

@@ -1,6 +1,8 @@
 // CloudVolume: grid helpers, derived maps, and the lazy time-step cache.
 #include "volume/cloud_volume.hpp"
 
+#include "io/parallel.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -67,57 +69,60 @@ void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& o
     double ground = 0.0;
     bool any_data = false;
   };
-  std::vector<ColumnState> row(static_cast<std::size_t>(nx));
-  for (int j = 0; j < grid.lat_deg.count; ++j) {
-    for (int i = 0; i < nx; ++i) {
-      ColumnState& st = row[static_cast<std::size_t>(i)];
-      st = ColumnState{};
-      // Layers by height above the ground where the terrain is known, above sea level otherwise.
-      const std::size_t col = grid.column(i, j);
-      st.ground = col < data.ground_m.size() && std::isfinite(data.ground_m[col]) ? data.ground_m[col] : 0.0;
-    }
-    for (int k = grid.alt_m.count - 1; k >= 0; --k) {
-      const double alt = grid.alt_m.at(k);
-      const std::size_t p0 = grid.index(0, j, k);
+  // Rows are independent: split over the cores.
+  parallel_ranges(static_cast<std::size_t>(grid.lat_deg.count), 16, [&](std::size_t j_begin, std::size_t j_end, unsigned) {
+    std::vector<ColumnState> row(static_cast<std::size_t>(nx));
+    for (int j = static_cast<int>(j_begin); j < static_cast<int>(j_end); ++j) {
       for (int i = 0; i < nx; ++i) {
         ColumnState& st = row[static_cast<std::size_t>(i)];
-        const std::size_t p = p0 + static_cast<std::size_t>(i);
-        const double ext = (el.empty() || std::isnan(el[p]) ? 0.0 : el[p]) + (ei.empty() || std::isnan(ei[p]) ? 0.0 : ei[p]);
-        const bool have = (!cf.empty() && !std::isnan(cf[p])) || (!el.empty() && !std::isnan(el[p])) ||
-                          (!ei.empty() && !std::isnan(ei[p]));
-        if (!have) continue;
-        st.any_data = true;
-        // Without a cloud-fraction field, a point with water counts as fully cloudy.
-        const double frac = cf.empty() || std::isnan(cf[p]) ? (ext > 0.0 ? 1.0 : 0.0) : cf[p];
-        const bool cloudy = map_cloudy(frac, ext, options);
-        const double c = cloudy ? frac : 0.0;
-        const double above = alt - st.ground;
-        MaxRandomOverlap& layer = above < options.low_top_m ? st.low : above < options.mid_top_m ? st.mid : st.high;
-        if (cloudy) {
-          st.all.add(c);
-          layer.add(c);
-          st.tau += c * ext * dz;
-          st.top = std::isnan(st.top) ? alt : st.top;
-          st.base = alt;
-        } else {
-          st.all.gap();
-          layer.gap();
+        st = ColumnState{};
+        // Layers by height above the ground where the terrain is known, above sea level otherwise.
+        const std::size_t col = grid.column(i, j);
+        st.ground = col < data.ground_m.size() && std::isfinite(data.ground_m[col]) ? data.ground_m[col] : 0.0;
+      }
+      for (int k = grid.alt_m.count - 1; k >= 0; --k) {
+        const double alt = grid.alt_m.at(k);
+        const std::size_t p0 = grid.index(0, j, k);
+        for (int i = 0; i < nx; ++i) {
+          ColumnState& st = row[static_cast<std::size_t>(i)];
+          const std::size_t p = p0 + static_cast<std::size_t>(i);
+          const double ext = (el.empty() || std::isnan(el[p]) ? 0.0 : el[p]) + (ei.empty() || std::isnan(ei[p]) ? 0.0 : ei[p]);
+          const bool have = (!cf.empty() && !std::isnan(cf[p])) || (!el.empty() && !std::isnan(el[p])) ||
+                            (!ei.empty() && !std::isnan(ei[p]));
+          if (!have) continue;
+          st.any_data = true;
+          // Without a cloud-fraction field, a point with water counts as fully cloudy.
+          const double frac = cf.empty() || std::isnan(cf[p]) ? (ext > 0.0 ? 1.0 : 0.0) : cf[p];
+          const bool cloudy = map_cloudy(frac, ext, options);
+          const double c = cloudy ? frac : 0.0;
+          const double above = alt - st.ground;
+          MaxRandomOverlap& layer = above < options.low_top_m ? st.low : above < options.mid_top_m ? st.mid : st.high;
+          if (cloudy) {
+            st.all.add(c);
+            layer.add(c);
+            st.tau += c * ext * dz;
+            st.top = std::isnan(st.top) ? alt : st.top;
+            st.base = alt;
+          } else {
+            st.all.gap();
+            layer.gap();
+          }
         }
       }
+      for (int i = 0; i < nx; ++i) {
+        const ColumnState& st = row[static_cast<std::size_t>(i)];
+        if (!st.any_data) continue;
+        const std::size_t col = grid.column(i, j);
+        m.cloud_cover[col] = static_cast<float>(st.all.cover());
+        m.low_cover[col] = static_cast<float>(st.low.cover());
+        m.mid_cover[col] = static_cast<float>(st.mid.cover());
+        m.high_cover[col] = static_cast<float>(st.high.cover());
+        m.optical_depth[col] = static_cast<float>(st.tau);
+        m.cloud_base_m[col] = static_cast<float>(st.base);
+        m.cloud_top_m[col] = static_cast<float>(st.top);
+      }
     }
-    for (int i = 0; i < nx; ++i) {
-      const ColumnState& st = row[static_cast<std::size_t>(i)];
-      if (!st.any_data) continue;
-      const std::size_t col = grid.column(i, j);
-      m.cloud_cover[col] = static_cast<float>(st.all.cover());
-      m.low_cover[col] = static_cast<float>(st.low.cover());
-      m.mid_cover[col] = static_cast<float>(st.mid.cover());
-      m.high_cover[col] = static_cast<float>(st.high.cover());
-      m.optical_depth[col] = static_cast<float>(st.tau);
-      m.cloud_base_m[col] = static_cast<float>(st.base);
-      m.cloud_top_m[col] = static_cast<float>(st.top);
-    }
-  }
+  });
 }
 
 void CloudVolume::set_loader(Loader loader, std::size_t cache_steps) {
