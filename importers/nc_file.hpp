@@ -106,6 +106,9 @@ class NcFile {
   void get_doubles(const NcVar& v, const std::vector<std::size_t>& start, const std::vector<std::size_t>& count,
                    double* out, std::size_t n) const;
   void get_text(const NcVar& v, char* out, std::size_t n) const;
+  // The checks every read makes (indices, size, type, memory limit); returns the values asked for.
+  std::size_t checked_read_count(const NcVar& v, const std::vector<std::size_t>& start,
+                                 const std::vector<std::size_t>& count) const;
   // Sends a request and receives its status, or throws naming `what` when the reader died or hung.
   int ask_reader(const std::string& request, const std::string& what) const;
   // opening: the header, under the open wait (CLOUDVIEWER_OPEN_TIMEOUT_S), else a read's wait.

@@ -531,3 +531,92 @@ TEST_F(HostileImport, TheReaderProcessGivesNetcdfsOwnValues) {
 }
 
 }  // namespace
+
+namespace {
+using cv::test::NcBuilder;
+
+// int16 variables of classic files are read straight to float (NcFile::read_float_into's short
+// path, one pass with SSE2); every value, fill and range rule must come out as the general path
+// (netCDF's doubles, unpacked in double) rounded to float, and the missing count the same.
+TEST(NcShortReads, UnpackToTheSameFloatsAsTheDoublePath) {
+  const fs::path dir = fs::temp_directory_path() / ("cv_short_reads_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  // Every int16 value once, in a 2 x 3 x 127 x 86 array (not a multiple of the SIMD width per row).
+  const std::size_t nt = 2, nz = 3, ny = 127, nx = 86, n = nt * nz * ny * nx;
+  std::vector<short> raw(n);
+  for (std::size_t i = 0; i < n; ++i) raw[i] = static_cast<short>(static_cast<int>(i % 65536) - 32768);
+  struct Case {
+    const char* name;
+    int mode;
+    bool fill, missing, range, pack;
+  };
+  const Case cases[] = {
+      {"fill_packed", NC_CLOBBER | NC_64BIT_OFFSET, true, false, false, true},
+      {"fill_missing_range", NC_CLOBBER | NC_64BIT_OFFSET, true, true, true, true},
+      {"default_fill_unpacked", NC_CLOBBER | NC_64BIT_OFFSET, false, false, false, false},
+      {"netcdf4_reader_process", NC_CLOBBER | NC_NETCDF4, true, true, false, true},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string p = (dir / (std::string(c.name) + ".nc")).string();
+    {
+      NcBuilder b(p, c.mode);
+      const int t = b.dim("time", nt), z = b.dim("level", nz), y = b.dim("lat", ny), x = b.dim("lon", nx);
+      const int v = b.var("q", NC_SHORT, {t, z, y, x});
+      if (c.fill) b.number(v, "_FillValue", NC_SHORT, {-32767});
+      if (c.missing) b.number(v, "missing_value", NC_SHORT, {12345});
+      if (c.range) b.number(v, "valid_range", NC_SHORT, {-30000, 30000});
+      if (c.pack) {
+        b.number(v, "scale_factor", NC_DOUBLE, {1.52597204419215e-08});
+        b.number(v, "add_offset", NC_DOUBLE, {0.0005});
+      }
+      b.put_short(v, raw);
+      b.close();
+    }
+    importers::NcFile f(p);
+    const importers::NcVar& v = f.var("q");
+    // The whole variable, and a hyperslab that starts inside it.
+    for (const auto& [start, count] :
+         std::vector<std::pair<std::vector<std::size_t>, std::vector<std::size_t>>>{{{0, 0, 0, 0}, {nt, nz, ny, nx}},
+                                                                                     {{1, 1, 3, 5}, {1, 2, 101, 77}}}) {
+      importers::UnpackInfo as_double_info, as_float_info;
+      std::vector<double> d;
+      f.read_into(d, v, start, count, &as_double_info);
+      std::vector<float> fl;
+      f.read_float_into(fl, v, start, count, &as_float_info);
+      ASSERT_EQ(fl.size(), d.size());
+      std::size_t nan = 0;
+      for (std::size_t i = 0; i < d.size(); ++i) {
+        if (std::isnan(d[i])) {
+          ++nan;
+          ASSERT_TRUE(std::isnan(fl[i])) << "at " << i;
+        } else {
+          ASSERT_EQ(fl[i], static_cast<float>(d[i])) << "at " << i;
+        }
+      }
+      if (start[0] == 0) {
+        // Against CF's rules directly: markers and the valid range in the packed domain, then
+        // x * scale + offset.
+        EXPECT_GT(nan, 0u);  // the whole variable holds the fill value
+        const double scale = c.pack ? 1.52597204419215e-08 : 1.0, offset = c.pack ? 0.0005 : 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+          const int r = raw[i];
+          const bool missing = r == -32767 || (c.missing && r == 12345) || (c.range && (r < -30000 || r > 30000));
+          if (missing) {
+            ASSERT_TRUE(std::isnan(fl[i])) << "raw " << r;
+          } else {
+            ASSERT_EQ(fl[i], static_cast<float>(r * scale + offset)) << "raw " << r;
+          }
+        }
+      }
+      EXPECT_EQ(as_float_info.missing, as_double_info.missing);
+      EXPECT_EQ(as_float_info.missing, nan);
+      EXPECT_EQ(as_float_info.packed, as_double_info.packed);
+      EXPECT_EQ(as_float_info.scale, as_double_info.scale);
+      EXPECT_EQ(as_float_info.offset, as_double_info.offset);
+    }
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
