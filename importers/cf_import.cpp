@@ -398,7 +398,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   auto alloc = [&](core::Field f, bool on) {
     if (on) {
       // Filled on every core: a fresh global field is 190 MB of pages to touch.
-      core::reserve_huge(out[f], grid.points());
+      core::reserve_exact(out[f], grid.points());
       out[f].resize(grid.points());
       float* d = out[f].data();
       core::parallel_ranges(grid.points(), std::size_t(1) << 22, [&](std::size_t b, std::size_t e, unsigned) {

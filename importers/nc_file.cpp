@@ -753,7 +753,7 @@ void NcFile::read_into(std::vector<double>& out, const NcVar& v, std::vector<std
   whole_if_empty(v, start, count);
   const std::size_t n = checked_read_count(v, start, count);
   // Every value is written by get_doubles: a buffer of the right size is not cleared first.
-  core::reserve_huge(out, n);
+  core::reserve_exact(out, n);
   if (out.size() != n) out.resize(n);
   if (n == 0) return;
   get_doubles(v, start, count, out.data(), n);
@@ -849,7 +849,7 @@ void NcFile::read_float_into(std::vector<float>& out, const NcVar& v, std::vecto
       // Straight from the file's int16 to float, in one pass: the values and the arithmetic are
       // those of read_into (x * scale + offset in double, then rounded to float).
       const std::size_t m = checked_read_count(v, s, n);
-      core::reserve_huge(raw, m);
+      core::reserve_exact(raw, m);
       raw.resize(m);
       if (m) {
         if (const int st = nc_get_vara_short(id_, v.id, s.data(), n.data(), raw.data()); st != NC_NOERR) {
@@ -857,7 +857,7 @@ void NcFile::read_float_into(std::vector<float>& out, const NcVar& v, std::vecto
         }
       }
       if (c == 0 && out.size() != m * chunks) {
-        core::reserve_huge(out, m * chunks);
+        core::reserve_exact(out, m * chunks);
         out.resize(m * chunks);
       }
       const double lo = rules.lo, hi = rules.hi, scale = rules.scale, offset = rules.offset;
@@ -913,7 +913,7 @@ void NcFile::read_float_into(std::vector<float>& out, const NcVar& v, std::vecto
     }
     read_into(d, v, s, n, &part);
     if (c == 0 && out.size() != d.size() * chunks) {
-      core::reserve_huge(out, d.size() * chunks);
+      core::reserve_exact(out, d.size() * chunks);
       out.resize(d.size() * chunks);
     }
     float* o = out.data() + filled;

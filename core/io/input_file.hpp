@@ -57,19 +57,18 @@ std::string byte_size_text(double bytes);
 // (CLOUDVIEWER_MEMORY_LIMIT)" when `bytes` (nothing: an overflowing product) exceeds the limit.
 void require_within_memory_limit(const std::string& source, const std::string& what, std::optional<std::uint64_t> bytes);
 
-// Asks the kernel to back [p, p + bytes) with transparent huge pages (Linux, madvise
-// MADV_HUGEPAGE on its 2 MiB-aligned part; advice only, nothing happens elsewhere or on failure).
-// A global step's arrays are hundreds of megabytes: touched first 4 KiB at a time, a global import
-// spent 3.5 s of its 25 in page faults.
-void advise_huge_pages(const void* p, std::size_t bytes);
-// Makes room for n values in v with huge pages advised, before any is written; v's old contents
-// are dropped when it has to grow (for buffers whose every value the caller writes next).
+// Makes room for exactly n values in v before any is written; v's old contents are dropped when it
+// has to grow (for buffers whose every value the caller writes next, reused step to step).
+//
+// No transparent huge pages are asked for here any more. They were (madvise MADV_HUGEPAGE): fewer
+// page faults, but with the kernel's usual defrag setting ("madvise") each fault in an advised
+// region compacts memory synchronously, and once the page cache had fragmented memory the global
+// import took 14 s instead of 10 (docs/BENCHMARKS.md, "Import: direct writes").
 template <typename T>
-void reserve_huge(std::vector<T>& v, std::size_t n) {
+void reserve_exact(std::vector<T>& v, std::size_t n) {
   if (v.capacity() >= n) return;
   std::vector<T>().swap(v);
   v.reserve(n);
-  advise_huge_pages(v.data(), n * sizeof(T));
 }
 
 }  // namespace cv::core
