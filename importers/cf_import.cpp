@@ -332,7 +332,8 @@ Slab read_slab(const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* 
 // What one conversion worker owns: a row of level samples, the running state of the hypsometric
 // integration up each column, its consistency counts, and the error that stopped it, if any.
 struct RowWork {
-  std::vector<LevelSample> row;
+  RowLevels levels;  // the row's level samples, level-major
+  StoredStats stored;  // ranges of the values the row's conversion stored
   std::vector<double> z_prev, p_prev, tv_prev;
   std::size_t negative_water = 0, clamped_cf = 0;
   double worst_negative = 0.0;
@@ -445,8 +446,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
       const int k = S.levels[static_cast<std::size_t>(l)];
       for (int x = 0; x < nx; ++x) {
         const int i = S.lon.src[static_cast<std::size_t>(x)];
-        LevelSample& c = W.row[static_cast<std::size_t>(x) * static_cast<std::size_t>(nlev) + static_cast<std::size_t>(l)];
-        c = LevelSample{};
+        LevelSample c;
         const std::size_t L_ = static_cast<std::size_t>(l), X_ = static_cast<std::size_t>(x);
         // The surface where the file gives it: as a geopotential height (hypsometric start) and as a
         // geometric altitude (heights above ground). A surface_altitude variable is the latter already.
@@ -548,6 +548,10 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
           const double rho = c.p_pa / (kRd * c.t_k * (1.0 + 0.608 * c.qv));
           c.w = -value(Role::Omega, i, j0, j1, w, k) / (rho * kG0);
         }
+        RowLevels& R = W.levels;
+        const std::size_t at = R.at(l, x);
+        R.z_m[at] = c.z_m, R.p_pa[at] = c.p_pa, R.t_k[at] = c.t_k, R.qv[at] = c.qv, R.cf[at] = c.cf;
+        R.q_liquid[at] = c.q_liquid, R.q_ice[at] = c.q_ice, R.u[at] = c.u, R.v[at] = c.v, R.w[at] = c.w;
       }
     }
     if (L.surface_geopotential) {
@@ -557,18 +561,14 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
         out.ground_m[grid.column(x, y)] = static_cast<float>(zg);
       }
     }
-    for (int x = 0; x < nx; ++x) {
-      place_column(std::span<LevelSample>(W.row).subspan(static_cast<std::size_t>(x) * static_cast<std::size_t>(nlev),
-                                                       static_cast<std::size_t>(nlev)),
-                   grid, x, y, conv, out, W.counts);
-    }
+    place_row(W.levels, grid, 0, y, conv, out, W.counts, &W.stored);
     };
   unsigned hw = std::max(1u, std::thread::hardware_concurrency());
   if (const char* env = std::getenv("CLOUDVIEWER_THREADS"); env && std::atoi(env) > 0) hw = static_cast<unsigned>(std::atoi(env));
   const int workers = static_cast<int>(std::min<unsigned>(std::min(hw, 8u), static_cast<unsigned>(std::max(1, ny / 4))));
   std::vector<RowWork> work(static_cast<std::size_t>(workers));
   for (auto& W : work) {
-    W.row.resize(static_cast<std::size_t>(nx) * static_cast<std::size_t>(nlev));
+    W.levels.resize(nx, nlev);
     W.z_prev.resize(row_len), W.p_prev.resize(row_len), W.tv_prev.resize(row_len);
   }
   auto run = [&](int wid) {
@@ -586,20 +586,24 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   std::size_t negative_water = 0, clamped_cf = 0;
   double worst_negative = 0.0;
   ColumnCounts counts;
+  StoredStats stored;
   for (auto& W : work) {
     if (W.error) std::rethrow_exception(W.error);
     negative_water += W.negative_water;
     clamped_cf += W.clamped_cf;
     worst_negative = std::min(worst_negative, W.worst_negative);
     counts.merge(W.counts);
+    for (std::size_t f = 0; f < stored.size(); ++f) stored[f].merge(W.stored[f]);
   }
+  // Every point the conversion did not store (no level pair around it) holds NaN: missing.
+  for (auto& st : stored) st.missing = grid.points() - st.count;
   // Report: SI ranges, conversions, consistency.
   const double r_l = S.options.r_eff_liquid_um;
   auto after = [&](Role r, core::Field f, const std::string& conv) {
     if (!have[static_cast<int>(r)]) return;
     auto& use = report.use(role_name(r));
     if (use.conversion.find(conv) == std::string::npos) use.conversion += conv;
-    use.after.add_all(out[f].data(), out[f].size());
+    use.after.merge(stored[static_cast<std::size_t>(f)]);
     use.after_units = core::field_units(f);
   };
   after(Role::Liquid, core::Field::ExtinctionLiquid,
@@ -616,7 +620,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
                                                 : L.roles[static_cast<int>(Role::Humidity)]->name;
     use.units = L.roles[static_cast<int>(has(Role::RelativeHumidity) ? Role::RelativeHumidity : Role::Humidity)]->text("units");
     use.conversion = S.scheme_text;
-    use.after.add_all(out[core::Field::CloudFraction].data(), out[core::Field::CloudFraction].size());
+    use.after.merge(stored[static_cast<std::size_t>(core::Field::CloudFraction)]);
     use.after_units = "cloud fraction";
   }
   after(Role::U, core::Field::WindU, "interpolated in altitude");

@@ -38,67 +38,87 @@ core::RegularAxis altitude_axis(double zmin_m, double zmax_m, double dz_m, bool 
   return {zmin_m, dz, intervals + 1};
 }
 
-void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, int x, int y,
-                  const ConversionOptions& options, core::TimeStepData& out, ColumnCounts& counts) {
-  const int n = static_cast<int>(levels.size());
-  // Per level: SI quantities in the order of core::Field (a per-thread buffer, reused). The two
-  // extinctions are grid-box means here; they become in-cloud values node by node below.
+void RowLevels::resize(int columns, int levels) {
+  nx = columns, nlev = levels;
+  const std::size_t n = static_cast<std::size_t>(columns) * static_cast<std::size_t>(levels);
+  for (auto* a : {&z_m, &p_pa, &t_k, &qv, &cf, &q_liquid, &q_ice, &u, &v, &w}) a->resize(n);
+}
+
+void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, const ConversionOptions& options,
+               core::TimeStepData& out, ColumnCounts& counts, StoredStats* stored) {
+  const int n = r.nlev, nx = r.nx, nz = grid.alt_m.count;
+  const std::size_t plane = static_cast<std::size_t>(n) * static_cast<std::size_t>(nx);
+  // Per level and column: SI quantities in the order of core::Field, level-major like `r` (a
+  // per-thread buffer, reused). The two extinctions are grid-box means here; they become in-cloud
+  // values node by node below.
   thread_local std::vector<double> buffer;
-  buffer.resize(static_cast<std::size_t>(core::kFieldCount) * static_cast<std::size_t>(n));
-  auto q = [&](int f) { return buffer.data() + static_cast<std::size_t>(f) * static_cast<std::size_t>(n); };
+  buffer.resize(static_cast<std::size_t>(core::kFieldCount) * plane);
+  auto q = [&](int f) { return buffer.data() + static_cast<std::size_t>(f) * plane; };
   constexpr int kLiq = static_cast<int>(core::Field::ExtinctionLiquid), kIce = static_cast<int>(core::Field::ExtinctionIce),
                 kCf = static_cast<int>(core::Field::CloudFraction);
-  for (int l = 0; l < n; ++l) {
-    LevelSample& s = levels[static_cast<std::size_t>(l)];
-    const double rho = s.p_pa / (kRdJPerKgK * s.t_k * (1.0 + 0.608 * s.qv));
-    const double total = (std::isnan(s.q_liquid) ? 0.0 : s.q_liquid) + (std::isnan(s.q_ice) ? 0.0 : s.q_ice);
+  const double r_liq_m = options.r_eff_liquid_um * 1e-6;
+  for (std::size_t i = 0; i < plane; ++i) {
+    const double p = r.p_pa[i], t = r.t_k[i], ql = r.q_liquid[i], qi = r.q_ice[i], cf = r.cf[i];
+    const double rho = p / (kRdJPerKgK * t * (1.0 + 0.608 * r.qv[i]));
+    const double total = (std::isnan(ql) ? 0.0 : ql) + (std::isnan(qi) ? 0.0 : qi);
     // A box's water counts only where its fraction says there is cloud to hold it.
     double keep = 1.0;
-    if (!std::isnan(s.cf)) {
-      if (total > 0.0 && s.cf < kZeroCloudFraction) {
+    if (!std::isnan(cf)) {
+      if (total > 0.0 && cf < kZeroCloudFraction) {
         ++counts.water_without_cf;
         if (total > kZeroWater) ++counts.water_without_cf_significant;
         counts.most_water_without_cf = std::max(counts.most_water_without_cf, total);
         keep = 0.0;
       }
-      if (s.cf > 0.1 && total <= kZeroWater) ++counts.cf_without_water;
+      if (cf > 0.1 && total <= kZeroWater) ++counts.cf_without_water;
     }
-    const double r_liq_m = options.r_eff_liquid_um * 1e-6;
-    const double r_ice_m = (options.r_eff_ice_um > 0 ? options.r_eff_ice_um : ice_effective_radius_um(s.t_k)) * 1e-6;
-    q(kLiq)[l] = std::isnan(s.q_liquid) ? kNaN : keep * 3.0 * rho * s.q_liquid / (2.0 * kRhoWater * r_liq_m);
-    q(kIce)[l] = std::isnan(s.q_ice) ? kNaN : keep * 3.0 * rho * s.q_ice / (2.0 * kRhoIce * r_ice_m);
-    q(kCf)[l] = s.cf;
-    q(static_cast<int>(core::Field::WindU))[l] = s.u;
-    q(static_cast<int>(core::Field::WindV))[l] = s.v;
-    q(static_cast<int>(core::Field::WindW))[l] = s.w;
-    q(static_cast<int>(core::Field::Temperature))[l] = s.t_k;
+    q(kLiq)[i] = std::isnan(ql) ? kNaN : keep * 3.0 * rho * ql / (2.0 * kRhoWater * r_liq_m);
+    if (!std::isnan(qi)) {
+      const double r_ice_m = (options.r_eff_ice_um > 0 ? options.r_eff_ice_um : ice_effective_radius_um(t)) * 1e-6;
+      q(kIce)[i] = keep * 3.0 * rho * qi / (2.0 * kRhoIce * r_ice_m);
+    } else {
+      q(kIce)[i] = kNaN;
+    }
+    q(kCf)[i] = cf;
+    q(static_cast<int>(core::Field::WindU))[i] = r.u[i];
+    q(static_cast<int>(core::Field::WindV))[i] = r.v[i];
+    q(static_cast<int>(core::Field::WindW))[i] = r.w[i];
+    q(static_cast<int>(core::Field::Temperature))[i] = t;
     // Pressure is interpolated in its logarithm (exact in an isothermal layer), turned back below.
-    q(static_cast<int>(core::Field::Pressure))[l] = s.p_pa > 0.0 ? std::log(s.p_pa) : kNaN;
+    q(static_cast<int>(core::Field::Pressure))[i] = p > 0.0 ? std::log(p) : kNaN;
   }
   for (int l = 1; l < n; ++l) {
-    if (!(levels[static_cast<std::size_t>(l)].z_m > levels[static_cast<std::size_t>(l - 1)].z_m)) ++counts.nonmonotonic;
+    for (int x = 0; x < nx; ++x) {
+      if (!(r.z_m[r.at(l, x)] > r.z_m[r.at(l - 1, x)])) ++counts.nonmonotonic;
+    }
   }
   const bool has_cf = !out.fields[static_cast<std::size_t>(kCf)].empty();
-  // Linear interpolation in altitude; outside the column's levels: no data. A node within a
+  // Linear interpolation in altitude; outside a column's levels: no data. A node within a
   // micrometre of the top level (the axis was fitted to end there) takes the top level's value.
-  // First each node's level pair and weight, then field by field over the nodes.
-  const double z_top = n > 0 ? levels[static_cast<std::size_t>(n - 1)].z_m : kNaN;
+  // First each node's level pair and weight (node-major, like the output's layers), then field by
+  // field, node by node, along the row.
   thread_local std::vector<int> node_level;
   thread_local std::vector<double> node_weight;
-  node_level.assign(static_cast<std::size_t>(grid.alt_m.count), -1);
-  node_weight.resize(static_cast<std::size_t>(grid.alt_m.count));
-  int l = 1;
-  for (int z = 0; z < grid.alt_m.count; ++z) {
-    double alt = grid.alt_m.at(z);
-    if (alt > z_top && alt - z_top < 1e-6) alt = z_top;
-    while (l < n && !(levels[static_cast<std::size_t>(l)].z_m >= alt)) ++l;
-    if (l >= n) break;
-    const double z0 = levels[static_cast<std::size_t>(l - 1)].z_m, z1 = levels[static_cast<std::size_t>(l)].z_m;
-    if (!(z0 <= alt) || !(z1 > z0)) continue;
-    node_level[static_cast<std::size_t>(z)] = l;
-    node_weight[static_cast<std::size_t>(z)] = (alt - z0) / (z1 - z0);
+  const std::size_t nodes = static_cast<std::size_t>(nz) * static_cast<std::size_t>(nx);
+  node_level.assign(nodes, -1);
+  node_weight.resize(nodes);
+  for (int x = 0; x < nx; ++x) {
+    auto zl = [&](int l) { return r.z_m[r.at(l, x)]; };
+    const double z_top = n > 0 ? zl(n - 1) : kNaN;
+    int l = 1;
+    for (int z = 0; z < nz; ++z) {
+      double alt = grid.alt_m.at(z);
+      if (alt > z_top && alt - z_top < 1e-6) alt = z_top;
+      while (l < n && !(zl(l) >= alt)) ++l;
+      if (l >= n) break;
+      const double z0 = zl(l - 1), z1 = zl(l);
+      if (!(z0 <= alt) || !(z1 > z0)) continue;
+      const std::size_t k = static_cast<std::size_t>(z) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(x);
+      node_level[k] = l;
+      node_weight[k] = (alt - z0) / (z1 - z0);
+    }
   }
-  const std::size_t layer = grid.columns(), p0 = grid.index(x, y, 0);
+  const std::size_t nxs = static_cast<std::size_t>(nx);
   const double* qcf = q(kCf);
   for (int f = 0; f < core::kFieldCount; ++f) {
     auto& dst = out.fields[static_cast<std::size_t>(f)];
@@ -108,19 +128,54 @@ void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, i
     // so where the fraction vanishes the mean does too and the ratio stays bounded by its
     // neighbours' in-cloud values.
     const bool in_cloud = (f == kLiq || f == kIce) && has_cf;
-    for (int z = 0; z < grid.alt_m.count; ++z) {
-      const int lz = node_level[static_cast<std::size_t>(z)];
-      if (lz < 0) continue;
-      const double a = node_weight[static_cast<std::size_t>(z)];
-      double v = qf[lz - 1] + a * (qf[lz] - qf[lz - 1]);
-      if (in_cloud) {
-        const double cf = qcf[lz - 1] + a * (qcf[lz] - qcf[lz - 1]);
-        if (!std::isnan(cf)) v = v > 0.0 && cf > 0.0 ? v / cf : (std::isnan(v) ? v : 0.0);
+    const bool pressure = f == static_cast<int>(core::Field::Pressure);
+    float lo = std::numeric_limits<float>::infinity(), hi = -std::numeric_limits<float>::infinity();
+    std::size_t finite = 0;
+    for (int z = 0; z < nz; ++z) {
+      const int* lev = node_level.data() + static_cast<std::size_t>(z) * nxs;
+      const double* wt = node_weight.data() + static_cast<std::size_t>(z) * nxs;
+      float* row = dst.data() + grid.index(x0, y, z);
+      for (std::size_t x = 0; x < nxs; ++x) {
+        const int lz = lev[x];
+        if (lz < 0) continue;
+        const double a = wt[x];
+        const std::size_t i1 = static_cast<std::size_t>(lz) * nxs + x, i0 = i1 - nxs;
+        double v = qf[i0] + a * (qf[i1] - qf[i0]);
+        if (in_cloud) {
+          const double cf = qcf[i0] + a * (qcf[i1] - qcf[i0]);
+          if (!std::isnan(cf)) v = v > 0.0 && cf > 0.0 ? v / cf : (std::isnan(v) ? v : 0.0);
+        }
+        if (pressure) v = std::exp(v);
+        const float s = static_cast<float>(v);
+        row[x] = s;
+        if (std::abs(s) <= std::numeric_limits<float>::max()) {  // finite, as ValueStats counts
+          lo = std::min(lo, s), hi = std::max(hi, s);
+          ++finite;
+        }
       }
-      if (f == static_cast<int>(core::Field::Pressure)) v = std::exp(v);
-      dst[p0 + static_cast<std::size_t>(z) * layer] = static_cast<float>(v);
     }
+    if (stored && finite) {
+      core::ValueStats& st = (*stored)[static_cast<std::size_t>(f)];
+      st.min = std::min(st.min, static_cast<double>(lo));
+      st.max = std::max(st.max, static_cast<double>(hi));
+    }
+    if (stored) (*stored)[static_cast<std::size_t>(f)].count += finite;
   }
+}
+
+void place_column(std::span<LevelSample> levels, const core::VolumeGrid& grid, int x, int y,
+                  const ConversionOptions& options, core::TimeStepData& out, ColumnCounts& counts) {
+  // A row of one column.
+  thread_local RowLevels r;
+  const int n = static_cast<int>(levels.size());
+  r.resize(1, n);
+  for (int l = 0; l < n; ++l) {
+    const LevelSample& s = levels[static_cast<std::size_t>(l)];
+    const std::size_t i = static_cast<std::size_t>(l);
+    r.z_m[i] = s.z_m, r.p_pa[i] = s.p_pa, r.t_k[i] = s.t_k, r.qv[i] = s.qv, r.cf[i] = s.cf;
+    r.q_liquid[i] = s.q_liquid, r.q_ice[i] = s.q_ice, r.u[i] = s.u, r.v[i] = s.v, r.w[i] = s.w;
+  }
+  place_row(r, grid, x, y, options, out, counts);
 }
 
 bool in_time_range(const core::ValidTime& t, const ImportOptions& o) {

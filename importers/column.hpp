@@ -3,6 +3,7 @@
 // on the volume's altitude grid, with the consistency counts the import report needs.
 #pragma once
 
+#include <array>
 #include <limits>
 #include <span>
 #include <string>
@@ -50,6 +51,27 @@ inline constexpr double kZeroCloudFraction = 1e-4;
 // Water below this counts as none for the consistency checks: int16 packing leaves a step or two
 // (~5e-8 kg/kg) where there is none, and 1e-7 kg/kg gives an optical depth of ~0.015 per km.
 inline constexpr double kZeroWater = 1e-7;
+
+// The levels of a row of columns, level-major (the value of level l in column x is at l * nx + x):
+// the layout the file's slabs are read in and the volume's layers are written in, so neither
+// side is transposed through a cache-hostile column buffer. Absent quantities as in LevelSample.
+struct RowLevels {
+  int nx = 0, nlev = 0;
+  std::vector<double> z_m, p_pa, t_k, qv, cf, q_liquid, q_ice, u, v, w;
+  // Sizes every array for nx columns of nlev levels (values are the caller's to write).
+  void resize(int columns, int levels);
+  std::size_t at(int l, int x) const { return static_cast<std::size_t>(l) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(x); }
+};
+
+// The value ranges of what place_row stored, per field (finite values only; the caller adds the
+// points left without data as missing): the import report's "after" figures without a pass over
+// the volume.
+using StoredStats = std::array<core::ValueStats, core::kFieldCount>;
+
+// Converts a row's levels and interpolates them linearly in altitude into columns x0 .. x0 + nx - 1
+// of row y of `out` (below). Adds to `stored` when given.
+void place_row(const RowLevels& levels, const core::VolumeGrid& grid, int x0, int y, const ConversionOptions& options,
+               core::TimeStepData& out, ColumnCounts& counts, StoredStats* stored = nullptr);
 
 // Converts the levels and interpolates them linearly in altitude into column (x, y) of `out`, whose
 // fields were allocated by the caller (absent fields stay empty). Outside the column's levels,
