@@ -179,6 +179,7 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
                          static_cast<double>(v.times.size()) * (half ? 2.0 : 4.0);
     BackgroundWriter::Options wo;
     wo.direct = bytes >= kDirectWriteBytes;
+    if (!wo.direct) wo.chunk_bytes = std::size_t(1) << 20;  // a small file: a small queue (4 MB)
     BackgroundWriter out(f, wo);
     out.write("CVVOL01\n", 8);
     const std::uint64_t len = header.size();
