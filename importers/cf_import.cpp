@@ -263,10 +263,15 @@ struct Era5Source {
 
 namespace {
 
-// Reads into `s`, reusing its memory.
-void read_slab_into(Slab& s, const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* info, bool as_double) {
+// Reads into `s`, reusing its memory: the region's rows, or rows j_lo .. j_hi of the file when
+// given (j_lo >= 0).
+void read_slab_into(Slab& s, const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* info, bool as_double,
+                    int j_lo = -1, int j_hi = -1) {
   const NcFile& f = *S.file;
   const CfLayout& L = S.layout;
+  if (j_lo < 0) j_lo = S.lat_lo, j_hi = S.lat_hi;
+  s.s_lon = s.s_lat = s.s_lev = 0;
+  s.i_off = s.j_off = s.k_off = 0;
   std::vector<std::size_t> start(v.dims.size(), 0), count(v.dims.size(), 0);
   std::size_t stride = 1;
   for (int a = static_cast<int>(v.dims.size()) - 1; a >= 0; --a) {
@@ -280,7 +285,7 @@ void read_slab_into(Slab& s, const Era5Source& S, const NcVar& v, int time_index
     };
     if (d == L.time.dim) first = static_cast<std::size_t>(time_index), c = 1;
     if (d == L.lon.dim) range(S.lon_lo, S.lon_hi, s.i_off), s.s_lon = stride;
-    if (d == L.lat.dim) range(S.lat_lo, S.lat_hi, s.j_off), s.s_lat = stride;
+    if (d == L.lat.dim) range(j_lo, j_hi, s.j_off), s.s_lat = stride;
     if (d == L.vertical.dim) range(S.lev_lo, S.lev_hi, s.k_off), s.s_lev = stride;
     start[static_cast<std::size_t>(a)] = first;
     count[static_cast<std::size_t>(a)] = c;
@@ -349,37 +354,58 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   std::vector<Slab>& slab = S.scratch;
   bool have[kRoleCount] = {};
   const bool diagnose = S.diagnose;
+  // The variables read: every role present, relative humidity only for a diagnosed cloud (humidity
+  // of the file's own cloud is not needed).
+  std::vector<int> roles_read;
   for (int r = 0; r < kRoleCount; ++r) {
     if (!L.roles[r]) continue;
-    // Relative humidity is read only for a diagnosed cloud (humidity of the file's own cloud is
-    // not needed).
     if (static_cast<Role>(r) == Role::RelativeHumidity && !diagnose) continue;
-    UnpackInfo info;
-    const bool heights = static_cast<Role>(r) == Role::Geopotential || static_cast<Role>(r) == Role::GeopotentialHeight;
-    read_slab_into(slab[static_cast<std::size_t>(r)], S, *L.roles[r], t, &info, heights);
     have[r] = true;
+    roles_read.push_back(r);
     auto& use = report.use(role_name(static_cast<Role>(r)));
     use.variable = L.roles[r]->name;
     use.units = L.roles[r]->text("units");
-    use.before.add_all(slab[r].f.data(), slab[r].f.size());
-    use.before.add_all(slab[r].d.data(), slab[r].d.size());
-    if (info.packed && use.conversion.empty()) {
-      use.conversion = "unpacked x * " + fmt(info.scale) + " + " + fmt(info.offset) + "; ";
-    }
-    // Units to the conversion's: % to 0..1, g/kg to kg/kg.
-    if (const double k = L.role_scale[r]; k != 1.0) {
-      float* fv = slab[r].f.data();
-      double* dv = slab[r].d.data();
-      core::parallel_ranges(slab[r].f.size(), std::size_t(1) << 22, [&](std::size_t b, std::size_t e, unsigned) {
-        for (std::size_t i = b; i < e; ++i) fv[i] = static_cast<float>(fv[i] * k);
-      });
-      core::parallel_ranges(slab[r].d.size(), std::size_t(1) << 22, [&](std::size_t b, std::size_t e, unsigned) {
-        for (std::size_t i = b; i < e; ++i) dv[i] *= k;
-      });
-      const std::string what = "x " + fmt(k) + " (units '" + use.units + "'); ";
-      if (use.conversion.find(what) == std::string::npos) use.conversion += what;
-    }
   }
+  // Reads a band of the file's rows for every role: rows j_lo .. j_hi, of which rows j_lo .. j_own
+  // are counted in the report's "before" ranges (each row is counted by one band only). The
+  // slabs hold a band, not the step: a global step's slabs were 900 MB of fresh memory.
+  bool first_band = true;
+  auto read_band = [&](int j_lo, int j_hi, int j_own) {
+    for (int r : roles_read) {
+      UnpackInfo info;
+      const bool heights = static_cast<Role>(r) == Role::Geopotential || static_cast<Role>(r) == Role::GeopotentialHeight;
+      Slab& sl = slab[static_cast<std::size_t>(r)];
+      read_slab_into(sl, S, *L.roles[r], t, &info, heights, j_lo, j_hi);
+      auto& use = report.use(role_name(static_cast<Role>(r)));
+      // The owned rows, level by level (a row's longitudes are contiguous in the usual layout).
+      const int nlon = S.lon_hi - S.lon_lo + 1, nk = sl.s_lev ? S.lev_hi - S.lev_lo + 1 : 1;
+      for (int k = 0; k < nk; ++k) {
+        for (int j = j_lo; j <= j_own; ++j) {
+          const std::size_t base = static_cast<std::size_t>(j - sl.j_off) * sl.s_lat + static_cast<std::size_t>(k) * sl.s_lev;
+          if (sl.s_lon == 1) {
+            if (!sl.f.empty()) use.before.add_all(sl.f.data() + base, static_cast<std::size_t>(nlon));
+            if (!sl.d.empty()) use.before.add_all(sl.d.data() + base, static_cast<std::size_t>(nlon));
+          } else {
+            for (int i = 0; i < nlon; ++i) {
+              const std::size_t at = base + static_cast<std::size_t>(i) * sl.s_lon;
+              use.before.add(sl.f.empty() ? sl.d[at] : static_cast<double>(sl.f[at]));
+            }
+          }
+        }
+      }
+      if (first_band && info.packed && use.conversion.empty()) {
+        use.conversion = "unpacked x * " + fmt(info.scale) + " + " + fmt(info.offset) + "; ";
+      }
+      // Units to the conversion's: % to 0..1, g/kg to kg/kg.
+      if (const double k = L.role_scale[r]; k != 1.0) {
+        for (float& x : sl.f) x = static_cast<float>(x * k);
+        for (double& x : sl.d) x *= k;
+        const std::string what = "x " + fmt(k) + " (units '" + use.units + "'); ";
+        if (use.conversion.find(what) == std::string::npos) use.conversion += what;
+      }
+    }
+    first_band = false;
+  };
   const int nlev = static_cast<int>(S.levels.size());
   Slab ps, zs;
   if (L.vertical_kind == Vertical::Hybrid) ps = read_slab(S, *L.surface_pressure, t, nullptr, true);
@@ -571,18 +597,46 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     W.levels.resize(nx, nlev);
     W.z_prev.resize(row_len), W.p_prev.resize(row_len), W.tv_prev.resize(row_len);
   }
-  auto run = [&](int wid) {
-    RowWork& W = work[static_cast<std::size_t>(wid)];
-    try {
-      for (int y = wid; y < ny; y += workers) do_row(y, W);
-    } catch (...) {
-      W.error = std::current_exception();
+  // Bands of kBandRows file rows: each output row goes with the band holding the lowest file row
+  // it reads, and a band's read reaches as far as its rows need.
+  constexpr int kBandRows = 32;
+  const int bands = (S.lat_hi - S.lat_lo) / kBandRows + 1;
+  std::vector<std::vector<int>> band_rows(static_cast<std::size_t>(bands));
+  std::vector<int> band_hi(static_cast<std::size_t>(bands));
+  for (int b = 0; b < bands; ++b) band_hi[static_cast<std::size_t>(b)] = std::min(S.lat_hi, S.lat_lo + (b + 1) * kBandRows - 1);
+  for (int y = 0; y < ny; ++y) {
+    const std::size_t yy = static_cast<std::size_t>(y);
+    const int j0 = S.lat.j0[yy], j1 = S.lat.j1[yy];
+    const double w = S.lat.w[yy];
+    // The rows value() reads: j0 unless the weight is all j1's, j1 unless it is all j0's.
+    const int lo = w == 1.0 ? j1 : w == 0.0 ? j0 : std::min(j0, j1), hi = w == 1.0 ? j1 : w == 0.0 ? j0 : std::max(j0, j1);
+    const std::size_t b = static_cast<std::size_t>((lo - S.lat_lo) / kBandRows);
+    band_rows[b].push_back(y);
+    band_hi[b] = std::max(band_hi[b], hi);
+  }
+  for (int b = 0; b < bands; ++b) {
+    const std::size_t bb = static_cast<std::size_t>(b);
+    const int j_lo = S.lat_lo + b * kBandRows, j_own = std::min(S.lat_hi, j_lo + kBandRows - 1);
+    read_band(j_lo, band_hi[bb], j_own);
+    const std::vector<int>& rows = band_rows[bb];
+    auto run = [&](int wid) {
+      RowWork& W = work[static_cast<std::size_t>(wid)];
+      try {
+        for (std::size_t n = static_cast<std::size_t>(wid); n < rows.size(); n += static_cast<std::size_t>(workers)) {
+          do_row(rows[n], W);
+        }
+      } catch (...) {
+        W.error = std::current_exception();
+      }
+    };
+    std::vector<std::thread> threads;
+    for (int wid = 1; wid < workers && static_cast<std::size_t>(wid) < rows.size(); ++wid) threads.emplace_back(run, wid);
+    run(0);
+    for (auto& th : threads) th.join();
+    for (auto& W : work) {
+      if (W.error) std::rethrow_exception(W.error);
     }
-  };
-  std::vector<std::thread> threads;
-  for (int wid = 1; wid < workers; ++wid) threads.emplace_back(run, wid);
-  run(0);
-  for (auto& th : threads) th.join();
+  }
   std::size_t negative_water = 0, clamped_cf = 0;
   double worst_negative = 0.0;
   ColumnCounts counts;
@@ -827,10 +881,8 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
     std::vector<double> thick;
     std::optional<double> median_thickness;
     if (zv || ghv) {
-      // Read into the step loader's slab, whose memory the first step then reuses (fresh pages
-      // cost more than the reading).
-      const Role zr = zv ? Role::Geopotential : Role::GeopotentialHeight;
-      Slab& s = S->scratch[static_cast<std::size_t>(zr)];
+      // The whole step's heights at once (freed below: the steps read bands of rows).
+      Slab s;
       read_slab_into(s, *S, zv ? *zv : *ghv, S->steps.front(), nullptr, true);
       // Each column's level heights, bottom up, to `visit(raw value, height, thickness below or NaN)`.
       auto heights = [&](auto&& visit) {
