@@ -545,3 +545,48 @@ TEST_F(CfImport, ARegionReadsOnlyItsPartOfTheFile) {
 }
 
 }  // namespace
+
+// A step's input is read in bands of 32 file rows (importers.md): with 100 rows, stored north to
+// south, every output row must still read its own row, and every file row must be counted once in
+// the report's input ranges; the ranges of what was stored must be those of the volume.
+TEST_F(CfImport, BandsOfRowsReadEveryRowOnce) {
+  SynthOptions o;
+  o.lats.clear();
+  for (int k = 0; k < 100; ++k) o.lats.push_back(89.1 - 1.8 * k);  // 89.1 .. -89.1, north first
+  importers::ImportOptions opt;
+  opt.keep_cloudless_levels = true;  // every level read: the counts below are the whole file's
+  for (int stride : {1, 3}) {
+    SCOPED_TRACE("stride " + std::to_string(stride));
+    opt.horizontal_stride = stride;
+    auto v = import(write(o, "rows" + std::to_string(stride) + ".nc"), opt);
+    const auto& g = v.grid;
+    ASSERT_EQ(g.lat_deg.count, stride == 1 ? 100 : 34);
+    // The wind u = 10 + lat / 10 tells which file row each output row read (at 700 hPa).
+    const std::size_t nsteps = v.times.size();
+    ASSERT_EQ(nsteps, 2u);
+    core::ValueStats stored_u;
+    for (std::size_t t = 0; t < nsteps; ++t) {
+      const auto& d = v.step(t);
+      for (int j = 0; j < g.lat_deg.count; ++j) {
+        for (int i = 0; i < g.lon_deg.count; ++i) {
+          ASSERT_NEAR(d[core::Field::WindU][g.index(i, j, 1)], 10.0 + g.lat_deg.at(j) / 10.0, 1e-3) << "row " << j;
+        }
+      }
+      stored_u.add_all(d[core::Field::WindU].data(), d[core::Field::WindU].size());
+    }
+    const auto& u = v.report.use("eastward wind");
+    // Read: each step's 100 rows x 5 levels over the columns from the first used to the last
+    // (all 6; with stride 3, columns 0 and 3 are used, so 0..3), once. A stride reads the rows
+    // between the used ones too.
+    const std::size_t columns_read = stride == 1 ? 6u : 4u;
+    EXPECT_EQ(u.before.count + u.before.missing, columns_read * 100u * 5u * 2u);
+    EXPECT_EQ(u.before.missing, 0u);
+    EXPECT_NEAR(u.before.min, 10.0 - 8.91, 1e-3);
+    EXPECT_NEAR(u.before.max, 10.0 + 8.91, 1e-3);
+    // Stored: exactly the ranges of the volume's values.
+    EXPECT_EQ(u.after.count, stored_u.count);
+    EXPECT_EQ(u.after.missing, stored_u.missing);
+    EXPECT_EQ(u.after.min, stored_u.min);
+    EXPECT_EQ(u.after.max, stored_u.max);
+  }
+}
