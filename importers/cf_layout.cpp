@@ -165,16 +165,26 @@ bool units_fit(Role r, const std::string& raw_units, double& scale) {
 // (discipline, category, number) and Grib_Variable_Id "VAR_0-1-23_L100"; NCL's
 // parameter_discipline_and_category / parameter_template_discipline_category_number.
 std::optional<Grib2> grib2_of(const NcVar& v) {
+  // A GRIB code is a whole number 0..65535; anything else names no parameter (a huge value would
+  // overflow the conversion to int, as fuzzing found for another attribute).
+  auto code = [](double x) -> std::optional<int> {
+    if (!(x >= 0.0 && x <= 65535.0) || x != std::floor(x)) return std::nullopt;
+    return static_cast<int>(x);
+  };
+  auto grib = [](std::optional<int> d, std::optional<int> c, std::optional<int> n) -> std::optional<Grib2> {
+    if (d && c && n) return Grib2{*d, *c, *n};
+    return std::nullopt;
+  };
   if (const NcAtt* a = v.att("Grib2_Parameter"); a && a->values.size() == 3) {
-    return Grib2{static_cast<int>(a->values[0]), static_cast<int>(a->values[1]), static_cast<int>(a->values[2])};
+    return grib(code(a->values[0]), code(a->values[1]), code(a->values[2]));
   }
   if (const NcAtt* a = v.att("parameter_template_discipline_category_number"); a && a->values.size() == 4) {
-    return Grib2{static_cast<int>(a->values[1]), static_cast<int>(a->values[2]), static_cast<int>(a->values[3])};
+    return grib(code(a->values[1]), code(a->values[2]), code(a->values[3]));
   }
-  static const std::regex id("^VAR_(\\d+)-(\\d+)-(\\d+)(_|$)");
+  static const std::regex id("^VAR_(\\d{1,5})-(\\d{1,5})-(\\d{1,5})(_|$)");
   std::smatch m;
   const std::string vid = v.text("Grib_Variable_Id");
-  if (std::regex_search(vid, m, id)) return Grib2{std::stoi(m[1]), std::stoi(m[2]), std::stoi(m[3])};
+  if (std::regex_search(vid, m, id)) return grib(code(std::stod(m[1])), code(std::stod(m[2])), code(std::stod(m[3])));
   return std::nullopt;
 }
 

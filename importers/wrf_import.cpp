@@ -44,7 +44,14 @@ class WrfProjection {
       if (!v) throw ImportError(path_ + ": global attribute '" + std::string(name) + "' is missing; expected WRF map projection attributes");
       return *v;
     };
-    proj_ = static_cast<int>(need("MAP_PROJ"));
+    // Checked before it becomes an int: a huge or NaN value would overflow the conversion (found
+    // by fuzz_netcdf_semantic: MAP_PROJ = 3.4e38).
+    const double map_proj = need("MAP_PROJ");
+    if (!(map_proj == 1.0 || map_proj == 2.0 || map_proj == 3.0)) {
+      throw ImportError(path_ + ": MAP_PROJ is " + fmt(map_proj) +
+                        ", expected 1 (Lambert conformal), 2 (polar stereographic) or 3 (Mercator)");
+    }
+    proj_ = static_cast<int>(map_proj);
     truelat1_ = need("TRUELAT1");
     truelat2_ = f.global_number("TRUELAT2").value_or(truelat1_);
     stand_lon_ = need("STAND_LON");
@@ -447,7 +454,8 @@ core::CloudVolume import_wrf(std::unique_ptr<NcFile> file, const ImportOptions& 
   for (std::size_t d = 0; d < f.dims().size(); ++d) {
     if (f.dims()[d].name == "Time") S->dim_time = static_cast<int>(d);
   }
-  if (const auto claimed = f.global_number("WEST-EAST_GRID_DIMENSION"); claimed && static_cast<int>(*claimed) - 1 != S->nx) {
+  // Compared as numbers, not converted to int (a huge claim would overflow the conversion).
+  if (const auto claimed = f.global_number("WEST-EAST_GRID_DIMENSION"); claimed && !(*claimed - 1.0 == static_cast<double>(S->nx))) {
     vol.report.notes.push_back("global attributes claim " + fmt(*claimed - 1) + " x " +
                                fmt(f.global_number("SOUTH-NORTH_GRID_DIMENSION").value_or(0) - 1) +
                                " mass points; the file holds " + std::to_string(S->nx) + " x " + std::to_string(S->ny) +

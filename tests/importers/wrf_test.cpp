@@ -195,3 +195,50 @@ TEST(Wrf, PolarStereographicInBothHemispheres) {
 }
 
 }  // namespace
+
+namespace {
+// Global attributes that become integers are checked as numbers first: fuzz_netcdf_semantic found
+// MAP_PROJ = 3.4e38, whose conversion to int is undefined (and a UBSan abort in `info`).
+TEST(Wrf, HugeProjectionAndGridClaimsAreNumbersNotOverflows) {
+  REAL_FILE(real, "ci_test_file.nc");
+  const auto dir = std::filesystem::temp_directory_path() / ("cv_wrf_claims_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto with = [&](const char* name, double value) {
+    const std::string p = (dir / (std::string(name) + ".nc")).string();
+    std::filesystem::copy_file(real, p, std::filesystem::copy_options::overwrite_existing);
+    std::filesystem::permissions(p, std::filesystem::perms::owner_write, std::filesystem::perm_options::add);
+    int id = -1;
+    cv::test::nc_check(nc_open(p.c_str(), NC_WRITE, &id), "open " + p);
+    cv::test::nc_check(nc_redef(id), "redef");
+    cv::test::nc_check(nc_put_att_double(id, NC_GLOBAL, name, NC_DOUBLE, 1, &value), "att");
+    cv::test::nc_check(nc_close(id), "close");
+    return p;
+  };
+  for (double bad : {3.4e38, -1e300, 2.5, 6.0}) {
+    const std::string p = with("MAP_PROJ", bad);
+    std::string msg;
+    try {
+      importers::import_file(p);
+    } catch (const importers::ImportError& e) {
+      msg = e.what();
+    }
+    EXPECT_NE(msg.find(": MAP_PROJ is "), std::string::npos) << bad << ": " << msg;
+    EXPECT_NE(msg.find("expected 1 (Lambert conformal), 2 (polar stereographic) or 3 (Mercator)"), std::string::npos) << msg;
+    // `info` refuses the same way.
+    std::string info;
+    try {
+      info = importers::describe_file(p);
+    } catch (const importers::ImportError& e) {
+      info = e.what();
+    }
+    EXPECT_NE(info.find(": MAP_PROJ is "), std::string::npos) << bad << ": " << info;
+  }
+  // A grid size claim past any int is a claim that differs from the file: noted, and the file's
+  // own dimensions used.
+  const auto vol = importers::import_file(with("WEST-EAST_GRID_DIMENSION", 1e30));
+  bool noted = false;
+  for (const auto& n : vol.report.notes) noted |= n.find("(cropped?)") != std::string::npos;
+  EXPECT_TRUE(noted);
+  std::filesystem::remove_all(dir);
+}
+}  // namespace

@@ -527,3 +527,43 @@ TEST(VolumeIo, Float16VolumeReadsBackWithinItsStatedBound) {
 }
 
 }  // namespace
+
+namespace {
+// GRIB codes in attributes are whole numbers 0..65535 or name no parameter: a huge code (1e30, or
+// a 12-digit Grib_Variable_Id) was converted to int, which is undefined (UBSan) or threw
+// std::out_of_range past the importer's errors.
+TEST_F(CfImportFixes, HugeGribCodesNameNoParameter) {
+  const std::vector<double> hpa = {1000, 700, 500};
+  const std::vector<std::string> d = {"time1", "isobaric3", "lat", "lon"};
+  std::vector<CfAxis> axes = {{"time1", {0.0}, {{"units", "Hour since 2021-01-30T12:00:00Z"}}},
+                              {"isobaric3", {100000, 70000, 50000}, {{"units", "Pa"}, {"positive", "down"}}},
+                              {"lat", {0, 10}, {{"units", "degrees_north"}}},
+                              {"lon", {0, 10, 20}, {{"units", "degrees_east"}}}};
+  auto gh = [hpa](const Idx& i) { return cv::test::isa_height_m(hpa[static_cast<std::size_t>(i[1])] * 100.0); };
+  const std::string a = path("huge_codes.nc");
+  cv::test::write_cf(a, axes,
+                     {{"Geopotential_height_isobaric", d, {{"units", "gpm"}}, {}, gh},
+                      {"Temperature_isobaric", d, {{"units", "K"}}, {{"Grib2_Parameter", {0, 0, 0}}}, [](const Idx&) { return 250.0; }},
+                      {"u-component_of_wind_isobaric", d, {{"units", "m/s"}, {"Grib_Variable_Id", "VAR_999999999999-2-2_L100"}}, {},
+                       [](const Idx&) { return 7.0; }},
+                      {"Ice_water_mixing_ratio_isobaric", d, {{"units", "kg/kg"}}, {{"Grib2_Parameter", {0, 1, 23}}},
+                       [](const Idx& i) { return i[1] == 1 ? 1e-5 : 0.0; }}});
+  {  // a code past any int, as a double attribute
+    int id = -1, var = -1;
+    cv::test::nc_check(nc_open(a.c_str(), NC_WRITE, &id), "open");
+    cv::test::nc_check(nc_inq_varid(id, "Geopotential_height_isobaric", &var), "varid");
+    cv::test::nc_check(nc_redef(id), "redef");
+    const double codes[3] = {1e30, 3, 5};
+    cv::test::nc_check(nc_put_att_double(id, var, "Grib2_Parameter", NC_DOUBLE, 3, codes), "att");
+    cv::test::nc_check(nc_close(id), "close");
+  }
+  importers::ImportOptions o;
+  o.dz_m = level_alt(700) - level_alt(1000);
+  auto v = importers::import_file(a, o);
+  v.step(0);  // the report names the variables a step read
+  EXPECT_TRUE(v.has_field[static_cast<int>(core::Field::ExtinctionIce)]);
+  EXPECT_EQ(v.report.use("temperature").variable, "Temperature_isobaric");
+  EXPECT_EQ(v.report.use("eastward wind").variable, "u-component_of_wind_isobaric");  // by its name
+  EXPECT_NE(importers::describe_file(a).find("importable: yes"), std::string::npos);
+}
+}  // namespace
