@@ -589,8 +589,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     }
     place_row(W.levels, grid, 0, y, conv, out, W.counts, &W.stored);
     };
-  unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  if (const char* env = std::getenv("CLOUDVIEWER_THREADS"); env && std::atoi(env) > 0) hw = static_cast<unsigned>(std::atoi(env));
+  const unsigned hw = core::worker_count();  // the machine's cores, or CLOUDVIEWER_THREADS
   const int workers = static_cast<int>(std::min<unsigned>(std::min(hw, 8u), static_cast<unsigned>(std::max(1, ny / 4))));
   std::vector<RowWork> work(static_cast<std::size_t>(workers));
   for (auto& W : work) {

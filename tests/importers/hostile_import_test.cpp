@@ -20,6 +20,7 @@
 
 #include "importer.hpp"
 #include "nc_file.hpp"
+#include "support/scratch_dir.hpp"
 #include "support/nc_builder.hpp"
 #include "support/real_data.hpp"
 
@@ -539,7 +540,8 @@ using cv::test::NcBuilder;
 // path, one pass with SSE2); every value, fill and range rule must come out as the general path
 // (netCDF's doubles, unpacked in double) rounded to float, and the missing count the same.
 TEST(NcShortReads, UnpackToTheSameFloatsAsTheDoublePath) {
-  const fs::path dir = fs::temp_directory_path() / ("cv_short_reads_" + std::to_string(::getpid()));
+  // The process's scratch folder: removed when the process ends, a failed assertion included.
+  const fs::path dir = fs::path(cv::test_support::scratch_dir()) / "short_reads";
   fs::create_directories(dir);
   // Every int16 value once, in a 2 x 3 x 127 x 86 array (not a multiple of the SIMD width per row).
   const std::size_t nt = 2, nz = 3, ny = 127, nx = 86, n = nt * nz * ny * nx;
@@ -616,7 +618,6 @@ TEST(NcShortReads, UnpackToTheSameFloatsAsTheDoublePath) {
       EXPECT_EQ(as_float_info.offset, as_double_info.offset);
     }
   }
-  fs::remove_all(dir);
 }
 
 }  // namespace

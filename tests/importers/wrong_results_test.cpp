@@ -109,16 +109,26 @@ TEST_F(CfImportFixes, GlobalGridWithAShortWrapGapIsCutAtTheWrap) {
   EXPECT_NE(info2.find("importable: no: " + why), std::string::npos) << info2;
 }
 
+// A GFS file as netCDF-Java writes it: one time, the isobaric levels 1000, 700 and 500 hPa in Pa,
+// 2 x 3 points; the standard atmosphere's height at each level.
+const std::vector<std::string> kGfsJavaDims = {"time1", "isobaric3", "lat", "lon"};
+std::vector<CfAxis> gfs_java_axes() {
+  return {{"time1", {0.0}, {{"units", "Hour since 2021-01-30T12:00:00Z"}}},
+          {"isobaric3", {100000, 70000, 50000}, {{"units", "Pa"}, {"positive", "down"}}},
+          {"lat", {0, 10}, {{"units", "degrees_north"}}},
+          {"lon", {0, 10, 20}, {{"units", "degrees_east"}}}};
+}
+double gfs_java_height(const Idx& i) {
+  static const double kHpa[] = {1000, 700, 500};
+  return cv::test::isa_height_m(kHpa[static_cast<std::size_t>(i[1])] * 100.0);
+}
+
 // 2. GFS/NCEP names: netCDF-Java's "<Name>_isobaric" with Grib2_Parameter, a cloud cover in %,
 // "u-component_of_wind_isobaric"; and plain "ice_water_mixing_ratio" with uppercase T/U/V.
 TEST_F(CfImportFixes, GribToNetcdfNamesAreRecognised) {
-  const std::vector<double> hpa = {1000, 700, 500};
-  const std::vector<std::string> d = {"time1", "isobaric3", "lat", "lon"};
-  std::vector<CfAxis> axes = {{"time1", {0.0}, {{"units", "Hour since 2021-01-30T12:00:00Z"}}},
-                              {"isobaric3", {100000, 70000, 50000}, {{"units", "Pa"}, {"positive", "down"}}},
-                              {"lat", {0, 10}, {{"units", "degrees_north"}}},
-                              {"lon", {0, 10, 20}, {{"units", "degrees_east"}}}};
-  auto gh = [hpa](const Idx& i) { return cv::test::isa_height_m(hpa[static_cast<std::size_t>(i[1])] * 100.0); };
+  const std::vector<std::string> d = kGfsJavaDims;
+  const std::vector<CfAxis> axes = gfs_java_axes();
+  auto gh = gfs_java_height;
   const std::string a = path("gfs_java.nc");
   cv::test::write_cf(a, axes,
                      {{"Geopotential_height_isobaric", d, {{"units", "gpm"}}, {{"Grib2_Parameter", {0, 3, 5}}}, gh},
@@ -533,13 +543,9 @@ namespace {
 // a 12-digit Grib_Variable_Id) was converted to int, which is undefined (UBSan) or threw
 // std::out_of_range past the importer's errors.
 TEST_F(CfImportFixes, HugeGribCodesNameNoParameter) {
-  const std::vector<double> hpa = {1000, 700, 500};
-  const std::vector<std::string> d = {"time1", "isobaric3", "lat", "lon"};
-  std::vector<CfAxis> axes = {{"time1", {0.0}, {{"units", "Hour since 2021-01-30T12:00:00Z"}}},
-                              {"isobaric3", {100000, 70000, 50000}, {{"units", "Pa"}, {"positive", "down"}}},
-                              {"lat", {0, 10}, {{"units", "degrees_north"}}},
-                              {"lon", {0, 10, 20}, {{"units", "degrees_east"}}}};
-  auto gh = [hpa](const Idx& i) { return cv::test::isa_height_m(hpa[static_cast<std::size_t>(i[1])] * 100.0); };
+  const std::vector<std::string> d = kGfsJavaDims;
+  const std::vector<CfAxis> axes = gfs_java_axes();
+  auto gh = gfs_java_height;
   const std::string a = path("huge_codes.nc");
   cv::test::write_cf(a, axes,
                      {{"Geopotential_height_isobaric", d, {{"units", "gpm"}}, {}, gh},
