@@ -13,6 +13,8 @@
 #include <cstring>
 #include <limits>
 
+#include "io/parallel.hpp"
+
 namespace cv::core {
 namespace {
 
@@ -135,6 +137,26 @@ void require_within_memory_limit(const std::string& source, const std::string& w
                    (bytes ? byte_size_text(static_cast<double>(*bytes)) : std::string("more than 2^64 bytes")) +
                    ", expected at most the memory limit " + byte_size_text(static_cast<double>(limit)) +
                    " (set CLOUDVIEWER_MEMORY_LIMIT to change it)");
+}
+
+void populate_pages(void* p, std::size_t bytes) {
+#ifdef MADV_POPULATE_WRITE
+  const long page_size = ::sysconf(_SC_PAGESIZE);
+  if (!p || page_size <= 0 || bytes < (std::size_t(1) << 24)) return;  // small buffers: not worth a thread
+  const std::size_t page = static_cast<std::size_t>(page_size);
+  // The whole pages inside the buffer (madvise wants a page-aligned start).
+  const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(p) + page - 1) / page * page;
+  const std::uintptr_t hi = (reinterpret_cast<std::uintptr_t>(p) + bytes) / page * page;
+  if (hi <= lo) return;
+  const std::size_t pages = (hi - lo) / page;
+  parallel_ranges(pages, 1024, [&](std::size_t b, std::size_t e, unsigned) {
+    // Advice only: a kernel without it (EINVAL) leaves the pages to be faulted in as written.
+    (void)::madvise(reinterpret_cast<void*>(lo + b * page), (e - b) * page, MADV_POPULATE_WRITE);
+  });
+#else
+  (void)p;
+  (void)bytes;
+#endif
 }
 
 }  // namespace cv::core

@@ -71,4 +71,9 @@ void reserve_exact(std::vector<T>& v, std::size_t n) {
   v.reserve(n);
 }
 
+// Faults in the pages of [p, p + bytes) on every core (madvise MADV_POPULATE_WRITE in slices),
+// before a vector's resize writes them from one thread: a fresh global field is 190 MB of pages
+// the kernel clears as they are first touched. Nothing happens where the kernel lacks it.
+void populate_pages(void* p, std::size_t bytes);
+
 }  // namespace cv::core

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "io/background_writer.hpp"
+#include "io/input_file.hpp"
 #include "io/output_file.hpp"
 
 namespace {
@@ -134,3 +135,25 @@ TEST_F(BackgroundWriterTest, AFullDiskIsOneWriteError) {
 }
 
 }  // namespace
+
+namespace cv::core {
+namespace {
+// populate_pages is advice: the pages it faults in keep what they hold, from an unaligned start
+// and length, on a buffer large enough to be split between threads; null and small buffers are
+// left alone.
+TEST(PopulatePages, KeepsWhatTheBufferHolds) {
+  std::vector<float> v;
+  v.reserve((std::size_t(48) << 20) / sizeof(float) + 7);  // 48 MB: split between threads
+  v.resize(v.capacity());
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<float>(i % 1000003) * 0.5f;
+  populate_pages(reinterpret_cast<char*>(v.data()) + 3, v.size() * sizeof(float) - 5);
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < v.size(); ++i) wrong += v[i] != static_cast<float>(i % 1000003) * 0.5f;
+  EXPECT_EQ(wrong, 0u);
+  populate_pages(nullptr, std::size_t(1) << 30);
+  float small[16] = {1.0f};
+  populate_pages(small, sizeof small);
+  EXPECT_EQ(small[0], 1.0f);
+}
+}  // namespace
+}  // namespace cv::core
