@@ -424,15 +424,11 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   const bool has_cf = have[static_cast<int>(Role::CloudFraction)];
   auto alloc = [&](core::Field f, bool on) {
     if (on) {
-      // Faulted in and filled on every core: a fresh global field is 190 MB of pages to touch.
+      // Faulted in on every core: a fresh global field is 190 MB of pages to touch.
       const bool fresh = out[f].capacity() < grid.points();
       core::reserve_exact(out[f], grid.points());
       if (fresh) core::populate_pages(out[f].data(), grid.points() * sizeof(float));
-      out[f].resize(grid.points());
-      float* d = out[f].data();
-      core::parallel_ranges(grid.points(), std::size_t(1) << 22, [&](std::size_t b, std::size_t e, unsigned) {
-        std::fill(d + b, d + e, std::numeric_limits<float>::quiet_NaN());
-      });
+      out[f].resize(grid.points());  // every node is written by its row's place_row, NaN where it has no data
     }
     else out[f].clear();
   };

@@ -137,7 +137,10 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
       float* row = dst.data() + grid.index(x0, y, z);
       for (std::size_t x = 0; x < nxs; ++x) {
         const int lz = lev[x];
-        if (lz < 0) continue;
+        if (lz < 0) {  // no level pair around the node: no data
+          row[x] = std::numeric_limits<float>::quiet_NaN();
+          continue;
+        }
         const double a = wt[x];
         const std::size_t i1 = static_cast<std::size_t>(lz) * nxs + x, i0 = i1 - nxs;
         double v = qf[i0] + a * (qf[i1] - qf[i0]);
