@@ -44,6 +44,31 @@ void RowLevels::resize(int columns, int levels) {
   for (auto* a : {&z_m, &p_pa, &t_k, &qv, &cf, &q_liquid, &q_ice, &u, &v, &w}) a->resize(n);
 }
 
+namespace {
+// One layer of a row's nodes: linear interpolation between each node's level pair (lev: the upper
+// level, -1 where the node has none: NaN), in-cloud values (the mean over the interpolated
+// fraction) or pressure (interpolated in its logarithm) as the field needs.
+template <bool kInCloud, bool kPressure>
+void interpolate_nodes(const int* lev, const double* wt, const double* qf, const double* qcf, std::size_t nxs, float* row) {
+  for (std::size_t x = 0; x < nxs; ++x) {
+    const int lz = lev[x];
+    if (lz < 0) {  // no level pair around the node: no data
+      row[x] = std::numeric_limits<float>::quiet_NaN();
+      continue;
+    }
+    const double a = wt[x];
+    const std::size_t i1 = static_cast<std::size_t>(lz) * nxs + x, i0 = i1 - nxs;
+    double v = qf[i0] + a * (qf[i1] - qf[i0]);
+    if constexpr (kInCloud) {
+      const double cf = qcf[i0] + a * (qcf[i1] - qcf[i0]);
+      if (!std::isnan(cf)) v = v > 0.0 && cf > 0.0 ? v / cf : (std::isnan(v) ? v : 0.0);
+    }
+    if constexpr (kPressure) v = std::exp(v);
+    row[x] = static_cast<float>(v);
+  }
+}
+}  // namespace
+
 void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, const ConversionOptions& options,
                core::TimeStepData& out, ColumnCounts& counts, StoredStats* stored) {
   const int n = r.nlev, nx = r.nx, nz = grid.alt_m.count;
@@ -57,6 +82,8 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
   constexpr int kLiq = static_cast<int>(core::Field::ExtinctionLiquid), kIce = static_cast<int>(core::Field::ExtinctionIce),
                 kCf = static_cast<int>(core::Field::CloudFraction);
   const double r_liq_m = options.r_eff_liquid_um * 1e-6;
+  // On pressure levels every column of a level has the same pressure: its logarithm is taken once.
+  double last_p = std::numeric_limits<double>::quiet_NaN(), last_log_p = kNaN;
   for (std::size_t i = 0; i < plane; ++i) {
     const double p = r.p_pa[i], t = r.t_k[i], ql = r.q_liquid[i], qi = r.q_ice[i], cf = r.cf[i];
     const double rho = p / (kRdJPerKgK * t * (1.0 + 0.608 * r.qv[i]));
@@ -85,7 +112,8 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
     q(static_cast<int>(core::Field::WindW))[i] = r.w[i];
     q(static_cast<int>(core::Field::Temperature))[i] = t;
     // Pressure is interpolated in its logarithm (exact in an isothermal layer), turned back below.
-    q(static_cast<int>(core::Field::Pressure))[i] = p > 0.0 ? std::log(p) : kNaN;
+    if (!(p == last_p)) last_p = p, last_log_p = p > 0.0 ? std::log(p) : kNaN;
+    q(static_cast<int>(core::Field::Pressure))[i] = last_log_p;
   }
   for (int l = 1; l < n; ++l) {
     for (int x = 0; x < nx; ++x) {
@@ -129,40 +157,23 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
     // neighbours' in-cloud values.
     const bool in_cloud = (f == kLiq || f == kIce) && has_cf;
     const bool pressure = f == static_cast<int>(core::Field::Pressure);
-    float lo = std::numeric_limits<float>::infinity(), hi = -std::numeric_limits<float>::infinity();
-    std::size_t finite = 0;
+    core::ValueStats st;  // of the finite values stored (the caller counts the missing ones)
     for (int z = 0; z < nz; ++z) {
       const int* lev = node_level.data() + static_cast<std::size_t>(z) * nxs;
       const double* wt = node_weight.data() + static_cast<std::size_t>(z) * nxs;
       float* row = dst.data() + grid.index(x0, y, z);
-      for (std::size_t x = 0; x < nxs; ++x) {
-        const int lz = lev[x];
-        if (lz < 0) {  // no level pair around the node: no data
-          row[x] = std::numeric_limits<float>::quiet_NaN();
-          continue;
-        }
-        const double a = wt[x];
-        const std::size_t i1 = static_cast<std::size_t>(lz) * nxs + x, i0 = i1 - nxs;
-        double v = qf[i0] + a * (qf[i1] - qf[i0]);
-        if (in_cloud) {
-          const double cf = qcf[i0] + a * (qcf[i1] - qcf[i0]);
-          if (!std::isnan(cf)) v = v > 0.0 && cf > 0.0 ? v / cf : (std::isnan(v) ? v : 0.0);
-        }
-        if (pressure) v = std::exp(v);
-        const float s = static_cast<float>(v);
-        row[x] = s;
-        if (std::abs(s) <= std::numeric_limits<float>::max()) {  // finite, as ValueStats counts
-          lo = std::min(lo, s), hi = std::max(hi, s);
-          ++finite;
-        }
-      }
+      // The three kinds of field as their own loops: no per-node test of what the field is.
+      if (in_cloud) interpolate_nodes<true, false>(lev, wt, qf, qcf, nxs, row);
+      else if (pressure) interpolate_nodes<false, true>(lev, wt, qf, qcf, nxs, row);
+      else interpolate_nodes<false, false>(lev, wt, qf, qcf, nxs, row);
+      st.add_all(row, nxs);
     }
-    if (stored && finite) {
-      core::ValueStats& st = (*stored)[static_cast<std::size_t>(f)];
-      st.min = std::min(st.min, static_cast<double>(lo));
-      st.max = std::max(st.max, static_cast<double>(hi));
+    if (stored && st.count) {
+      core::ValueStats& acc = (*stored)[static_cast<std::size_t>(f)];
+      acc.min = std::min(acc.min, st.min);
+      acc.max = std::max(acc.max, st.max);
     }
-    if (stored) (*stored)[static_cast<std::size_t>(f)].count += finite;
+    if (stored) (*stored)[static_cast<std::size_t>(f)].count += st.count;
   }
 }
 
