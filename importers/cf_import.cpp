@@ -220,6 +220,37 @@ struct Slab {
   }
 };
 
+// One role's values along a row of one level: the slab's one or two file rows (weights w and
+// 1 - w between them, as the output row's latitude falls) and its stride along longitude, so a
+// value is one index and no more (value() in load_era5_step's rows: the same arithmetic).
+struct RoleRow {
+  const float* f0 = nullptr;
+  const float* f1 = nullptr;
+  const double* d0 = nullptr;
+  const double* d1 = nullptr;
+  std::size_t s_lon = 0;
+  int i_off = 0;
+  double w = 0.0;
+  // Only rows with weight are read: the slab may hold no more than those.
+  RoleRow(const Slab& s, int j0, int j1, double w_, int k) : s_lon(s.s_lon), i_off(s.i_off), w(w_) {
+    const std::size_t lev = s.s_lev ? static_cast<std::size_t>(k - s.k_off) * s.s_lev : 0;
+    const int ja = w == 1.0 ? j1 : j0, jb = w == 0.0 ? j0 : j1;
+    const std::size_t a = static_cast<std::size_t>(ja - s.j_off) * s.s_lat + lev, b = static_cast<std::size_t>(jb - s.j_off) * s.s_lat + lev;
+    if (s.d.empty()) f0 = s.f.data() + a, f1 = s.f.data() + b;
+    else d0 = s.d.data() + a, d1 = s.d.data() + b;
+  }
+  RoleRow() = default;
+  double at(int i) const {
+    const std::size_t n = static_cast<std::size_t>(i - i_off) * s_lon;
+    if (d0) {
+      if (w == 0.0 || w == 1.0) return d0[n];
+      return (1.0 - w) * d0[n] + w * d1[n];
+    }
+    if (w == 0.0 || w == 1.0) return f0[n];
+    return (1.0 - w) * f0[n] + w * f1[n];
+  }
+};
+
 }  // namespace
 
 double ice_effective_radius_um(double temperature_k) {
@@ -449,13 +480,6 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   ConversionOptions conv{S.options.r_eff_liquid_um, S.options.r_eff_ice_um};
   // A latitude row at a time, levels outer and longitudes inner: the slabs are read along their
   // contiguous axis (a column's levels lie megabytes apart in a global file).
-  auto value = [&](Role r, int i, int j0, int j1, double w, int k) {
-    // Only rows with weight are read: the slab may hold no more than those.
-    const Slab& s = slab[static_cast<std::size_t>(r)];
-    if (w == 0.0) return s.at(i, j0, k);
-    if (w == 1.0) return s.at(i, j1, k);
-    return (1.0 - w) * s.at(i, j0, k) + w * s.at(i, j1, k);
-  };
   auto bad = [&](Role r, double v, const char* expected) {
     throw ImportError(path + ": variable '" + L.roles[static_cast<int>(r)]->name + "' has value " + fmt(v) +
                       " at time step " + std::to_string(t) + ", expected " + expected);
@@ -468,6 +492,9 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     const double w = S.lat.w[static_cast<std::size_t>(y)];
     for (int l = 0; l < nlev; ++l) {
       const int k = S.levels[static_cast<std::size_t>(l)];
+      RoleRow role_row[kRoleCount];
+      for (int r : roles_read) role_row[r] = RoleRow(slab[static_cast<std::size_t>(r)], j0, j1, w, k);
+      auto value = [&](Role r, int i) { return role_row[static_cast<int>(r)].at(i); };
       for (int x = 0; x < nx; ++x) {
         const int i = S.lon.src[static_cast<std::size_t>(x)];
         LevelSample c;
@@ -486,14 +513,14 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
             c.p_pa = isa_pressure_pa(S.level_z[L_] + (L.height_above_ground ? zsurf_geometric : 0.0));
             break;
         }
-        const double t_read = has(Role::Temperature) ? value(Role::Temperature, i, j0, j1, w, k) : NAN;
-        c.qv = has(Role::Humidity) ? value(Role::Humidity, i, j0, j1, w, k) : 0.0;
+        const double t_read = has(Role::Temperature) ? value(Role::Temperature, i) : NAN;
+        c.qv = has(Role::Humidity) ? value(Role::Humidity, i) : 0.0;
         if (std::isnan(c.qv)) c.qv = 0.0;
         // Height: geopotential -> geometric height on the sphere; else from the coordinate itself.
         if (has(Role::Geopotential)) {
-          c.z_m = physics::f64::geopotential_to_height_m(value(Role::Geopotential, i, j0, j1, w, k), grid.earth_radius_m);
+          c.z_m = physics::f64::geopotential_to_height_m(value(Role::Geopotential, i), grid.earth_radius_m);
         } else if (has(Role::GeopotentialHeight)) {
-          c.z_m = physics::f64::geopotential_to_height_m(kG0 * value(Role::GeopotentialHeight, i, j0, j1, w, k),
+          c.z_m = physics::f64::geopotential_to_height_m(kG0 * value(Role::GeopotentialHeight, i),
                                                          grid.earth_radius_m);
         } else if (L.vertical_kind == Vertical::Height) {
           c.z_m = S.level_z[L_] + (L.height_above_ground ? zsurf_geometric : 0.0);
@@ -515,7 +542,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
         if (!std::isnan(c.t_k) && (c.t_k < 100.0 || c.t_k > 400.0)) bad(Role::Temperature, c.t_k, "a temperature between 100 and 400 K");
         // Cloud fraction: tiny excursions from unpacking are clamped and counted; absurd values stop.
         if (has(Role::CloudFraction)) {
-          c.cf = value(Role::CloudFraction, i, j0, j1, w, k);
+          c.cf = value(Role::CloudFraction, i);
           if (!std::isnan(c.cf)) {
             if (c.cf < -0.01 || c.cf > 1.01) bad(Role::CloudFraction, c.cf, "a fraction between 0 and 1");
             if (c.cf < 0.0 || c.cf > 1.0) {
@@ -528,7 +555,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
         double* water[2] = {&c.q_liquid, &c.q_ice};
         for (int ph = 0; ph < 2; ++ph) {
           if (!has(water_role[ph])) continue;
-          double qw = value(water_role[ph], i, j0, j1, w, k);
+          double qw = value(water_role[ph], i);
           if (std::isnan(qw)) continue;
           if (qw < -1e-5 || qw > 0.05) bad(water_role[ph], qw, "a mixing ratio between 0 and 0.05 kg/kg");
           if (qw < 0.0) {
@@ -539,7 +566,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
           *water[ph] = qw;
         }
         if (has(Role::Snow)) {
-          double qs = value(Role::Snow, i, j0, j1, w, k);
+          double qs = value(Role::Snow, i);
           if (!std::isnan(qs)) {
             if (qs < -1e-5 || qs > 0.05) bad(Role::Snow, qs, "a mixing ratio between 0 and 0.05 kg/kg");
             if (qs < 0.0) {
@@ -553,7 +580,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
         if (diagnose) {
           // Relative humidity from the file, or from specific humidity and q_sat(p, T).
           double rh = NAN;
-          if (has(Role::RelativeHumidity)) rh = value(Role::RelativeHumidity, i, j0, j1, w, k);
+          if (has(Role::RelativeHumidity)) rh = value(Role::RelativeHumidity, i);
           else if (has(Role::Humidity)) rh = c.qv / saturation_specific_humidity(c.p_pa, c.t_k);
           if (!std::isnan(rh) && !std::isnan(c.t_k)) {
             if (rh < -0.01 || rh > 2.0) bad(has(Role::RelativeHumidity) ? Role::RelativeHumidity : Role::Humidity, rh,
@@ -564,13 +591,13 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
             c.q_ice = box.q_ice;
           }
         }
-        if (has(Role::U)) c.u = value(Role::U, i, j0, j1, w, k);
-        if (has(Role::V)) c.v = value(Role::V, i, j0, j1, w, k);
-        if (has(Role::UpwardVelocity)) c.w = value(Role::UpwardVelocity, i, j0, j1, w, k);
+        if (has(Role::U)) c.u = value(Role::U, i);
+        if (has(Role::V)) c.v = value(Role::V, i);
+        if (has(Role::UpwardVelocity)) c.w = value(Role::UpwardVelocity, i);
         // Omega (Pa/s) to w (m/s) by hydrostatics: w = -omega / (rho g).
         if (has(Role::Omega)) {
           const double rho = c.p_pa / (kRd * c.t_k * (1.0 + 0.608 * c.qv));
-          c.w = -value(Role::Omega, i, j0, j1, w, k) / (rho * kG0);
+          c.w = -value(Role::Omega, i) / (rho * kG0);
         }
         RowLevels& R = W.levels;
         const std::size_t at = R.at(l, x);
