@@ -73,14 +73,25 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
                core::TimeStepData& out, ColumnCounts& counts, StoredStats* stored) {
   const int n = r.nlev, nx = r.nx, nz = grid.alt_m.count;
   const std::size_t plane = static_cast<std::size_t>(n) * static_cast<std::size_t>(nx);
-  // Per level and column: SI quantities in the order of core::Field, level-major like `r` (a
-  // per-thread buffer, reused). The two extinctions are grid-box means here; they become in-cloud
-  // values node by node below.
-  thread_local std::vector<double> buffer;
-  buffer.resize(static_cast<std::size_t>(core::kFieldCount) * plane);
-  auto q = [&](int f) { return buffer.data() + static_cast<std::size_t>(f) * plane; };
+  // Per level and column, level-major like `r`: the quantities the conversion makes (the two
+  // extinctions, grid-box means here that become in-cloud values node by node below, and the
+  // pressure's logarithm) in a per-thread buffer, reused; the rest are interpolated from `r` as
+  // they are.
   constexpr int kLiq = static_cast<int>(core::Field::ExtinctionLiquid), kIce = static_cast<int>(core::Field::ExtinctionIce),
-                kCf = static_cast<int>(core::Field::CloudFraction);
+                kCf = static_cast<int>(core::Field::CloudFraction), kP = static_cast<int>(core::Field::Pressure);
+  thread_local std::vector<double> buffer;
+  buffer.resize(3 * plane);
+  std::array<const double*, core::kFieldCount> source{};
+  source[kLiq] = buffer.data(), source[kIce] = buffer.data() + plane, source[kP] = buffer.data() + 2 * plane;
+  source[kCf] = r.cf.data();
+  source[static_cast<int>(core::Field::WindU)] = r.u.data();
+  source[static_cast<int>(core::Field::WindV)] = r.v.data();
+  source[static_cast<int>(core::Field::WindW)] = r.w.data();
+  source[static_cast<int>(core::Field::Temperature)] = r.t_k.data();
+  static_assert(core::kFieldCount == 8, "every field has its source above");
+  double* const liq = buffer.data();
+  double* const ice = buffer.data() + plane;
+  double* const log_p = buffer.data() + 2 * plane;
   const double r_liq_m = options.r_eff_liquid_um * 1e-6;
   // On pressure levels every column of a level has the same pressure: its logarithm is taken once.
   double last_p = std::numeric_limits<double>::quiet_NaN(), last_log_p = kNaN;
@@ -99,21 +110,16 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
       }
       if (cf > 0.1 && total <= kZeroWater) ++counts.cf_without_water;
     }
-    q(kLiq)[i] = std::isnan(ql) ? kNaN : keep * 3.0 * rho * ql / (2.0 * kRhoWater * r_liq_m);
+    liq[i] = std::isnan(ql) ? kNaN : keep * 3.0 * rho * ql / (2.0 * kRhoWater * r_liq_m);
     if (!std::isnan(qi)) {
       const double r_ice_m = (options.r_eff_ice_um > 0 ? options.r_eff_ice_um : ice_effective_radius_um(t)) * 1e-6;
-      q(kIce)[i] = keep * 3.0 * rho * qi / (2.0 * kRhoIce * r_ice_m);
+      ice[i] = keep * 3.0 * rho * qi / (2.0 * kRhoIce * r_ice_m);
     } else {
-      q(kIce)[i] = kNaN;
+      ice[i] = kNaN;
     }
-    q(kCf)[i] = cf;
-    q(static_cast<int>(core::Field::WindU))[i] = r.u[i];
-    q(static_cast<int>(core::Field::WindV))[i] = r.v[i];
-    q(static_cast<int>(core::Field::WindW))[i] = r.w[i];
-    q(static_cast<int>(core::Field::Temperature))[i] = t;
     // Pressure is interpolated in its logarithm (exact in an isothermal layer), turned back below.
     if (!(p == last_p)) last_p = p, last_log_p = p > 0.0 ? std::log(p) : kNaN;
-    q(static_cast<int>(core::Field::Pressure))[i] = last_log_p;
+    log_p[i] = last_log_p;
   }
   for (int l = 1; l < n; ++l) {
     for (int x = 0; x < nx; ++x) {
@@ -147,16 +153,16 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
     }
   }
   const std::size_t nxs = static_cast<std::size_t>(nx);
-  const double* qcf = q(kCf);
+  const double* qcf = source[kCf];
   for (int f = 0; f < core::kFieldCount; ++f) {
     auto& dst = out.fields[static_cast<std::size_t>(f)];
     if (dst.empty()) continue;
-    const double* qf = q(f);
+    const double* qf = source[static_cast<std::size_t>(f)];
     // In-cloud = grid-box mean / fraction. Water was kept only where the fraction is meaningful,
     // so where the fraction vanishes the mean does too and the ratio stays bounded by its
     // neighbours' in-cloud values.
     const bool in_cloud = (f == kLiq || f == kIce) && has_cf;
-    const bool pressure = f == static_cast<int>(core::Field::Pressure);
+    const bool pressure = f == kP;
     core::ValueStats st;  // of the finite values stored (the caller counts the missing ones)
     for (int z = 0; z < nz; ++z) {
       const int* lev = node_level.data() + static_cast<std::size_t>(z) * nxs;
