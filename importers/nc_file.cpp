@@ -21,6 +21,7 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 
@@ -69,6 +70,12 @@ std::vector<NcAtt> read_atts(int ncid, int varid, int natts, const std::string& 
 // 2^32 - 1 makes it memcpy a negative size (a crash), a large one makes it calloc 16 GiB and more
 // (both found by fuzz/fuzz_netcdf). The header is walked here first, every declared length and
 // count held to the bytes the file has, before netCDF opens it.
+// The most of a file read to walk its header, and what is read first: a header is usually a few
+// kilobytes, so a big file is not read 64 MiB deep to check one.
+constexpr std::size_t kClassicHeaderMost = std::size_t(64) << 20, kClassicHeaderFirst = std::size_t(256) << 10;
+// Thrown when the header runs past the bytes read so far but not past the file: read more.
+struct NeedMoreBytes {};
+
 class ClassicHeader {
  public:
   ClassicHeader(const std::string& path, const std::vector<unsigned char>& b, std::uint64_t file_bytes)
@@ -100,7 +107,10 @@ class ClassicHeader {
   }
   std::uint64_t take(std::size_t n, const std::string& what) {
     if (pos_ + n > b_.size()) {
-      if (pos_ + n <= file_bytes_) throw ImportError(path_ + ": the netCDF classic header is larger than 64 MiB; expected a smaller header");
+      if (pos_ + n <= file_bytes_) {
+        if (b_.size() < kClassicHeaderMost) throw NeedMoreBytes{};
+        throw ImportError(path_ + ": the netCDF classic header is larger than 64 MiB; expected a smaller header");
+      }
       corrupt(what, n);
     }
     std::uint64_t v = 0;
@@ -165,14 +175,30 @@ std::size_t type_bytes(int t) {
 }  // namespace
 
 void check_classic_header(const std::string& path, std::uint64_t file_bytes) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!f) return;  // netCDF's open says why
-  std::vector<unsigned char> b(static_cast<std::size_t>(std::min<std::uint64_t>(file_bytes, 64u << 20)));
-  const std::size_t got = b.empty() ? 0 : std::fread(b.data(), 1, b.size(), f);
-  std::fclose(f);
-  b.resize(got);
-  if (b.size() < 4 || b[0] != 'C' || b[1] != 'D' || b[2] != 'F' || (b[3] != 1 && b[3] != 2 && b[3] != 5)) return;  // not classic
-  ClassicHeader(path, b, file_bytes).check();
+  const std::size_t most = static_cast<std::size_t>(std::min<std::uint64_t>(file_bytes, kClassicHeaderMost));
+  std::vector<unsigned char> b;
+  // The first bytes, then 16 times as many each time the header runs past them (to 64 MiB).
+  for (std::size_t want = std::min(most, kClassicHeaderFirst);; want = std::min(most, want * 16)) {
+    const std::size_t had = b.size();
+    b.resize(want);
+    const std::size_t got = want > had ? std::fread(b.data() + had, 1, want - had, f.get()) : 0;
+    b.resize(had + got);
+    if (b.size() < 4 || b[0] != 'C' || b[1] != 'D' || b[2] != 'F' || (b[3] != 1 && b[3] != 2 && b[3] != 5)) return;  // not classic
+    try {
+      ClassicHeader(path, b, file_bytes).check();
+      return;
+    } catch (const NeedMoreBytes&) {
+      // A file that is shorter than its size said (got < want - had) is read no further: its
+      // header is walked against what there is.
+      if (b.size() >= most || got < want - had) {
+        file_bytes = b.size();
+        ClassicHeader(path, b, file_bytes).check();
+        return;
+      }
+    }
+  }
 }
 
 const NcAtt* NcVar::att(const std::string& n) const {

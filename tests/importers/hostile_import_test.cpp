@@ -309,6 +309,42 @@ TEST_F(HostileImport, CorruptClassicHeaderIsRefusedBeforeNetcdfReadsIt) {
   }
 }
 
+TEST_F(HostileImport, AClassicHeaderLongerThanItsFirstReadIsWalkedToItsEnd) {
+  // The header is read 256 KiB at first and further only as it needs (a big file is not read
+  // 64 MiB deep to check a header of a few kilobytes): a valid header of 600 KB opens, and a
+  // corrupt length beyond the first read is still found before netCDF reads it.
+  const std::string p = (dir_ / "long_header.nc").string();
+  const std::string history(600000, 'h');
+  {
+    int nc, x, v;
+    ASSERT_EQ(nc_create(p.c_str(), NC_CLOBBER | NC_64BIT_OFFSET, &nc), NC_NOERR);
+    ASSERT_EQ(nc_def_dim(nc, "x", 1 << 20, &x), NC_NOERR);
+    ASSERT_EQ(nc_put_att_text(nc, NC_GLOBAL, "history", history.size(), history.data()), NC_NOERR);
+    ASSERT_EQ(nc_def_var(nc, "v", NC_FLOAT, 1, &x, &v), NC_NOERR);
+    ASSERT_EQ(nc_enddef(nc), NC_NOERR);
+    ASSERT_EQ(nc_close(nc), NC_NOERR);  // the variable's fill values follow: about 4.8 MB in all
+  }
+  ASSERT_GT(std::filesystem::file_size(p), std::uintmax_t(4) << 20);
+  EXPECT_NO_THROW(importers::NcFile{p});
+  // The variable's name length: after the magic and record count (8), the dimension list (8 + 12),
+  // the attribute list's tag and count (8), the attribute's name (4 + 8), type and length (8), its
+  // values (600 000) and the variable list's tag and count (8).
+  const std::streamoff at = 8 + 20 + 8 + 12 + 8 + 600000 + 8;
+  {
+    std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(at);
+    unsigned char was[4] = {};
+    f.read(reinterpret_cast<char*>(was), 4);
+    ASSERT_EQ(was[3], 1u) << "the layout above is not the file's: 'v' has a name of length 1";
+    f.seekp(at);
+    const unsigned char be[4] = {0x7F, 0xFF, 0xFF, 0xF0};
+    f.write(reinterpret_cast<const char*>(be), 4);
+  }
+  const std::string msg = import_error(p);
+  EXPECT_NE(msg.find(p + ": the netCDF classic header is corrupt: the name of variable 0 declares 2147483632"), std::string::npos)
+      << msg;
+}
+
 TEST_F(HostileImport, ARecordCountBeyondAnyIntegerIsNamedNotOverflowed) {
   // fuzz_netcdf: a classic header declaring 2^62 records made the truncation check's byte count
   // overflow its conversion to long long (undefined behaviour; UBSan's float-cast-overflow). A
