@@ -26,7 +26,7 @@
 #include "render/frame_renderer.hpp"
 #include "render/land_sea_mask.hpp"
 #include "render/overlay_pass.hpp"
-#include "support/nc_builder.hpp"
+#include "support/cf_writer.hpp"
 
 namespace {
 using namespace cv;
@@ -987,54 +987,20 @@ TEST(Section, AnIsobaricSectionOfAFileOnPressureLevels) {
   const std::string path = cv::test_support::scratch_dir() + "isobaric_section.nc";
   constexpr double kR = 6371000.0;
   const std::vector<double> levels_pa = {100000.0, 92500.0, 85000.0, 77500.0, 70000.0, 62500.0, 55000.0};
-  const int nx = 9, ny = 3, nz = static_cast<int>(levels_pa.size());
+  const int nx = 9, ny = 3;
   {
-    test::NcBuilder b(path);
-    const int dt = b.dim("time", 1), dz = b.dim("level", levels_pa.size()), dy = b.dim("latitude", ny), dx = b.dim("longitude", nx);
-    const int vlon = b.var("longitude", NC_DOUBLE, {dx});
-    b.text(vlon, "units", "degrees_east");
-    b.text(vlon, "standard_name", "longitude");
-    const int vlat = b.var("latitude", NC_DOUBLE, {dy});
-    b.text(vlat, "units", "degrees_north");
-    b.text(vlat, "standard_name", "latitude");
-    const int vlev = b.var("level", NC_DOUBLE, {dz});
-    b.text(vlev, "units", "Pa");
-    b.text(vlev, "standard_name", "air_pressure");
-    b.text(vlev, "positive", "down");
-    const int vtime = b.var("time", NC_INT, {dt});
-    b.text(vtime, "units", "hours since 2026-12-02 00:00:00");
-    b.text(vtime, "calendar", "gregorian");
-    const std::vector<int> dims{dt, dz, dy, dx};
-    const int vz = b.var("z", NC_DOUBLE, dims);
-    b.text(vz, "units", "m**2 s**-2");
-    b.text(vz, "standard_name", "geopotential");
-    const int vt = b.var("t", NC_DOUBLE, dims);
-    b.text(vt, "units", "K");
-    b.text(vt, "standard_name", "air_temperature");
-    const int vq = b.var("clwc", NC_DOUBLE, dims);
-    b.text(vq, "units", "kg kg**-1");
-    b.text(vq, "long_name", "specific cloud liquid water content");
-    std::vector<double> lon, lat, z, t, q;
-    for (int i = 0; i < nx; ++i) lon.push_back(-4.0 + i);
-    for (int j = 0; j < ny; ++j) lat.push_back(50.0 + j);
-    for (int k = 0; k < nz; ++k) {
-      for (int j = 0; j < ny; ++j) {
-        for (int i = 0; i < nx; ++i) {
-          const double alt = Isothermal::altitude_m(lon[static_cast<std::size_t>(i)], levels_pa[static_cast<std::size_t>(k)]);
-          z.push_back(Isothermal::kG0 * kR * alt / (kR + alt));  // the inverse of the importer's z = Phi R / (g0 R - Phi)
-          t.push_back(Isothermal::kT);
-          q.push_back(k == 2 ? 1e-4 : 0.0);
-        }
-      }
-    }
-    b.put(vlon, lon);
-    b.put(vlat, lat);
-    b.put(vlev, levels_pa);
-    b.put(vtime, {0.0});
-    b.put(vz, z);
-    b.put(vt, t);
-    b.put(vq, q);
-    b.close();
+    test::PressureLevelFile f;
+    for (int i = 0; i < nx; ++i) f.lon.push_back(-4.0 + i);
+    for (int j = 0; j < ny; ++j) f.lat.push_back(50.0 + j);
+    f.levels_pa = levels_pa;
+    f.time_units = "hours since 2026-12-02 00:00:00";
+    f.geopotential = [&](int i, int, int k) {
+      const double alt = Isothermal::altitude_m(f.lon[static_cast<std::size_t>(i)], levels_pa[static_cast<std::size_t>(k)]);
+      return Isothermal::kG0 * kR * alt / (kR + alt);  // the inverse of the importer's z = Phi R / (g0 R - Phi)
+    };
+    f.temperature = [](int, int, int) { return Isothermal::kT; };
+    f.water = [](int, int, int k) { return k == 2 ? 1e-4 : 0.0; };
+    test::write_pressure_level_file(path, f);
   }
   importers::ImportOptions o;
   o.dz_m = 100.0;

@@ -69,4 +69,62 @@ inline void write_cf(const std::string& path, const std::vector<CfAxis>& axes, c
   b.close();
 }
 
+// An ERA5-style file on pressure levels with one time step: longitude, latitude, level (Pa,
+// positive down), time, then geopotential `z`, temperature `t` and one cloud water variable under
+// ECMWF's names, their values functions of the longitude, latitude and level indices (i, j, k).
+struct PressureLevelFile {
+  std::vector<double> lon, lat, levels_pa;
+  std::string time_units = "hours since 2024-06-21 00:00:00";
+  std::function<double(int, int, int)> geopotential, temperature, water;
+  bool ice = false;  // the water is `ciwc` (ice), else `clwc` (liquid)
+};
+
+inline void write_pressure_level_file(const std::string& path, const PressureLevelFile& f) {
+  NcBuilder b(path);
+  const int nx = static_cast<int>(f.lon.size()), ny = static_cast<int>(f.lat.size()), nz = static_cast<int>(f.levels_pa.size());
+  const int dt = b.dim("time", 1), dz = b.dim("level", f.levels_pa.size());
+  const int dy = b.dim("latitude", f.lat.size()), dx = b.dim("longitude", f.lon.size());
+  const int vlon = b.var("longitude", NC_DOUBLE, {dx});
+  b.text(vlon, "units", "degrees_east");
+  b.text(vlon, "standard_name", "longitude");
+  const int vlat = b.var("latitude", NC_DOUBLE, {dy});
+  b.text(vlat, "units", "degrees_north");
+  b.text(vlat, "standard_name", "latitude");
+  const int vlev = b.var("level", NC_DOUBLE, {dz});
+  b.text(vlev, "units", "Pa");
+  b.text(vlev, "standard_name", "air_pressure");
+  b.text(vlev, "positive", "down");
+  const int vtime = b.var("time", NC_INT, {dt});
+  b.text(vtime, "units", f.time_units);
+  b.text(vtime, "calendar", "gregorian");
+  const std::vector<int> dims{dt, dz, dy, dx};
+  const int vz = b.var("z", NC_DOUBLE, dims);
+  b.text(vz, "units", "m**2 s**-2");
+  b.text(vz, "standard_name", "geopotential");
+  const int vt = b.var("t", NC_DOUBLE, dims);
+  b.text(vt, "units", "K");
+  b.text(vt, "standard_name", "air_temperature");
+  const int vq = b.var(f.ice ? "ciwc" : "clwc", NC_DOUBLE, dims);
+  b.text(vq, "units", "kg kg**-1");
+  b.text(vq, "long_name", f.ice ? "specific cloud ice water content" : "specific cloud liquid water content");
+  std::vector<double> z, t, q;
+  for (int k = 0; k < nz; ++k) {
+    for (int j = 0; j < ny; ++j) {
+      for (int i = 0; i < nx; ++i) {
+        z.push_back(f.geopotential(i, j, k));
+        t.push_back(f.temperature(i, j, k));
+        q.push_back(f.water(i, j, k));
+      }
+    }
+  }
+  b.put(vlon, f.lon);
+  b.put(vlat, f.lat);
+  b.put(vlev, f.levels_pa);
+  b.put(vtime, {0.0});
+  b.put(vz, z);
+  b.put(vt, t);
+  b.put(vq, q);
+  b.close();
+}
+
 }  // namespace cv::test

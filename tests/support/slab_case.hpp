@@ -19,7 +19,7 @@
 #include "geo/geodesy.hpp"
 #include "importer.hpp"
 #include "reference/monte_carlo.hpp"
-#include "support/nc_builder.hpp"
+#include "support/cf_writer.hpp"
 #include "volume/grid_mean.hpp"
 
 namespace cv::test::slab {
@@ -65,59 +65,25 @@ struct SlabLayout {
 // inner levels. One time step.
 inline void write_slab_file(const std::string& path, double tau, SlabPhase phase, const SlabLayout& L = {}) {
   constexpr double kR = 6371000.0, kG0 = 9.80665, kRd = 287.05;
-  NcBuilder b(path);
   const int nx = static_cast<int>(std::lround(2.0 * L.half_width_deg / L.lon_lat_step_deg)) + 1, ny = nx;
-  const int dt = b.dim("time", 1), dz = b.dim("level", static_cast<std::size_t>(L.levels));
-  const int dy = b.dim("latitude", static_cast<std::size_t>(ny)), dx = b.dim("longitude", static_cast<std::size_t>(nx));
-  const int vlon = b.var("longitude", NC_DOUBLE, {dx});
-  b.text(vlon, "units", "degrees_east");
-  b.text(vlon, "standard_name", "longitude");
-  const int vlat = b.var("latitude", NC_DOUBLE, {dy});
-  b.text(vlat, "units", "degrees_north");
-  b.text(vlat, "standard_name", "latitude");
-  const int vlev = b.var("level", NC_DOUBLE, {dz});
-  b.text(vlev, "units", "Pa");
-  b.text(vlev, "standard_name", "air_pressure");
-  b.text(vlev, "positive", "down");
-  const int vtime = b.var("time", NC_INT, {dt});
-  b.text(vtime, "units", "hours since 2024-06-21 00:00:00");
-  b.text(vtime, "calendar", "gregorian");
-  const std::vector<int> dims{dt, dz, dy, dx};
-  const int vz = b.var("z", NC_DOUBLE, dims);
-  b.text(vz, "units", "m**2 s**-2");
-  b.text(vz, "standard_name", "geopotential");
-  const int vt = b.var("t", NC_DOUBLE, dims);
-  b.text(vt, "units", "K");
-  b.text(vt, "standard_name", "air_temperature");
   const bool ice = phase == SlabPhase::HG085;
-  const int vq = b.var(ice ? "ciwc" : "clwc", NC_DOUBLE, dims);
-  b.text(vq, "units", "kg kg**-1");
-  b.text(vq, "long_name", ice ? "specific cloud ice water content" : "specific cloud liquid water content");
   const double sigma = tau / L.depth_per_sigma_m();
   const double rho_particle = ice ? 917.0 : 1000.0, r_eff_m = (ice ? L.r_eff_ice_um : L.r_eff_liquid_um) * 1e-6;
-  const std::size_t per_level = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
-  std::vector<double> z, t, q;
-  for (int k = 0; k < L.levels; ++k) {
+  PressureLevelFile f;
+  for (int i = 0; i < nx; ++i) f.lon.push_back(-L.half_width_deg + L.lon_lat_step_deg * i);
+  for (int j = 0; j < ny; ++j) f.lat.push_back(-L.half_width_deg + L.lon_lat_step_deg * j);
+  for (int k = 0; k < L.levels; ++k) f.levels_pa.push_back(L.pressure_pa(k));
+  f.ice = ice;
+  f.geopotential = [&](int, int, int k) {
     const double alt = L.base_m + L.dz_m * k;
-    const double phi = kG0 * kR * alt / (kR + alt);  // inverse of z = Phi R / (g0 R - Phi)
+    return kG0 * kR * alt / (kR + alt);  // inverse of z = Phi R / (g0 R - Phi)
+  };
+  f.temperature = [&](int, int, int) { return L.temperature_k; };
+  f.water = [&](int, int, int k) {
     const double rho = L.pressure_pa(k) / (kRd * L.temperature_k);
-    const double qk = !L.cloudy(k) ? 0.0 : 2.0 * rho_particle * r_eff_m * sigma / (3.0 * rho);
-    z.insert(z.end(), per_level, phi);
-    t.insert(t.end(), per_level, L.temperature_k);
-    q.insert(q.end(), per_level, qk);
-  }
-  std::vector<double> lon, lat, lev;
-  for (int i = 0; i < nx; ++i) lon.push_back(-L.half_width_deg + L.lon_lat_step_deg * i);
-  for (int j = 0; j < ny; ++j) lat.push_back(-L.half_width_deg + L.lon_lat_step_deg * j);
-  for (int k = 0; k < L.levels; ++k) lev.push_back(L.pressure_pa(k));
-  b.put(vlon, lon);
-  b.put(vlat, lat);
-  b.put(vlev, lev);
-  b.put(vtime, {0.0});
-  b.put(vz, z);
-  b.put(vt, t);
-  b.put(vq, q);
-  b.close();
+    return !L.cloudy(k) ? 0.0 : 2.0 * rho_particle * r_eff_m * sigma / (3.0 * rho);
+  };
+  write_pressure_level_file(path, f);
 }
 
 // The imported slab: its grid, the renderer's medium, and the column optical depth measured on it.
