@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_args.hpp"
 #include "bench/metrics.hpp"
 #include "bench/standard_scenes.hpp"
 #include "kernel/ms_source.hpp"
@@ -25,41 +26,18 @@ int main(int argc, char** argv) {
   int w = 32, h = 18, spp = 256, max_bounces = 0;
   bool rows = false;
   std::vector<std::string> scenes;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_ms_model [--size WxH] [--spp N] [--max-bounces N] [--rows] [SCENE...]\n"
-                  "  octave sum and two-stream source against the Monte Carlo reference, clouds only\n"
-                  "  --max-bounces N  cut the reference's paths at N scattering events (1: single scattering,\n"
-                  "                   against one octave)\n"
-                  "  --rows           print each image row's mean luminance: reference, octaves, two-stream\n");
-      return 0;
-    } else if (a == "--size" && i + 1 < argc) {
-      if (std::sscanf(argv[++i], "%dx%d", &w, &h) != 2 || w < 1 || h < 1) {
-        std::fprintf(stderr, "bench_ms_model: --size: found %s, expected WxH\n", argv[i]);
-        return 2;
-      }
-    } else if (a == "--spp" && i + 1 < argc) {
-      spp = std::atoi(argv[++i]);
-      if (spp < 1) {
-        std::fprintf(stderr, "bench_ms_model: --spp: found %s, expected an integer >= 1\n", argv[i]);
-        return 2;
-      }
-    } else if (a == "--max-bounces" && i + 1 < argc) {
-      max_bounces = std::atoi(argv[++i]);
-      if (max_bounces < 1) {
-        std::fprintf(stderr, "bench_ms_model: --max-bounces: found %s, expected an integer >= 1\n", argv[i]);
-        return 2;
-      }
-    } else if (a == "--rows") {
-      rows = true;
-    } else if (!a.empty() && a[0] != '-') {
-      scenes.push_back(a);
-    } else {
-      std::fprintf(stderr, "bench_ms_model: unknown option %s (see --help)\n", a.c_str());
-      return 2;
-    }
-  }
+  namespace ba = cv::bench_args;
+  const int code = ba::parse("bench_ms_model",
+                             "usage: bench_ms_model [--size WxH] [--spp N] [--max-bounces N] [--rows] [SCENE...]\n"
+                             "  octave sum and two-stream source against the Monte Carlo reference, clouds only\n"
+                             "  --max-bounces N  cut the reference's paths at N scattering events (1: single scattering,\n"
+                             "                   against one octave)\n"
+                             "  --rows           print each image row's mean luminance: reference, octaves, two-stream\n",
+                             argc, argv,
+                             {ba::size("--size", w, h), ba::integer("--spp", spp), ba::integer("--max-bounces", max_bounces),
+                              ba::flag("--rows", rows)},
+                             &scenes);
+  if (code >= 0) return code;
   if (scenes.empty()) {
     for (const auto& n : cv::bench::standard_scene_names()) if (n != "clear_sky") scenes.push_back(n);
   }

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_args.hpp"
 #include "physics/slab_solver.hpp"
 #include "reference/raymarcher.hpp"
 #include "support/slab_case.hpp"
@@ -39,26 +40,14 @@ int main(int argc, char** argv) {
   std::string phases = "both";
   int octaves = 4;
   std::vector<double> taus{1, 2, 5, 10, 20, 50, 100}, zeniths{0, 30, 60};
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_slab_models [--phase hg|mie|both] [--tau 1,2,...] [--zenith 0,30,...] [--octaves N]\n");
-      return 0;
-    }
-    if (i + 1 >= argc) {
-      std::fprintf(stderr, "bench_slab_models: %s needs a value (see --help)\n", a.c_str());
-      return 2;
-    }
-    const std::string v = argv[++i];
-    if (a == "--phase") phases = v;
-    else if (a == "--tau") taus = number_list(v);
-    else if (a == "--zenith") zeniths = number_list(v);
-    else if (a == "--octaves") octaves = std::atoi(v.c_str());
-    else {
-      std::fprintf(stderr, "bench_slab_models: unknown option %s (see --help)\n", a.c_str());
-      return 2;
-    }
-  }
+  namespace ba = cv::bench_args;
+  const int code = ba::parse("bench_slab_models",
+                             "usage: bench_slab_models [--phase hg|mie|both] [--tau 1,2,...] [--zenith 0,30,...] [--octaves N]\n"
+                             "  the octave sum and the two-stream source against the adding-doubling solver at nadir\n",
+                             argc, argv,
+                             {ba::one_of("--phase", phases, {"hg", "mie", "both"}), ba::numbers("--tau", taus),
+                              ba::numbers("--zenith", zeniths), ba::integer("--octaves", octaves)});
+  if (code >= 0) return code;
   const auto dir = std::filesystem::temp_directory_path() / "cv_slab_models";
   std::filesystem::create_directories(dir);
   std::vector<SlabPhase> which;

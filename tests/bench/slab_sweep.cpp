@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_args.hpp"
 #include "physics/slab_solver.hpp"
 #include "support/slab_case.hpp"
 
@@ -30,19 +31,16 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 11;
   std::string phases = "both";
   std::vector<double> taus{1, 2, 5, 10, 20, 50, 100}, zeniths{0, 30, 60, 75};
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string a = argv[i], v = argv[i + 1];
-    if (a == "--spp") spp = std::atoi(v.c_str());
-    else if (a == "--paths") paths = std::atoi(v.c_str());
-    else if (a == "--phase") phases = v;
-    else if (a == "--tau") taus = number_list(v);
-    else if (a == "--zenith") zeniths = number_list(v);
-    else if (a == "--seed") seed = std::strtoull(v.c_str(), nullptr, 10);
-    else {
-      std::fprintf(stderr, "unknown option %s\n", a.c_str());
-      return 2;
-    }
-  }
+  namespace ba = cv::bench_args;
+  const int code = ba::parse("bench_slab_sweep",
+                             "usage: bench_slab_sweep [--spp N] [--paths N] [--phase hg|mie|both] [--tau 1,2,...] [--zenith 0,30,...]\n"
+                             "                        [--seed S]\n"
+                             "  the Monte Carlo on the imported slab against the adding-doubling solver: nadir radiance\n"
+                             "  (--spp camera samples) and plane albedo (--paths beams), both fewer by 10 / tau above tau 10\n",
+                             argc, argv,
+                             {ba::integer("--spp", spp), ba::integer("--paths", paths), ba::one_of("--phase", phases, {"hg", "mie", "both"}),
+                              ba::numbers("--tau", taus), ba::numbers("--zenith", zeniths), ba::seed("--seed", seed)});
+  if (code >= 0) return code;
   const auto dir = std::filesystem::temp_directory_path() / "cv_slab_sweep";
   std::filesystem::create_directories(dir);
   std::vector<SlabPhase> which;

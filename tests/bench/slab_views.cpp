@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_args.hpp"
 #include "reference/monte_carlo.hpp"
 #include "reference/raymarcher.hpp"
 #include "support/slab_case.hpp"
@@ -41,34 +42,19 @@ int main(int argc, char** argv) {
   std::vector<double> taus{2, 5, 20}, zeniths{30}, views{0, 45, 70, 85}, azimuths{0, 90, 180};
   int spp = 20000, max_bounces = 1000000;
   std::uint64_t seed = 5;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_slab_views [--phase hg|mie|both] [--tau 1,2,...] [--zenith SUN,...] [--view V,...]\n"
-                  "                        [--azimuth A,...] [--spp N] [--seed S] [--max-bounces N]\n"
-                  "  the octave sum and the two-stream source against the Monte Carlo on a slab seen obliquely\n"
-                  "  (view zenith V at the cloud top, heading A from the sun's azimuth: 0 toward the sun);\n"
-                  "  --max-bounces cuts the Monte Carlo's paths (the light of the first N orders of scattering)\n");
-      return 0;
-    }
-    if (i + 1 >= argc) {
-      std::fprintf(stderr, "bench_slab_views: %s needs a value (see --help)\n", a.c_str());
-      return 2;
-    }
-    const std::string v = argv[++i];
-    if (a == "--phase" && (v == "hg" || v == "mie" || v == "both")) phases = v;
-    else if (a == "--tau") taus = number_list(v);
-    else if (a == "--zenith") zeniths = number_list(v);
-    else if (a == "--view") views = number_list(v);
-    else if (a == "--azimuth") azimuths = number_list(v);
-    else if (a == "--spp" && std::atoi(v.c_str()) > 0) spp = std::atoi(v.c_str());
-    else if (a == "--max-bounces" && std::atoi(v.c_str()) > 0) max_bounces = std::atoi(v.c_str());
-    else if (a == "--seed") seed = std::strtoull(v.c_str(), nullptr, 10);
-    else {
-      std::fprintf(stderr, "bench_slab_views: %s %s: unknown option or bad value (see --help)\n", a.c_str(), v.c_str());
-      return 2;
-    }
-  }
+  namespace ba = cv::bench_args;
+  const int code = ba::parse(
+      "bench_slab_views",
+      "usage: bench_slab_views [--phase hg|mie|both] [--tau 1,2,...] [--zenith SUN,...] [--view V,...]\n"
+      "                        [--azimuth A,...] [--spp N] [--seed S] [--max-bounces N]\n"
+      "  the octave sum and the two-stream source against the Monte Carlo on a slab seen obliquely\n"
+      "  (view zenith V at the cloud top, heading A from the sun's azimuth: 0 toward the sun);\n"
+      "  --max-bounces cuts the Monte Carlo's paths (the light of the first N orders of scattering)\n",
+      argc, argv,
+      {ba::one_of("--phase", phases, {"hg", "mie", "both"}), ba::numbers("--tau", taus), ba::numbers("--zenith", zeniths),
+       ba::numbers("--view", views), ba::numbers("--azimuth", azimuths), ba::integer("--spp", spp),
+       ba::integer("--max-bounces", max_bounces), ba::seed("--seed", seed)});
+  if (code >= 0) return code;
   const auto dir = std::filesystem::temp_directory_path() / "cv_slab_views";
   std::filesystem::create_directories(dir);
   std::vector<SlabPhase> which;

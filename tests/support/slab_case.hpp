@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -27,15 +26,6 @@ namespace cv::test::slab {
 // Henyey-Greenstein g = 0.85 goes in as ice (the Monte Carlo's ice phase is HG with ice_g); the
 // droplet phase goes in as liquid (approximate Mie at 2 r_eff).
 enum class SlabPhase { HG085, Mie };
-// "1,2,5" -> {1, 2, 5}: the sweeps' lists of optical depths and sun angles.
-inline std::vector<double> number_list(const std::string& s) {
-  std::vector<double> v;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ',')) v.push_back(std::atof(item.c_str()));
-  return v;
-}
-
 inline const char* phase_name(SlabPhase p) { return p == SlabPhase::HG085 ? "HG 0.85" : "Mie 20 um"; }
 
 // The slab's layout. Levels every dz_m from base_m up; water on levels 1 .. levels - 3, none on the
