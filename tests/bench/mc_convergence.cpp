@@ -8,45 +8,26 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_args.hpp"
 #include "bench/standard_scenes.hpp"
 #include "reference/monte_carlo.hpp"
 #include "volume/grid_mean.hpp"
 
 int main(int argc, char** argv) {
-  int w = 48, h = 27, spp = 64;
-  unsigned threads = 0;
-  bool peak_mis = true;
+  int w = 48, h = 27, spp = 64, threads = 0;
+  bool no_peak_mis = false;
   std::vector<std::string> scenes;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      std::printf(
-          "usage: bench_mc_convergence [--size WxH] [--spp N] [--threads T] [--no-peak-mis] SCENE...\n"
-          "  the clouds-only Monte Carlo reference of each standard scene at N and 4N samples per pixel;\n"
-          "  prints the mean relative standard errors and their ratio (2: 1/sqrt(N) convergence)\n");
-      return 0;
-    } else if (a == "--size" && i + 1 < argc) {
-      if (std::sscanf(argv[++i], "%dx%d", &w, &h) != 2 || w < 1 || h < 1) {
-        std::fprintf(stderr, "bench_mc_convergence: --size: found %s, expected WxH\n", argv[i]);
-        return 2;
-      }
-    } else if (a == "--spp" && i + 1 < argc) {
-      spp = std::atoi(argv[++i]);
-      if (spp < 1) {
-        std::fprintf(stderr, "bench_mc_convergence: --spp: found %s, expected an integer >= 1\n", argv[i]);
-        return 2;
-      }
-    } else if (a == "--threads" && i + 1 < argc) {
-      threads = static_cast<unsigned>(std::atoi(argv[++i]));
-    } else if (a == "--no-peak-mis") {
-      peak_mis = false;
-    } else if (!a.empty() && a[0] != '-') {
-      scenes.push_back(a);
-    } else {
-      std::fprintf(stderr, "bench_mc_convergence: unknown option %s (see --help)\n", a.c_str());
-      return 2;
-    }
-  }
+  namespace ba = cv::bench_args;
+  const int code = ba::parse("bench_mc_convergence",
+                             "usage: bench_mc_convergence [--size WxH] [--spp N] [--threads T] [--no-peak-mis] SCENE...\n"
+                             "  the clouds-only Monte Carlo reference of each standard scene at N and 4N samples per pixel;\n"
+                             "  prints the mean relative standard errors and their ratio (2: 1/sqrt(N) convergence)\n",
+                             argc, argv,
+                             {ba::size("--size", w, h), ba::integer("--spp", spp), ba::integer("--threads", threads, 0, 1024),
+                              ba::flag("--no-peak-mis", no_peak_mis)},
+                             &scenes);
+  if (code >= 0) return code;
+  const bool peak_mis = !no_peak_mis;
   if (scenes.empty()) scenes = {"stratocumulus", "cumulus_field"};
   std::printf("%-20s %8s %10s %8s %10s %8s %7s\n", "scene", "N", "rel.s.e.", "s", "4N rel.s.e.", "s", "ratio");
   for (const std::string& name : scenes) {
@@ -63,7 +44,7 @@ int main(int argc, char** argv) {
     m.medium.ambient = 0.0, m.medium.noise_amount = 0.0;
     if (!(m.medium.droplet_diameter_um > 0.0)) m.medium.droplet_diameter_um = 20.0;
     cv::core::MonteCarloSettings mc;
-    mc.threads = threads;
+    mc.threads = static_cast<unsigned>(threads);
     mc.peak_mis = peak_mis;
     const cv::core::MonteCarloRenderer r(sc.grid, ext, sc.camera, sc.sun, m, mc);
     cv::core::MonteCarloImage img = r.start();
