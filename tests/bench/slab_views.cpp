@@ -43,22 +43,29 @@ int main(int argc, char** argv) {
   int spp = 20000, max_bounces = 1000000;
   std::uint64_t seed = 5;
   bool delta_scaled = false;
+  std::vector<double> delta_f;  // the truncated share; empty: g^2 (delta-Eddington)
   namespace ba = cv::bench_args;
   const int code = ba::parse(
       "bench_slab_views",
       "usage: bench_slab_views [--phase hg|mie|both] [--tau 1,2,...] [--zenith SUN,...] [--view V,...]\n"
-      "                        [--azimuth A,...] [--spp N] [--seed S] [--max-bounces N] [--delta-scaled]\n"
+      "                        [--azimuth A,...] [--spp N] [--seed S] [--max-bounces N] [--delta-scaled [--delta-f F]]\n"
       "  the octave sum and the two-stream source against the Monte Carlo on a slab seen obliquely\n"
       "  (view zenith V at the cloud top, heading A from the sun's azimuth: 0 toward the sun);\n"
       "  --max-bounces cuts the Monte Carlo's paths (the light of the first N orders of scattering);\n"
       "  --delta-scaled (HG only) also solves the delta-Eddington problem the two-stream's diffuse path\n"
       "  assumes (extinction (1 - g^2) sigma, HG g / (1 + g)) by the same Monte Carlo: the error that\n"
-      "  scaling keeps even when its transport is solved exactly\n",
+      "  scaling keeps even when its transport is solved exactly; --delta-f F truncates the share F\n"
+      "  instead of g^2 (extinction (1 - F) sigma, HG (g - F) / (1 - F))\n",
       argc, argv,
       {ba::one_of("--phase", phases, {"hg", "mie", "both"}), ba::numbers("--tau", taus), ba::numbers("--zenith", zeniths),
        ba::numbers("--view", views), ba::numbers("--azimuth", azimuths), ba::integer("--spp", spp),
-       ba::integer("--max-bounces", max_bounces), ba::seed("--seed", seed), ba::flag("--delta-scaled", delta_scaled)});
+       ba::integer("--max-bounces", max_bounces), ba::seed("--seed", seed), ba::flag("--delta-scaled", delta_scaled),
+       ba::numbers("--delta-f", delta_f)});
   if (code >= 0) return code;
+  if (!delta_f.empty() && (!delta_scaled || delta_f.size() != 1 || !(delta_f[0] >= 0.0 && delta_f[0] < 0.85))) {
+    std::fprintf(stderr, "bench_slab_views: --delta-f: expected one share from 0 to below 0.85 (the slab's g), with --delta-scaled\n");
+    return 2;
+  }
   if (delta_scaled && phases != "hg") {
     std::fprintf(stderr, "bench_slab_views: --delta-scaled: found --phase %s, expected --phase hg (the droplets' phase has no free mean cosine to scale)\n",
                  phases.c_str());
@@ -115,11 +122,11 @@ int main(int argc, char** argv) {
             std::printf("| %s | %g | %g | %g | %g | %.5f +- %.5f | %+.1f %% | %+.1f %% |", phase_name(ph), tau, z, v, az, ref, se,
                         100.0 * (model[0] / ref - 1.0), 100.0 * (model[1] / ref - 1.0));
             if (delta_scaled) {  // the slab's HG phase is its ice (support/slab_case.hpp)
-              const double g = mm.medium.ice_g;
+              const double g = mm.medium.ice_g, f = delta_f.empty() ? g * g : delta_f[0];
               cv::core::GridMeanExtinction scaled = s.medium;
-              for (float& x : scaled.ice_per_m) x = static_cast<float>(x * (1.0 - g * g));
+              for (float& x : scaled.ice_per_m) x = static_cast<float>(x * (1.0 - f));
               cv::core::MarchSettings ms = mm;
-              ms.medium.ice_g = g / (1.0 + g);
+              ms.medium.ice_g = (g - f) / (1.0 - f);
               double se_scaled = 0.0;
               const double l = monte_carlo(scaled, ms, se_scaled);
               std::printf(" %+.1f %% +- %.1f %% |", 100.0 * (l / ref - 1.0), 100.0 * std::hypot(se_scaled / ref, l * se / (ref * ref)));
