@@ -85,15 +85,34 @@ class ClassicHeader {
     take(version_ == 5 ? 8 : 4, "the record count");
     list(0x0A, "dimension", [&](std::uint64_t i) {
       name("dimension", i);
-      take(version_ == 5 ? 8 : 4, "a dimension length");
+      dims_.push_back(take(version_ == 5 ? 8 : 4, "a dimension length"));
     });
     attributes("global");
     list(0x0B, "variable", [&](std::uint64_t i) {
       name("variable", i);
       const std::uint64_t nd = count("variable " + std::to_string(i) + "'s dimensions", version_ == 5 ? 8 : 4);
-      skip(nd, version_ == 5 ? 8 : 4, "variable " + std::to_string(i) + "'s dimension ids");
+      const std::size_t width = version_ == 5 ? 8 : 4;
+      const std::uint64_t ids_at = pos_;
+      skip(nd, width, "variable " + std::to_string(i) + "'s dimension ids");
+      // A dimension a variable uses is no longer than the file has bytes (each of its values takes
+      // one at least; the record dimension's 0 stands for its records). netCDF-C multiplies the
+      // lengths as signed integers: a CDF-5 length of 2^63 made its product 0 and its next division
+      // a floating-point exception (found by fuzz/fuzz_netcdf).
+      for (std::uint64_t d = 0; d < nd; ++d) {
+        std::uint64_t id = 0;
+        for (std::size_t k = 0; k < width; ++k) id = (id << 8) | b_[ids_at + d * width + k];
+        if (id < dims_.size() && dims_[id] > file_bytes_) {
+          pos_ = ids_at + d * width;
+          corrupt("the length of variable " + std::to_string(i) + "'s dimension " + std::to_string(d) + " (dimension " +
+                      std::to_string(id) + ")",
+                  dims_[id]);
+        }
+      }
       attributes("variable " + std::to_string(i));
-      take(4, "a variable's type");
+      // A type the format has: netCDF-C took NC_STRING (12) in a CDF-5 header with a size of 0,
+      // and divided by it (a floating-point exception found by fuzz/fuzz_netcdf).
+      const std::uint64_t type = take(4, "variable " + std::to_string(i) + "'s type");
+      if (type < 1 || type > 11 || (version_ != 5 && type > 6)) corrupt("variable " + std::to_string(i) + "'s type", type);
       take(version_ == 5 ? 8 : 4, "a variable's size");
       take(version_ == 1 ? 4 : 8, "a variable's offset");
     });
@@ -154,6 +173,7 @@ class ClassicHeader {
   }
   const std::string& path_;
   const std::vector<unsigned char>& b_;
+  std::vector<std::uint64_t> dims_;  // the dimensions' declared lengths (0: the record dimension)
   std::uint64_t file_bytes_;
   unsigned version_;
   std::uint64_t pos_ = 0;

@@ -345,6 +345,48 @@ TEST_F(HostileImport, AClassicHeaderLongerThanItsFirstReadIsWalkedToItsEnd) {
       << msg;
 }
 
+// fuzz_netcdf: netCDF-C took a CDF-5 variable of type NC_STRING (12, a netCDF-4 type) with a size
+// of 0 and divided by it while opening the file (a floating-point exception). A CDF-5 file with one
+// variable v(x, y), its type and then its first dimension's length patched; each is named before
+// netCDF reads the header.
+TEST_F(HostileImport, AClassicVariableOfNoClassicTypeOrAnEndlessDimensionIsNamedNotACrash) {
+  const std::string p = (dir_ / "types.nc").string();
+  auto write = [&] {
+    int nc, x, y, v;
+    ASSERT_EQ(nc_create(p.c_str(), NC_CLOBBER | NC_64BIT_DATA, &nc), NC_NOERR);
+    ASSERT_EQ(nc_def_dim(nc, "x", 4, &x), NC_NOERR);
+    ASSERT_EQ(nc_def_dim(nc, "y", 3, &y), NC_NOERR);
+    const int dims[2] = {x, y};
+    ASSERT_EQ(nc_def_var(nc, "v", NC_FLOAT, 2, dims, &v), NC_NOERR);
+    ASSERT_EQ(nc_close(nc), NC_NOERR);
+  };
+  // The header: magic 4, record count 8, the dimension list (tag 4, count 8, then per dimension a
+  // name length 8, the name padded to 4 and a length 8), no attributes (12), the variable list
+  // (tag 4, count 8), v's name (8 + 4), its dimension count and ids (8 + 16), no attributes (12),
+  // then its type.
+  auto patch = [&](std::streamoff at, int width, std::uint64_t expected, std::uint64_t value) {
+    std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(at);
+    std::uint64_t was = 0;
+    for (int k = 0; k < width; ++k) was = (was << 8) | static_cast<unsigned char>(f.get());
+    ASSERT_EQ(was, expected) << "the layout above is not the file's at byte " << at;
+    f.seekp(at);
+    for (int k = width - 1; k >= 0; --k) f.put(static_cast<char>((value >> (8 * k)) & 0xFF));
+  };
+  write();
+  EXPECT_NO_THROW(importers::NcFile{p});
+  patch(136, 4, NC_FLOAT, 12);  // NC_STRING
+  std::string msg = import_error(p);
+  EXPECT_NE(msg.find(p + ": the netCDF classic header is corrupt: variable 0's type declares 12"), std::string::npos) << msg;
+  write();
+  patch(36, 8, 4, std::uint64_t(1) << 63);  // x's length
+  msg = import_error(p);
+  EXPECT_NE(msg.find(p + ": the netCDF classic header is corrupt: the length of variable 0's dimension 0 (dimension 0) declares " +
+                     std::to_string(std::uint64_t(1) << 63)),
+            std::string::npos)
+      << msg;
+}
+
 TEST_F(HostileImport, ARecordCountBeyondAnyIntegerIsNamedNotOverflowed) {
   // fuzz_netcdf: a classic header declaring 2^62 records made the truncation check's byte count
   // overflow its conversion to long long (undefined behaviour; UBSan's float-cast-overflow). A
