@@ -66,16 +66,16 @@ std::vector<NcAtt> read_atts(int ncid, int varid, int natts, const std::string& 
   return out;
 }
 
-// netCDF-C's classic-format reader trusts the lengths its header declares: a name length of
-// 2^32 - 1 makes it memcpy a negative size (a crash), a large one makes it calloc 16 GiB and more
-// (both found by fuzz/fuzz_netcdf). The header is walked here first, every declared length and
-// count held to the bytes the file has, before netCDF opens it.
 // The most of a file read to walk its header, and what is read first: a header is usually a few
 // kilobytes, so a big file is not read 64 MiB deep to check one.
 constexpr std::size_t kClassicHeaderMost = std::size_t(64) << 20, kClassicHeaderFirst = std::size_t(256) << 10;
 // Thrown when the header runs past the bytes read so far but not past the file: read more.
 struct NeedMoreBytes {};
 
+// netCDF-C's classic-format reader trusts the lengths its header declares: a name length of
+// 2^32 - 1 makes it memcpy a negative size (a crash), a large one makes it calloc 16 GiB and more
+// (both found by fuzz/fuzz_netcdf). The header is walked here first, every declared length and
+// count held to the bytes the file has, before netCDF opens it.
 class ClassicHeader {
  public:
   ClassicHeader(const std::string& path, const std::vector<unsigned char>& b, std::uint64_t file_bytes)
