@@ -1,4 +1,4 @@
-// The two-stream source: a closed-form delta-Eddington column per grid column.
+// The two-stream source: a closed-form delta-scaled two-stream column per grid column.
 #include "kernel/ms_source.hpp"
 
 #include <algorithm>
@@ -13,42 +13,62 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 }
 
-// Eddington's I(tau, mu) = I0 + I1 mu (mu upward, tau downward from the top) in a conservative
-// medium (omega = 1), delta-scaled: f = g^2, dtau' = (1 - f) dtau, g' = g / (1 + g), the direct beam
-// exp(-tau' / mu0) (it keeps the light the forward peak scatters). The moment equations
-//   dI1/dtau' = -(3 F0 / 4 pi) exp(-tau'/mu0),  dI0/dtau' = (1 - g') I1 + (3 F0 g' mu0 / 4 pi) exp(-tau'/mu0)
-// integrate in closed form: I1 = C1 + K E, I0 = C0 + C1 G - mu0 K (E - 1), K = 3 F0 mu0 / (4 pi),
-// E = exp(-tau'/mu0), G = int (1 - g') dtau' = int (1 - g) dtau. Marshak's conditions fix C0, C1:
-// no diffuse light down at the top (I0 = 2/3 I1), and at the bottom the upward diffuse flux
-// pi (I0 + 2/3 I1) equals the ground's albedo times what reaches it, pi (I0 - 2/3 I1) + mu0 F0 E.
-TwoStreamColumn two_stream_column(const double* sigma, const double* g, int n, double dz, double mu0, double a) {
+// The two-stream fluxes up and down, F+ and F-, of a conservative column (omega = 1), delta-scaled:
+// f = g^2, dtau' = (1 - f) dtau, g' = g / (1 + g), the direct beam exp(-tau'/mu0) per unit
+// irradiance (it keeps the light the forward peak scatters), tau' downward from the top:
+//   dF+/dtau' = gamma1 (F+ - F-) - gamma3 e,   dF-/dtau' = gamma1 (F+ - F-) + gamma4 e,
+// e = exp(-tau'/mu0), gamma4 = 1 - gamma3, gamma1 = c (1 - g') (gamma2 = gamma1 with no absorption).
+// The net flux N = F+ - F- and the sum S = F+ + F- then integrate in closed form, for any g' per
+// layer: dN/dtau' = -e gives N = N0 + mu0 (e - 1); dS/dtau' = 2 gamma1 N + (gamma4 - gamma3) e gives
+//   S = N0 + 2 c (N0 - mu0) G + B,  G = int (1 - g') dtau' = int (1 - g) dtau,
+//   B = int (2 c mu0 (1 - g') + 1 - 2 gamma3) e dtau',
+// with no diffuse light down at the top (S0 = N0). At the bottom the upward diffuse flux is the
+// ground's albedo A times what reaches it: (1 - A) S + (1 + A) N = 2 A mu0 e, linear in N0, whose
+// coefficient (1 - A)(1 + 2 c G) + 1 + A is never small: no optical depth overflows or cancels.
+// The radiance I0 + I1 mu with these hemispheric fluxes (F+- = pi (I0 +- 2/3 I1)) has
+// I0 = S / 2 pi and I1 = 3 N / 4 pi. With Eddington's gamma1 and gamma3 this is the delta-Eddington
+// solution (its moment equations dI1/dtau' = -(3/4 pi) e, dI0/dtau' = (1 - g') I1 + (3 g' mu0/4 pi) e).
+TwoStreamColumn two_stream_column(const double* sigma, const double* g, int n, double dz, double mu0, double a,
+                                  TwoStreamClosure closure) {
   TwoStreamColumn c;
   c.i0.assign(static_cast<std::size_t>(std::max(n, 0)), 0.0);
   c.i1.assign(c.i0.size(), 0.0);
   if (n < 1 || !(mu0 > 0.0)) return c;
   a = std::clamp(std::isfinite(a) ? a : 0.0, 0.0, 1.0);
   dz = std::abs(dz);
-  // Scaled optical depth and G at each node, from the top (node n - 1) down; layers by the trapezoid.
-  std::vector<double> tau(c.i0.size(), 0.0), big_g(c.i0.size(), 0.0);
+  const bool eddington = closure == TwoStreamClosure::Eddington;
+  const double s3 = std::sqrt(3.0);
+  const double cc = eddington ? 0.75 : 0.5 * s3;  // gamma1 / (1 - g')
+  // What the beam's scattering adds to dS/dtau' per unit e: 2 gamma1 mu0 + gamma4 - gamma3.
+  auto beam_weight = [&](double gp) {
+    const double gamma3 = eddington ? (2.0 - 3.0 * gp * mu0) / 4.0 : 0.5 * (1.0 - s3 * gp * mu0);
+    return 2.0 * cc * mu0 * (1.0 - gp) + 1.0 - 2.0 * gamma3;
+  };
+  // Scaled optical depth, G and B at each node, from the top (node n - 1) down; layers by the
+  // trapezoid for the optical depth, with the layer's g' for G and B (exact for e within a layer).
+  std::vector<double> tau(c.i0.size(), 0.0), big_g(c.i0.size(), 0.0), big_b(c.i0.size(), 0.0);
+  double e_above = 1.0;
   for (int k = n - 2; k >= 0; --k) {
+    const std::size_t K = static_cast<std::size_t>(k);
     const double s0 = std::max(sigma[k + 1], 0.0), s1 = std::max(sigma[k], 0.0);
     const double st = s0 + s1;
     const double dtau = std::isfinite(st) ? 0.5 * st * dz : 0.0;
     const double gl = st > 0.0 ? std::clamp((s0 * g[k + 1] + s1 * g[k]) / st, -0.999, 0.999) : 0.0;
-    tau[static_cast<std::size_t>(k)] = tau[static_cast<std::size_t>(k) + 1] + (1.0 - gl * gl) * dtau;
-    big_g[static_cast<std::size_t>(k)] = big_g[static_cast<std::size_t>(k) + 1] + (1.0 - gl) * dtau;
+    tau[K] = tau[K + 1] + (1.0 - gl * gl) * dtau;
+    big_g[K] = big_g[K + 1] + (1.0 - gl) * dtau;
+    const double e_below = std::exp(-tau[K] / mu0);
+    big_b[K] = big_b[K + 1] + beam_weight(gl / (1.0 + gl)) * mu0 * (e_above - e_below);
+    e_above = e_below;
   }
-  const double k_ = 3.0 * mu0 / (4.0 * kPi);  // F0 = 1
-  const double e_b = std::exp(-tau[0] / mu0), g_b = big_g[0];
-  // (1 - A) I0* + 2/3 (1 + A) I1* - A mu0 E* / pi = 0 with I0*, I1* linear in C1 (C0 = 2/3 (C1 + K)):
-  const double num = (1.0 - a) * k_ * (2.0 / 3.0 + mu0 * (1.0 - e_b)) + (2.0 / 3.0) * (1.0 + a) * k_ * e_b -
-                     a * mu0 * e_b / kPi;
-  const double den = 4.0 / 3.0 + (1.0 - a) * g_b;
-  const double c1 = -num / den, c0 = (2.0 / 3.0) * (c1 + k_);
+  const double e_b = std::exp(-tau[0] / mu0), g_b = big_g[0], b_b = big_b[0];
+  const double n0 = (2.0 * a * mu0 * e_b - (1.0 - a) * (b_b - 2.0 * cc * mu0 * g_b) - (1.0 + a) * mu0 * (e_b - 1.0)) /
+                    ((1.0 - a) * (1.0 + 2.0 * cc * g_b) + 1.0 + a);
   for (std::size_t k = 0; k < c.i0.size(); ++k) {
     const double e = std::exp(-tau[k] / mu0);
-    c.i0[k] = c0 + c1 * big_g[k] - mu0 * k_ * (e - 1.0);
-    c.i1[k] = c1 + k_ * e;
+    const double net = n0 + mu0 * (e - 1.0);
+    const double sum = n0 + 2.0 * cc * (n0 - mu0) * big_g[k] + big_b[k];
+    c.i0[k] = sum / (2.0 * kPi);
+    c.i1[k] = 3.0 * net / (4.0 * kPi);
   }
   const std::size_t top = c.i0.size() - 1;
   c.reflected = kPi * (c.i0[top] + (2.0 / 3.0) * c.i1[top]) / mu0;

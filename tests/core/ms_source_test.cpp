@@ -1,5 +1,6 @@
-// The two-stream source's column solution (core/kernel/ms_source): the closed-form delta-Eddington
-// plane albedo of a homogeneous conservative layer, energy conserved, a white ground reflecting
+// The two-stream source's column solution (core/kernel/ms_source): the closed-form plane albedos of
+// a homogeneous conservative layer (delta-Eddington's, and the quadrature two-stream's from Meador
+// and Weaver's general solution), energy conserved, a white ground reflecting
 // everything, and no NaN or Inf at extreme optical depths and grazing suns.
 #include <gtest/gtest.h>
 
@@ -25,21 +26,68 @@ double delta_eddington_albedo(double tau, double g, double mu0) {
   return ((1.0 - gp) * tp + (2.0 / 3.0 - mu0) * (1.0 - std::exp(-tp / mu0))) / (4.0 / 3.0 + (1.0 - gp) * tp);
 }
 
-TwoStreamColumn homogeneous(double tau, double g, double mu0, double albedo, int n = 51) {
+// Meador & Weaver (1980), the conservative two-stream's plane albedo over a black ground for any
+// coefficients (gamma1 = gamma2): R = (gamma1 tau' + (gamma3 - gamma1 mu0)(1 - exp(-tau'/mu0))) /
+// (1 + gamma1 tau'); the quadrature's gamma1 = sqrt(3) (1 - g') / 2, gamma3 = (1 - sqrt(3) g' mu0) / 2,
+// delta-scaled as above.
+double quadrature_albedo(double tau, double g, double mu0) {
+  const double tp = (1.0 - g * g) * tau, gp = g / (1.0 + g), s3 = std::sqrt(3.0);
+  const double gamma1 = s3 * (1.0 - gp) / 2.0, gamma3 = (1.0 - s3 * gp * mu0) / 2.0;
+  return (gamma1 * tp + (gamma3 - gamma1 * mu0) * (1.0 - std::exp(-tp / mu0))) / (1.0 + gamma1 * tp);
+}
+
+TwoStreamColumn homogeneous(double tau, double g, double mu0, double albedo, int n = 51,
+                            TwoStreamClosure closure = TwoStreamClosure::Quadrature) {
   const double dz = 10.0;
   const double sigma = tau / ((n - 1) * dz);
   std::vector<double> s(static_cast<std::size_t>(n), sigma), gg(static_cast<std::size_t>(n), g);
-  return two_stream_column(s.data(), gg.data(), n, dz, mu0, albedo);
+  return two_stream_column(s.data(), gg.data(), n, dz, mu0, albedo, closure);
 }
 
 TEST(TwoStream, MatchesTheClosedFormDeltaEddingtonAlbedo) {
   for (double tau : {0.1, 1.0, 5.0, 20.0, 100.0}) {
     for (double mu0 : {1.0, 0.5, 0.1}) {
       for (double g : {0.0, 0.75, 0.85}) {
-        const TwoStreamColumn c = homogeneous(tau, g, mu0, 0.0);
+        const TwoStreamColumn c = homogeneous(tau, g, mu0, 0.0, 51, TwoStreamClosure::Eddington);
         EXPECT_NEAR(c.reflected, delta_eddington_albedo(tau, g, mu0), 1e-12) << tau << " " << mu0 << " " << g;
       }
     }
+  }
+}
+
+TEST(TwoStream, MatchesTheClosedFormQuadratureAlbedo) {
+  for (double tau : {0.1, 1.0, 5.0, 20.0, 100.0}) {
+    for (double mu0 : {1.0, 0.5, 0.1}) {
+      for (double g : {0.0, 0.75, 0.85}) {
+        const TwoStreamColumn c = homogeneous(tau, g, mu0, 0.0);
+        EXPECT_NEAR(c.reflected, quadrature_albedo(tau, g, mu0), 1e-12) << tau << " " << mu0 << " " << g;
+      }
+    }
+  }
+}
+
+// Eddington's moment equations hold for the Eddington closure at every node (dI1/dtau' = -(3/4 pi) e,
+// dI0/dtau' = (1 - g') I1 + (3 g' mu0 / 4 pi) e), checked by differences on a layered column whose g
+// changes with height: the general flux solution reduces to them.
+TEST(TwoStream, TheEddingtonClosureSolvesEddingtonsMomentEquations) {
+  const int n = 2001;
+  const double dz = 1.0, mu0 = 0.6, pi = 3.14159265358979323846;
+  std::vector<double> s(n), gg(n);
+  for (int k = 0; k < n; ++k) {
+    s[static_cast<std::size_t>(k)] = 0.01 * (1.0 + 0.5 * std::sin(0.01 * k));  // optical depth about 20
+    gg[static_cast<std::size_t>(k)] = 0.86 - 0.2 * k / (n - 1.0);            // ice-like on top
+  }
+  const TwoStreamColumn c = two_stream_column(s.data(), gg.data(), n, dz, mu0, 0.3, TwoStreamClosure::Eddington);
+  double tau = 0.0;  // scaled, from the top
+  for (int k = n - 2; k >= 1; --k) {
+    const std::size_t K = static_cast<std::size_t>(k);
+    const double gl = 0.5 * (gg[K] + gg[K + 1]), dtau = (1.0 - gl * gl) * 0.5 * (s[K] + s[K + 1]) * dz;
+    const double gp = gl / (1.0 + gl), t_mid = tau + 0.5 * dtau, e = std::exp(-t_mid / mu0);
+    const double di1 = (c.i1[K] - c.i1[K + 1]) / dtau, di0 = (c.i0[K] - c.i0[K + 1]) / dtau;
+    const double i1_mid = 0.5 * (c.i1[K] + c.i1[K + 1]);
+    EXPECT_NEAR(di1, -3.0 / (4.0 * pi) * e, 1e-5) << k;
+    EXPECT_NEAR(di0, (1.0 - gp) * i1_mid + 3.0 * gp * mu0 / (4.0 * pi) * e, 1e-5) << k;
+    tau += dtau;
   }
 }
 
