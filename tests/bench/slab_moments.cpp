@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "bench/bench_args.hpp"
+#include "kernel/ms_source.hpp"
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
@@ -248,6 +249,23 @@ ScaledResult run_slab(double tau, const Phase& phase, double mu0, const std::vec
   return r;
 }
 
+// The march's own two-stream source (core::two_stream_column: delta-Eddington, closed form) for the
+// slab, scattered into the view (I0 + g' I1 mu, g' = g / (1 + g)) along the scaled view path.
+double from_two_stream(double tau, double g, double mu0, const View& w, cv::core::TwoStreamClosure closure) {
+  constexpr int kNodes = 4001;
+  const double dz = 1.0;
+  const std::vector<double> sigma(kNodes, tau / ((kNodes - 1) * dz)), gs(kNodes, g);
+  const cv::core::TwoStreamColumn c = cv::core::two_stream_column(sigma.data(), gs.data(), kNodes, dz, mu0, 0.0, closure);
+  const double f = g * g, gp = g / (1.0 + g), dt = (1.0 - f) * tau / (kNodes - 1);
+  double sum = 0.0;
+  for (int k = kNodes - 1; k > 0; --k) {  // from the top (node kNodes - 1) down, layer by layer
+    const double t0 = (kNodes - 1 - k) * dt, t1 = t0 + dt;
+    const auto j = [&](int n) { return c.i0[static_cast<std::size_t>(n)] + gp * c.i1[static_cast<std::size_t>(n)] * w.mu; };
+    sum += 0.5 * (j(k) + j(k - 1)) * (std::exp(-t0 / w.mu) - std::exp(-t1 / w.mu));
+  }
+  return sum;
+}
+
 // Exact single scattering of the true slab into a view.
 double single_scattering(double tau, double g, double mu0, const View& w) {
   const Dir beam{-std::sqrt(1.0 - mu0 * mu0), 0.0, -mu0};
@@ -285,12 +303,13 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 11;
   bool rows = false;
   std::string scaled_phase = "hg", single = "exact";
+  bool two_stream = false;
   namespace ba = cv::bench_args;
   const int code = ba::parse(
       "bench_slab_moments",
       "usage: bench_slab_moments [--tau 2,5,...] [--zenith SUN,...] [--view V,...] [--azimuth A,...]\n"
       "                          [--truncation N,...] [--scaled-phase hg|clip] [--single exact|tms]\n"
-      "                          [--g G] [--photons N] [--seed S] [--rows]\n"
+      "                          [--g G] [--photons N] [--seed S] [--two-stream] [--rows]\n"
       "  the reflected radiance of a conservative Henyey-Greenstein slab over a black ground, modelled as\n"
       "  exact single scattering plus the scattering of a delta-M-scaled problem's exact diffuse radiance\n"
       "  kept to moments <= L (L = 1, 3, 5, 7 and all), against a Monte Carlo of the true slab;\n"
@@ -298,7 +317,10 @@ int main(int argc, char** argv) {
       "  (g - g^N) / (1 - g^N), or with --scaled-phase clip the true phase with its peak cut flat where the\n"
       "  share g^N lies above the cut); --single tms: the single scattering of Nakajima and Tanaka's TMS\n"
       "  correction (the true phase over 1 - f, along the scaled extinction) instead of the exact one; --view: view zenith angles (degrees); --azimuth: the camera's heading\n"
-      "  from the sun's azimuth (0: looking toward the sun); --rows prints every case\n",
+      "  from the sun's azimuth (0: looking toward the sun); --two-stream adds the march's own closed-form\n"
+      "  two-stream columns (I0, I1 with Eddington's and the quadrature's closure) in place of the exact\n"
+      "  L <= 1 moments;\n"
+      "  --rows prints every case\n",
       argc, argv,
       {ba::numbers("--tau", taus), ba::numbers("--zenith", zeniths), ba::numbers("--view", view_zeniths),
        ba::numbers("--azimuth", azimuths), ba::numbers("--truncation", truncations),
@@ -309,7 +331,12 @@ int main(int argc, char** argv) {
           g = x;
           return true;
         }},
-       ba::one_of("--scaled-phase", scaled_phase, {"hg", "clip"}), ba::one_of("--single", single, {"exact", "tms"}), ba::integer("--photons", photons), ba::seed("--seed", seed), {"--rows", "", [&rows](const std::string&) {
+       ba::one_of("--scaled-phase", scaled_phase, {"hg", "clip"}), ba::one_of("--single", single, {"exact", "tms"}), ba::integer("--photons", photons), ba::seed("--seed", seed),
+       {"--two-stream", "", [&two_stream](const std::string&) {
+          two_stream = true;
+          return true;
+        }},
+       {"--rows", "", [&rows](const std::string&) {
                                                                          rows = true;
                                                                          return true;
                                                                        }}});
@@ -354,6 +381,10 @@ int main(int argc, char** argv) {
   // [thin or thick][truncation][order][view zenith]: sums of |error|; and the largest |error|.
   std::vector<double> abs_err(2 * nt * (kOrders + 1) * nz, 0.0), worst(2 * nt * (kOrders + 1), 0.0);
   std::vector<int> cases(2 * nz, 0);
+  // [closure][thin or thick][view zenith] and [closure][thin or thick]
+  const cv::core::TwoStreamClosure closures[2] = {cv::core::TwoStreamClosure::Eddington, cv::core::TwoStreamClosure::Quadrature};
+  const char* closure_names[2] = {"Eddington", "quadrature"};
+  std::vector<double> ts_err(4 * nz, 0.0), ts_worst(4, 0.0);
   auto cell = [&](int thick, std::size_t ti, int o) { return (static_cast<std::size_t>(thick) * nt + ti) * (kOrders + 1) + static_cast<std::size_t>(o); };
   std::printf("conservative HG %.2f slab over a black ground, %d photons per run, scaled phase %s, single scattering %s\n", g,
               photons, scaled_phase.c_str(), single.c_str());
@@ -385,6 +416,20 @@ int main(int argc, char** argv) {
         const std::size_t zi = static_cast<std::size_t>(std::find(view_zeniths.begin(), view_zeniths.end(), w.zenith_deg) - view_zeniths.begin());
         const int thick = tau >= 5.0 ? 1 : 0;
         ++cases[static_cast<std::size_t>(thick) * nz + zi];
+        if (two_stream) {
+          const double f = g * g;
+          const double ss = single == "tms" ? single_scattering((1.0 - f) * tau, g, mu0, w) / (1.0 - f) : exact_ss;
+          for (int cl = 0; cl < 2; ++cl) {
+            const double e = (ss + from_two_stream(tau, g, mu0, w, closures[cl])) / truth - 1.0;
+            const std::size_t at = static_cast<std::size_t>(2 * cl + thick);
+            ts_err[at * nz + zi] += std::abs(e);
+            ts_worst[at] = std::max(ts_worst[at], std::abs(e));
+            if (rows) {
+              std::printf("| %g | %g | %g | %g | %.5f | two-stream, %s | %+.1f %% |\n", tau, sz, w.zenith_deg, w.azimuth_deg, truth,
+                          closure_names[cl], 100.0 * e);
+            }
+          }
+        }
         for (std::size_t ti = 0; ti < nt; ++ti) {
           const double f = phases[ti].f;
           // TMS: light scattered into the truncated peak stays in the scaled beam, so the single
@@ -423,6 +468,17 @@ int main(int argc, char** argv) {
           std::printf(" %.1f %% |", 100.0 * abs_err[cell(thick, ti, o) * nz + zi] / std::max(1, c));
         }
         std::printf(" %.1f %% |\n", 100.0 * worst[cell(thick, ti, o)]);
+      }
+    }
+    if (two_stream) {
+      for (int cl = 0; cl < 2; ++cl) {
+        const std::size_t at = static_cast<std::size_t>(2 * cl + thick);
+        std::printf("| g^2 | two-stream columns, %s |", closure_names[cl]);
+        for (std::size_t zi = 0; zi < nz; ++zi) {
+          const int c = cases[static_cast<std::size_t>(thick) * nz + zi];
+          std::printf(" %.1f %% |", 100.0 * ts_err[at * nz + zi] / std::max(1, c));
+        }
+        std::printf(" %.1f %% |\n", 100.0 * ts_worst[at]);
       }
     }
   }
