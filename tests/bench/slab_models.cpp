@@ -15,6 +15,7 @@
 #include "bench/bench_args.hpp"
 #include "physics/slab_solver.hpp"
 #include "reference/raymarcher.hpp"
+#include "support/scratch_dir.hpp"
 #include "support/slab_case.hpp"
 
 namespace {
@@ -48,8 +49,8 @@ int main(int argc, char** argv) {
                              {ba::one_of("--phase", phases, {"hg", "mie", "both"}), ba::numbers("--tau", taus),
                               ba::numbers("--zenith", zeniths), ba::integer("--octaves", octaves)});
   if (code >= 0) return code;
-  const auto dir = std::filesystem::temp_directory_path() / "cv_slab_models";
-  std::filesystem::create_directories(dir);
+  // The process's own folder (removed at exit): two runs at once never share a file.
+  const std::filesystem::path dir = cv::test_support::scratch_dir();
   std::vector<SlabPhase> which;
   if (phases == "hg" || phases == "both") which.push_back(SlabPhase::HG085);
   if (phases == "mie" || phases == "both") which.push_back(SlabPhase::Mie);
@@ -82,6 +83,5 @@ int main(int argc, char** argv) {
       }
     }
   }
-  std::filesystem::remove_all(dir);
   return 0;
 }

@@ -18,6 +18,7 @@
 
 #include "bench/bench_args.hpp"
 #include "physics/slab_solver.hpp"
+#include "support/scratch_dir.hpp"
 #include "support/slab_case.hpp"
 
 namespace {
@@ -41,8 +42,8 @@ int main(int argc, char** argv) {
                              {ba::integer("--spp", spp), ba::integer("--paths", paths), ba::one_of("--phase", phases, {"hg", "mie", "both"}),
                               ba::numbers("--tau", taus), ba::numbers("--zenith", zeniths), ba::seed("--seed", seed)});
   if (code >= 0) return code;
-  const auto dir = std::filesystem::temp_directory_path() / "cv_slab_sweep";
-  std::filesystem::create_directories(dir);
+  // The process's own folder (removed at exit): two runs at once never share a file.
+  const std::filesystem::path dir = cv::test_support::scratch_dir();
   std::vector<SlabPhase> which;
   if (phases == "hg" || phases == "both") which.push_back(SlabPhase::HG085);
   if (phases == "mie" || phases == "both") which.push_back(SlabPhase::Mie);
@@ -82,6 +83,5 @@ int main(int argc, char** argv) {
       }
     }
   }
-  std::filesystem::remove_all(dir);
   return 0;
 }

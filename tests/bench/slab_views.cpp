@@ -20,6 +20,7 @@
 #include "bench/bench_args.hpp"
 #include "reference/monte_carlo.hpp"
 #include "reference/raymarcher.hpp"
+#include "support/scratch_dir.hpp"
 #include "support/slab_case.hpp"
 
 namespace {
@@ -71,8 +72,8 @@ int main(int argc, char** argv) {
                  phases.c_str());
     return 2;
   }
-  const auto dir = std::filesystem::temp_directory_path() / "cv_slab_views";
-  std::filesystem::create_directories(dir);
+  // The process's own folder (removed at exit): two runs at once never share a file.
+  const std::filesystem::path dir = cv::test_support::scratch_dir();
   std::vector<SlabPhase> which;
   if (phases == "hg" || phases == "both") which.push_back(SlabPhase::HG085);
   if (phases == "mie" || phases == "both") which.push_back(SlabPhase::Mie);
@@ -138,6 +139,5 @@ int main(int argc, char** argv) {
       }
     }
   }
-  std::filesystem::remove_all(dir);
   return 0;
 }
