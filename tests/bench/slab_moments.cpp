@@ -68,12 +68,22 @@ void harmonics(double mu, double phi, std::array<double, kMoments>& y) {
   for (int m = 0; m <= kMaxL; ++m) {
     for (int l = m + 2; l <= kMaxL; ++l) p[l][m] = ((2 * l - 1) * mu * p[l - 1][m] - (l + m - 1) * p[l - 2][m]) / (l - m);
   }
+  // The normalisations, once (this runs for every flight of every photon).
+  static const std::array<double, kMoments> norm = [] {
+    std::array<double, kMoments> n{};
+    for (int l = 0; l <= kMaxL; ++l) {
+      for (int m = 0; m <= l; ++m) {
+        double ratio = 1.0;  // (l - m)! / (l + m)!
+        for (int k = l - m + 1; k <= l + m; ++k) ratio /= k;
+        n[static_cast<std::size_t>(l * (l + 1) / 2 + m)] = std::sqrt((m ? 2.0 : 1.0) * (2 * l + 1) / (4.0 * kPi) * ratio);
+      }
+    }
+    return n;
+  }();
   for (int l = 0; l <= kMaxL; ++l) {
     for (int m = 0; m <= l; ++m) {
-      double ratio = 1.0;  // (l - m)! / (l + m)!
-      for (int k = l - m + 1; k <= l + m; ++k) ratio /= k;
-      const double n = std::sqrt((m ? 2.0 : 1.0) * (2 * l + 1) / (4.0 * kPi) * ratio);
-      y[static_cast<std::size_t>(l * (l + 1) / 2 + m)] = n * p[l][m] * std::cos(m * phi);
+      const std::size_t i = static_cast<std::size_t>(l * (l + 1) / 2 + m);
+      y[i] = norm[i] * p[l][m] * std::cos(m * phi);
     }
   }
 }
