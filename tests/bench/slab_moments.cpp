@@ -259,18 +259,22 @@ ScaledResult run_slab(double tau, const Phase& phase, double mu0, const std::vec
   return r;
 }
 
-// The march's own two-stream source (core::two_stream_column: delta-Eddington, closed form) for the
-// slab, scattered into the view (I0 + g' I1 mu, g' = g / (1 + g)) along the scaled view path.
-double from_two_stream(double tau, double g, double mu0, const View& w, cv::core::TwoStreamClosure closure) {
-  constexpr int kNodes = 4001;
+// The march's own two-stream column (core::two_stream_column, closed form) for the slab, on a fine
+// grid of nodes: built once per slab, sun and closure, then scattered into each view.
+constexpr int kColumnNodes = 4001;
+cv::core::TwoStreamColumn slab_column(double tau, double g, double mu0, cv::core::TwoStreamClosure closure) {
   const double dz = 1.0;
-  const std::vector<double> sigma(kNodes, tau / ((kNodes - 1) * dz)), gs(kNodes, g);
-  const cv::core::TwoStreamColumn c = cv::core::two_stream_column(sigma.data(), gs.data(), kNodes, dz, mu0, 0.0, closure);
-  const double f = g * g, gp = g / (1.0 + g), dt = (1.0 - f) * tau / (kNodes - 1);
+  const std::vector<double> sigma(kColumnNodes, tau / ((kColumnNodes - 1) * dz)), gs(kColumnNodes, g);
+  return cv::core::two_stream_column(sigma.data(), gs.data(), kColumnNodes, dz, mu0, 0.0, closure);
+}
+
+// The column's I0 + g' I1 mu (g' = g / (1 + g)) integrated along the scaled view path.
+double from_two_stream(const cv::core::TwoStreamColumn& c, double tau, double g, const View& w) {
+  const double f = g * g, gp = g / (1.0 + g), dt = (1.0 - f) * tau / (kColumnNodes - 1);
+  const auto j = [&](int n) { return c.i0[static_cast<std::size_t>(n)] + gp * c.i1[static_cast<std::size_t>(n)] * w.mu; };
   double sum = 0.0;
-  for (int k = kNodes - 1; k > 0; --k) {  // from the top (node kNodes - 1) down, layer by layer
-    const double t0 = (kNodes - 1 - k) * dt, t1 = t0 + dt;
-    const auto j = [&](int n) { return c.i0[static_cast<std::size_t>(n)] + gp * c.i1[static_cast<std::size_t>(n)] * w.mu; };
+  for (int k = kColumnNodes - 1; k > 0; --k) {  // from the top (node kColumnNodes - 1) down, layer by layer
+    const double t0 = (kColumnNodes - 1 - k) * dt, t1 = t0 + dt;
     sum += 0.5 * (j(k) + j(k - 1)) * (std::exp(-t0 / w.mu) - std::exp(-t1 / w.mu));
   }
   return sum;
@@ -419,6 +423,10 @@ int main(int argc, char** argv) {
         const double f = std::pow(g, truncations[ti]);
         scaled.push_back(run_slab((1.0 - f) * tau, phases[ti], mu0, views, photons, run_seed++, true));
       }
+      std::vector<cv::core::TwoStreamColumn> columns;
+      if (two_stream) {
+        for (const auto closure : closures) columns.push_back(slab_column(tau, g, mu0, closure));
+      }
       for (std::size_t v = 0; v < views.size(); ++v) {
         const View& w = views[v];
         const double exact_ss = single_scattering(tau, g, mu0, w);
@@ -430,7 +438,7 @@ int main(int argc, char** argv) {
           const double f = g * g;
           const double ss = single == "tms" ? single_scattering((1.0 - f) * tau, g, mu0, w) / (1.0 - f) : exact_ss;
           for (int cl = 0; cl < 2; ++cl) {
-            const double e = (ss + from_two_stream(tau, g, mu0, w, closures[cl])) / truth - 1.0;
+            const double e = (ss + from_two_stream(columns[static_cast<std::size_t>(cl)], tau, g, w)) / truth - 1.0;
             const std::size_t at = static_cast<std::size_t>(2 * cl + thick);
             ts_err[at * nz + zi] += std::abs(e);
             ts_worst[at] = std::max(ts_worst[at], std::abs(e));
