@@ -454,14 +454,26 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   const int nx = grid.lon_deg.count, ny = grid.lat_deg.count;
   const bool has_cf = have[static_cast<int>(Role::CloudFraction)];
   auto alloc = [&](core::Field f, bool on) {
-    if (on) {
+    auto& halves = out.halves[static_cast<std::size_t>(f)];
+    if (on && S.options.half_fields) {
+      out[f].clear();
+      out[f].shrink_to_fit();
+      const bool fresh = halves.capacity() < grid.points();
+      core::reserve_exact(halves, grid.points());
+      if (fresh) core::populate_pages(halves.data(), grid.points() * sizeof(std::uint16_t));
+      halves.resize(grid.points());  // every node is written by its row's place_row
+    } else if (on) {
+      halves.clear();
+      halves.shrink_to_fit();
       // Faulted in on every core: a fresh global field is 190 MB of pages to touch.
       const bool fresh = out[f].capacity() < grid.points();
       core::reserve_exact(out[f], grid.points());
       if (fresh) core::populate_pages(out[f].data(), grid.points() * sizeof(float));
       out[f].resize(grid.points());  // every node is written by its row's place_row, NaN where it has no data
+    } else {
+      out[f].clear();
+      halves.clear();
     }
-    else out[f].clear();
   };
   alloc(core::Field::ExtinctionLiquid, have[static_cast<int>(Role::Liquid)] || diagnose);
   alloc(core::Field::ExtinctionIce, have[static_cast<int>(Role::Ice)] || have[static_cast<int>(Role::Snow)] || diagnose);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "importer.hpp"
+#include "volume/volume_io.hpp"
 
 namespace cv::importers {
 namespace {
@@ -126,7 +127,7 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
       if (!(r.z_m[r.at(l, x)] > r.z_m[r.at(l - 1, x)])) ++counts.nonmonotonic;
     }
   }
-  const bool has_cf = !out.fields[static_cast<std::size_t>(kCf)].empty();
+  const bool has_cf = !out.fields[static_cast<std::size_t>(kCf)].empty() || !out.halves[static_cast<std::size_t>(kCf)].empty();
   // Linear interpolation in altitude; outside a column's levels: no data. A node within a
   // micrometre of the top level (the axis was fitted to end there) takes the top level's value.
   // First each node's level pair and weight (node-major, like the output's layers), then field by
@@ -154,9 +155,16 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
   }
   const std::size_t nxs = static_cast<std::size_t>(nx);
   const double* qcf = source[kCf];
+  // A field held as half floats (TimeStepData::halves): each layer row is made in floats here, in
+  // cache, and stored converted, as write_cvvol would convert the float field.
+  thread_local std::vector<float> layer;
+  layer.resize(nxs);
   for (int f = 0; f < core::kFieldCount; ++f) {
     auto& dst = out.fields[static_cast<std::size_t>(f)];
-    if (dst.empty()) continue;
+    auto& halves = out.halves[static_cast<std::size_t>(f)];
+    const bool as_half = dst.empty() && !halves.empty();
+    if (dst.empty() && !as_half) continue;
+    const float half_scale = core::half_field_scale(static_cast<core::Field>(f));
     const double* qf = source[static_cast<std::size_t>(f)];
     // In-cloud = grid-box mean / fraction. Water was kept only where the fraction is meaningful,
     // so where the fraction vanishes the mean does too and the ratio stays bounded by its
@@ -167,12 +175,13 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
     for (int z = 0; z < nz; ++z) {
       const int* lev = node_level.data() + static_cast<std::size_t>(z) * nxs;
       const double* wt = node_weight.data() + static_cast<std::size_t>(z) * nxs;
-      float* row = dst.data() + grid.index(x0, y, z);
+      float* row = as_half ? layer.data() : dst.data() + grid.index(x0, y, z);
       // The three kinds of field as their own loops: no per-node test of what the field is.
       if (in_cloud) interpolate_nodes<true, false>(lev, wt, qf, qcf, nxs, row);
       else if (pressure) interpolate_nodes<false, true>(lev, wt, qf, qcf, nxs, row);
       else interpolate_nodes<false, false>(lev, wt, qf, qcf, nxs, row);
       st.add_all(row, nxs);
+      if (as_half) core::floats_to_halves(row, half_scale, halves.data() + grid.index(x0, y, z), nxs);
     }
     if (stored && st.count) {
       core::ValueStats& acc = (*stored)[static_cast<std::size_t>(f)];

@@ -43,6 +43,10 @@ struct ImportOptions {
   // left out, with one cloud-free level kept above the cloud.
   bool keep_cloudless_levels = false;
   double rh_critical = 0.8;        // the scheme's threshold relative humidity, 0..1
+  // Steps hold their fields as half floats (core::TimeStepData::halves) where the reader can make
+  // them (CF files): for the import on its way to a float16 .cvvol, which needs nothing else of a
+  // step. Half the memory, and the half floats made row by row as the conversion stores them.
+  bool half_fields = false;
 };
 
 // What the importer understands of a file (grid, axes, variables it will use, times), as text,

@@ -290,6 +290,8 @@ int cmd_import(const std::vector<std::string>& args) {
     cv::core::check_output_not_input(p, "-o", input, "the input");
   }
   o.cache_steps = 1;  // steps are written one after another: keep only the current one
+  // A float16 volume alone needs nothing of a step but its half floats: the reader makes them.
+  o.half_fields = encoding == cv::core::CvvolEncoding::Float16 && !vti && !vdb;
   cv::core::CloudVolume vol = cv::importers::import_file(input, o);
   for (const auto& w : vol.report.warnings) {
     if (w.rfind("DIAGNOSED CLOUD", 0) == 0) std::fprintf(stderr, "cloudviewer import: %s\n", w.c_str());

@@ -1,5 +1,6 @@
 // CloudVolume: grid helpers, derived maps, and the lazy time-step cache.
 #include "volume/cloud_volume.hpp"
+#include "volume/volume_io.hpp"
 
 #include "io/parallel.hpp"
 
@@ -28,6 +29,7 @@ const char* field_units(Field f) {
 std::size_t TimeStepData::bytes() const {
   std::size_t b = 0;
   for (const auto& f : fields) b += f.size() * sizeof(float);
+  for (const auto& h : halves) b += h.size() * sizeof(std::uint16_t);
   b += ground_m.size() * sizeof(float);
   for (const auto* m : {&maps.cloud_cover, &maps.cloud_base_m, &maps.cloud_top_m, &maps.optical_depth,
                         &maps.low_cover, &maps.mid_cover, &maps.high_cover}) {
@@ -49,9 +51,23 @@ bool named_layer_band(const std::string& name, LayerBand& out, const MapOptions&
 
 void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& options) {
   const std::size_t ncol = grid.columns();
-  const auto& cf = data[Field::CloudFraction];
-  const auto& el = data[Field::ExtinctionLiquid];
-  const auto& ei = data[Field::ExtinctionIce];
+  // The three fields the maps read, as floats or as half floats (a step on its way to a float16
+  // .cvvol): a layer's row of halves is widened into a buffer first, as read_cvvol widens them.
+  struct Source {
+    const float* f = nullptr;
+    const std::uint16_t* h = nullptr;
+    float k = 1.0f;  // 1 / half_field_scale
+  };
+  auto source = [&](Field which) {
+    Source s;
+    const auto& fv = data[which];
+    const auto& hv = data.halves[static_cast<std::size_t>(which)];
+    if (fv.size() == grid.points()) s.f = fv.data();
+    else if (hv.size() == grid.points()) s.h = hv.data(), s.k = 1.0f / half_field_scale(which);
+    return s;
+  };
+  const Source src_cf = source(Field::CloudFraction), src_el = source(Field::ExtinctionLiquid),
+               src_ei = source(Field::ExtinctionIce);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   Maps2D& m = data.maps;
   for (auto* v : {&m.cloud_cover, &m.cloud_base_m, &m.cloud_top_m, &m.optical_depth, &m.low_cover, &m.mid_cover,
@@ -72,6 +88,15 @@ void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& o
   // Rows are independent: split over the cores.
   parallel_ranges(static_cast<std::size_t>(grid.lat_deg.count), 16, [&](std::size_t j_begin, std::size_t j_end, unsigned) {
     std::vector<ColumnState> row(static_cast<std::size_t>(nx));
+    std::vector<float> widened[3];
+    // The layer row at p0 of a field: nullptr where the field is absent.
+    auto layer_row = [&](const Source& s, std::size_t p0, std::vector<float>& buf) -> const float* {
+      if (s.f) return s.f + p0;
+      if (!s.h) return nullptr;
+      buf.resize(static_cast<std::size_t>(nx));
+      halves_to_floats(s.h + p0, s.k, buf.data(), buf.size());
+      return buf.data();
+    };
     for (int j = static_cast<int>(j_begin); j < static_cast<int>(j_end); ++j) {
       for (int i = 0; i < nx; ++i) {
         ColumnState& st = row[static_cast<std::size_t>(i)];
@@ -83,16 +108,18 @@ void derive_maps(const VolumeGrid& grid, TimeStepData& data, const MapOptions& o
       for (int k = grid.alt_m.count - 1; k >= 0; --k) {
         const double alt = grid.alt_m.at(k);
         const std::size_t p0 = grid.index(0, j, k);
+        const float* cf = layer_row(src_cf, p0, widened[0]);
+        const float* el = layer_row(src_el, p0, widened[1]);
+        const float* ei = layer_row(src_ei, p0, widened[2]);
         for (int i = 0; i < nx; ++i) {
           ColumnState& st = row[static_cast<std::size_t>(i)];
-          const std::size_t p = p0 + static_cast<std::size_t>(i);
-          const double ext = (el.empty() || std::isnan(el[p]) ? 0.0 : el[p]) + (ei.empty() || std::isnan(ei[p]) ? 0.0 : ei[p]);
-          const bool have = (!cf.empty() && !std::isnan(cf[p])) || (!el.empty() && !std::isnan(el[p])) ||
-                            (!ei.empty() && !std::isnan(ei[p]));
+          const std::size_t p = static_cast<std::size_t>(i);
+          const double ext = (!el || std::isnan(el[p]) ? 0.0 : el[p]) + (!ei || std::isnan(ei[p]) ? 0.0 : ei[p]);
+          const bool have = (cf && !std::isnan(cf[p])) || (el && !std::isnan(el[p])) || (ei && !std::isnan(ei[p]));
           if (!have) continue;
           st.any_data = true;
           // Without a cloud-fraction field, a point with water counts as fully cloudy.
-          const double frac = cf.empty() || std::isnan(cf[p]) ? (ext > 0.0 ? 1.0 : 0.0) : cf[p];
+          const double frac = !cf || std::isnan(cf[p]) ? (ext > 0.0 ? 1.0 : 0.0) : cf[p];
           const bool cloudy = map_cloudy(frac, ext, options);
           const double c = cloudy ? frac : 0.0;
           const double above = alt - st.ground;

@@ -80,8 +80,21 @@ struct MapOptions {
   double mid_top_m = 6000.0;
 };
 
+// The factor a field's SI value is multiplied by before it is stored as a half float (the .cvvol's
+// float16 encoding, docs/formats.md): extinction in 1/km (values down to 6.1e-8 /m stay normal),
+// pressure in hPa (Pa would pass the largest half, 65504), the others in SI units.
+inline float half_field_scale(Field f) {
+  if (f == Field::Pressure) return 0.01f;
+  return f == Field::ExtinctionLiquid || f == Field::ExtinctionIce ? 1000.0f : 1.0f;
+}
+
 struct TimeStepData {
   std::array<std::vector<float>, kFieldCount> fields;
+  // A field held as half floats of its value x half_field_scale instead of `fields` (whose vector
+  // is then empty): only the import on its way to a float16 .cvvol asks a reader for these
+  // (importers' ImportOptions::half_fields), which halves the step's memory and leaves write_cvvol
+  // no conversion. derive_maps and write_cvvol read either; nothing else is given such a step.
+  std::array<std::vector<std::uint16_t>, kFieldCount> halves;
   // Per column, the ground's altitude (m) where the file gives terrain; empty (or NaN in a column)
   // where it does not. Low/mid/high cover is measured from here.
   std::vector<float> ground_m;

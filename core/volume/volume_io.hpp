@@ -34,6 +34,8 @@ float half_to_float(std::uint16_t h);
 // out[i] = float_to_half(in[i] * scale) for i < n, bit for bit; with the processor's F16C
 // instructions where it has them (eight at a time), else value by value.
 void floats_to_halves(const float* in, float scale, std::uint16_t* out, std::size_t n);
+// out[i] = half_to_float(in[i]) * scale for i < n, bit for bit (eight at a time with F16C).
+void halves_to_floats(const std::uint16_t* in, float scale, float* out, std::size_t n);
 // A .cvvol that cannot be read: missing, of another kind, truncated or corrupt (bad input).
 class VolumeFileError : public InputError {
  public:

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <vector>
@@ -495,6 +497,78 @@ TEST(VolumeIo, ArrayHalfConversionEqualsTheScalarOne) {
     }
     EXPECT_EQ(differ, 0u) << "scale " << scale << " over " << in.size() << " values";
   }
+}
+
+// The widening of half floats (read_cvvol, derive_maps of a step held as halves) is the scalar
+// half_to_float times the scale, bit for bit, over every half: with F16C and without.
+TEST(VolumeIo, ArrayHalfWideningEqualsTheScalarOne) {
+  std::vector<std::uint16_t> in(65536 + 5);
+  for (std::size_t i = 0; i < in.size(); ++i) in[i] = static_cast<std::uint16_t>(i);  // the last 5 again, past a multiple of 8
+  for (float scale : {1.0f, 0.001f, 100.0f}) {
+    std::vector<float> out(in.size());
+    core::halves_to_floats(in.data(), scale, out.data(), in.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < in.size(); ++i) {
+      const float want = core::half_to_float(in[i]) * scale;
+      if (std::isnan(want) ? !std::isnan(out[i]) : std::memcmp(&want, &out[i], sizeof want) != 0) ++differ;
+    }
+    EXPECT_EQ(differ, 0u) << "scale " << scale;
+  }
+}
+
+// A step held as half floats (the import's, on its way to a float16 .cvvol) is written as the same
+// step held as floats would be, and widened when float32 is asked for.
+TEST(VolumeIo, AStepHeldAsHalvesIsWrittenAsItsFloatsWouldBe) {
+  const auto dir = cv::test::temp_dir("cvvol_halves");
+  core::CloudVolume v;
+  v.grid.lon_deg = {0, 1, 5};
+  v.grid.lat_deg = {0, 1, 3};
+  v.grid.alt_m = {0, 500, 4};
+  v.times = {{0, "2024-01-01T00:00:00Z"}};
+  const std::vector<int> present = {0, 2, 5, 6, 7};
+  for (int f : present) v.has_field[static_cast<std::size_t>(f)] = true;
+  const std::size_t n = v.grid.points();
+  core::TimeStepData floats, halves;
+  for (int f : present) {
+    auto& a = floats.fields[static_cast<std::size_t>(f)];
+    a.resize(n);
+    for (std::size_t p = 0; p < n; ++p) {
+      const double x = static_cast<double>(p) + 1.0;
+      a[p] = f == 0 ? static_cast<float>(1e-6 * x * x) : f == 2 ? static_cast<float>(x / static_cast<double>(n))
+                                                     : f == 7 ? static_cast<float>(1e5 - 900.0 * x) : static_cast<float>(200.0 + 1.3 * x);
+    }
+    if (f == 0) a[7] = std::numeric_limits<float>::quiet_NaN();
+    // Held as halves: the floats through the float16 encoding's scale, then the floats the reader
+    // would widen them to, so both steps stand for the same volume.
+    const float k = core::half_field_scale(static_cast<core::Field>(f));
+    auto& h = halves.halves[static_cast<std::size_t>(f)];
+    h.resize(n);
+    core::floats_to_halves(a.data(), k, h.data(), n);
+    core::halves_to_floats(h.data(), 1.0f / k, a.data(), n);
+  }
+  core::derive_maps(v.grid, floats);
+  core::derive_maps(v.grid, halves);
+  ASSERT_EQ(halves.maps.optical_depth.size(), v.grid.columns());
+  for (std::size_t c = 0; c < v.grid.columns(); ++c) {
+    EXPECT_EQ(halves.maps.optical_depth[c], floats.maps.optical_depth[c]) << c;
+    EXPECT_EQ(halves.maps.cloud_cover[c], floats.maps.cloud_cover[c]) << c;
+  }
+  EXPECT_EQ(halves.bytes(), floats.bytes() - n * present.size() * 2);
+  for (const auto encoding : {core::CvvolEncoding::Float16, core::CvvolEncoding::Float32}) {
+    const bool f16 = encoding == core::CvvolEncoding::Float16;
+    std::string bytes[2];
+    for (int held = 0; held < 2; ++held) {
+      core::CloudVolume w = v;
+      w.put(0, held ? halves : floats);
+      const std::string path = (dir / (std::string(held ? "h" : "f") + (f16 ? "16" : "32") + ".cvvol")).string();
+      core::write_cvvol(path, w, nullptr, encoding);
+      std::ifstream in(path, std::ios::binary);
+      bytes[held].assign(std::istreambuf_iterator<char>(in), {});
+    }
+    EXPECT_GT(bytes[0].size(), n * 2 * present.size());
+    EXPECT_TRUE(bytes[0] == bytes[1]) << (f16 ? "float16" : "float32") << ": " << bytes[0].size() << " and " << bytes[1].size() << " bytes";
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(VolumeIo, Float16VolumeReadsBackWithinItsStatedBound) {
