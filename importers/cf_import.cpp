@@ -371,6 +371,9 @@ struct RowWork {
   RowLevels levels;  // the row's level samples, level-major
   StoredStats stored;  // ranges of the values the row's conversion stored
   std::vector<double> z_prev, p_prev, tv_prev;
+  // Per column of the row: the surface geopotential height and geometric altitude, and the surface
+  // pressure (hybrid levels), found once per row instead of once per level.
+  std::vector<double> zsurf, zsurf_geometric, p_surface;
   std::size_t negative_water = 0, clamped_cf = 0;
   double worst_negative = 0.0;
   ColumnCounts counts;
@@ -502,6 +505,18 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   auto do_row = [&](int y, RowWork& W) {
     const int j0 = S.lat.j0[static_cast<std::size_t>(y)], j1 = S.lat.j1[static_cast<std::size_t>(y)];
     const double w = S.lat.w[static_cast<std::size_t>(y)];
+    // The surface where the file gives it, once per column: as a geopotential height (hypsometric
+    // start) and as a geometric altitude (heights above ground); a surface_altitude variable is the
+    // latter already. And the surface pressure of hybrid levels.
+    const bool given_altitude = L.surface_geopotential_scale != 1.0;
+    for (int x = 0; x < nx; ++x) {
+      const int i = S.lon.src[static_cast<std::size_t>(x)];
+      const std::size_t X_ = static_cast<std::size_t>(x);
+      const double surf_raw = L.surface_geopotential ? surf(zs, i, j0, j1, w) : 0.0;
+      W.zsurf[X_] = given_altitude ? surf_raw * grid.earth_radius_m / (grid.earth_radius_m + surf_raw) : surf_raw / kG0;
+      W.zsurf_geometric[X_] = given_altitude ? surf_raw : physics::f64::geopotential_to_height_m(surf_raw, grid.earth_radius_m);
+      W.p_surface[X_] = L.vertical_kind == Vertical::Hybrid ? surface_pressure(i, j0, j1, w) : 0.0;
+    }
     for (int l = 0; l < nlev; ++l) {
       const int k = S.levels[static_cast<std::size_t>(l)];
       RoleRow role_row[kRoleCount];
@@ -511,16 +526,10 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
         const int i = S.lon.src[static_cast<std::size_t>(x)];
         LevelSample c;
         const std::size_t L_ = static_cast<std::size_t>(l), X_ = static_cast<std::size_t>(x);
-        // The surface where the file gives it: as a geopotential height (hypsometric start) and as a
-        // geometric altitude (heights above ground). A surface_altitude variable is the latter already.
-        const bool given_altitude = L.surface_geopotential_scale != 1.0;
-        const double surf_raw = L.surface_geopotential ? surf(zs, i, j0, j1, w) : 0.0;
-        const double zsurf = given_altitude ? surf_raw * grid.earth_radius_m / (grid.earth_radius_m + surf_raw) : surf_raw / kG0;
-        const double zsurf_geometric =
-            given_altitude ? surf_raw : physics::f64::geopotential_to_height_m(surf_raw, grid.earth_radius_m);
+        const double zsurf = W.zsurf[X_], zsurf_geometric = W.zsurf_geometric[X_];
         switch (L.vertical_kind) {
           case Vertical::Pressure: c.p_pa = S.level_pa[L_]; break;
-          case Vertical::Hybrid: c.p_pa = S.hyb_a[L_] + S.hyb_b[L_] * surface_pressure(i, j0, j1, w); break;
+          case Vertical::Hybrid: c.p_pa = S.hyb_a[L_] + S.hyb_b[L_] * W.p_surface[X_]; break;
           case Vertical::Height:
             c.p_pa = isa_pressure_pa(S.level_z[L_] + (L.height_above_ground ? zsurf_geometric : 0.0));
             break;
@@ -539,7 +548,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
         } else if (L.vertical_kind == Vertical::Hybrid) {
           // Hypsometric equation from the surface: dZ = R_d T_v / g0 d(ln p), in geopotential metres.
           const double tv = t_read * (1.0 + 0.608 * c.qv);
-          const double zgp = l == 0 ? zsurf + kRd * tv / kG0 * std::log(surface_pressure(i, j0, j1, w) / c.p_pa)
+          const double zgp = l == 0 ? zsurf + kRd * tv / kG0 * std::log(W.p_surface[X_] / c.p_pa)
                                     : W.z_prev[X_] + kRd * 0.5 * (tv + W.tv_prev[X_]) / kG0 * std::log(W.p_prev[X_] / c.p_pa);
           W.z_prev[X_] = zgp, W.p_prev[X_] = c.p_pa, W.tv_prev[X_] = tv;
           c.z_m = physics::f64::geopotential_to_height_m(kG0 * zgp, grid.earth_radius_m);
@@ -632,6 +641,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   for (auto& W : work) {
     W.levels.resize(nx, nlev);
     W.z_prev.resize(row_len), W.p_prev.resize(row_len), W.tv_prev.resize(row_len);
+    W.zsurf.resize(row_len), W.zsurf_geometric.resize(row_len), W.p_surface.resize(row_len);
   }
   // Bands of kBandRows file rows: each output row goes with the band holding the lowest file row
   // it reads, and a band's read reaches as far as its rows need.
