@@ -348,11 +348,7 @@ bool level_has_cloud(const Era5Source& S, int k, int time_index) {
       if (d == L.lat.dim) start[a] = static_cast<std::size_t>(S.lat_lo), count[a] = static_cast<std::size_t>(S.lat_hi - S.lat_lo + 1);
     }
     const double threshold = (r == Role::CloudFraction ? kZeroCloudFraction : kZeroWater) / L.role_scale[static_cast<int>(r)];
-    thread_local std::vector<float> buf;
-    S.file->read_float_into(buf, *v, start, count);
-    for (float x : buf) {
-      if (x >= threshold) return true;
-    }
+    if (S.file->any_at_least(*v, start, count, threshold)) return true;
   }
   return false;
 }

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <csignal>
 #include <cmath>
@@ -863,6 +864,50 @@ std::vector<float> NcFile::read_float(const NcVar& v, std::vector<std::size_t> s
   std::vector<float> out;
   read_float_into(out, v, std::move(start), std::move(count), info);
   return out;
+}
+
+bool NcFile::any_at_least(const NcVar& v, std::vector<std::size_t> start, std::vector<std::size_t> count,
+                          double threshold) const {
+  whole_if_empty(v, start, count);
+  const UnpackRules rules = unpack_rules(v);
+  if (isolated_ || v.type != NC_SHORT || !rules.approx.empty() || rules.exact.size() > 2) {
+    thread_local std::vector<float> values;
+    read_float_into(values, v, std::move(start), std::move(count));
+    for (float x : values) {
+      if (x >= threshold) return true;
+    }
+    return false;
+  }
+  // What read_float_into's int16 path makes of each int16 value (the same tests and arithmetic),
+  // compared as it is compared above: a table of 65536 answers.
+  std::array<bool, 65536> hit{};
+  const double lo = rules.lo, hi = rules.hi, scale = rules.scale, offset = rules.offset;
+  const double m0 = rules.exact.empty() ? NAN : rules.exact[0], m1 = rules.exact.size() < 2 ? NAN : rules.exact[1];
+  bool any_hit = false;
+  for (int raw = -32768; raw <= 32767; ++raw) {
+    const double x = raw;
+    const bool miss = (x < lo) | (x > hi) | (x == m0) | (x == m1);
+    const bool h = !miss && static_cast<double>(static_cast<float>(x * scale + offset)) >= threshold;
+    hit[static_cast<std::uint16_t>(static_cast<std::int16_t>(raw))] = h;  // indexed by the int16's bits
+    any_hit |= h;
+  }
+  if (!any_hit) {
+    checked_read_count(v, start, count);  // the same checks a read makes, though nothing is read
+    return false;
+  }
+  const std::size_t m = checked_read_count(v, start, count);
+  thread_local std::vector<std::int16_t> raw;
+  core::reserve_exact(raw, m);
+  raw.resize(m);
+  if (m) {
+    if (const int st = nc_get_vara_short(id_, v.id, start.data(), count.data(), raw.data()); st != NC_NOERR) {
+      fail(st, "variable '" + v.name + "': cannot read values");
+    }
+  }
+  for (std::int16_t x : raw) {
+    if (hit[static_cast<std::uint16_t>(x)]) return true;
+  }
+  return false;
 }
 
 void NcFile::read_float_into(std::vector<float>& out, const NcVar& v, std::vector<std::size_t> start,

@@ -92,6 +92,11 @@ class NcFile {
   // The same into `out`, reusing its memory.
   void read_float_into(std::vector<float>& out, const NcVar& v, std::vector<std::size_t> start,
                        std::vector<std::size_t> count, UnpackInfo* info = nullptr) const;
+  // Whether any value of the hyperslab, read as read_float_into reads it, is at least `threshold`
+  // (NaN, missing, never is). For int16 variables read in process, the file's int16 values are
+  // tested against a table of what each of the 65536 unpacks to, with no unpacking pass.
+  bool any_at_least(const NcVar& v, std::vector<std::size_t> start, std::vector<std::size_t> count,
+                    double threshold) const;
   // A text variable (e.g. WRF's Times) as one string per leading index.
   std::vector<std::string> read_strings(const NcVar& v) const;
 

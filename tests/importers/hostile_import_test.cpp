@@ -689,6 +689,21 @@ TEST(NcShortReads, UnpackToTheSameFloatsAsTheDoublePath) {
           }
         }
       }
+      // any_at_least (the importer's search for the levels with cloud) answers as a scan of
+      // these floats would, around the largest valid value (values past the valid range and the
+      // markers unpack larger but are missing) and elsewhere.
+      float lo = INFINITY, hi = -INFINITY;
+      for (float x : fl) {
+        if (!std::isnan(x)) lo = std::min(lo, x), hi = std::max(hi, x);
+      }
+      ASSERT_LT(lo, hi);
+      for (double threshold : {static_cast<double>(lo), static_cast<double>(hi), std::nextafter(static_cast<double>(hi), INFINITY),
+                               static_cast<double>(std::nextafter(hi, INFINITY)), 0.5 * (static_cast<double>(lo) + hi),
+                               static_cast<double>(INFINITY), -static_cast<double>(INFINITY)}) {
+        bool want = false;
+        for (float x : fl) want = want || x >= threshold;
+        EXPECT_EQ(f.any_at_least(v, start, count, threshold), want) << "threshold " << threshold;
+      }
       EXPECT_EQ(as_float_info.missing, as_double_info.missing);
       EXPECT_EQ(as_float_info.missing, nan);
       EXPECT_EQ(as_float_info.packed, as_double_info.packed);
