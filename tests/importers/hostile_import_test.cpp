@@ -684,8 +684,10 @@ TEST(NcShortReads, UnpackToTheSameFloatsAsTheDoublePath) {
           const bool missing = r == -32767 || (c.missing && r == 12345) || (c.range && (r < -30000 || r > 30000));
           if (missing) {
             ASSERT_TRUE(std::isnan(fl[i])) << "raw " << r;
+            ASSERT_TRUE(std::isnan(d[i])) << "raw " << r;
           } else {
             ASSERT_EQ(fl[i], static_cast<float>(r * scale + offset)) << "raw " << r;
+            ASSERT_EQ(d[i], r * scale + offset) << "raw " << r;  // the double read's own int16 path too
           }
         }
       }
