@@ -3,14 +3,19 @@
 #include <gtest/gtest.h>
 #include <netcdf.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "importer.hpp"
 #include "support/real_data.hpp"
 #include "nc_file.hpp"
+#include "volume/volume_io.hpp"
 
 namespace {
 using namespace cv;
@@ -129,4 +134,52 @@ TEST(RealFiles, GfsTimeUnitsAndSeamAreUnderstood) {
   EXPECT_NE(info.find("gpm"), std::string::npos) << info;
 }
 
+}  // namespace
+
+namespace {
+// `cloudviewer import` asks the reader for half floats (ImportOptions::half_fields): on the real
+// files they are the float import's values as the float16 .cvvol stores them, bit for bit; WRF
+// files keep float steps.
+TEST(RealFiles, HalfFieldsAreTheFloatImportAsTheVolumeStoresIt) {
+  struct Case {
+    const char* name;
+    bool diagnose;
+    bool halves;  // whether the reader makes half floats
+  };
+  for (const Case c : {Case{"met-era5-cocip1.nc", false, true}, Case{"met-accf-pl.nc", true, true},
+                       Case{"wrf_d01_allvars_cropped.nc", false, false}}) {
+    SCOPED_TRACE(c.name);
+    REAL_FILE(path, c.name);
+    importers::ImportOptions o;
+    o.diagnose_cloud = c.diagnose;
+    auto f = importers::import_file(path, o);
+    o.half_fields = true;
+    auto h = importers::import_file(path, o);
+    ASSERT_EQ(f.times.size(), h.times.size());
+    const std::size_t n = f.grid.points();
+    std::size_t compared = 0;
+    for (std::size_t t = 0; t < f.times.size(); t += std::max<std::size_t>(1, f.times.size() / 3)) {
+      const auto& df = f.step(t);
+      const auto& dh = h.step(t);
+      for (int k = 0; k < core::kFieldCount; ++k) {
+        const std::size_t kk = static_cast<std::size_t>(k);
+        if (!f.has_field[kk]) continue;
+        ASSERT_EQ(df.fields[kk].size(), n);
+        if (!c.halves) {
+          EXPECT_TRUE(dh.halves[kk].empty());
+          ASSERT_EQ(dh.fields[kk].size(), n);
+          EXPECT_EQ(std::memcmp(dh.fields[kk].data(), df.fields[kk].data(), n * sizeof(float)), 0)  // NaN == NaN here
+              << core::field_name(static_cast<core::Field>(k));
+          continue;
+        }
+        ASSERT_EQ(dh.halves[kk].size(), n) << core::field_name(static_cast<core::Field>(k));
+        std::vector<std::uint16_t> want(n);
+        core::floats_to_halves(df.fields[kk].data(), core::half_field_scale(static_cast<core::Field>(k)), want.data(), n);
+        EXPECT_TRUE(want == dh.halves[kk]) << core::field_name(static_cast<core::Field>(k)) << " at step " << t;
+        compared += n;
+      }
+    }
+    if (c.halves) EXPECT_GT(compared, 0u);
+  }
+}
 }  // namespace
