@@ -1,7 +1,8 @@
 // The NetCDF importers' fuzz body, shared by the byte-level target (fuzz_netcdf) and the semantic
 // one (fuzz_netcdf_semantic): `info`'s description, the import and every time step (up to 4)
-// loaded. Bad input must end in an InputError (exit 2 on the command line); anything else that
-// escapes, a crash, a sanitizer report or a hang is a finding.
+// loaded, as floats or (inputs of odd size) as half floats. Bad input must end in an InputError
+// (exit 2 on the command line); anything else that escapes, a crash, a sanitizer report or a hang
+// is a finding.
 //
 // fuzz_netcdf and fuzz_netcdf_semantic take netCDF classic inputs (CDF-1, -2 and -5); fuzz_netcdf4
 // takes NetCDF-4 (HDF5) inputs, which NcFile reads in a child process because the HDF5 library
@@ -36,6 +37,9 @@ inline int run_netcdf_input(const std::uint8_t* data, std::size_t size, bool net
   try {
     importers::ImportOptions o;
     o.cache_steps = 1;
+    // Half the inputs take the path `cloudviewer import` takes to a float16 volume (steps held
+    // as half floats), the other half the float steps a render loads.
+    o.half_fields = (size & 1) != 0;
     core::CloudVolume v = importers::import_file(file.path(), o);
     for (std::size_t t = 0; t < v.times.size() && t < 4; ++t) (void)v.step(t);
   } catch (const core::InputError&) {
