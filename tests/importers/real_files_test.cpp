@@ -179,7 +179,9 @@ TEST(RealFiles, HalfFieldsAreTheFloatImportAsTheVolumeStoresIt) {
         compared += n;
       }
     }
-    if (c.halves) EXPECT_GT(compared, 0u);
+    if (c.halves) {
+      EXPECT_GT(compared, 0u);
+    }
   }
 }
 }  // namespace
