@@ -14,10 +14,10 @@
 #include <unistd.h>
 
 #include "io/background_writer.hpp"
+#include "io/cpu.hpp"
 #include "io/parallel.hpp"
 
 #if defined(__x86_64__) && defined(__GNUC__)
-#include <cpuid.h>
 #include <immintrin.h>
 #endif
 
@@ -90,25 +90,12 @@ __attribute__((target("avx,f16c"))) void halves_f16c(const float* in, float scal
   for (; i < n; ++i) out[i] = float_to_half(in[i] * scale);
 }
 
-// Whether the processor and the operating system allow AVX with F16C: CPUID leaf 1 (ECX bit 27
-// OSXSAVE, 28 AVX, 29 F16C) and the YMM state enabled in XCR0. Read here rather than with
-// __builtin_cpu_supports, whose "f16c" clang 14 (the fuzz build) does not know.
-bool cpu_has_f16c() {
-  unsigned a = 0, b = 0, c = 0, d = 0;
-  if (!__get_cpuid(1, &a, &b, &c, &d)) return false;
-  const unsigned osxsave = 1u << 27, avx = 1u << 28, f16c = 1u << 29;
-  if ((c & (osxsave | avx | f16c)) != (osxsave | avx | f16c)) return false;
-  unsigned lo = 0, hi = 0;
-  __asm__ volatile("xgetbv" : "=a"(lo), "=d"(hi) : "c"(0u));
-  return (lo & 0x6u) == 0x6u;  // SSE and AVX register state saved by the OS
-}
 #endif
 }  // namespace
 
 void floats_to_halves(const float* in, float scale, std::uint16_t* out, std::size_t n) {
 #if defined(__x86_64__) && defined(__GNUC__)
-  static const bool f16c = cpu_has_f16c();
-  if (f16c) {
+  if (cpu_has_avx_f16c()) {
     halves_f16c(in, scale, out, n);
     return;
   }
@@ -134,8 +121,7 @@ __attribute__((target("avx,f16c"))) void floats_f16c(const std::uint16_t* in, fl
 
 void halves_to_floats(const std::uint16_t* in, float scale, float* out, std::size_t n) {
 #if defined(__x86_64__) && defined(__GNUC__)
-  static const bool f16c = cpu_has_f16c();
-  if (f16c) {
+  if (cpu_has_avx_f16c()) {
     floats_f16c(in, scale, out, n);
     return;
   }
