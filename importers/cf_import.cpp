@@ -240,6 +240,23 @@ struct RoleRow {
     else d0 = s.d.data() + a, d1 = s.d.data() + b;
   }
   RoleRow() = default;
+  // The values of file columns src[0 .. n-1] into out: at() of each, with the row's weight and
+  // type tested once for the row, not once per value.
+  void fill(const int* src, std::size_t n, double* out) const {
+    const bool one = w == 0.0 || w == 1.0;
+    auto run = [&](const auto* p0, const auto* p1) {
+      if (one) {
+        for (std::size_t x = 0; x < n; ++x) out[x] = p0[static_cast<std::size_t>(src[x] - i_off) * s_lon];
+      } else {
+        for (std::size_t x = 0; x < n; ++x) {
+          const std::size_t k = static_cast<std::size_t>(src[x] - i_off) * s_lon;
+          out[x] = (1.0 - w) * p0[k] + w * p1[k];
+        }
+      }
+    };
+    if (d0) run(d0, d1);
+    else run(f0, f1);
+  }
   double at(int i) const {
     const std::size_t n = static_cast<std::size_t>(i - i_off) * s_lon;
     if (d0) {
@@ -370,6 +387,8 @@ struct RowWork {
   // Per column of the row: the surface geopotential height and geometric altitude, and the surface
   // pressure (hybrid levels), found once per row instead of once per level.
   std::vector<double> zsurf, zsurf_geometric, p_surface;
+  // One level's values of each role read, per column of the row (RoleRow::fill).
+  std::array<std::vector<double>, kRoleCount> role_values;
   std::size_t negative_water = 0, clamped_cf = 0;
   double worst_negative = 0.0;
   ColumnCounts counts;
@@ -521,11 +540,13 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     }
     for (int l = 0; l < nlev; ++l) {
       const int k = S.levels[static_cast<std::size_t>(l)];
-      RoleRow role_row[kRoleCount];
-      for (int r : roles_read) role_row[r] = RoleRow(slab[static_cast<std::size_t>(r)], j0, j1, w, k);
-      auto value = [&](Role r, int i) { return role_row[static_cast<int>(r)].at(i); };
+      for (int r : roles_read) {
+        RoleRow(slab[static_cast<std::size_t>(r)], j0, j1, w, k).fill(S.lon.src.data(), row_len, W.role_values[static_cast<std::size_t>(r)].data());
+      }
+      const double* role_value[kRoleCount];
+      for (int r = 0; r < kRoleCount; ++r) role_value[r] = W.role_values[static_cast<std::size_t>(r)].data();
       for (int x = 0; x < nx; ++x) {
-        const int i = S.lon.src[static_cast<std::size_t>(x)];
+        auto value = [&](Role r) { return role_value[static_cast<int>(r)][x]; };
         LevelSample c;
         const std::size_t L_ = static_cast<std::size_t>(l), X_ = static_cast<std::size_t>(x);
         const double zsurf = W.zsurf[X_], zsurf_geometric = W.zsurf_geometric[X_];
@@ -536,14 +557,14 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
             c.p_pa = isa_pressure_pa(S.level_z[L_] + (L.height_above_ground ? zsurf_geometric : 0.0));
             break;
         }
-        const double t_read = has(Role::Temperature) ? value(Role::Temperature, i) : NAN;
-        c.qv = has(Role::Humidity) ? value(Role::Humidity, i) : 0.0;
+        const double t_read = has(Role::Temperature) ? value(Role::Temperature) : NAN;
+        c.qv = has(Role::Humidity) ? value(Role::Humidity) : 0.0;
         if (std::isnan(c.qv)) c.qv = 0.0;
         // Height: geopotential -> geometric height on the sphere; else from the coordinate itself.
         if (has(Role::Geopotential)) {
-          c.z_m = physics::f64::geopotential_to_height_m(value(Role::Geopotential, i), grid.earth_radius_m);
+          c.z_m = physics::f64::geopotential_to_height_m(value(Role::Geopotential), grid.earth_radius_m);
         } else if (has(Role::GeopotentialHeight)) {
-          c.z_m = physics::f64::geopotential_to_height_m(kG0 * value(Role::GeopotentialHeight, i),
+          c.z_m = physics::f64::geopotential_to_height_m(kG0 * value(Role::GeopotentialHeight),
                                                          grid.earth_radius_m);
         } else if (L.vertical_kind == Vertical::Height) {
           c.z_m = S.level_z[L_] + (L.height_above_ground ? zsurf_geometric : 0.0);
@@ -565,7 +586,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
         if (!std::isnan(c.t_k) && (c.t_k < 100.0 || c.t_k > 400.0)) bad(Role::Temperature, c.t_k, "a temperature between 100 and 400 K");
         // Cloud fraction: tiny excursions from unpacking are clamped and counted; absurd values stop.
         if (has(Role::CloudFraction)) {
-          c.cf = value(Role::CloudFraction, i);
+          c.cf = value(Role::CloudFraction);
           if (!std::isnan(c.cf)) {
             if (c.cf < -0.01 || c.cf > 1.01) bad(Role::CloudFraction, c.cf, "a fraction between 0 and 1");
             if (c.cf < 0.0 || c.cf > 1.0) {
@@ -578,7 +599,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
         double* water[2] = {&c.q_liquid, &c.q_ice};
         for (int ph = 0; ph < 2; ++ph) {
           if (!has(water_role[ph])) continue;
-          double qw = value(water_role[ph], i);
+          double qw = value(water_role[ph]);
           if (std::isnan(qw)) continue;
           if (qw < -1e-5 || qw > 0.05) bad(water_role[ph], qw, "a mixing ratio between 0 and 0.05 kg/kg");
           if (qw < 0.0) {
@@ -589,7 +610,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
           *water[ph] = qw;
         }
         if (has(Role::Snow)) {
-          double qs = value(Role::Snow, i);
+          double qs = value(Role::Snow);
           if (!std::isnan(qs)) {
             if (qs < -1e-5 || qs > 0.05) bad(Role::Snow, qs, "a mixing ratio between 0 and 0.05 kg/kg");
             if (qs < 0.0) {
@@ -603,7 +624,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
         if (diagnose) {
           // Relative humidity from the file, or from specific humidity and q_sat(p, T).
           double rh = NAN;
-          if (has(Role::RelativeHumidity)) rh = value(Role::RelativeHumidity, i);
+          if (has(Role::RelativeHumidity)) rh = value(Role::RelativeHumidity);
           else if (has(Role::Humidity)) rh = c.qv / saturation_specific_humidity(c.p_pa, c.t_k);
           if (!std::isnan(rh) && !std::isnan(c.t_k)) {
             if (rh < -0.01 || rh > 2.0) bad(has(Role::RelativeHumidity) ? Role::RelativeHumidity : Role::Humidity, rh,
@@ -614,13 +635,13 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
             c.q_ice = box.q_ice;
           }
         }
-        if (has(Role::U)) c.u = value(Role::U, i);
-        if (has(Role::V)) c.v = value(Role::V, i);
-        if (has(Role::UpwardVelocity)) c.w = value(Role::UpwardVelocity, i);
+        if (has(Role::U)) c.u = value(Role::U);
+        if (has(Role::V)) c.v = value(Role::V);
+        if (has(Role::UpwardVelocity)) c.w = value(Role::UpwardVelocity);
         // Omega (Pa/s) to w (m/s) by hydrostatics: w = -omega / (rho g).
         if (has(Role::Omega)) {
           const double rho = c.p_pa / (kRd * c.t_k * (1.0 + 0.608 * c.qv));
-          c.w = -value(Role::Omega, i) / (rho * kG0);
+          c.w = -value(Role::Omega) / (rho * kG0);
         }
         RowLevels& R = W.levels;
         const std::size_t at = R.at(l, x);
@@ -644,6 +665,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     W.levels.resize(nx, nlev);
     W.z_prev.resize(row_len), W.p_prev.resize(row_len), W.tv_prev.resize(row_len);
     W.zsurf.resize(row_len), W.zsurf_geometric.resize(row_len), W.p_surface.resize(row_len);
+    for (int r : roles_read) W.role_values[static_cast<std::size_t>(r)].resize(row_len);
   }
   // Bands of kBandRows file rows: each output row goes with the band holding the lowest file row
   // it reads, and a band's read reaches as far as its rows need.
