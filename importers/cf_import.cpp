@@ -389,6 +389,7 @@ struct RowWork {
   std::vector<double> zsurf, zsurf_geometric, p_surface;
   // One level's values of each role read, per column of the row (RoleRow::fill).
   std::array<std::vector<double>, kRoleCount> role_values;
+  std::vector<double> snow;  // a level's snow, checked before it joins the ice
   std::size_t negative_water = 0, clamped_cf = 0;
   double worst_negative = 0.0;
   ColumnCounts counts;
@@ -545,108 +546,128 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
       }
       const double* role_value[kRoleCount];
       for (int r = 0; r < kRoleCount; ++r) role_value[r] = W.role_values[static_cast<std::size_t>(r)].data();
-      for (int x = 0; x < nx; ++x) {
-        auto value = [&](Role r) { return role_value[static_cast<int>(r)][x]; };
-        LevelSample c;
-        const std::size_t L_ = static_cast<std::size_t>(l), X_ = static_cast<std::size_t>(x);
-        const double zsurf = W.zsurf[X_], zsurf_geometric = W.zsurf_geometric[X_];
-        switch (L.vertical_kind) {
-          case Vertical::Pressure: c.p_pa = S.level_pa[L_]; break;
-          case Vertical::Hybrid: c.p_pa = S.hyb_a[L_] + S.hyb_b[L_] * W.p_surface[X_]; break;
-          case Vertical::Height:
-            c.p_pa = isa_pressure_pa(S.level_z[L_] + (L.height_above_ground ? zsurf_geometric : 0.0));
-            break;
+      // The level's quantities a row at a time, each in its own loop (the checks apart), written
+      // where place_row reads them: the level's row of each of W.levels' arrays.
+      RowLevels& R = W.levels;
+      const std::size_t L_ = static_cast<std::size_t>(l), base = R.at(l, 0), n = row_len;
+      double *const zr = R.z_m.data() + base, *const pr = R.p_pa.data() + base, *const tr = R.t_k.data() + base;
+      double *const qvr = R.qv.data() + base, *const cfr = R.cf.data() + base, *const qlr = R.q_liquid.data() + base;
+      double *const qir = R.q_ice.data() + base, *const ur = R.u.data() + base, *const vr = R.v.data() + base;
+      double *const wr = R.w.data() + base;
+      auto row_of = [&](Role r) { return role_value[static_cast<int>(r)]; };
+      auto copy_or_nan = [&](Role r, double* dst) {
+        if (has(r)) std::copy(row_of(r), row_of(r) + n, dst);
+        else std::fill(dst, dst + n, kNaN);
+      };
+      switch (L.vertical_kind) {
+        case Vertical::Pressure: std::fill(pr, pr + n, S.level_pa[L_]); break;
+        case Vertical::Hybrid:
+          for (std::size_t x = 0; x < n; ++x) pr[x] = S.hyb_a[L_] + S.hyb_b[L_] * W.p_surface[x];
+          break;
+        case Vertical::Height:
+          for (std::size_t x = 0; x < n; ++x) pr[x] = isa_pressure_pa(S.level_z[L_] + (L.height_above_ground ? W.zsurf_geometric[x] : 0.0));
+          break;
+      }
+      // Humidity, 0 where absent; the temperature as read (NaN where the file has none, filled below).
+      if (has(Role::Humidity)) {
+        const double* q = row_of(Role::Humidity);
+        for (std::size_t x = 0; x < n; ++x) qvr[x] = std::isnan(q[x]) ? 0.0 : q[x];
+      } else {
+        std::fill(qvr, qvr + n, 0.0);
+      }
+      copy_or_nan(Role::Temperature, tr);
+      // Height: geopotential -> geometric height on the sphere; else from the coordinate itself.
+      if (has(Role::Geopotential)) {
+        const double* g = row_of(Role::Geopotential);
+        for (std::size_t x = 0; x < n; ++x) zr[x] = physics::f64::geopotential_to_height_m(g[x], grid.earth_radius_m);
+      } else if (has(Role::GeopotentialHeight)) {
+        const double* g = row_of(Role::GeopotentialHeight);
+        for (std::size_t x = 0; x < n; ++x) zr[x] = physics::f64::geopotential_to_height_m(kG0 * g[x], grid.earth_radius_m);
+      } else if (L.vertical_kind == Vertical::Height) {
+        for (std::size_t x = 0; x < n; ++x) zr[x] = S.level_z[L_] + (L.height_above_ground ? W.zsurf_geometric[x] : 0.0);
+      } else if (L.vertical_kind == Vertical::Hybrid) {
+        // Hypsometric equation from the surface: dZ = R_d T_v / g0 d(ln p), in geopotential metres.
+        for (std::size_t x = 0; x < n; ++x) {
+          const double tv = tr[x] * (1.0 + 0.608 * qvr[x]);
+          const double zgp = l == 0 ? W.zsurf[x] + kRd * tv / kG0 * std::log(W.p_surface[x] / pr[x])
+                                    : W.z_prev[x] + kRd * 0.5 * (tv + W.tv_prev[x]) / kG0 * std::log(W.p_prev[x] / pr[x]);
+          W.z_prev[x] = zgp, W.p_prev[x] = pr[x], W.tv_prev[x] = tv;
+          zr[x] = physics::f64::geopotential_to_height_m(kG0 * zgp, grid.earth_radius_m);
         }
-        const double t_read = has(Role::Temperature) ? value(Role::Temperature) : NAN;
-        c.qv = has(Role::Humidity) ? value(Role::Humidity) : 0.0;
-        if (std::isnan(c.qv)) c.qv = 0.0;
-        // Height: geopotential -> geometric height on the sphere; else from the coordinate itself.
-        if (has(Role::Geopotential)) {
-          c.z_m = physics::f64::geopotential_to_height_m(value(Role::Geopotential), grid.earth_radius_m);
-        } else if (has(Role::GeopotentialHeight)) {
-          c.z_m = physics::f64::geopotential_to_height_m(kG0 * value(Role::GeopotentialHeight),
-                                                         grid.earth_radius_m);
-        } else if (L.vertical_kind == Vertical::Height) {
-          c.z_m = S.level_z[L_] + (L.height_above_ground ? zsurf_geometric : 0.0);
-        } else if (L.vertical_kind == Vertical::Hybrid) {
-          // Hypsometric equation from the surface: dZ = R_d T_v / g0 d(ln p), in geopotential metres.
-          const double tv = t_read * (1.0 + 0.608 * c.qv);
-          const double zgp = l == 0 ? zsurf + kRd * tv / kG0 * std::log(W.p_surface[X_] / c.p_pa)
-                                    : W.z_prev[X_] + kRd * 0.5 * (tv + W.tv_prev[X_]) / kG0 * std::log(W.p_prev[X_] / c.p_pa);
-          W.z_prev[X_] = zgp, W.p_prev[X_] = c.p_pa, W.tv_prev[X_] = tv;
-          c.z_m = physics::f64::geopotential_to_height_m(kG0 * zgp, grid.earth_radius_m);
-        } else {
-          c.z_m = isa_altitude_m(c.p_pa);
+      } else {
+        for (std::size_t x = 0; x < n; ++x) zr[x] = isa_altitude_m(pr[x]);
+      }
+      for (std::size_t x = 0; x < n; ++x) {
+        if (!std::isnan(zr[x]) && (zr[x] < -1000.0 || zr[x] > 1.0e5)) {
+          bad(has(Role::Geopotential) ? Role::Geopotential : Role::GeopotentialHeight, zr[x], "a height between -1 km and 100 km");
         }
-        if (!std::isnan(c.z_m) && (c.z_m < -1000.0 || c.z_m > 1.0e5)) {
-          bad(has(Role::Geopotential) ? Role::Geopotential : Role::GeopotentialHeight, c.z_m,
-              "a height between -1 km and 100 km");
+      }
+      if (!has(Role::Temperature)) {
+        for (std::size_t x = 0; x < n; ++x) tr[x] = isa_temperature_k(zr[x]);
+      }
+      for (std::size_t x = 0; x < n; ++x) {
+        if (!std::isnan(tr[x]) && (tr[x] < 100.0 || tr[x] > 400.0)) bad(Role::Temperature, tr[x], "a temperature between 100 and 400 K");
+      }
+      // Cloud fraction: tiny excursions from unpacking are clamped and counted; absurd values stop.
+      copy_or_nan(Role::CloudFraction, cfr);
+      if (has(Role::CloudFraction)) {
+        for (std::size_t x = 0; x < n; ++x) {
+          const double cf = cfr[x];
+          if (std::isnan(cf) || (cf >= 0.0 && cf <= 1.0)) continue;
+          if (cf < -0.01 || cf > 1.01) bad(Role::CloudFraction, cf, "a fraction between 0 and 1");
+          ++W.clamped_cf;
+          cfr[x] = std::clamp(cf, 0.0, 1.0);
         }
-        c.t_k = has(Role::Temperature) ? t_read : isa_temperature_k(c.z_m);
-        if (!std::isnan(c.t_k) && (c.t_k < 100.0 || c.t_k > 400.0)) bad(Role::Temperature, c.t_k, "a temperature between 100 and 400 K");
-        // Cloud fraction: tiny excursions from unpacking are clamped and counted; absurd values stop.
-        if (has(Role::CloudFraction)) {
-          c.cf = value(Role::CloudFraction);
-          if (!std::isnan(c.cf)) {
-            if (c.cf < -0.01 || c.cf > 1.01) bad(Role::CloudFraction, c.cf, "a fraction between 0 and 1");
-            if (c.cf < 0.0 || c.cf > 1.0) {
-              ++W.clamped_cf;
-              c.cf = std::clamp(c.cf, 0.0, 1.0);
-            }
-          }
+      }
+      // Water: small negatives from unpacking are set to 0 and counted; absurd values stop.
+      auto water_row = [&](Role r, double* dst) {
+        for (std::size_t x = 0; x < n; ++x) {
+          const double qw = dst[x];
+          if (std::isnan(qw) || (qw >= 0.0 && qw <= 0.05)) continue;
+          if (qw < -1e-5 || qw > 0.05) bad(r, qw, "a mixing ratio between 0 and 0.05 kg/kg");
+          ++W.negative_water;
+          W.worst_negative = std::min(W.worst_negative, qw);
+          dst[x] = 0.0;
         }
-        const Role water_role[2] = {Role::Liquid, Role::Ice};
-        double* water[2] = {&c.q_liquid, &c.q_ice};
-        for (int ph = 0; ph < 2; ++ph) {
-          if (!has(water_role[ph])) continue;
-          double qw = value(water_role[ph]);
-          if (std::isnan(qw)) continue;
-          if (qw < -1e-5 || qw > 0.05) bad(water_role[ph], qw, "a mixing ratio between 0 and 0.05 kg/kg");
-          if (qw < 0.0) {
-            ++W.negative_water;
-            W.worst_negative = std::min(W.worst_negative, qw);
-            qw = 0.0;
-          }
-          *water[ph] = qw;
+      };
+      copy_or_nan(Role::Liquid, qlr);
+      if (has(Role::Liquid)) water_row(Role::Liquid, qlr);
+      copy_or_nan(Role::Ice, qir);
+      if (has(Role::Ice)) water_row(Role::Ice, qir);
+      if (has(Role::Snow)) {
+        // Snow adds to the ice (missing ice counts as none where there is snow).
+        double* const qs = W.snow.data();
+        std::copy(row_of(Role::Snow), row_of(Role::Snow) + n, qs);
+        water_row(Role::Snow, qs);
+        for (std::size_t x = 0; x < n; ++x) {
+          if (!std::isnan(qs[x])) qir[x] = (std::isnan(qir[x]) ? 0.0 : qir[x]) + qs[x];
         }
-        if (has(Role::Snow)) {
-          double qs = value(Role::Snow);
-          if (!std::isnan(qs)) {
-            if (qs < -1e-5 || qs > 0.05) bad(Role::Snow, qs, "a mixing ratio between 0 and 0.05 kg/kg");
-            if (qs < 0.0) {
-              ++W.negative_water;
-              W.worst_negative = std::min(W.worst_negative, qs);
-              qs = 0.0;
-            }
-            c.q_ice = (std::isnan(c.q_ice) ? 0.0 : c.q_ice) + qs;
-          }
-        }
-        if (diagnose) {
+      }
+      if (diagnose) {
+        for (std::size_t x = 0; x < n; ++x) {
           // Relative humidity from the file, or from specific humidity and q_sat(p, T).
           double rh = NAN;
-          if (has(Role::RelativeHumidity)) rh = value(Role::RelativeHumidity);
-          else if (has(Role::Humidity)) rh = c.qv / saturation_specific_humidity(c.p_pa, c.t_k);
-          if (!std::isnan(rh) && !std::isnan(c.t_k)) {
-            if (rh < -0.01 || rh > 2.0) bad(has(Role::RelativeHumidity) ? Role::RelativeHumidity : Role::Humidity, rh,
-                                            "a relative humidity between 0 and 200 %");
-            const DiagnosedBox box = diagnose_box(rh, c.p_pa, c.t_k, S.scheme);
-            c.cf = box.cloud_fraction;
-            c.q_liquid = box.q_liquid;
-            c.q_ice = box.q_ice;
-          }
+          if (has(Role::RelativeHumidity)) rh = row_of(Role::RelativeHumidity)[x];
+          else if (has(Role::Humidity)) rh = qvr[x] / saturation_specific_humidity(pr[x], tr[x]);
+          if (std::isnan(rh) || std::isnan(tr[x])) continue;
+          if (rh < -0.01 || rh > 2.0) bad(has(Role::RelativeHumidity) ? Role::RelativeHumidity : Role::Humidity, rh,
+                                          "a relative humidity between 0 and 200 %");
+          const DiagnosedBox box = diagnose_box(rh, pr[x], tr[x], S.scheme);
+          cfr[x] = box.cloud_fraction;
+          qlr[x] = box.q_liquid;
+          qir[x] = box.q_ice;
         }
-        if (has(Role::U)) c.u = value(Role::U);
-        if (has(Role::V)) c.v = value(Role::V);
-        if (has(Role::UpwardVelocity)) c.w = value(Role::UpwardVelocity);
-        // Omega (Pa/s) to w (m/s) by hydrostatics: w = -omega / (rho g).
-        if (has(Role::Omega)) {
-          const double rho = c.p_pa / (kRd * c.t_k * (1.0 + 0.608 * c.qv));
-          c.w = -value(Role::Omega) / (rho * kG0);
+      }
+      copy_or_nan(Role::U, ur);
+      copy_or_nan(Role::V, vr);
+      copy_or_nan(Role::UpwardVelocity, wr);
+      // Omega (Pa/s) to w (m/s) by hydrostatics: w = -omega / (rho g).
+      if (has(Role::Omega)) {
+        const double* om = row_of(Role::Omega);
+        for (std::size_t x = 0; x < n; ++x) {
+          const double rho = pr[x] / (kRd * tr[x] * (1.0 + 0.608 * qvr[x]));
+          wr[x] = -om[x] / (rho * kG0);
         }
-        RowLevels& R = W.levels;
-        const std::size_t at = R.at(l, x);
-        R.z_m[at] = c.z_m, R.p_pa[at] = c.p_pa, R.t_k[at] = c.t_k, R.qv[at] = c.qv, R.cf[at] = c.cf;
-        R.q_liquid[at] = c.q_liquid, R.q_ice[at] = c.q_ice, R.u[at] = c.u, R.v[at] = c.v, R.w[at] = c.w;
       }
     }
     if (L.surface_geopotential) {
@@ -666,6 +687,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     W.z_prev.resize(row_len), W.p_prev.resize(row_len), W.tv_prev.resize(row_len);
     W.zsurf.resize(row_len), W.zsurf_geometric.resize(row_len), W.p_surface.resize(row_len);
     for (int r : roles_read) W.role_values[static_cast<std::size_t>(r)].resize(row_len);
+    W.snow.resize(row_len);
   }
   // Bands of kBandRows file rows: each output row goes with the band holding the lowest file row
   // it reads, and a band's read reaches as far as its rows need.

@@ -647,3 +647,37 @@ TEST_F(CfImportFixes, HugeGribCodesNameNoParameter) {
   EXPECT_NE(importers::describe_file(a).find("importable: yes"), std::string::npos);
 }
 }  // namespace
+
+// Snow (ECMWF `cswc`) joins the ice: where both are given they add, where the ice is missing the
+// snow stands alone, and where the snow is missing the ice is kept; a small negative snow value
+// from packing is set to zero and counted like the other waters'.
+namespace {
+TEST(CfSnow, SnowJoinsTheIceAndItsSmallNegativesAreCounted) {
+  const auto dir = cv::test::temp_dir("cf_snow");
+  const std::vector<double> hpa = {1000, 700, 500};
+  const std::string p = (dir / "snow.nc").string();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double ice[] = {1e-4, nan, 0.0, 1e-4}, snow[] = {5e-5, 5e-5, -2e-6, nan};
+  auto at_cloud = [](const Idx& i, double v) { return i[1] == 1 ? v : 0.0; };
+  cv::test::write_cf(p, era5_axes({0, 10, 20, 30}, {-10, 0, 10}, hpa),
+                     {geopotential(hpa), constant("t", "K", "air_temperature", 260.0),
+                      {"cc", kDims, {{"units", "(0 - 1)"}}, {}, [&](const Idx& i) { return at_cloud(i, 0.5); }},
+                      {"ciwc", kDims, {{"units", "kg kg**-1"}}, {}, [&](const Idx& i) { return at_cloud(i, ice[i[3]]); }},
+                      {"cswc", kDims, {{"units", "kg kg**-1"}}, {}, [&](const Idx& i) { return at_cloud(i, snow[i[3]]); }}});
+  importers::ImportOptions o;
+  o.dz_m = level_alt(700) - level_alt(1000);  // a node on the 700 hPa level
+  auto v = importers::import_file(p, o);
+  ASSERT_NEAR(v.grid.alt_m.at(1), level_alt(700), 0.5);
+  const double rho = 70000.0 / (287.05 * 260.0);
+  const double want[] = {ice_sigma(rho, 1.5e-4 / 0.5, 260.0), ice_sigma(rho, 5e-5 / 0.5, 260.0), 0.0,
+                         ice_sigma(rho, 1e-4 / 0.5, 260.0)};
+  const auto& ext = v.step(0)[core::Field::ExtinctionIce];
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      EXPECT_NEAR(ext[v.grid.index(i, j, 1)], want[i], 1e-6 * want[0]) << "lon index " << i << " lat index " << j;
+    }
+  }
+  EXPECT_TRUE(any_contains(v.report.warnings, "negative mixing ratios")) << v.report.to_text();
+  std::filesystem::remove_all(dir);
+}
+}  // namespace
