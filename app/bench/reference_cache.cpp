@@ -1,7 +1,10 @@
 // Reading and writing the benchmark's resumable Monte Carlo references (see reference_cache.hpp).
 #include "bench/reference_cache.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <vector>
@@ -85,6 +88,87 @@ void write_reference_cache(const std::string& path, std::uint64_t key, const Mon
     std::fwrite(img.lum_sum.data(), sizeof(double), n, f);
     std::fwrite(img.lum_sq.data(), sizeof(double), n, f);
   });
+}
+
+std::string reference_key(const StandardScene& sc, const GridMeanExtinction& medium, const MarchSettings& m,
+                          const MonteCarloSettings& mc) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < medium.liquid_per_m.size(); ++i) sum += medium.liquid_per_m[i] * (1.0 + 1e-3 * static_cast<double>(i % 977));
+  for (std::size_t i = 0; i < medium.ice_per_m.size(); ++i) sum += medium.ice_per_m[i] * (2.0 + 1e-3 * static_cast<double>(i % 983));
+  const auto& g = sc.grid;
+  const auto& c = sc.camera;
+  char b[1024];
+  std::snprintf(b, sizeof b,
+                "v2 grid %d %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g data %.17g cam %.17g %.17g %.17g %.17g %.17g "
+                "%.17g %d %d sun %.17g %.17g %.17g %.17g %.17g march d%.17g hg%d ice%.17g noise%.17g mc %d %d %llu peak%d",
+                g.lon_deg.count, g.lat_deg.count, g.alt_m.count, g.lon_deg.start, g.lon_deg.step, g.lat_deg.start,
+                g.lat_deg.step, g.alt_m.start, g.alt_m.step, g.earth_radius_m, sum, c.lat_deg, c.lon_deg, c.alt_m,
+                c.heading_deg, c.pitch_deg, c.fov_deg, c.width, c.height, sc.sun.subsolar_lat_deg, sc.sun.subsolar_lon_deg,
+                sc.sun.irradiance.x, sc.sun.irradiance.y, sc.sun.irradiance.z, m.medium.droplet_diameter_um,
+                m.medium.liquid_phase_hg ? 1 : 0, m.medium.ice_g, m.medium.noise_amount, mc.max_bounces, mc.roulette_after,
+                static_cast<unsigned long long>(mc.seed), mc.peak_mis ? 1 : 0);
+  std::string key = b;
+  if (m.medium.modelled) {  // the modelled cloud's own density (data-mode keys stay as they were)
+    char d[160];
+    std::snprintf(d, sizeof d, " modelled detail%.17g scale%.17g fraction%zu", m.medium.detail_amount, m.medium.detail_scale_m,
+                  medium.fraction.size());
+    key += d;
+  }
+  return key;
+}
+
+ExtendedReference extend_reference(const std::string& dir, const std::string& name, const StandardScene& sc,
+                                   const GridMeanExtinction& medium, const MarchSettings& m,
+                                   const MonteCarloSettings& mc, int spp, double ref_error,
+                                   const ErosionNoise* noise, std::FILE* log) {
+  using clock = std::chrono::steady_clock;
+  auto seconds_since = [](clock::time_point t) { return std::chrono::duration<double>(clock::now() - t).count(); };
+  const int w = sc.camera.width, h = sc.camera.height;
+  const std::uint64_t key = reference_key_hash(reference_key(sc, medium, m, mc));
+  char hash[20];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(key));
+  ExtendedReference out;
+  out.path = (std::filesystem::path(dir) /
+              ("ref_" + name + "_" + std::to_string(w) + "x" + std::to_string(h) + "_" + hash + ".cvref"))
+                 .string();
+  const MonteCarloRenderer mcr(sc.grid, medium, sc.camera, sc.sun, m, mc, noise);
+  out.img = mcr.start();
+  MonteCarloImage& img = out.img;
+  std::string why;
+  if (read_reference_cache(out.path, key, w, h, img, &why)) {
+    std::fprintf(log, "%s: reference %s holds %llu spp (mean relative standard error %.3g)\n", name.c_str(),
+                 out.path.c_str(), static_cast<unsigned long long>(img.spp), img.mean_relative_standard_error());
+  } else if (why != "no file") {
+    std::fprintf(log, "%s: not using %s (%s): rendering it afresh\n", name.c_str(), out.path.c_str(), why.c_str());
+  }
+  out.cached_spp = img.spp;
+  const std::uint64_t target = static_cast<std::uint64_t>(std::max(spp, 0));
+  auto converged = [&] {
+    return img.spp >= target || (ref_error > 0.0 && img.spp >= 16 && img.mean_relative_standard_error() <= ref_error);
+  };
+  const auto t0 = clock::now();
+  int chunk = 1;  // grows so that each chunk takes about 10 s; every chunk is saved
+  while (!converged()) {
+    const int n = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(chunk), target - img.spp));
+    const auto tc = clock::now();
+    mcr.add_samples(img, n);
+    const double dt = seconds_since(tc);
+    write_reference_cache(out.path, key, img);
+    const double per_spp = dt / n;
+    chunk = static_cast<int>(std::clamp(10.0 / std::max(per_spp, 1e-6), 1.0, 4.0 * n));
+    std::fprintf(log, "\r%s: Monte Carlo reference %llu/%d spp, mean rel. s.e. %.3g, %.0f s, about %.0f s to go   ",
+                 name.c_str(), static_cast<unsigned long long>(img.spp), spp, img.mean_relative_standard_error(),
+                 seconds_since(t0), per_spp * static_cast<double>(target - img.spp));
+    std::fflush(log);
+  }
+  if (img.spp > out.cached_spp) {
+    out.seconds = seconds_since(t0);
+    std::fprintf(log, "\n%s: reference at %llu spp (%llu new, %.1f s), mean relative standard error %.3g, saved in %s\n",
+                 name.c_str(), static_cast<unsigned long long>(img.spp),
+                 static_cast<unsigned long long>(img.spp - out.cached_spp), out.seconds,
+                 img.mean_relative_standard_error(), out.path.c_str());
+  }
+  return out;
 }
 
 }  // namespace cv::bench

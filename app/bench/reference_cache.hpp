@@ -4,8 +4,10 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 
+#include "bench/standard_scenes.hpp"
 #include "reference/monte_carlo.hpp"
 
 namespace cv::core {}
@@ -29,5 +31,28 @@ void write_reference_cache(const std::string& path, std::uint64_t key, const Mon
 
 // FNV-1a, 64 bit, of a text: the key of everything that decides a reference.
 std::uint64_t reference_key_hash(const std::string& text);
+
+// Everything that decides a standard scene's reference image under march settings `m` and Monte
+// Carlo settings `mc`, as text (the medium enters through a checksum).
+std::string reference_key(const StandardScene& sc, const GridMeanExtinction& medium, const MarchSettings& m,
+                          const MonteCarloSettings& mc);
+
+struct ExtendedReference {
+  MonteCarloImage img;
+  std::string path;              // the cache file
+  std::uint64_t cached_spp = 0;  // samples per pixel read from it
+  double seconds = 0.0;          // to render the samples added in this call
+};
+
+// The reference of scene `name` (sc, or a variant of it such as "<scene>+modelled") at the
+// camera's size: read from `dir` when a file there holds it (ref_<name>_<W>x<H>_<key>.cvref), then
+// extended to `spp` samples per pixel, or until its mean relative standard error is at most
+// `ref_error` when that is above 0, in chunks of about 10 s, each saved atomically as it is done
+// (so `bench` and the benchmark programs share references and an interrupted one resumes).
+// Progress goes to `log`. A cache file of other settings or size is rendered afresh and replaced.
+ExtendedReference extend_reference(const std::string& dir, const std::string& name, const StandardScene& sc,
+                                   const GridMeanExtinction& medium, const MarchSettings& m,
+                                   const MonteCarloSettings& mc, int spp, double ref_error,
+                                   const ErosionNoise* noise, std::FILE* log);
 
 }  // namespace cv::bench

@@ -138,34 +138,6 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
   return a;
 }
 
-// Everything that decides the reference image, as text (the data enter through a checksum).
-std::string reference_key(const bench::StandardScene& sc, const core::GridMeanExtinction& medium,
-                          const core::MarchSettings& m, const core::MonteCarloSettings& mc) {
-  double sum = 0.0;
-  for (std::size_t i = 0; i < medium.liquid_per_m.size(); ++i) sum += medium.liquid_per_m[i] * (1.0 + 1e-3 * static_cast<double>(i % 977));
-  for (std::size_t i = 0; i < medium.ice_per_m.size(); ++i) sum += medium.ice_per_m[i] * (2.0 + 1e-3 * static_cast<double>(i % 983));
-  const auto& g = sc.grid;
-  const auto& c = sc.camera;
-  char b[1024];
-  std::snprintf(b, sizeof b,
-                "v2 grid %d %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g data %.17g cam %.17g %.17g %.17g %.17g %.17g "
-                "%.17g %d %d sun %.17g %.17g %.17g %.17g %.17g march d%.17g hg%d ice%.17g noise%.17g mc %d %d %llu peak%d",
-                g.lon_deg.count, g.lat_deg.count, g.alt_m.count, g.lon_deg.start, g.lon_deg.step, g.lat_deg.start,
-                g.lat_deg.step, g.alt_m.start, g.alt_m.step, g.earth_radius_m, sum, c.lat_deg, c.lon_deg, c.alt_m,
-                c.heading_deg, c.pitch_deg, c.fov_deg, c.width, c.height, sc.sun.subsolar_lat_deg, sc.sun.subsolar_lon_deg,
-                sc.sun.irradiance.x, sc.sun.irradiance.y, sc.sun.irradiance.z, m.medium.droplet_diameter_um,
-                m.medium.liquid_phase_hg ? 1 : 0, m.medium.ice_g, m.medium.noise_amount, mc.max_bounces, mc.roulette_after,
-                static_cast<unsigned long long>(mc.seed), mc.peak_mis ? 1 : 0);
-  std::string key = b;
-  if (m.medium.modelled) {  // the modelled cloud's own density (data-mode keys stay as they were)
-    char d[160];
-    std::snprintf(d, sizeof d, " modelled detail%.17g scale%.17g fraction%zu", m.medium.detail_amount, m.medium.detail_scale_m,
-                  medium.fraction.size());
-    key += d;
-  }
-  return key;
-}
-
 struct Config {
   std::string name, description;
   ConfigKind kind = ConfigKind::Sweep;
@@ -364,48 +336,11 @@ int cmd_bench(const std::vector<std::string>& args) {
     // The reference: cached by scene, size and a hash of what decides it, with its running sums, so
     // a later run with more samples (or one resumed after an interruption) extends it.
     if (!a.timing_only) {
-      const std::uint64_t key = bench::reference_key_hash(reference_key(sc, medium, base, mc));
-      char hash[20];
-      std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(key));
-      SceneReference ref{name, "ref_" + name + "_" + std::to_string(a.width) + "x" + std::to_string(a.height) + "_" + hash + ".cvref",
-                         a.spp, 0.0, false, 0.0};
-      const fs::path ref_path = fs::path(a.out) / ref.file;
-      const core::MonteCarloRenderer mcr(sc.grid, medium, sc.camera, sc.sun, base, mc, modelled ? &noise : nullptr);
-      core::MonteCarloImage img = mcr.start();
-      std::string why;
-      if (bench::read_reference_cache(ref_path.string(), key, a.width, a.height, img, &why)) {
-        std::printf("%s: reference %s holds %llu spp (mean relative standard error %.3g)\n", name.c_str(), ref_path.c_str(),
-                    static_cast<unsigned long long>(img.spp), img.mean_relative_standard_error());
-      } else if (why != "no file") {
-        std::printf("%s: not using %s (%s): rendering it afresh\n", name.c_str(), ref_path.c_str(), why.c_str());
-      }
-      const std::uint64_t cached_spp = img.spp;
-      auto converged = [&] {
-        return img.spp >= static_cast<std::uint64_t>(a.spp) ||
-               (a.ref_error > 0.0 && img.spp >= 16 && img.mean_relative_standard_error() <= a.ref_error);
-      };
-      const auto t0 = clock::now();
-      int chunk = 1;  // grows so that each chunk takes about 10 s; every chunk is saved
-      while (!converged()) {
-        const int n = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(chunk), a.spp - img.spp));
-        const auto tc = clock::now();
-        mcr.add_samples(img, n);
-        const double dt = seconds_since(tc);
-        bench::write_reference_cache(ref_path.string(), key, img);
-        const double per_spp = dt / n;
-        chunk = static_cast<int>(std::clamp(10.0 / std::max(per_spp, 1e-6), 1.0, 4.0 * n));
-        std::printf("\r%s: Monte Carlo reference %llu/%d spp, mean rel. s.e. %.3g, %.0f s, about %.0f s to go   ",
-                    name.c_str(), static_cast<unsigned long long>(img.spp), a.spp, img.mean_relative_standard_error(),
-                    seconds_since(t0), per_spp * static_cast<double>(a.spp - img.spp));
-        std::fflush(stdout);
-      }
-      if (img.spp > cached_spp) {
-        ref.seconds = seconds_since(t0);
-        std::printf("\n%s: reference at %llu spp (%llu new, %.1f s), mean relative standard error %.3g, saved in %s\n",
-                    name.c_str(), static_cast<unsigned long long>(img.spp),
-                    static_cast<unsigned long long>(img.spp - cached_spp), ref.seconds, img.mean_relative_standard_error(),
-                    ref_path.c_str());
-      }
+      const bench::ExtendedReference er = bench::extend_reference(a.out, name, sc, medium, base, mc, a.spp, a.ref_error,
+                                                                  modelled ? &noise : nullptr, stdout);
+      const core::MonteCarloImage& img = er.img;
+      SceneReference ref{name, fs::path(er.path).filename().string(), a.spp, 0.0, false, er.seconds};
+      const std::uint64_t cached_spp = er.cached_spp;
       ref.cached = cached_spp > 0;
       ref.cached_spp = static_cast<int>(cached_spp);
       ref.spp = static_cast<int>(img.spp);

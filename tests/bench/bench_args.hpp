@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <sstream>
 #include <string>
@@ -130,6 +131,18 @@ inline Option size(const std::string& name, int& w, int& h) {
               return false;
             }
             w = static_cast<int>(a), h = static_cast<int>(b);
+            return true;
+          }};
+}
+
+// A folder, made (with its parents) if it is not there yet.
+inline Option folder(const std::string& name, std::string& out) {
+  return {name, "a folder that exists or can be made", [&out](const std::string& v) {
+            std::error_code ec;
+            if (v.empty()) return false;
+            std::filesystem::create_directories(v, ec);
+            if (ec || !std::filesystem::is_directory(v)) return false;
+            out = v;
             return true;
           }};
 }

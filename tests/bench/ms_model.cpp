@@ -7,6 +7,8 @@
 // octave sum with one octave; the two-stream column then shows its single-scattering term with the
 // forward peak's light kept in the beam, and its diffuse term); --rows prints each image row's mean
 // luminance (top row first) for the reference and both models, to see where in a view they differ.
+// --reference-dir DIR keeps the references in DIR with their sums (app/bench/reference_cache, the
+// files `cloudviewer bench --out DIR` keeps): a later run reads them, and a larger --spp extends them.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +18,7 @@
 
 #include "bench/bench_args.hpp"
 #include "bench/metrics.hpp"
+#include "bench/reference_cache.hpp"
 #include "bench/standard_scenes.hpp"
 #include "kernel/ms_source.hpp"
 #include "reference/monte_carlo.hpp"
@@ -25,17 +28,20 @@
 int main(int argc, char** argv) {
   int w = 32, h = 18, spp = 256, max_bounces = 0;
   bool rows = false;
+  std::string ref_dir;
   std::vector<std::string> scenes;
   namespace ba = cv::bench_args;
   const int code = ba::parse("bench_ms_model",
-                             "usage: bench_ms_model [--size WxH] [--spp N] [--max-bounces N] [--rows] [SCENE...]\n"
+                             "usage: bench_ms_model [--size WxH] [--spp N] [--max-bounces N] [--rows] [--reference-dir DIR] [SCENE...]\n"
                              "  octave sum and two-stream source against the Monte Carlo reference, clouds only\n"
                              "  --max-bounces N  cut the reference's paths at N scattering events (1: single scattering,\n"
                              "                   against one octave)\n"
-                             "  --rows           print each image row's mean luminance: reference, octaves, two-stream\n",
+                             "  --rows           print each image row's mean luminance: reference, octaves, two-stream\n"
+                             "  --reference-dir DIR  read the references from DIR and save them there with their sums\n"
+                             "                   (as `cloudviewer bench --out DIR`): a larger --spp extends a saved one\n",
                              argc, argv,
                              {ba::size("--size", w, h), ba::integer("--spp", spp), ba::integer("--max-bounces", max_bounces),
-                              ba::flag("--rows", rows)},
+                              ba::flag("--rows", rows), ba::folder("--reference-dir", ref_dir)},
                              &scenes);
   if (code >= 0) return code;
   if (scenes.empty()) {
@@ -63,7 +69,9 @@ int main(int argc, char** argv) {
     cv::core::MonteCarloSettings mc;
     if (max_bounces > 0) mc.max_bounces = max_bounces;
     if (max_bounces == 1) m.quality.octaves = 1;
-    const cv::core::MonteCarloImage img = cv::core::render_monte_carlo(sc.grid, ext, sc.camera, sc.sun, m, mc, spp);
+    const cv::core::MonteCarloImage img =
+        ref_dir.empty() ? cv::core::render_monte_carlo(sc.grid, ext, sc.camera, sc.sun, m, mc, spp)
+                        : cv::bench::extend_reference(ref_dir, name, sc, ext, m, mc, spp, 0.0, nullptr, stderr).img;
     const std::vector<glm::dvec3> ref = img.radiance();
     std::vector<double> var(ref.size());
     double lum = 0.0, nvar = 0.0;

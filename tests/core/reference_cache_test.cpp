@@ -79,4 +79,42 @@ TEST_F(ReferenceCache, AFileOfOtherSettingsSizeOrLengthIsNotTaken) {
   EXPECT_EQ(out.spp, 0u);  // nothing taken from a bad file
 }
 
+TEST_F(ReferenceCache, ExtendReferenceResumesFromItsFolderAndStopsAtTheError) {
+  MarchSettings m = scene.march;
+  std::FILE* log = std::tmpfile();
+  ASSERT_NE(log, nullptr);
+  const ExtendedReference a = extend_reference(dir.string(), "cumulus_field", scene, ext, m, mc, 3, 0.0, nullptr, log);
+  EXPECT_EQ(a.cached_spp, 0u);
+  EXPECT_EQ(a.img.spp, 3u);
+  ASSERT_TRUE(fs::exists(a.path));
+  EXPECT_NE(a.path.find("ref_cumulus_field_12x7_"), std::string::npos) << a.path;
+
+  // The second call reads the three samples back and adds five: the image of eight in one go.
+  const ExtendedReference b = extend_reference(dir.string(), "cumulus_field", scene, ext, m, mc, 8, 0.0, nullptr, log);
+  EXPECT_EQ(b.cached_spp, 3u);
+  EXPECT_EQ(b.path, a.path);
+  MonteCarloImage whole = renderer.start();
+  renderer.add_samples(whole, 8);
+  EXPECT_TRUE(same_sums(b.img, whole));
+
+  // Fewer samples than the file holds: nothing is rendered, the file's image is returned.
+  const ExtendedReference c = extend_reference(dir.string(), "cumulus_field", scene, ext, m, mc, 4, 0.0, nullptr, log);
+  EXPECT_EQ(c.img.spp, 8u);
+  EXPECT_EQ(c.seconds, 0.0);
+
+  // Other settings are another reference (another key, another file), rendered afresh.
+  MarchSettings other = m;
+  other.medium.droplet_diameter_um = 31.0;
+  const ExtendedReference d = extend_reference(dir.string(), "cumulus_field", scene, ext, other, mc, 2, 0.0, nullptr, log);
+  EXPECT_EQ(d.cached_spp, 0u);
+  EXPECT_NE(d.path, a.path);
+
+  // A target error already met stops once the 16 samples the check needs first are there (the
+  // chunk in flight then ends), far short of the 1000 asked.
+  const ExtendedReference e = extend_reference(dir.string(), "cumulus_field", scene, ext, m, mc, 1000, 1e3, nullptr, log);
+  EXPECT_GE(e.img.spp, 16u);
+  EXPECT_LT(e.img.spp, 64u);
+  std::fclose(log);
+}
+
 }  // namespace
