@@ -99,7 +99,7 @@ std::string reference_key(const StandardScene& sc, const GridMeanExtinction& med
   const auto& c = sc.camera;
   char b[1024];
   std::snprintf(b, sizeof b,
-                "v2 grid %d %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g data %.17g cam %.17g %.17g %.17g %.17g %.17g "
+                "v3 grid %d %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g data %.17g cam %.17g %.17g %.17g %.17g %.17g "
                 "%.17g %d %d sun %.17g %.17g %.17g %.17g %.17g march d%.17g hg%d ice%.17g noise%.17g mc %d %d %llu peak%d",
                 g.lon_deg.count, g.lat_deg.count, g.alt_m.count, g.lon_deg.start, g.lon_deg.step, g.lat_deg.start,
                 g.lat_deg.step, g.alt_m.start, g.alt_m.step, g.earth_radius_m, sum, c.lat_deg, c.lon_deg, c.alt_m,

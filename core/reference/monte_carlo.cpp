@@ -177,9 +177,10 @@ MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec
                                                          MonteCarloStats& st) const {
   kernel::f64::TrackKernel::TrackCounts c = kernel_->track_counts();
   kernel::f64::TrackKernel::PathCounts pc = kernel_->path_counts();
+  kernel::f64::TrackKernel::path_branches().clear();  // trace_path empties it; a path never starts on another's branches
   const kernel::f64::TrackKernel::PathResult k = kernel_->trace_path(p, d, rng, c, pc);
   ++st.paths;
-  st.scatterings += static_cast<std::uint64_t>(k.scatterings);
+  st.scatterings += static_cast<std::uint64_t>(k.scatterings + k.scatterings_branches);
   st.null_collisions += c.null_collisions;
   st.shadow_lookups += c.lookups;
   st.majorant_exceeded += c.exceeded;
@@ -190,6 +191,8 @@ MonteCarloRenderer::PathResult MonteCarloRenderer::trace(glm::dvec3 p, glm::dvec
   r.radiance = k.radiance;
   r.weight = k.weight;
   r.absorbed = k.absorbed;
+  r.escaped = k.escaped;
+  r.grounded = k.grounded;
   r.scatterings = k.scatterings;
   r.end = k.end == CV_PATH_GROUND ? End::Ground
           : k.end == CV_PATH_TRUNCATED ? End::Truncated

@@ -36,9 +36,10 @@ struct MonteCarloSettings {
   // (docs/physics.md, "Monte Carlo reference").
   bool brick_majorants = false;
   // Multiple importance sampling of the droplets' forward peak toward the sun (docs/physics.md,
-  // "A reference that converges"): at every cloud vertex a second direction is drawn around the
-  // sun from the peak's own lobe, and the sun's light at the vertex it reaches is weighted against
-  // the path's own phase-sampled direction by the balance heuristic. Unbiased either way; without
+  // "A reference that converges"): at every cloud vertex holding liquid a second direction is drawn
+  // around the sun from the peak's own lobe and starts a branch of the path, the two continuations
+  // weighted by the balance heuristic (splitting; the GPU path tracer weights only the next-event
+  // estimate at the vertex that direction reaches). Unbiased either way; without
   // it, light scattered once through the peak (p up to ~5e3 /sr) is found only by rare paths and
   // droplet-cloud references do not converge as 1/sqrt(N). Only with the Mie phase (HG has no peak).
   bool peak_mis = true;
@@ -55,7 +56,7 @@ struct MonteCarloStats {
   std::uint64_t truncated = 0;          // paths stopped at max_bounces while still in flight
   std::uint64_t roulette_killed = 0;    // paths ended by Russian roulette
   std::uint64_t majorant_exceeded = 0;  // lookups above their majorant (a bug if ever non-zero)
-  std::uint64_t peak_samples = 0;       // directions drawn around the sun (peak_mis)
+  std::uint64_t peak_samples = 0;       // branches started around the sun (peak_mis; the GPU: directions drawn there)
   void add(const MonteCarloStats& o);
 };
 
@@ -106,9 +107,11 @@ class MonteCarloRenderer {
   struct PathResult {
     glm::dvec3 radiance{0.0};  // per unit sun irradiance
     glm::dvec3 weight{1.0};    // the throughput the path carried when it ended
-    glm::dvec3 absorbed{0.0};  // throughput the ground took out (1 - albedo of what reached it)
-    End end = End::Space;
-    int scatterings = 0;
+    glm::dvec3 absorbed{0.0};  // throughput the ground took out (1 - albedo of what reached it), branches included
+    glm::dvec3 escaped{0.0};   // throughput that left into space, the peak technique's branches included
+    glm::dvec3 grounded{0.0};  // throughput that ended on a ground that takes it all (no globe), the same
+    End end = End::Space;      // how the path itself ended (its branches may end otherwise)
+    int scatterings = 0;       // the path's own vertices
   };
   // One path from p along d (the first segment is the view ray): next-event estimation toward the sun
   // at every vertex, new directions by the phase functions, roulette, until it ends.

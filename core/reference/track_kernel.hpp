@@ -6,6 +6,8 @@
 #include "kernel/march_kernel.hpp"
 #include "reference/path_rng.hpp"
 
+#include <vector>
+
 namespace cv::kernel::f64 {
 
 #define CV_FN inline
@@ -23,8 +25,25 @@ struct TrackKernel : MarchKernel {
   int u_path_roulette_after = 4;  // MonteCarloSettings::roulette_after
   bool u_path_peak_mis = true;    // MonteCarloSettings::peak_mis
 
+#define CV_PATH_SPLIT 1
 #include "kernel/tracking.glsl"
 #include "kernel/path.glsl"
+#undef CV_PATH_SPLIT
+
+  // The branches the peak technique splits off (path.glsl, CV_PATH_SPLIT), per thread: a path and
+  // its branches are traced by one thread, one after the other.
+  static std::vector<PathState>& path_branches() {
+    static thread_local std::vector<PathState> v;
+    return v;
+  }
+  static void path_split(const PathState& b) { path_branches().push_back(b); }
+  static bool path_pop(PathState& b) {
+    auto& v = path_branches();
+    if (v.empty()) return false;
+    b = v.back();
+    v.pop_back();
+    return true;
+  }
 };
 
 #undef CV_FN

@@ -5,11 +5,13 @@
 // water, or the constant albedo without a ground texture), with next-event estimation toward the
 // sun (ratio tracking) at every vertex, new directions drawn from the phase function of the
 // component that scattered, multiple importance sampling of the droplets' forward peak toward the
-// sun, and Russian roulette on the throughput (docs/physics.md, "Monte Carlo reference" and "A
-// reference that converges"). With the air on (kAtmosphere) the sunlight reaching a vertex is
-// reddened by the air's transmittance, and a path that leaves into the sky takes the sky's
-// single-scattered radiance in its direction: the sky as an environment light (docs/physics.md,
-// "The path tracer's sky and ground"). The air between vertices neither dims nor adds light.
+// sun (with CV_PATH_SPLIT, the CPU reference's: the direction drawn around the sun starts a branch,
+// and the includer provides path_split(PathState) and path_pop(PathState)), and Russian roulette on
+// the throughput (docs/physics.md, "Monte Carlo reference" and "A reference that converges"). With
+// the air on (kAtmosphere) the sunlight reaching a vertex is reddened by the air's transmittance,
+// and a path that leaves into the sky takes the sky's single-scattered radiance in its direction:
+// the sky as an environment light (docs/physics.md, "The path tracer's sky and ground"). The air
+// between vertices neither dims nor adds light.
 // Needs march.glsl and tracking.glsl, and from the including side: track_bits(rng) (32 random
 // bits, for the Mie sampler's own stream), u_path_max_bounces, u_path_roulette_after and
 // u_path_peak_mis.
@@ -27,8 +29,11 @@ struct PathResult {
   real3 radiance;
   real3 weight;
   real3 absorbed;
+  real3 escaped;   // the throughput that left into space, the branches' included
+  real3 grounded;  // the throughput that ended on the ground (a black one, or the globe off), the same
   int end;
   int scatterings;
+  int scatterings_branches;
 };
 
 // A path's counters, beside the tracking's (TrackCounts).
@@ -210,7 +215,17 @@ CV_FN PathState path_begin(real3 p, real3 d) {
 // ends the path; a survivor's throughput is divided by its survival probability.
 CV_FN bool path_roulette(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(PathCounts) pc) {
   if (s.scatterings < u_path_roulette_after) return true;
-  real q = min(real(1.0), max(s.beta.x, max(s.beta.y, s.beta.z)));
+  real importance = real(1.0);
+#ifdef CV_PATH_SPLIT
+  // A path heading into the droplets' peak around the sun is about to meet a next-event estimate
+  // of up to q per sr: its survival is raised by q, so a survivor's weight is never raised above
+  // 1 / q there (a boosted path in the peak would be the heavy tail again).
+  if (u_path_peak_mis && !u_liquid_phase_hg) {
+    MieParams mie = mie_params(u_droplet_um);
+    importance = max(real(1.0), phase_hg_c(dot(s.d, u_to_sun), mie.g_hg, mie.c_hg));
+  }
+#endif
+  real q = min(real(1.0), importance * max(s.beta.x, max(s.beta.y, s.beta.z)));
   if (q >= real(1.0)) return true;
   if (track_uniform(rng) >= q) {
     s.end = CV_PATH_ROULETTE;
@@ -269,6 +284,30 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
       s.radiance += s.beta * u_irradiance * path_sun_air(s.p, c) *
                     (w * path_phase(sl, si, dot(s.d, u_to_sun), mie, liquid_g) * path_transmittance(s.p, u_to_sun, rng, c));
       if (!path_continues(s, rng, pc)) break;
+#ifdef CV_PATH_SPLIT
+      // Splitting (the CPU reference): the direction wq ~ q around the sun starts a branch of its
+      // own, weighted p / (p + q) by the balance heuristic and kept by Russian roulette on that
+      // weight; the path's own direction is weighted the same way below.
+      bool split_here = peak && sl > real(0.0);
+      if (split_here) {
+        real q;
+        real u1 = track_uniform(rng);
+        real u2 = track_uniform(rng);
+        real3 wq = sample_hg(u_to_sun, mie.g_hg, real2(u1, u2), q);
+        q = phase_hg_c(dot(wq, u_to_sun), mie.g_hg, mie.c_hg);
+        real p_here = path_phase(sl, si, dot(s.d, wq), mie, liquid_g);
+        real3 bb = s.beta * (p_here / (p_here + q));
+        real keep = min(real(1.0), max(real(1.0), q) * max(bb.x, max(bb.y, bb.z)));
+        if (keep > real(0.0) && track_uniform(rng) < keep) {
+          pc.peak_samples += 1u;
+          PathState b = path_begin(s.p, wq);
+          b.beta = bb / keep;
+          b.scatterings = s.scatterings;
+          path_split(b);
+        }
+      }
+      real3 d_in = s.d;
+#else
       // The peak technique: a direction wq ~ q around the sun, the free path along it, the sun's
       // light at the vertex it reaches, weighted q / (p + q) (the path's own technique is weighted above).
       s.prev_peak = peak && sl > real(0.0);
@@ -295,6 +334,7 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
         s.prev_si = si;
         s.prev_d = s.d;
       }
+#endif
       // Clouds do not absorb (albedo 1): the new direction is drawn from the phase function of the
       // component that scattered, chosen by its share of the extinction; beta is unchanged.
       real pdf;
@@ -312,6 +352,12 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
         real v2 = track_uniform(rng);
         s.d = sample_hg(s.d, u_ice_g, real2(v1, v2), pdf);
       }
+#ifdef CV_PATH_SPLIT
+      if (split_here) {
+        real p_mix = path_phase(sl, si, dot(d_in, s.d), mie, liquid_g);
+        s.beta *= p_mix / (p_mix + phase_hg_c(dot(s.d, u_to_sun), mie.g_hg, mie.c_hg));
+      }
+#endif
     } else if (kGlobe && t_ground < CV_PATH_FAR) {
       // The ground as the march sees it (ground_at): Lambertian land of its albedo and a water
       // fraction with the glint and the water body (water_radiance), lit by the sun through the
@@ -368,6 +414,24 @@ CV_FN PathResult trace_path(real3 p, real3 d, CV_INOUT(TrackRng) rng, CV_INOUT(T
   PathState s = path_begin(p, d);
   path_advance(s, rng, c, pc, 0xFFFFFFFFu);
   PathResult r;
+  r.escaped = real3(0.0);
+  r.grounded = real3(0.0);
+  r.scatterings_branches = 0;
+#ifdef CV_PATH_SPLIT
+  // The branches, last made first: their light joins the path's.
+  PathState b;
+  while (path_pop(b)) {
+    int b0 = b.scatterings;  // the vertices before the split are the path's
+    path_advance(b, rng, c, pc, 0xFFFFFFFFu);
+    s.radiance += b.radiance;
+    s.absorbed += b.absorbed;
+    r.escaped += b.end == CV_PATH_SPACE ? b.beta : real3(0.0);
+    r.grounded += b.end == CV_PATH_GROUND ? b.beta : real3(0.0);
+    r.scatterings_branches += b.scatterings - b0;
+  }
+#endif
+  r.escaped += s.end == CV_PATH_SPACE ? s.beta : real3(0.0);
+  r.grounded += s.end == CV_PATH_GROUND ? s.beta : real3(0.0);
   r.radiance = s.radiance;
   r.weight = s.beta;
   r.absorbed = s.absorbed;

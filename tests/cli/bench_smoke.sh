@@ -9,7 +9,7 @@ exe=$1 dir=$2
 rm -rf "$dir"
 XDG_CACHE_HOME=$dir/cache
 export XDG_CACHE_HOME
-"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --path-spp 1,4 --out "$dir"
+"$exe" bench stratocumulus --size 24x14 --reference-spp 32 --repeats 1 --path-spp 1,4 --out "$dir"
 header='scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,wall_ms,gpu_ms,rel_rmse,rel_rmse_raw,ref_noise_floor,rel_rmse_resolution,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,error_image,path_spp,path_rel_stderr'
 test "$(head -n 1 "$dir/results.csv")" = "$header" || { echo "bad header: $(head -n 1 "$dir/results.csv")"; exit 1; }
 rows=$(tail -n +2 "$dir/results.csv" | grep -c '^stratocumulus,')
@@ -30,20 +30,20 @@ done
 test "$(awk -F, 'NR > 1 && $20 == 1' "$dir/results.csv" | wc -l)" -ge 1 || { echo "no configuration on the Pareto front"; exit 1; }
 test -s "$dir/summary.md" && test -s "$dir/stratocumulus_pareto.png" && test -s "$dir/stratocumulus/err_default.png"
 # (Output to a file first: grep -q on a pipe would end the run early by SIGPIPE.)
-"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --path-spp none --out "$dir" > "$dir/run2.txt"
-grep -q 'holds 2 spp' "$dir/run2.txt" \
+"$exe" bench stratocumulus --size 24x14 --reference-spp 32 --repeats 1 --path-spp none --out "$dir" > "$dir/run2.txt"
+grep -q 'holds 32 spp' "$dir/run2.txt" \
   || { echo "the second run did not reuse the cached reference"; exit 1; }
 grep -q '"format": "cloudviewer-quality-front"' "$dir/quality_front.json" || { echo "no quality_front.json"; exit 1; }
 grep -q '"candidate": true' "$dir/quality_front.json" || { echo "no candidate in quality_front.json"; exit 1; }
 cmp -s "$dir/quality_front.json" "$dir/cache/cloudviewer/quality_front.json" || { echo "the front was not cached"; exit 1; }
 rm "$dir/cache/cloudviewer/quality_front.json"
-"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --path-spp none --out "$dir" --no-cache >/dev/null
+"$exe" bench stratocumulus --size 24x14 --reference-spp 32 --repeats 1 --path-spp none --out "$dir" --no-cache >/dev/null
 test ! -e "$dir/cache/cloudviewer/quality_front.json" || { echo "--no-cache wrote the cache"; exit 1; }
 # A larger --reference-spp extends the cached reference instead of starting over.
-"$exe" bench stratocumulus --size 24x14 --reference-spp 3 --repeats 1 --path-spp none --out "$dir" > "$dir/run3.txt"
-grep -q 'at 3 spp (1 new' "$dir/run3.txt" \
+"$exe" bench stratocumulus --size 24x14 --reference-spp 33 --repeats 1 --path-spp none --out "$dir" > "$dir/run3.txt"
+grep -q 'at 33 spp (1 new' "$dir/run3.txt" \
   || { echo "the third run did not extend the cached reference"; exit 1; }
-test "$(awk -F, 'NR == 2 { print $21 }' "$dir/results.csv")" = 3 || { echo "results.csv does not say 3 spp"; exit 1; }
+test "$(awk -F, 'NR == 2 { print $21 }' "$dir/results.csv")" = 33 || { echo "results.csv does not say 33 spp"; exit 1; }
 # --timing-only: frame times without a reference (no error, no front, no plots); the path tracer
 # with its own noise estimate.
 "$exe" bench stratocumulus --size 24x14 --repeats 1 --path-spp 2 --timing-only --out "$dir/timing" --no-cache > "$dir/run4.txt"
@@ -53,7 +53,7 @@ awk -F, '$2 == "default" && $13 == "nan" && $11 > 0 { f = 1 } END { exit !f }' "
 awk -F, '$2 == "path_2spp" && $25 > 0 && $25 < 1e300 { f = 1 } END { exit !f }' "$dir/timing/results.csv" || { echo "timing only: no noise estimate of the path tracer"; exit 1; }
 # --cloud-model both: each scene also as <scene>+modelled, against a reference of the modelled
 # density (its own cached file), its rows in the CSV and its scene in the front.
-"$exe" bench stratocumulus --size 24x14 --reference-spp 2 --repeats 1 --path-spp 1 --cloud-model both --out "$dir/models" --no-cache > "$dir/run5.txt"
+"$exe" bench stratocumulus --size 24x14 --reference-spp 32 --repeats 1 --path-spp 1 --cloud-model both --out "$dir/models" --no-cache > "$dir/run5.txt"
 test "$(tail -n +2 "$dir/models/results.csv" | grep -c '^stratocumulus+modelled,')" -eq 21 || { echo "modelled: expected 21 rows"; exit 1; }
 test "$(tail -n +2 "$dir/models/results.csv" | grep -c '^stratocumulus,')" -eq 21 || { echo "both: expected 21 data rows"; exit 1; }
 test "$(ls "$dir/models"/ref_stratocumulus+modelled_24x14_*.cvref | wc -l)" -eq 1 || { echo "no reference of the modelled cloud"; exit 1; }
@@ -62,7 +62,7 @@ grep -q '"scene": "stratocumulus+modelled"' "$dir/models/quality_front.json" || 
 test -s "$dir/models/stratocumulus+modelled/err_default.png" || { echo "no error image of the modelled default"; exit 1; }
 # The modelled images differ from the data mode's (the default row's raw error, with the noise left
 # in, is not the data row's: the noise-corrected error of both can be clamped to 0 against a reference
-# of 2 spp once the model is close to it).
+# of few samples once the model is close to it).
 awk -F, '$2 == "default" { e[$1] = $14 } END { exit !(e["stratocumulus"] != e["stratocumulus+modelled"]) }' "$dir/models/results.csv" \
   || { echo "the modelled rows are the data rows"; exit 1; }
 echo "bench smoke: $rows rows"

@@ -191,6 +191,7 @@ inline AnalogFluxes mc_analog_fluxes(const ImportedSlab& s, const core::MarchSet
   core::MonteCarloSettings mc;
   mc.seed = seed;
   mc.max_bounces = 1000000;
+  mc.peak_mis = false;  // the analog walk: the peak technique's branches would weight it
   const core::Sun sun = sun_at_zenith_angle(theta0_deg);
   const core::MonteCarloRenderer r(s.grid, s.medium, cam, sun, m, mc);
   const double r0 = s.grid.earth_radius_m;
