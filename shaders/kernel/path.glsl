@@ -211,20 +211,22 @@ CV_FN PathState path_begin(real3 p, real3 d) {
   return s;
 }
 
-// Russian roulette on the path's throughput from u_path_roulette_after vertices on: false when it
-// ends the path; a survivor's throughput is divided by its survival probability.
-CV_FN bool path_roulette(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(PathCounts) pc) {
-  if (s.scatterings < u_path_roulette_after) return true;
-  real importance = real(1.0);
+// How much more a path heading along d is worth keeping than its weight says: with splitting, a
+// path heading into the droplets' peak around the sun is about to meet a next-event estimate of up
+// to q per sr, so its survival is raised by q and a survivor's weight is never raised above 1 / q
+// there (a boosted path in the peak would be the heavy tail again); 1 otherwise.
+CV_FN real path_importance(real3 d, MieParams mie, bool peak) {
 #ifdef CV_PATH_SPLIT
-  // A path heading into the droplets' peak around the sun is about to meet a next-event estimate
-  // of up to q per sr: its survival is raised by q, so a survivor's weight is never raised above
-  // 1 / q there (a boosted path in the peak would be the heavy tail again).
-  if (u_path_peak_mis && !u_liquid_phase_hg) {
-    MieParams mie = mie_params(u_droplet_um);
-    importance = max(real(1.0), phase_hg_c(dot(s.d, u_to_sun), mie.g_hg, mie.c_hg));
-  }
+  if (peak) return max(real(1.0), phase_hg_c(dot(d, u_to_sun), mie.g_hg, mie.c_hg));
 #endif
+  return real(1.0);
+}
+
+// Russian roulette on the path's throughput from u_path_roulette_after vertices on: false when it
+// ends the path; a survivor's throughput is divided by its survival probability (its weight times
+// `importance`, path_importance, at most 1).
+CV_FN bool path_roulette(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(PathCounts) pc, real importance) {
+  if (s.scatterings < u_path_roulette_after) return true;
   real q = min(real(1.0), importance * max(s.beta.x, max(s.beta.y, s.beta.z)));
   if (q >= real(1.0)) return true;
   if (track_uniform(rng) >= q) {
@@ -238,14 +240,14 @@ CV_FN bool path_roulette(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT
 
 // After a vertex's light is added: whether the path goes on past it. It ends (s.done, s.end set)
 // at u_path_max_bounces vertices (truncated) or when Russian roulette ends it.
-CV_FN bool path_continues(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(PathCounts) pc) {
+CV_FN bool path_continues(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(PathCounts) pc, real importance) {
   if (s.scatterings >= u_path_max_bounces) {
     s.end = CV_PATH_TRUNCATED;
     pc.truncated += 1u;
     s.done = true;
     return false;
   }
-  if (!path_roulette(s, rng, pc)) {
+  if (!path_roulette(s, rng, pc, importance)) {
     s.done = true;
     return false;
   }
@@ -283,7 +285,7 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
       }
       s.radiance += s.beta * u_irradiance * path_sun_air(s.p, c) *
                     (w * path_phase(sl, si, dot(s.d, u_to_sun), mie, liquid_g) * path_transmittance(s.p, u_to_sun, rng, c));
-      if (!path_continues(s, rng, pc)) break;
+      if (!path_continues(s, rng, pc, path_importance(s.d, mie, peak))) break;
 #ifdef CV_PATH_SPLIT
       // Splitting (the CPU reference): the direction wq ~ q around the sun starts a branch of its
       // own, weighted p / (p + q) by the balance heuristic and kept by Russian roulette on that
@@ -392,7 +394,7 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
       }
       s.absorbed += s.beta * (real3(1.0) - weight);  // in expectation, 1 - the albedo
       s.beta *= weight;
-      if (!path_continues(s, rng, pc)) break;
+      if (!path_continues(s, rng, pc, path_importance(s.d, mie, peak))) break;
       s.prev_peak = false;  // a cosine draw from the ground: no other technique makes it
       if (!wet) {
         real v1 = track_uniform(rng);
