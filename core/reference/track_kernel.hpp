@@ -36,6 +36,7 @@ struct TrackKernel : MarchKernel {
     static thread_local std::vector<PathState> v;
     return v;
   }
+  static bool path_room() { return true; }  // no bound: the one-sample fallback is the GPU's
   static void path_split(const PathState& b) { path_branches().push_back(b); }
   static bool path_pop(PathState& b) {
     auto& v = path_branches();

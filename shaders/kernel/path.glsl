@@ -5,8 +5,8 @@
 // water, or the constant albedo without a ground texture), with next-event estimation toward the
 // sun (ratio tracking) at every vertex, new directions drawn from the phase function of the
 // component that scattered, multiple importance sampling of the droplets' forward peak toward the
-// sun (with CV_PATH_SPLIT, the CPU reference's: the direction drawn around the sun starts a branch,
-// and the includer provides path_split(PathState) and path_pop(PathState)), and Russian roulette on
+// sun (with CV_PATH_SPLIT: the direction drawn around the sun starts a branch, and the includer
+// provides path_room(), path_split(PathState) and path_pop(PathState)), and Russian roulette on
 // the throughput (docs/physics.md, "Monte Carlo reference" and "A reference that converges"). With
 // the air on (kAtmosphere) the sunlight reaching a vertex is reddened by the air's transmittance,
 // and a path that leaves into the sky takes the sky's single-scattered radiance in its direction:
@@ -41,6 +41,7 @@ struct PathCounts {
   uint roulette_killed;
   uint truncated;
   uint peak_samples;
+  uint vertices;  // scatterings in cloud and bounces off the ground
 };
 
 CV_FN PathCounts path_counts() {
@@ -48,6 +49,7 @@ CV_FN PathCounts path_counts() {
   c.roulette_killed = 0u;
   c.truncated = 0u;
   c.peak_samples = 0u;
+  c.vertices = 0u;
   return c;
 }
 
@@ -193,6 +195,14 @@ struct PathState {
   real3 prev_d;
 };
 
+#if defined(CV_PATH_SPLIT) && defined(CV_GLSL)
+// The branch stack, defined by the includer (GLSL wants a function declared before its use; C++
+// finds the class's members anyway): whether it has room for one more branch, push, pop.
+bool path_room();
+void path_split(PathState b);
+bool path_pop(out PathState b);
+#endif
+
 // A path from p along unit d (the first segment is the view ray).
 CV_FN PathState path_begin(real3 p, real3 d) {
   PathState s;
@@ -275,6 +285,7 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
       medium_at_point(s.p, sl, si);
       real sigma = sl + si;
       s.scatterings += 1;
+      pc.vertices += 1u;
       // Next-event estimation: the sun is a delta light, reachable only this way. The scattering
       // cosine is between the sunlight's propagation (-to_sun) and the light's toward the camera
       // (-d). Balance heuristic against the peak technique, which could have drawn d at the vertex before.
@@ -286,12 +297,19 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
       s.radiance += s.beta * u_irradiance * path_sun_air(s.p, c) *
                     (w * path_phase(sl, si, dot(s.d, u_to_sun), mie, liquid_g) * path_transmittance(s.p, u_to_sun, rng, c));
       if (!path_continues(s, rng, pc, path_importance(s.d, mie, peak))) break;
+      // Splitting (CV_PATH_SPLIT): the direction wq ~ q around the sun starts a branch of its own,
+      // weighted p / (p + q) by the balance heuristic and kept by Russian roulette on that weight;
+      // the path's own direction is weighted the same way below. Without it, or where the branch
+      // stack is full (the GPU's holds a few per pixel), the one-sample technique instead.
 #ifdef CV_PATH_SPLIT
-      // Splitting (the CPU reference): the direction wq ~ q around the sun starts a branch of its
-      // own, weighted p / (p + q) by the balance heuristic and kept by Russian roulette on that
-      // weight; the path's own direction is weighted the same way below.
-      bool split_here = peak && sl > real(0.0);
+      bool split_here = peak && sl > real(0.0) && path_room();
+#else
+      bool split_here = false;
+#endif
+      real3 d_in = s.d;
+      s.prev_peak = peak && sl > real(0.0) && !split_here;
       if (split_here) {
+#ifdef CV_PATH_SPLIT
         real q;
         real u1 = track_uniform(rng);
         real u2 = track_uniform(rng);
@@ -307,13 +325,11 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
           b.scatterings = s.scatterings;
           path_split(b);
         }
-      }
-      real3 d_in = s.d;
-#else
-      // The peak technique: a direction wq ~ q around the sun, the free path along it, the sun's
-      // light at the vertex it reaches, weighted q / (p + q) (the path's own technique is weighted above).
-      s.prev_peak = peak && sl > real(0.0);
-      if (s.prev_peak) {
+#endif
+      } else if (s.prev_peak) {
+        // The one-sample technique: a direction wq ~ q around the sun, the free path along it, the
+        // sun's light at the vertex it reaches, weighted q / (p + q) (the path's own technique is
+        // weighted at its next vertex, above).
         pc.peak_samples += 1u;
         real q;
         real u1 = track_uniform(rng);
@@ -336,7 +352,6 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
         s.prev_si = si;
         s.prev_d = s.d;
       }
-#endif
       // Clouds do not absorb (albedo 1): the new direction is drawn from the phase function of the
       // component that scattered, chosen by its share of the extinction; beta is unchanged.
       real pdf;
@@ -354,12 +369,10 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
         real v2 = track_uniform(rng);
         s.d = sample_hg(s.d, u_ice_g, real2(v1, v2), pdf);
       }
-#ifdef CV_PATH_SPLIT
       if (split_here) {
         real p_mix = path_phase(sl, si, dot(d_in, s.d), mie, liquid_g);
         s.beta *= p_mix / (p_mix + phase_hg_c(dot(s.d, u_to_sun), mie.g_hg, mie.c_hg));
       }
-#endif
     } else if (kGlobe && t_ground < CV_PATH_FAR) {
       // The ground as the march sees it (ground_at): Lambertian land of its albedo and a water
       // fraction with the glint and the water body (water_radiance), lit by the sun through the
@@ -367,6 +380,7 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
       s.p = normalize(s.p + t_ground * s.d) * u_r0;
       real3 n = s.p / u_r0;
       s.scatterings += 1;
+      pc.vertices += 1u;
       real3 ll = ecef_to_sphere(s.p, u_r0);
       real4 g = ground_at(ll.x, ll.y);
       real3 land = real3(g.x, g.y, g.z);
