@@ -519,12 +519,14 @@ std::vector<glm::vec4> path_trace(render::GpuRaymarcher& gpu, const core::FrameS
   end_progress();
   gpu_s = 0.0;
   std::printf("path tracer: %llu paths, %.2f scatterings per path, %llu null collisions, %llu sun-ray lookups, %llu cut at %d "
-              "bounces, %llu ended by roulette%s\n",
+              "bounces, %llu ended by roulette, %llu directions drawn in the droplets' peak (branches, from a stack of %d per pixel; "
+              "the one-sample technique at %llu vertices that found it full)%s\n",
               static_cast<unsigned long long>(img.stats.paths),
               double(img.stats.scatterings) / double(std::max<std::uint64_t>(img.stats.paths, 1)),
               static_cast<unsigned long long>(img.stats.null_collisions), static_cast<unsigned long long>(img.stats.shadow_lookups),
               static_cast<unsigned long long>(img.stats.truncated), pt.max_bounces,
-              static_cast<unsigned long long>(img.stats.roulette_killed),
+              static_cast<unsigned long long>(img.stats.roulette_killed), static_cast<unsigned long long>(img.stats.peak_samples),
+              extra.branch_slots, static_cast<unsigned long long>(extra.splits_without_room),
               ra.target_error > 0.0 && error > ra.target_error ? "; the target error was not reached within --spp" : "");
   if (img.stats.majorant_exceeded) {
     std::fprintf(stderr, "cloudviewer render: the medium exceeded its majorant at %llu lookups (a bug: the image is biased)\n",

@@ -78,6 +78,7 @@ const GlProgram& GpuRaymarcher::path_program_for(const kernel::MarchVariant& v) 
 GpuRaymarcher::~GpuRaymarcher() {
   if (path_sums_) glDeleteBuffers(1, &path_sums_);
   if (path_state_) glDeleteBuffers(1, &path_state_);
+  if (path_branches_) glDeleteBuffers(1, &path_branches_);
   if (path_stats_) glDeleteBuffers(1, &path_stats_);
   if (textures_[0]) glDeleteTextures(2, textures_);
   if (state_[0]) glDeleteTextures(4, state_);
@@ -435,7 +436,25 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
     glNamedBufferStorage(path_state_, static_cast<GLsizeiptr>(n * 5 * sizeof(glm::vec4)), nullptr, 0);
     path_pixels_ = n;
   }
-  constexpr int kPathStats = 11;
+  // The branch stacks: as many slots as asked for that a storage buffer of the driver holds for
+  // the whole image, and at most 4 GB (the shader indexes floats with 32 bits); at least one float,
+  // so the binding is never empty.
+  GLint64 max_block = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+  max_block = std::min<GLint64>(max_block, GLint64(1) << 32);
+  constexpr std::size_t kBranchFloats = 10;
+  const std::size_t per_slot = n * kBranchFloats * sizeof(float);
+  const int slots = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(std::max(0, pt.branch_slots)),
+                                                           static_cast<std::size_t>(std::max<GLint64>(max_block, 0)) / per_slot));
+  const std::size_t branch_floats = std::max<std::size_t>(1, n * kBranchFloats * static_cast<std::size_t>(slots));
+  if (!path_branches_ || path_branch_floats_ != branch_floats) {
+    if (path_branches_) glDeleteBuffers(1, &path_branches_);
+    glCreateBuffers(1, &path_branches_);
+    glNamedBufferStorage(path_branches_, static_cast<GLsizeiptr>(branch_floats * sizeof(float)), nullptr, 0);
+    path_branch_floats_ = branch_floats;
+  }
+  if (extra) extra->branch_slots = slots;
+  constexpr int kPathStats = 12;
   if (!path_stats_) {
     glCreateBuffers(1, &path_stats_);
     glNamedBufferStorage(path_stats_, 2 * kPathStats * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -443,6 +462,7 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PATH_SUMS, path_sums_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PATH_STATS, path_stats_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PATH_STATE, path_state_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_PATH_BRANCHES, path_branches_);
   glUseProgram(p);
   glProgramUniform1ui(p, loc(p, "u_seed"), pt.seed);
   glProgramUniform1i(p, loc(p, "u_row_offset"), 0);
@@ -456,6 +476,7 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
   glProgramUniform1i(p, loc(p, "u_path_roulette_after"), pt.roulette_after);
   glProgramUniform1i(p, loc(p, "u_path_peak_mis"), pt.peak_mis ? 1 : 0);
   glProgramUniform1i(p, loc(p, "u_loop_budget"), loop_budget_ ? 1 : 0);
+  glProgramUniform1i(p, loc(p, "u_path_branch_slots"), slots);
   const auto groups_x = static_cast<GLuint>((cam.width + 7) / 8), groups_y = static_cast<GLuint>((cam.height + 7) / 8);
   const int batch = std::max(1, pt.samples_per_readback);
   std::vector<glm::vec4> sums(2 * n);
@@ -500,7 +521,7 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
     img.stats.roulette_killed += counter(5);
     img.stats.peak_samples += counter(6);
     img.stats.majorant_exceeded += counter(7);
-    if (extra) extra->near_loop_budget += counter(8), extra->non_finite += counter(9);
+    if (extra) extra->near_loop_budget += counter(8), extra->non_finite += counter(9), extra->splits_without_room += counter(11);
     img.spp += static_cast<std::uint64_t>(k);
     done += k;
     if (on_samples) on_samples(done, spp);

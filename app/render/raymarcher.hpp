@@ -90,6 +90,10 @@ struct PathTraceSettings {
   bool brick_majorants = true;
   std::uint32_t seed = 1;
   int samples_per_readback = 16;  // samples summed in float on the GPU before the host adds them in double
+  // Branches of the droplets' peak a pixel's stack holds (the CPU's is unbounded; docs/physics.md,
+  // "Splitting on the GPU"): ten floats each per pixel. Fewer where the driver's largest storage
+  // buffer cannot hold them for the whole image; 0: no splitting.
+  int branch_slots = 8;
 };
 
 // What the path tracer did beyond core::MonteCarloStats: samples left out as not finite, and, on a
@@ -100,6 +104,8 @@ struct PathTraceStats {
   std::uint64_t non_finite = 0;
   std::uint64_t near_loop_budget = 0;
   std::uint64_t resumed_dispatches = 0;
+  std::uint64_t splits_without_room = 0;  // vertices that found the pixel's branch stack full
+  int branch_slots = 0;                    // the stack's size the paths were traced with
 };
 
 class GpuRaymarcher {
@@ -174,6 +180,8 @@ class GpuRaymarcher {
   std::unique_ptr<GlProgram> programs_[kernel::MarchVariant::kCount];  // by MarchVariant::key
   std::unique_ptr<GlProgram> path_programs_[kernel::MarchVariant::kCount];
   GLuint path_sums_ = 0, path_stats_ = 0, path_state_ = 0;  // the path tracer's per-pixel sums, counters, paths in flight
+  GLuint path_branches_ = 0;                                 // and their branch stacks
+  std::size_t path_branch_floats_ = 0;
   std::size_t path_pixels_ = 0;
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};

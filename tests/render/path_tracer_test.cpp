@@ -28,7 +28,8 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 // march.medium.ground_texture) and the GPU path tracer, and checks that the two agree within their
 // joint noise. Returns the GPU image's mean luminance.
 double expect_gpu_matches_cpu(const bench::StandardScene& sc, const core::MarchSettings& march, const core::AlbedoMap* ground_map,
-                              const core::ErosionNoise* noise = nullptr) {
+                              const core::ErosionNoise* noise = nullptr, render::PathTraceSettings pt = {},
+                              render::PathTraceStats* stats = nullptr) {
   const int spp = 48;
   const core::GridMeanExtinction medium = core::grid_mean_extinction(sc.grid, sc.data);
   core::MonteCarloSettings mc;
@@ -44,7 +45,6 @@ double expect_gpu_matches_cpu(const bench::StandardScene& sc, const core::MarchS
   if (noise) gpu.upload_noise(*noise);
   core::MonteCarloImage img;
   render::PathTraceStats extra;
-  render::PathTraceSettings pt;
   pt.seed = 11;
   t0 = std::chrono::steady_clock::now();
   gpu.trace_paths(img, sc.camera, sc.sun, march, spp, pt, &extra);
@@ -93,6 +93,7 @@ double expect_gpu_matches_cpu(const bench::StandardScene& sc, const core::MarchS
   if (lit > 0) {
     EXPECT_LT(z2 / lit, 2.0);
   }
+  if (stats) *stats = extra;
   return mean_g;
 }
 
@@ -104,6 +105,31 @@ TEST_P(PathTracer, GpuMatchesTheCpuMonteCarloWithinTheirJointNoise) {
   } else {
     EXPECT_GT(mean, 0.0);
   }
+}
+
+// Splitting of the droplets' peak around the sun on the GPU (path.glsl CV_PATH_SPLIT): each pixel
+// holds a few branches; a vertex that finds its stack full falls back to the one-sample technique.
+// The deck (droplets, the sun ahead of the camera) with one slot, so that most vertices that would
+// split find the stack full, must agree with the CPU (whose stack has no bound) as the default does.
+TEST(PathTracerSplitting, AFullBranchStackLeavesTheImageUnbiased) {
+  const bench::StandardScene sc = bench::standard_scene("stratocumulus", 16, 9);
+  render::PathTraceStats full;
+  render::PathTraceSettings one;
+  one.branch_slots = 1;
+  EXPECT_GT(expect_gpu_matches_cpu(sc, sc.march, nullptr, nullptr, one, &full), 0.0);
+  EXPECT_EQ(full.branch_slots, 1);
+  EXPECT_GT(full.splits_without_room, 0u) << "the test needs vertices that find the stack full";
+
+  render::PathTraceStats roomy;
+  EXPECT_GT(expect_gpu_matches_cpu(sc, sc.march, nullptr, nullptr, {}, &roomy), 0.0);
+  EXPECT_EQ(roomy.branch_slots, render::PathTraceSettings{}.branch_slots);
+  EXPECT_LT(roomy.splits_without_room * 10, full.splits_without_room) << "the default stack should rarely be full";
+
+  render::PathTraceSettings none;
+  none.branch_slots = 0;  // the one-sample technique alone, the GPU's before splitting
+  render::PathTraceStats off;
+  EXPECT_GT(expect_gpu_matches_cpu(sc, sc.march, nullptr, nullptr, none, &off), 0.0);
+  EXPECT_EQ(off.branch_slots, 0);
 }
 
 // The air and the physical ground (issue 11, item 4): sunlight reddened by the air at every vertex,
