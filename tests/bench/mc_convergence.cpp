@@ -2,7 +2,8 @@
 // scene named, the clouds-only reference at N and then 4N samples per pixel, and the ratio of the
 // mean relative standard errors (2 for 1/sqrt(N) convergence; about 1 where heavy tails dominate).
 // With --gpu the GPU path tracer's (headless OpenGL: llvmpipe here) instead of the CPU's.
-// usage: bench_mc_convergence [--size WxH] [--spp N] [--threads T] [--no-peak-mis] [--gpu [--branch-slots K]] SCENE...
+// usage: bench_mc_convergence [--size WxH] [--spp N] [--threads T] [--no-peak-mis] [--gpu [--branch-slots K]] [--globe]
+//        SCENE...
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -20,18 +21,19 @@
 
 int main(int argc, char** argv) {
   int w = 48, h = 27, spp = 64, threads = 0, slots = cv::render::PathTraceSettings{}.branch_slots;
-  bool no_peak_mis = false, gpu = false;
+  bool no_peak_mis = false, gpu = false, globe = false;
   std::vector<std::string> scenes;
   namespace ba = cv::bench_args;
   const int code = ba::parse("bench_mc_convergence",
-                             "usage: bench_mc_convergence [--size WxH] [--spp N] [--threads T] [--no-peak-mis] [--gpu [--branch-slots K]] SCENE...\n"
+                             "usage: bench_mc_convergence [--size WxH] [--spp N] [--threads T] [--no-peak-mis] [--gpu [--branch-slots K]] [--globe] SCENE...\n"
                              "  the clouds-only Monte Carlo reference of each standard scene at N and 4N samples per pixel;\n"
                              "  prints the mean relative standard errors and their ratio (2: 1/sqrt(N) convergence)\n"
                              "  --gpu             the GPU path tracer (headless OpenGL) instead of the CPU reference\n"
-                             "  --branch-slots K  with --gpu: branches of the droplets' peak a pixel's stack holds (default 8)\n",
+                             "  --branch-slots K  with --gpu: branches of the droplets' peak a pixel's stack holds (default 8)\n"
+                             "  --globe           with the scene's ground under the clouds (its constant albedo), not clouds alone\n",
                              argc, argv,
                              {ba::size("--size", w, h), ba::integer("--spp", spp), ba::integer("--threads", threads, 0, 1024),
-                              ba::flag("--no-peak-mis", no_peak_mis), ba::flag("--gpu", gpu), ba::integer("--branch-slots", slots, 0, 64)},
+                              ba::flag("--no-peak-mis", no_peak_mis), ba::flag("--gpu", gpu), ba::integer("--branch-slots", slots, 0, 64), ba::flag("--globe", globe)},
                              &scenes);
   if (code >= 0) return code;
   const bool peak_mis = !no_peak_mis;
@@ -61,7 +63,8 @@ int main(int argc, char** argv) {
     }
     const cv::core::GridMeanExtinction ext = cv::core::grid_mean_extinction(sc.grid, sc.data);
     cv::core::MarchSettings m = sc.march;  // clouds only, as the bench's references
-    m.features.atmosphere = m.features.globe = false;
+    m.features.atmosphere = false;
+    m.features.globe = globe;
     m.medium.ambient = 0.0, m.medium.noise_amount = 0.0;
     if (!(m.medium.droplet_diameter_um > 0.0)) m.medium.droplet_diameter_um = 20.0;
     cv::core::MonteCarloSettings mc;
