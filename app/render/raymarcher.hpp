@@ -93,7 +93,7 @@ struct PathTraceSettings {
   // Branches of the droplets' peak a pixel's stack holds (the CPU's is unbounded; docs/physics.md,
   // "Splitting on the GPU"): ten floats each per pixel. Fewer where the driver's largest storage
   // buffer cannot hold them for the whole image; 0: no splitting.
-  int branch_slots = 8;
+  int branch_slots = 16;
 };
 
 // What the path tracer did beyond core::MonteCarloStats: samples left out as not finite, and, on a

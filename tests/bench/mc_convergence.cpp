@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
                              "  the clouds-only Monte Carlo reference of each standard scene at N and 4N samples per pixel;\n"
                              "  prints the mean relative standard errors and their ratio (2: 1/sqrt(N) convergence)\n"
                              "  --gpu             the GPU path tracer (headless OpenGL) instead of the CPU reference\n"
-                             "  --branch-slots K  with --gpu: branches of the droplets' peak a pixel's stack holds (default 8)\n"
+                             "  --branch-slots K  with --gpu: branches of the droplets' peak a pixel's stack holds (default 16)\n"
                              "  --globe           with the scene's ground under the clouds (its constant albedo), not clouds alone\n",
                              argc, argv,
                              {ba::size("--size", w, h), ba::integer("--spp", spp), ba::integer("--threads", threads, 0, 1024),
@@ -99,6 +99,7 @@ int main(int argc, char** argv) {
     if (gpu) {
       std::printf("  %5d  %.3g per path", extra.branch_slots,
                   double(extra.splits_without_room) / double(std::max<std::uint64_t>(img.stats.paths, 1)));
+      if (extra.near_loop_budget) std::printf(" (%llu walks near llvmpipe's loop budget)", static_cast<unsigned long long>(extra.near_loop_budget));
     }
     std::printf("\n");
     std::fflush(stdout);
