@@ -8,6 +8,7 @@
 
 #include "kernel/bindings.glsl"
 #include "kernel/march_stats.glsl"
+#include "kernel/ms_beam.glsl"
 #include "kernel/detail_drift.hpp"
 #include "physics/physics.hpp"  // CV_DETAIL_COVERS (shaders/common/detail.glsl)
 #include "noise/blue_noise.hpp"
@@ -93,6 +94,7 @@ GpuRaymarcher::~GpuRaymarcher() {
   if (modelled_pyramid_) glDeleteBuffers(1, &modelled_pyramid_);
   if (pyramid_buffer_) glDeleteBuffers(1, &pyramid_buffer_);
   if (stats_buffer_) glDeleteBuffers(1, &stats_buffer_);
+  if (ms_beam_buffer_) glDeleteBuffers(1, &ms_beam_buffer_);
   if (params_buffer_) glDeleteBuffers(1, &params_buffer_);
 }
 
@@ -234,6 +236,23 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
       check_gl("uploading the two-stream source");
       ms_volume_ = &v, ms_key_ = key, ms_build_ms_ = src.build_ms;
     }
+  }
+  // The droplets' beam table (core::ms_peaks, remembered there per droplet size): always bound, since
+  // llvmpipe may read it under a mask where the kernel does not use it.
+  {
+    const core::MsPeaks peaks = s.medium.ms_two_stream ? core::ms_peaks(s) : core::MsPeaks{};
+    if (!ms_beam_buffer_) {
+      glCreateBuffers(1, &ms_beam_buffer_);
+      glNamedBufferStorage(ms_beam_buffer_, static_cast<GLsizeiptr>(sizeof(float) * CV_MS_BEAM_ROWS * CV_MS_BEAM_ANGLES), nullptr,
+                           GL_DYNAMIC_STORAGE_BIT);
+    }
+    if (peaks.beam && peaks.beam != ms_beam_uploaded_) {
+      glNamedBufferSubData(ms_beam_buffer_, 0, static_cast<GLsizeiptr>(sizeof(float) * peaks.beam->values.size()),
+                           peaks.beam->values.data());
+      check_gl("uploading the droplets' beam table");
+      ms_beam_uploaded_ = peaks.beam;
+    }
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_MS_BEAM, ms_beam_buffer_);
   }
   if (s.medium.modelled && params.u_has_fraction && fraction_volume_ != &v) {  // the cover, only when the modelled cloud reads it
     if (!fraction_) {

@@ -198,6 +198,8 @@ class GpuRaymarcher {
   core::MsSourceKey ms_key_;
   const core::PreparedVolume* ms_volume_ = nullptr;
   double ms_build_ms_ = 0.0;
+  GLuint ms_beam_buffer_ = 0;         // the droplets' beam table (CV_SSBO_MS_BEAM)
+  std::shared_ptr<const core::MsBeamTable> ms_beam_uploaded_;  // the table it holds
   GLuint column_tau_ = 0;           // the column maps (RGBA32F): optical depth (the octave gate), ground, cloud type
   core::MediumMask column_mask_;    // the mask column_tau_'s depths were made for (none: the prepared map)
   GLuint jitter_mask_ = 0;          // the blue-noise mask (R32F), uploaded at construction

@@ -10,6 +10,7 @@
 
 #include "kernel/march_params.hpp"
 #include "kernel/march_stats.glsl"
+#include "kernel/ms_beam.glsl"
 #include "physics/physics.hpp"
 
 namespace cv::kernel {
@@ -52,6 +53,7 @@ struct MarchKernel : MarchParams {
   sampler3D u_liquid, u_ice, u_noise_low, u_noise_high, u_ms_i0, u_ms_i1, u_fraction;
   sampler2D u_column_tau, u_jitter_mask, u_ground, u_depth, u_opaque, u_tl_distance, u_tl_color, u_detail_table, u_detail_shift;
   const glm::vec2* u_min_max = nullptr;
+  const float* u_ms_beam_table = nullptr;  // the droplets' beam table (ms_beam_table), read by the two-stream march with the Mie phase
   // The program switches (compile-time constants on the GPU).
   bool kSkipEmpty = true, kAdaptive = false, kAtmosphere = false, kGlobe = false, kNoise = false, kTwoStream = false,
        kTranslucent = false, kLayerMask = true,  // the CPU pays nothing for a uniform branch: the mask follows u_mask_band

@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 #include "geo/geodesy.hpp"
+#include "kernel/ms_beam.glsl"
 #include "physics/physics.hpp"
 
 namespace cv::core {
@@ -174,6 +176,31 @@ MsPeak ms_peak(const std::function<double(double)>& phase, double f) {
   return out;
 }
 
+namespace {
+// The droplets' beam table (ms_beam_table) for the Mie fit at droplet diameter d_um, remembered for
+// the last diameter asked (the ice's settings do not change it). The fit's HG lobe is kept apart (its
+// spike, narrower than a degree for large droplets) where it lies within the peak,
+// a = (1 - w_d) / f < 1: droplets above about 2 um. Below that the lobe is broad (g_hg < 0.92, wider
+// than 4 degrees), a > 1 would make its chain grow as e^(lambda (a - 1)), and the whole phase is
+// tabulated.
+std::shared_ptr<const MsBeamTable> droplet_beam_table(double d_um, double cut, double f) {
+  thread_local double memo_d = -1.0, memo_cut = -1.0;
+  thread_local std::shared_ptr<const MsBeamTable> memo;
+  if (memo && memo_d == d_um && memo_cut == cut) return memo;
+  const physics::f64::MieParams mie = physics::f64::mie_params(d_um);
+  const double wd = mie.w_d, gd = mie.g_d, al = mie.alpha;
+  if (1.0 - wd < f) {
+    memo = std::make_shared<const MsBeamTable>(ms_beam_table(
+        [wd, gd, al](double m) { return wd * physics::f64::phase_draine(m, gd, al); }, 1.0 - wd, mie.g_hg, mie.c_hg, cut, f));
+  } else {
+    memo = std::make_shared<const MsBeamTable>(
+        ms_beam_table([mie](double m) { return physics::f64::phase_mie(m, mie); }, 0.0, 0.0, 1.0, cut, f));
+  }
+  memo_d = d_um, memo_cut = cut;
+  return memo;
+}
+}  // namespace
+
 MsPeaks ms_peaks(const MarchSettings& s) {
   struct Memo {
     double droplet_um = -1.0, ice_g = -2.0;
@@ -190,7 +217,163 @@ MsPeaks ms_peaks(const MarchSettings& s) {
   out.liquid = hg ? ms_peak([gl](double m) { return physics::f64::phase_hg(m, gl); }, gl * gl)
                   : ms_peak([&mie](double m) { return physics::f64::phase_mie(m, mie); }, gl * gl);
   out.ice = ms_peak([ice_g](double m) { return physics::f64::phase_hg(m, ice_g); }, ice_g * ice_g);
+  out.beam = hg ? nullptr : droplet_beam_table(d, out.liquid.cut, gl * gl);
   memo = Memo{d, ice_g, hg, out};
+  return out;
+}
+
+namespace {
+// Gauss-Legendre nodes and weights of n points on [-1, 1] (Newton on the Legendre recurrence).
+void gauss_legendre_unit(int n, std::vector<double>& x, std::vector<double>& w) {
+  x.assign(static_cast<std::size_t>(n), 0.0);
+  w.assign(static_cast<std::size_t>(n), 0.0);
+  for (int i = 0; i < (n + 1) / 2; ++i) {
+    double z = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 1.0;
+    for (int it = 0; it < 100; ++it) {
+      double p0 = 1.0, p1 = z;
+      for (int l = 1; l < n; ++l) {
+        const double p2 = ((2.0 * l + 1.0) * z * p1 - l * p0) / (l + 1.0);
+        p0 = p1;
+        p1 = p2;
+      }
+      dp = n * (z * p1 - p0) / (z * z - 1.0);
+      const double dz = p1 / dp;
+      z -= dz;
+      if (std::abs(dz) < 1e-15) break;
+    }
+    x[static_cast<std::size_t>(i)] = z;
+    x[static_cast<std::size_t>(n - 1 - i)] = -z;
+    w[static_cast<std::size_t>(i)] = w[static_cast<std::size_t>(n - 1 - i)] = 2.0 / ((1.0 - z * z) * dp * dp);
+  }
+}
+
+// The same mapped onto [a, b]; the unit rule is made once.
+void gauss_legendre(double a, double b, std::vector<double>& x, std::vector<double>& w) {
+  constexpr int kNodes = 1700;
+  static const std::pair<std::vector<double>, std::vector<double>> unit = [] {
+    std::pair<std::vector<double>, std::vector<double>> r;
+    gauss_legendre_unit(kNodes, r.first, r.second);
+    return r;
+  }();
+  const double h = 0.5 * (b - a), m = 0.5 * (b + a);
+  x.resize(unit.first.size());
+  w.resize(unit.second.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    x[i] = m + h * unit.first[i];
+    w[i] = h * unit.second[i];
+  }
+}
+
+// out[l] += 2 pi sum_i w_i f(x_i) P_l(x_i), l = 0..L (degree by degree over all nodes: the
+// recurrence runs across the nodes, which vectorises).
+template <class F>
+void legendre_moments(const std::vector<double>& x, const std::vector<double>& w, F f, std::vector<double>& out) {
+  const int L = static_cast<int>(out.size()) - 1;
+  const std::size_t n = x.size();
+  std::vector<double> fx(n), prev(n, 1.0), cur(x);
+  for (std::size_t i = 0; i < n; ++i) fx[i] = 2.0 * kPi * w[i] * f(x[i]);
+  double s0 = 0.0, s1 = 0.0;
+  for (std::size_t i = 0; i < n; ++i) s0 += fx[i], s1 += fx[i] * x[i];
+  out[0] += s0;
+  if (L >= 1) out[1] += s1;
+  for (int l = 1; l < L; ++l) {
+    const double a = (2.0 * l + 1.0) / (l + 1.0), b = static_cast<double>(l) / (l + 1.0);
+    double sum = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double next = a * x[i] * cur[i] - b * prev[i];
+      prev[i] = cur[i];
+      cur[i] = next;
+      sum += fx[i] * next;
+    }
+    out[static_cast<std::size_t>(l + 1)] += sum;
+  }
+}
+}  // namespace
+
+MsBeamTable ms_beam_table(const std::function<double(double)>& smooth, double spike_weight, double spike_g, double spike_c,
+                          double cut, double f) {
+  const double w = 1.0 - spike_weight, c = cut;  // w: the smooth part's share
+  MsBeamTable out;
+  out.values.assign(static_cast<std::size_t>(CV_MS_BEAM_ROWS) * CV_MS_BEAM_ANGLES, static_cast<float>(1.0 / (4.0 * kPi)));
+  if (!(f > 0.0) || !(f < 1.0) || !(c > 0.0)) return out;  // no peak: the table is not read (lambda = 0)
+  const double a = spike_weight / f;
+  out.spike_share = a;
+  auto hg = [&](double m) { return spike_weight > 0.0 ? physics::f64::phase_hg_c(m, spike_g, spike_c) : 0.0; };
+  auto p0 = [&](double m) { return smooth(m) + spike_weight * hg(m); };
+  // The cone mu >= mu_c where p exceeds the cut (p falls from the forward direction until it meets c).
+  double th = 0.0;
+  const double dth = 0.05 * kPi / 180.0;
+  while (th < kPi && p0(std::cos(th)) > c) th += dth;
+  double lo = std::max(th - dth, 0.0), hi = std::min(th, kPi);
+  for (int it = 0; it < 100; ++it) {
+    const double m = 0.5 * (lo + hi);
+    (p0(std::cos(m)) > c ? lo : hi) = m;
+  }
+  const double mu_c = std::cos(0.5 * (lo + hi));
+  // Legendre coefficients chi_l = 2 pi int f P_l dmu of p, and of K_r = K - a HG: (smooth - c) / f
+  // on the cone, (max(p - c, 0) - spike_weight HG) / f off it (the HG lobe's spike, narrower than a
+  // degree for large droplets, is never integrated: its coefficients are g^l).
+  // Degrees up to 3000 (the HG lobe's g^l, g = 0.998 for 50 um droplets, is below 0.003 there).
+  // gauss_legendre's 1700 nodes integrate P_l f exactly for f a polynomial of degree below 400 on
+  // each side of the cone's edge, where the integrands are smooth: 3200 nodes gave the same table
+  // to 6e-8.
+  constexpr int kL = 3000;
+  std::vector<double> chi_p(kL + 1, 0.0), chi_kr(kL + 1, 0.0), x, wt;
+  gauss_legendre(-1.0, 1.0, x, wt);
+  legendre_moments(x, wt, smooth, chi_p);
+  gauss_legendre(mu_c, 1.0, x, wt);
+  legendre_moments(x, wt, [&](double m) { return (smooth(m) - c) / f; }, chi_kr);
+  gauss_legendre(-1.0, mu_c, x, wt);
+  legendre_moments(x, wt, [&](double m) { return (std::max(p0(m) - c, 0.0) - (1.0 - w) * hg(m)) / f; }, chi_kr);
+  const double log_g = spike_weight > 0.0 ? std::log1p(-spike_c) : 0.0;
+  std::vector<double> gl(kL + 1), chi_k(kL + 1);
+  for (int l = 0; l <= kL; ++l) {
+    const auto i = static_cast<std::size_t>(l);
+    gl[i] = spike_weight > 0.0 ? std::exp(l * log_g) : 0.0;
+    chi_p[i] = (1.0 - w) * gl[i] + chi_p[i];
+    chi_k[i] = a * gl[i] + chi_kr[i];
+  }
+  out.norm_error = std::abs(chi_k[0] - 1.0);
+  // The rows' coefficients r_l(lambda): chi_l(p) exp(-lambda (1 - chi_l(K))) less the HG lobe's own chain.
+  constexpr int kRows = CV_MS_BEAM_ROWS, kAngles = CV_MS_BEAM_ANGLES;
+  std::vector<double> r(static_cast<std::size_t>(kL + 1) * kRows);  // degree-major
+  for (int i = 0; i < kRows; ++i) {
+    const double s = static_cast<double>(i) / (kRows - 1);
+    const bool infinite = i == kRows - 1;  // lambda infinite: isotropic
+    const double lambda = infinite ? 0.0 : CV_MS_BEAM_LAMBDA0 * s / (1.0 - s);
+    for (int l = 0; l <= kL; ++l) {
+      const auto k = static_cast<std::size_t>(l);
+      r[k * kRows + static_cast<std::size_t>(i)] =
+          infinite ? (l == 0 ? 1.0 : 0.0)
+                   : chi_p[k] * std::exp(-lambda * (1.0 - chi_k[k])) - (1.0 - w) * gl[k] * std::exp(-lambda * (1.0 - a * gl[k]));
+    }
+  }
+  // The sums over l of (2l + 1) / 4 pi r_l P_l(cos theta_j), degree by degree (P_l's recurrence
+  // across the angles), into an angle-major table.
+  std::vector<double> table(static_cast<std::size_t>(kAngles) * kRows, 0.0), mu(kAngles), prev(kAngles, 0.0), cur(kAngles, 1.0);
+  for (int j = 0; j < kAngles; ++j) mu[static_cast<std::size_t>(j)] = std::cos(kPi * j / (kAngles - 1));
+  for (int l = 0; l <= kL; ++l) {
+    const double* rl = &r[static_cast<std::size_t>(l) * kRows];
+    const double scale = (2.0 * l + 1.0) / (4.0 * kPi);
+    for (int j = 0; j < kAngles; ++j) {
+      const double pj = scale * cur[static_cast<std::size_t>(j)];
+      double* tj = &table[static_cast<std::size_t>(j) * kRows];
+      for (int i = 0; i < kRows; ++i) tj[i] += rl[i] * pj;
+    }
+    const double a1 = (2.0 * l + 1.0) / (l + 1.0), b1 = static_cast<double>(l) / (l + 1.0);
+    for (int j = 0; j < kAngles; ++j) {
+      const auto jj = static_cast<std::size_t>(j);
+      const double next = a1 * mu[jj] * cur[jj] - b1 * prev[jj];
+      prev[jj] = cur[jj];
+      cur[jj] = next;
+    }
+  }
+  for (int i = 0; i < kRows; ++i) {
+    for (int j = 0; j < kAngles; ++j) {
+      out.values[static_cast<std::size_t>(i) * kAngles + static_cast<std::size_t>(j)] =
+          static_cast<float>(table[static_cast<std::size_t>(j) * kRows + static_cast<std::size_t>(i)]);
+    }
+  }
   return out;
 }
 

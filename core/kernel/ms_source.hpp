@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -79,9 +80,30 @@ inline double ms_peak_cut(const std::function<double(double)>& phase, double f) 
 // The peaks of the march's liquid and ice phases at f = g^2 (the kernel's u_ms_peak_* parameters):
 // the approximate Mie fit at the droplet diameter (or HG with its mean cosine with
 // liquid_phase_hg) and ice's Henyey-Greenstein. Remembers the last settings it was asked for.
+struct MsBeamTable;
 struct MsPeaks {
   MsPeak liquid, ice;
+  std::shared_ptr<const MsBeamTable> beam;  // the droplets' beam phase table (ms_beam_table; none with liquid_phase_hg)
 };
 MsPeaks ms_peaks(const MarchSettings& s);
+
+// The beam phase table (docs/physics.md, "The droplets' beam spread by the true peak kernel"). A
+// phase p = smooth + s HG(spike_g) (spike_c = 1 - spike_g kept apart for precision; s = 0: no lobe
+// apart) whose forward peak above the cut c holds the share f has the peak kernel
+// K = max(p - c, 0) / f. Light of the delta-scaled beam has met a Poisson number k of peak
+// scatterings (mean lambda), so it scatters toward the camera with the mixture over k of p convolved
+// k times with K, whose Legendre coefficients are chi_l(p) exp(-lambda (1 - chi_l(K))). With
+// K = a HG(spike_g) + K_r (a = s / f), the part made of the HG lobe alone, s g^l exp(-lambda (1 -
+// a g^l)), is a sum of narrow HG lobes the kernel evaluates in closed form (march.glsl
+// ms_beam_phase_mie); the rest is tabulated here: CV_MS_BEAM_ROWS rows of lambda by
+// CV_MS_BEAM_ANGLES scattering angles (shaders/kernel/ms_beam.glsl), per sr. The smooth part must
+// stay below c outside the cone about forward where p exceeds c.
+struct MsBeamTable {
+  std::vector<float> values;  // row-major: row (lambda) by column (angle)
+  double spike_share = 0.0;   // a = spike weight / f (0: no lobe apart, the table holds the whole mixture)
+  double norm_error = 0.0;    // |chi_0(K) - 1|, the quadrature's check on the cut
+};
+MsBeamTable ms_beam_table(const std::function<double(double)>& smooth, double spike_weight, double spike_g, double spike_c,
+                          double cut, double f);
 
 }  // namespace cv::core

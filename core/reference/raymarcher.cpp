@@ -48,6 +48,8 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
     k.u_ms_i0 = {ms.i0.data(), n};
     k.u_ms_i1 = {ms.i1.data(), n};
   }
+  const MsPeaks peaks = s.medium.ms_two_stream ? ms_peaks(s) : MsPeaks{};  // holds the droplets' beam table
+  if (peaks.beam) k.u_ms_beam_table = peaks.beam->values.data();
   const BlueNoiseMask& mask = step_jitter_mask();
   k.u_jitter_mask = {mask.values.data(), {mask.n, mask.n}, 1};
   if (ground_map) k.u_ground = {ground_map->rgba.data(), {ground_map->width, ground_map->height}, 4};

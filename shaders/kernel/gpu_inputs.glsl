@@ -46,6 +46,9 @@ layout(binding = CV_TEX_DETAIL_TABLE) uniform sampler2D u_detail_table;  // (thr
 layout(binding = CV_TEX_DETAIL_SHIFT) uniform sampler2D u_detail_shift;  // the detail's wind displacement per level, in tiles (core/kernel/detail_drift)
 // The extinction pyramid: (min, max) per brick, levels one after the other, x fastest.
 layout(std430, binding = CV_SSBO_PYRAMID) readonly buffer Pyramid { vec2 u_min_max[]; };
+// The droplets' beam phase table (core/kernel/ms_source ms_beam_table), CV_MS_BEAM_ROWS x CV_MS_BEAM_ANGLES.
+#include "../kernel/ms_beam.glsl"
+layout(std430, binding = CV_SSBO_MS_BEAM) readonly buffer MsBeam { float u_ms_beam_table[]; };
 // Per-frame counters (MarchStats), each as (low, high) 32-bit words.
 layout(std430, binding = CV_SSBO_STATS) buffer Stats { uint u_stats[]; };
 uint g_stats[CV_STAT_COUNT] = uint[CV_STAT_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u);

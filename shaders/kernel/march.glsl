@@ -9,7 +9,8 @@
 // distance to opaque geometry per pixel, m), u_opaque (that geometry's radiance), u_tl_distance and
 // u_tl_color (translucent fragments, u_tl_count per pixel side by side, nearest first) (sampler2D),
 // u_noise_low, u_noise_high (sampler3D), the pyramid u_min_max (vec2 per brick, levels one after
-// the other), the counters g_stats[CV_STAT_COUNT] (uint, indices in march_stats.glsl) and the switches kSkipEmpty, kAdaptive,
+// the other), the droplets' beam table u_ms_beam_table (floats, ms_beam.glsl's size), the counters
+// g_stats[CV_STAT_COUNT] (uint, indices in march_stats.glsl) and the switches kSkipEmpty, kAdaptive,
 // kAtmosphere, kGlobe, kNoise, kTwoStream and kTranslucent (compile-time constants on the GPU, where llvmpipe runs both sides
 // of a branch under masks; plain members in C++).
 //
@@ -426,15 +427,15 @@ CV_FN real3 tint_hue(real sl, real si, real sigma) {
 
 // The phase with which the delta-scaled beam exp(-(1 - f) tau_sun) scatters toward the camera. Its
 // light has met a Poisson number k of forward-peak scatterings (mean lambda = f tau_sun: the beam
-// without them is exp(-tau_sun)), each of which spreads it about the sun's direction like a
-// Henyey-Greenstein kernel of the peak's mean cosine g_pk (ms_peak). Kernels compose by
-// multiplying their mean cosines: HG(g) spread by k of them is HG(g g_pk^k). The phase p0 (the Mie
-// fit, or HG) spread by them is taken as p0 + HG(g g_pk^k) - HG(g): exact for HG, and for a phase
-// whose narrow diffraction peak and broad back lobes a narrow kernel moves little, the change is
-// that of its HG part, near forward. CV_MS_PEAK_TERMS terms, the rest of the weight at
-// k = max(terms, lambda).
+// without them is exp(-tau_sun)), each of which spreads it about the sun's direction. For a
+// Henyey-Greenstein phase (ice, and liquid_phase_hg) the spread is taken as a Henyey-Greenstein
+// kernel of the peak's mean cosine g_pk (ms_peak); kernels compose by multiplying their mean
+// cosines: HG(g) spread by k of them is HG(g g_pk^k). CV_MS_PEAK_TERMS terms, the rest of the weight
+// at k = max(terms, lambda). (The true kernel, max(p - c, 0) / f, ends at the cut's cone; with it
+// thin HG slabs were 1-5 points darker still, docs/physics.md.) The droplets' Mie phase is spread by
+// the true kernel: ms_beam_phase_mie.
 #define CV_MS_PEAK_TERMS 8
-CV_FN real ms_beam_phase(real mu, real p0, real g, real g_pk, real lambda) {
+CV_FN real ms_beam_phase_hg(real mu, real p0, real g, real g_pk, real lambda) {
   real l = clamp(lambda, real(0.0), real(1.0e4));
   real w = exp(-l);
   real sum = real(0.0);  // sum over k >= 1 of w_k HG(g g_pk^k)
@@ -449,6 +450,52 @@ CV_FN real ms_beam_phase(real mu, real p0, real g, real g_pk, real lambda) {
   real tail = max(real(1.0) - mass, real(0.0));
   sum += tail * phase_hg(mu, g * pow(max(g_pk, real(0.0)), max(real(CV_MS_PEAK_TERMS), l)));
   return max(p0 + sum - (real(1.0) - exp(-l)) * phase_hg(mu, g), real(0.0));
+}
+
+// The droplets' beam phase (docs/physics.md, "The droplets' beam spread by the true peak kernel"):
+// the light of the delta-scaled beam has met a Poisson number k of forward-peak scatterings (mean
+// lambda), each of which turns it by the peak kernel K = max(p - c, 0) / f, so it scatters with the
+// mixture over k of the Mie fit p convolved k times with K (core/kernel/ms_source ms_beam_table). The
+// fit's narrow HG lobe (weight spike_w = 1 - w_d) has its own chain, spike_w sum_k e^-lambda
+// (lambda a)^k / k! HG(g^(k+1)) (a = spike_w / f, u_ms_beam_a_liquid), summed here in closed form
+// (no table could hold it); the rest is read from the table, bilinear in s = lambda / (lambda +
+// lambda0) and the scattering angle. For droplets below about 2 um (a = 0) the table holds it all.
+CV_FN real ms_beam_table_at(int row, int col) { return real(u_ms_beam_table[row * CV_MS_BEAM_ANGLES + col]); }
+CV_FN real ms_beam_phase_mie(real mu, MieParams mie, real lambda) {
+  real l = clamp(lambda, real(0.0), real(1.0e4));
+  real s = l / (l + real(CV_MS_BEAM_LAMBDA0)) * real(CV_MS_BEAM_ROWS - 1);
+  real th = acos(clamp(mu, real(-1.0), real(1.0))) * (real(CV_MS_BEAM_ANGLES - 1) / CV_PI);
+  int r0 = min(int(s), CV_MS_BEAM_ROWS - 2);
+  int c0 = min(int(th), CV_MS_BEAM_ANGLES - 2);
+  real fr = s - real(r0);
+  real fc = th - real(c0);
+  real p = mix(mix(ms_beam_table_at(r0, c0), ms_beam_table_at(r0, c0 + 1), fc),
+               mix(ms_beam_table_at(r0 + 1, c0), ms_beam_table_at(r0 + 1, c0 + 1), fc), fr);
+  real a = u_ms_beam_a_liquid;  // 0: the table holds the whole phase (small droplets, ms_peaks)
+  real spike_w = a > real(0.0) ? real(1.0) - mie.w_d : real(0.0);
+  real spike_c = mie.c_hg;
+  real la = l * a;
+  real w = exp(-l);
+  real ck = spike_c;  // 1 - g^(k+1), without cancellation
+  real sum = real(0.0);
+  real mass = real(0.0);
+  real moment = real(0.0);  // sum of w_k (1 - g^(k+1))
+  for (int k = 0; k < CV_MS_BEAM_SPIKE_TERMS; ++k) {
+    sum += w * phase_hg_c(mu, real(1.0) - ck, ck);
+    mass += w;
+    moment += w * ck;
+    w *= la / real(k + 1);
+    ck = ck + spike_c - ck * spike_c;
+  }
+  // The terms beyond as one lobe with their mean cosine: over all k, sum w_k = e^-lambda(1 - a) and
+  // sum w_k (1 - g^(k+1)) = e^-lambda(1 - a) (1 - g e^-x), x = lambda a (1 - g), written
+  // x E(x) + (1 - g) e^-x without cancellation.
+  real whole = exp(-l * (real(1.0) - a));
+  real x = la * spike_c;
+  real tail = max(whole - mass, real(0.0));
+  real ct = tail > real(0.0) ? clamp((whole * (x * segment_factor(x) + spike_c * exp(-x)) - moment) / tail, ck, real(1.0)) : ck;
+  p += spike_w * (sum + tail * phase_hg_c(mu, real(1.0) - ct, ct));
+  return max(p, real(0.0));
 }
 
 CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real3 d, real mu, MieParams mie, CV_INOUT(MarchState) s) {
@@ -493,8 +540,9 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
       real lambda = g_mix * g_mix * tau_sun;  // forward-peak scatterings the beam has met, on average
       real p_liquid = real(0.0);
       real p_ice = real(0.0);
-      if (sl > real(0.0)) p_liquid = ms_beam_phase(mu, u_liquid_phase_hg ? phase_hg(mu, g_liquid) : phase_mie(mu, mie), g_liquid, u_ms_peak_g_liquid, lambda);
-      if (si > real(0.0)) p_ice = ms_beam_phase(mu, phase_hg(mu, g_ice), g_ice, u_ms_peak_g_ice, lambda);
+      if (sl > real(0.0)) p_liquid = u_liquid_phase_hg ? ms_beam_phase_hg(mu, phase_hg(mu, g_liquid), g_liquid, u_ms_peak_g_liquid, lambda)
+                                                       : ms_beam_phase_mie(mu, mie, lambda);
+      if (si > real(0.0)) p_ice = ms_beam_phase_hg(mu, phase_hg(mu, g_ice), g_ice, u_ms_peak_g_ice, lambda);
       real c_liquid = min(p_liquid, u_ms_peak_liquid);
       real c_ice = min(p_ice, u_ms_peak_ice);
       real beam = transmittance((real(1.0) - g_mix * g_mix) * tau_sun);

@@ -73,8 +73,9 @@ CV_PARAM(real, u_detail_amount)      // 0: the data's field, 1: the whole sub-gr
 CV_PARAM(bool, u_has_fraction)       // u_fraction holds the cloud fraction; else the cover is 1 where there is cloud
 CV_PARAM(real, u_ms_peak_liquid)     // two-stream: the liquid phase's cut (1/sr) above which its forward peak holds g^2 (ms_peak_cut)
 CV_PARAM(real, u_ms_peak_ice)        // the same for the ice's Henyey-Greenstein phase
-CV_PARAM(real, u_ms_peak_g_liquid)   // two-stream: the mean cosine of the liquid phase's peak above the cut (ms_peak)
+CV_PARAM(real, u_ms_peak_g_liquid)   // two-stream, liquid_phase_hg: the mean cosine of the liquid phase's peak above the cut (ms_peak)
 CV_PARAM(real, u_ms_peak_g_ice)      // the same for ice
+CV_PARAM(real, u_ms_beam_a_liquid)   // two-stream, Mie droplets: the fit's HG lobe's share of the peak kernel (ms_beam_table)
 CV_PARAM(ivec4, u_level_nodes)       // grid nodes per brick side, finest level first
 CV_PARAM(ivec4, u_level_offset)      // first brick of each level in u_min_max
 CV_PARAM_ARRAY(ivec4, u_bricks, 4)   // bricks per axis (xyz), finest level first

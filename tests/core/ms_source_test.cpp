@@ -7,8 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <random>
 #include <vector>
 
+#include "kernel/march_kernel.hpp"
 #include "kernel/ms_source.hpp"
 #include "physics/physics.hpp"
 #include "settings/march_settings.hpp"
@@ -311,7 +313,7 @@ TEST(TwoStream, PeakCutOfTheMiePhaseHoldsTheShareGSquared) {
 // The cuts the march gets, over the settings' whole ranges (a droplet diameter of 0 means "from the
 // data"; ice g from -0.999 to 0.999): finite, and between 0 and the phase's largest value.
 TEST(TwoStream, PeakCutsAreFiniteOverTheSettingsRanges) {
-  for (double d : {0.0, 0.01, 1.0, 20.0, 50.0}) {
+  for (double d : {0.0, 0.01, 0.3, 1.0, 1.49, 2.0, 20.0, 50.0}) {
     for (double ice_g : {-0.999, -0.5, 0.0, 0.75, 0.999}) {
       for (bool hg : {false, true}) {
         MarchSettings s;
@@ -323,6 +325,91 @@ TEST(TwoStream, PeakCutsAreFiniteOverTheSettingsRanges) {
         EXPECT_TRUE(std::isfinite(c.ice.cut) && c.ice.cut >= 0.0) << "ice g " << ice_g << ": " << c.ice.cut;
         EXPECT_LE(c.ice.cut, physics::f64::phase_hg(ice_g >= 0.0 ? 1.0 : -1.0, ice_g) * (1.0 + 1e-12)) << ice_g;
         for (double pg : {c.liquid.g, c.ice.g}) EXPECT_TRUE(pg >= -1.0 && pg <= 1.0) << "droplet " << d << " ice g " << ice_g << ": " << pg;
+        ASSERT_EQ(c.beam != nullptr, !hg) << "droplet " << d;
+        if (c.beam) {  // the beam table: finite, its lobe's share below 1 (the chain never grows)
+          EXPECT_TRUE(std::all_of(c.beam->values.begin(), c.beam->values.end(), [](float v) { return std::isfinite(v); })) << "droplet " << d;
+          EXPECT_LT(c.beam->spike_share, 1.0) << "droplet " << d;
+          EXPECT_LT(c.beam->norm_error, 1e-3) << "droplet " << d;
+        }
+      }
+    }
+  }
+}
+
+// The droplets' beam phase (march.glsl ms_beam_phase_mie: the table of ms_beam_table and the HG
+// lobe's chain in closed form) against the process it stands for, simulated photon by photon: a
+// Poisson number (mean lambda) of turns by the true peak kernel K = max(p - c, 0) / f, each drawn
+// from p and kept with probability (p - c)+ / p, then one scattering by p. Probabilities of the
+// final direction in bands of scattering angle: the model's integrated over each band (Simpson,
+// panels packed toward forward for the 0.15-degree HG lobe), the simulation's counted. Allowed: 4.5
+// standard errors of the count, and 1 % of the band for the table's bilinear interpolation (rows
+// 0.7 degrees apart).
+TEST(TwoStream, TheDropletsBeamPhaseIsThePeakKernelsPoissonMixture) {
+  constexpr double kPi = 3.14159265358979323846, kDeg = kPi / 180.0;
+  namespace ph = physics::f64;
+  for (double d : {20.0, 8.0, 2.0, 1.0}) {  // 2 um: the fit's branch below 5 um (HG lobe g 0.92); 1 um: no lobe apart
+    MarchSettings s;
+    s.medium.droplet_diameter_um = d;
+    const MsPeaks peaks = ms_peaks(s);
+    ASSERT_TRUE(peaks.beam) << d;
+    EXPECT_LT(peaks.beam->norm_error, 1e-3) << "droplet " << d << " um: the peak kernel's quadrature";
+    const ph::MieParams mie = ph::mie_params(d);
+    const double c = peaks.liquid.cut;
+    kernel::f64::MarchKernel k;
+    k.u_ms_beam_a_liquid = peaks.beam->spike_share;
+    k.u_ms_beam_table = peaks.beam->values.data();
+    const std::vector<double> edges = {0, 1, 3, 6, 10, 20, 35, 60, 90, 120, 150, 180};
+    for (double lambda : {0.5, 3.0, 12.0}) {
+      // The model's probability per band: 2 pi sin(theta) T(cos theta) over [a, b].
+      auto band = [&](double a_deg, double b_deg) {
+        const double a0 = std::max(a_deg * kDeg, 1e-7), b = b_deg * kDeg;
+        const int panels = 400;
+        const double r = std::pow(b / a0, 1.0 / panels);
+        double sum = 0.0, a = a0;
+        for (int i = 0; i < panels; ++i) {
+          const double e = i == panels - 1 ? b : a * r, m = 0.5 * (a + e);
+          auto y = [&](double t) { return 2.0 * kPi * std::sin(t) * k.ms_beam_phase_mie(std::cos(t), mie, lambda); };
+          sum += (e - a) / 6.0 * (y(a) + 4.0 * y(m) + y(e));
+          a = e;
+        }
+        return sum;
+      };
+      std::vector<double> model(edges.size() - 1);
+      double total = 0.0;
+      for (std::size_t i = 0; i + 1 < edges.size(); ++i) total += model[i] = band(edges[i], edges[i + 1]);
+      EXPECT_NEAR(total, 1.0, 5e-3) << "droplet " << d << " um, lambda " << lambda << ": the phase's integral";
+      // The simulation.
+      constexpr int kPhotons = 400000;
+      std::mt19937_64 gen(1234u + static_cast<unsigned>(lambda * 10.0 + d));
+      std::poisson_distribution<int> turns(lambda);
+      uint32_t rng = 99u;
+      auto scatter = [&](glm::dvec3 dir) {
+        double pdf = 0.0;
+        return ph::sample_mie(dir, mie, rng, pdf);
+      };
+      std::vector<double> counts(model.size(), 0.0);
+      for (int n = 0; n < kPhotons; ++n) {
+        glm::dvec3 dir(0.0, 0.0, 1.0);
+        const int kturns = turns(gen);
+        for (int t = 0; t < kturns; ++t) {
+          for (;;) {  // a turn by K: drawn from p, kept with probability (p - c)+ / p
+            const glm::dvec3 next = scatter(dir);
+            const double p = ph::phase_mie(glm::dot(next, dir), mie);
+            if (ph::rng_next(rng) * p < p - c) {
+              dir = next;
+              break;
+            }
+          }
+        }
+        dir = scatter(dir);
+        const double theta = std::acos(std::clamp(dir.z, -1.0, 1.0)) / kDeg;
+        const auto bin = static_cast<std::size_t>(std::upper_bound(edges.begin(), edges.end(), theta) - edges.begin()) - 1;
+        counts[std::min(bin, counts.size() - 1)] += 1.0;
+      }
+      for (std::size_t i = 0; i < model.size(); ++i) {
+        const double mc = counts[i] / kPhotons, se = std::sqrt(model[i] * (1.0 - model[i]) / kPhotons);
+        EXPECT_NEAR(model[i], mc, 4.5 * se + 0.01 * model[i])
+            << "droplet " << d << " um, lambda " << lambda << ", " << edges[i] << "-" << edges[i + 1] << " degrees";
       }
     }
   }
