@@ -462,11 +462,13 @@ CV_FN real ms_beam_phase_hg(real mu, real p0, real g, real g_pk, real lambda) {
 // lambda0) and the scattering angle. For droplets below about 2 um (a = 0) the table holds it all.
 CV_FN real ms_beam_table_at(int row, int col) { return real(u_ms_beam_table[row * CV_MS_BEAM_ANGLES + col]); }
 CV_FN real ms_beam_phase_mie(real mu, MieParams mie, real lambda) {
-  real l = clamp(lambda, real(0.0), real(1.0e4));
+  // The table's indices stay in range whatever comes in (a NaN reads as lambda 0, mu -1).
+  real l = lambda > real(0.0) ? min(lambda, real(1.0e4)) : real(0.0);
+  real m = mu > real(-1.0) ? min(mu, real(1.0)) : real(-1.0);
   real s = l / (l + real(CV_MS_BEAM_LAMBDA0)) * real(CV_MS_BEAM_ROWS - 1);
-  real th = acos(clamp(mu, real(-1.0), real(1.0))) * (real(CV_MS_BEAM_ANGLES - 1) / CV_PI);
-  int r0 = min(int(s), CV_MS_BEAM_ROWS - 2);
-  int c0 = min(int(th), CV_MS_BEAM_ANGLES - 2);
+  real th = acos(m) * (real(CV_MS_BEAM_ANGLES - 1) / CV_PI);
+  int r0 = clamp(int(s), 0, CV_MS_BEAM_ROWS - 2);
+  int c0 = clamp(int(th), 0, CV_MS_BEAM_ANGLES - 2);
   real fr = s - real(r0);
   real fc = th - real(c0);
   real p = mix(mix(ms_beam_table_at(r0, c0), ms_beam_table_at(r0, c0 + 1), fc),
@@ -481,7 +483,7 @@ CV_FN real ms_beam_phase_mie(real mu, MieParams mie, real lambda) {
   real mass = real(0.0);
   real moment = real(0.0);  // sum of w_k (1 - g^(k+1))
   for (int k = 0; k < CV_MS_BEAM_SPIKE_TERMS; ++k) {
-    sum += w * phase_hg_c(mu, real(1.0) - ck, ck);
+    sum += w * phase_hg_c(m, real(1.0) - ck, ck);
     mass += w;
     moment += w * ck;
     w *= la / real(k + 1);
@@ -494,7 +496,7 @@ CV_FN real ms_beam_phase_mie(real mu, MieParams mie, real lambda) {
   real x = la * spike_c;
   real tail = max(whole - mass, real(0.0));
   real ct = tail > real(0.0) ? clamp((whole * (x * segment_factor(x) + spike_c * exp(-x)) - moment) / tail, ck, real(1.0)) : ck;
-  p += spike_w * (sum + tail * phase_hg_c(mu, real(1.0) - ct, ct));
+  p += spike_w * (sum + tail * phase_hg_c(m, real(1.0) - ct, ct));
   return max(p, real(0.0));
 }
 

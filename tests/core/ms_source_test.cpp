@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -358,6 +359,14 @@ TEST(TwoStream, TheDropletsBeamPhaseIsThePeakKernelsPoissonMixture) {
     kernel::f64::MarchKernel k;
     k.u_ms_beam_a_liquid = peaks.beam->spike_share;
     k.u_ms_beam_table = peaks.beam->values.data();
+    // Whatever comes in, the table is read in range and the phase is finite.
+    const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+    for (double mu : {nan, -inf, -2.0, -1.0, 0.3, 1.0, 2.0, inf}) {
+      for (double lambda : {nan, -1.0, 0.0, 1e-30, 5.0, 1e6, inf}) {
+        const double v = k.ms_beam_phase_mie(mu, mie, lambda);
+        EXPECT_TRUE(std::isfinite(v) && v >= 0.0) << "droplet " << d << " um, mu " << mu << ", lambda " << lambda << ": " << v;
+      }
+    }
     const std::vector<double> edges = {0, 1, 3, 6, 10, 20, 35, 60, 90, 120, 150, 180};
     for (double lambda : {0.5, 3.0, 12.0}) {
       // The model's probability per band: 2 pi sin(theta) T(cos theta) over [a, b].
