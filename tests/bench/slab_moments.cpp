@@ -268,15 +268,33 @@ cv::core::TwoStreamColumn slab_column(double tau, double g, double mu0, cv::core
   return cv::core::two_stream_column(sigma.data(), gs.data(), kColumnNodes, dz, mu0, 0.0, closure);
 }
 
-// The column's I0 + g' I1 mu (g' = g / (1 + g)) integrated along the scaled view path.
-double from_two_stream(const cv::core::TwoStreamColumn& c, double tau, double g, const View& w) {
+// The column's I0 + g' I1 mu (g' = g / (1 + g)) integrated along the scaled view path. With
+// horizontal, the diffuse light's horizontal flux too, from the first-moment balance with P1's
+// closure: F_h = g' / (1 - g') E_b Omega0_h (E_b the scaled beam), I1_h = 3 F_h / (4 pi).
+double from_two_stream(const cv::core::TwoStreamColumn& c, double tau, double g, double mu0, const View& w, bool horizontal) {
   const double f = g * g, gp = g / (1.0 + g), dt = (1.0 - f) * tau / (kColumnNodes - 1);
-  const auto j = [&](int n) { return c.i0[static_cast<std::size_t>(n)] + gp * c.i1[static_cast<std::size_t>(n)] * w.mu; };
+  // The beam travels toward -x (the sun at azimuth 0): Omega0_h . out = -sin(theta0) out.x.
+  const double h = horizontal ? 3.0 / (4.0 * kPi) * gp / (1.0 - gp) * -std::sqrt(1.0 - mu0 * mu0) * w.out.x : 0.0;
+  const auto j = [&](int n) {
+    const double eb = std::exp(-(kColumnNodes - 1 - n) * dt / mu0);
+    return c.i0[static_cast<std::size_t>(n)] + gp * (c.i1[static_cast<std::size_t>(n)] * w.mu + h * eb);
+  };
   double sum = 0.0;
   for (int k = kColumnNodes - 1; k > 0; --k) {  // from the top (node kColumnNodes - 1) down, layer by layer
     const double t0 = (kColumnNodes - 1 - k) * dt, t1 = t0 + dt;
     sum += 0.5 * (j(k) + j(k - 1)) * (std::exp(-t0 / w.mu) - std::exp(-t1 / w.mu));
   }
+  return sum;
+}
+
+// The scaled problem's exact l = 1, m = 1 moment (the diffuse light's horizontal flux) scattered into
+// the view, integrated along the scaled view path.
+double from_horizontal_moment(const ScaledResult& r, const Phase& phase, const View& w) {
+  std::array<double, kMoments> y{};
+  harmonics(w.out.z, std::atan2(w.out.y, w.out.x), y);
+  double sum = 0.0;
+  for (std::size_t k = 0; k + 1 < r.edges.size(); ++k)
+    sum += phase.chi[1] * r.moments[k][2] * y[2] * (std::exp(-r.edges[k] / w.mu) - std::exp(-r.edges[k + 1] / w.mu));
   return sum;
 }
 
@@ -396,9 +414,11 @@ int main(int argc, char** argv) {
   std::vector<double> abs_err(2 * nt * (kOrders + 1) * nz, 0.0), worst(2 * nt * (kOrders + 1), 0.0);
   std::vector<int> cases(2 * nz, 0);
   // [closure][thin or thick][view zenith] and [closure][thin or thick]
-  const cv::core::TwoStreamClosure closures[2] = {cv::core::TwoStreamClosure::Eddington, cv::core::TwoStreamClosure::Quadrature};
-  const char* closure_names[2] = {"Eddington", "quadrature"};
-  std::vector<double> ts_err(4 * nz, 0.0), ts_worst(4, 0.0);
+  const cv::core::TwoStreamClosure closures[3] = {cv::core::TwoStreamClosure::Eddington, cv::core::TwoStreamClosure::Quadrature,
+                                                  cv::core::TwoStreamClosure::Quadrature};
+  const char* closure_names[4] = {"Eddington", "quadrature", "quadrature, horizontal flux", "quadrature, exact l=1 m=1"};
+  constexpr int kClosures = 4;
+  std::vector<double> ts_err(2 * kClosures * nz, 0.0), ts_worst(2 * kClosures, 0.0);
   auto cell = [&](int thick, std::size_t ti, int o) { return (static_cast<std::size_t>(thick) * nt + ti) * (kOrders + 1) + static_cast<std::size_t>(o); };
   std::printf("conservative HG %.2f slab over a black ground, %d photons per run, scaled phase %s, single scattering %s\n", g,
               photons, scaled_phase.c_str(), single.c_str());
@@ -426,6 +446,7 @@ int main(int argc, char** argv) {
       std::vector<cv::core::TwoStreamColumn> columns;
       if (two_stream) {
         for (const auto closure : closures) columns.push_back(slab_column(tau, g, mu0, closure));
+        columns.push_back(columns.back());
       }
       for (std::size_t v = 0; v < views.size(); ++v) {
         const View& w = views[v];
@@ -437,8 +458,10 @@ int main(int argc, char** argv) {
         if (two_stream) {
           const double f = g * g;
           const double ss = single == "tms" ? single_scattering((1.0 - f) * tau, g, mu0, w) / (1.0 - f) : exact_ss;
-          for (int cl = 0; cl < 2; ++cl) {
-            const double e = (ss + from_two_stream(columns[static_cast<std::size_t>(cl)], tau, g, w)) / truth - 1.0;
+          for (int cl = 0; cl < kClosures; ++cl) {
+            double model = ss + from_two_stream(columns[static_cast<std::size_t>(cl)], tau, g, mu0, w, cl == 2);
+            if (cl == 3) model = ss + from_two_stream(columns[1], tau, g, mu0, w, false) + from_horizontal_moment(scaled[0], phases[0], w);
+            const double e = model / truth - 1.0;
             const std::size_t at = static_cast<std::size_t>(2 * cl + thick);
             ts_err[at * nz + zi] += std::abs(e);
             ts_worst[at] = std::max(ts_worst[at], std::abs(e));
@@ -489,7 +512,7 @@ int main(int argc, char** argv) {
       }
     }
     if (two_stream) {
-      for (int cl = 0; cl < 2; ++cl) {
+      for (int cl = 0; cl < kClosures; ++cl) {
         const std::size_t at = static_cast<std::size_t>(2 * cl + thick);
         std::printf("| g^2 | two-stream columns, %s |", closure_names[cl]);
         for (std::size_t zi = 0; zi < nz; ++zi) {
