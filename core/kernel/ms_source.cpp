@@ -1,12 +1,14 @@
-// The two-stream source: a closed-form delta-scaled two-stream column per grid column.
+// The two-stream source: a delta-scaled two-stream column per grid column, fed by the sun's beam in 3-D.
 #include "kernel/ms_source.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <utility>
 
 #include "geo/geodesy.hpp"
+#include "io/parallel.hpp"
 #include "kernel/ms_beam.glsl"
 #include "physics/physics.hpp"
 
@@ -80,6 +82,118 @@ TwoStreamColumn two_stream_column(const double* sigma, const double* g, int n, d
   return c;
 }
 
+namespace {
+// One homogeneous layer of the general two-stream (quadrature closure, Meador and Weaver 1980):
+// optical depth dt (scattering plus leakage), single-scattering albedo w, scaled asymmetry gp, a
+// beam entering its top with irradiance et (normal to the beam) and leaving its bottom with eb.
+// Its diffuse reflectance r and transmittance t (the same from either side), absorption alpha =
+// 1 - r - t and 1 - r (both without cancellation), and the diffuse light it sends up from its top
+// (su) and down from its bottom (sd) with no diffuse light coming in.
+struct Layer {
+  double r = 0.0, t = 1.0, alpha = 0.0, one_minus_r = 1.0, su = 0.0, sd = 0.0;
+};
+Layer general_layer(double dt, double w, double gp, double mu0, double et, double eb) {
+  Layer L;
+  if (!(dt > 0.0)) return L;
+  const double s3 = std::sqrt(3.0);
+  const double g1 = 0.5 * s3 * (2.0 - w * (1.0 + gp)), g2 = 0.5 * s3 * w * (1.0 - gp);
+  const double g3 = 0.5 * (1.0 - s3 * gp * mu0), g4 = 1.0 - g3;
+  const double d12 = 0.5 * s3 * 2.0 * (1.0 - w);  // g1 - g2 without cancellation
+  const double lam = std::sqrt(std::max(d12 * (g1 + g2), 0.0));
+  if (lam * dt < 1e-9) {
+    // No absorption: the conservative limit.
+    L.r = g1 * dt / (1.0 + g1 * dt);
+    L.t = 1.0 / (1.0 + g1 * dt);
+    L.one_minus_r = L.t;
+    L.alpha = 0.0;
+  } else {
+    const double one_minus_x = -std::expm1(-2.0 * lam * dt), x = 1.0 - one_minus_x, sx = std::exp(-lam * dt);
+    const double den = lam * (1.0 + x) + g1 * one_minus_x;
+    L.r = g2 * one_minus_x / den;
+    L.t = 2.0 * lam * sx / den;
+    L.one_minus_r = (lam * (1.0 + x) + d12 * one_minus_x) / den;
+    L.alpha = (lam * (1.0 - sx) * (1.0 - sx) + d12 * one_minus_x) / den;
+  }
+  // The beam's scattered light: a particular solution A e^-kt up, B e^-kt down, k from the beam's
+  // decay across the layer (1/mu0 for a plane-parallel beam), then the homogeneous light that
+  // cancels its diffuse inflow at both faces.
+  const double e_top = std::isfinite(et) ? std::clamp(et, 0.0, 1.0) : 0.0, e_bot = std::isfinite(eb) ? std::clamp(eb, 0.0, 1.0) : 0.0;
+  if (!(w > 0.0) || !(std::max(e_top, e_bot) > 1e-300)) return L;
+  // The beam's decay in the layer from its two ends; where the lower end underflows, at least the
+  // plane-parallel rate 1/mu0 (the light then lies in the layer's first few optical depths).
+  constexpr double kTiny = 1e-300;
+  const double top = std::max(e_top, kTiny);
+  double k = (std::log(top) - std::log(std::max(e_bot, kTiny))) / dt;
+  if (e_bot < kTiny) k = std::max(k, 1.0 / mu0);
+  const double lam2 = lam * lam;
+  // Away from the particular solution's pole (k = lambda): a shift of 1e-4 in k changes the
+  // layer's deposit by about 1e-4 dt relative, where the cancellation would cost far more.
+  if (std::abs(lam2 - k * k) < 1e-8 * std::max({1.0, k * k, lam2})) k += (k >= lam ? 1e-4 : -1e-4) * std::max(1.0, std::abs(k));
+  const double den = lam2 - k * k;
+  const double a = w * top * (g3 * (g1 - k) + g2 * g4) / den;
+  const double b = w * top * ((g1 + k) * g4 + g2 * g3) / den;
+  const double ek = std::exp(-k * dt);
+  L.su = a - L.r * b - L.t * a * ek;
+  L.sd = b * ek - L.r * a * ek - L.t * b;
+  L.su = std::max(L.su, 0.0);
+  L.sd = std::max(L.sd, 0.0);
+  return L;
+}
+}  // namespace
+
+TwoStreamColumn two_stream_column_general(const double* sigma, const double* g, const double* leak, const double* beam, int n,
+                                          double dz, double mu0, double a) {
+  TwoStreamColumn c;
+  c.i0.assign(static_cast<std::size_t>(std::max(n, 0)), 0.0);
+  c.i1.assign(c.i0.size(), 0.0);
+  if (n < 1 || !(mu0 > 0.0)) return c;
+  a = std::clamp(std::isfinite(a) ? a : 0.0, 0.0, 1.0);
+  dz = std::abs(dz);
+  // Layer k lies between node k + 1 (its top) and node k (its bottom).
+  std::vector<Layer> layers(static_cast<std::size_t>(std::max(n - 1, 0)));
+  for (int k = n - 2; k >= 0; --k) {
+    const double s0 = std::max(sigma[k + 1], 0.0), s1 = std::max(sigma[k], 0.0), st = s0 + s1;
+    const double dtau = std::isfinite(st) ? 0.5 * st * dz : 0.0;
+    const double gl = st > 0.0 ? std::clamp((s0 * g[k + 1] + s1 * g[k]) / st, -0.999, 0.999) : 0.0;
+    const double ds = (1.0 - gl * gl) * dtau;
+    const double dl = st > 0.0 ? 0.5 * (std::max(leak[k + 1], 0.0) + std::max(leak[k], 0.0)) * dz : 0.0;
+    const double dt = ds + dl;
+    layers[static_cast<std::size_t>(k)] = general_layer(dt, dt > 0.0 ? ds / dt : 0.0, gl / (1.0 + gl), mu0, beam[k + 1], beam[k]);
+  }
+  // Upward sweep: what lies below each node reflects rb (1 - rb = vb) and sends up sb.
+  std::vector<double> rb(c.i0.size()), vb(c.i0.size()), sb(c.i0.size());
+  rb[0] = a, vb[0] = 1.0 - a, sb[0] = a * mu0 * std::max(beam[0], 0.0);
+  for (int k = 0; k + 1 < n; ++k) {
+    const Layer& L = layers[static_cast<std::size_t>(k)];
+    const std::size_t K = static_cast<std::size_t>(k);
+    const double den = L.one_minus_r + L.r * vb[K];  // 1 - r rb
+    rb[K + 1] = L.r + L.t * L.t * rb[K] / den;
+    vb[K + 1] = (L.alpha * (L.one_minus_r + L.t) + vb[K] * (L.one_minus_r * L.r + L.t * L.t)) / den;
+    sb[K + 1] = L.su + L.t * (sb[K] + rb[K] * L.sd) / den;
+  }
+  // Downward sweep: no diffuse light comes down at the top.
+  std::vector<double> up(c.i0.size()), down(c.i0.size());
+  const std::size_t top = c.i0.size() - 1;
+  down[top] = 0.0;
+  up[top] = sb[top];
+  for (int k = n - 2; k >= 0; --k) {
+    const Layer& L = layers[static_cast<std::size_t>(k)];
+    const std::size_t K = static_cast<std::size_t>(k);
+    const double den = L.one_minus_r + L.r * vb[K];
+    down[K] = (L.t * down[K + 1] + L.r * sb[K] + L.sd) / den;
+    up[K] = rb[K] * down[K] + sb[K];
+  }
+  for (std::size_t k = 0; k < c.i0.size(); ++k) {
+    c.i0[k] = (up[k] + down[k]) / (2.0 * kPi);
+    c.i1[k] = 3.0 * (up[k] - down[k]) / (4.0 * kPi);
+  }
+  c.reflected = up[top] / mu0;
+  const double down0 = down[0] + mu0 * std::max(beam[0], 0.0);
+  c.transmitted = down0 / mu0;
+  c.absorbed_ground = (1.0 - a) * down0 / mu0;
+  return c;
+}
+
 MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun) {
   MsSourceKey k;
   k.to_sun = to_sun;
@@ -91,6 +205,122 @@ MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun) {
   return k;
 }
 
+// The sun's delta-scaled beam per node, swept down level by level (see the header).
+std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<float>& scaled, const glm::dvec3& to_sun_in, int top_level) {
+  const int nx = grid.lon_deg.count, ny = grid.lat_deg.count, nz = grid.alt_m.count;
+  std::vector<float> beam(grid.points(), 1.0f);
+  if (nx < 1 || ny < 1 || nz < 1 || scaled.size() != grid.points()) return beam;
+  const glm::dvec3 to_sun = glm::length(to_sun_in) > 0.0 ? glm::normalize(to_sun_in) : glm::dvec3(0.0, 0.0, 1.0);
+  const bool wraps = grid.wraps_lon();
+  const double d2r = kPi / 180.0, dz = std::abs(grid.alt_m.step);
+  top_level = std::clamp(top_level, 0, nz - 1);
+  // Per column: the upstream point's shift per level in index units, the path per level (m) and its
+  // sub-samples, or mu0 <= 0 (the sun down: no beam).
+  struct Shift {
+    double di = 0.0, dj = 0.0, path = 0.0;
+    int sub = 1;
+    bool lit = false;
+  };
+  std::vector<Shift> shift(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+  for (int j = 0; j < ny; ++j) {
+    const double lat = grid.lat_deg.at(j);
+    const double dx = grid.earth_radius_m * std::cos(lat * d2r) * grid.lon_deg.step * d2r;
+    const double dy = grid.earth_radius_m * grid.lat_deg.step * d2r;
+    for (int i = 0; i < nx; ++i) {
+      const geo::EnuFrame f = geo::sphere_enu(lat, grid.lon_deg.at(i));
+      const double mu0 = glm::dot(f.up, to_sun);
+      Shift& s = shift[static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i)];
+      if (!(mu0 > 1e-4)) continue;
+      s.lit = true;
+      const double run = dz / mu0;  // metres along the ray per level
+      s.di = std::abs(dx) > 1e-9 ? run * glm::dot(f.east, to_sun) / dx : 0.0;
+      s.dj = std::abs(dy) > 1e-9 ? run * glm::dot(f.north, to_sun) / dy : 0.0;
+      s.path = run;
+      s.sub = static_cast<int>(std::clamp(std::ceil(2.0 * std::max({std::abs(s.di), std::abs(s.dj), 1.0})), 2.0, 64.0));
+    }
+  }
+  // Index-space lookups: outside a regional grid is clear air; longitude wraps on global grids and
+  // latitude clamps at the edge rows.
+  auto column_of = [&](double fi, double fj, int& i0, int& i1, int& j0, int& j1, double& wi, double& wj) {
+    if (wraps) {
+      fi = std::fmod(fi, double(nx));
+      if (fi < 0.0) fi += nx;
+    } else if (fi < 0.0 || fi > nx - 1) {
+      return false;
+    }
+    if (fj < 0.0 || fj > ny - 1) {
+      if (!(grid.lat_deg.at(0) <= -89.0 || grid.lat_deg.last() >= 89.0 || grid.lat_deg.at(0) >= 89.0 || grid.lat_deg.last() <= -89.0)) return false;
+      fj = std::clamp(fj, 0.0, double(ny - 1));
+    }
+    i0 = std::min(static_cast<int>(fi), nx - 1), j0 = std::min(static_cast<int>(fj), ny - 1);
+    wi = fi - i0, wj = fj - j0;
+    i1 = wraps ? (i0 + 1) % nx : std::min(i0 + 1, nx - 1);
+    j1 = std::min(j0 + 1, ny - 1);
+    return true;
+  };
+  auto level_value = [&](const float* lv, double fi, double fj) {
+    int i0, i1, j0, j1;
+    double wi, wj;
+    if (!column_of(fi, fj, i0, i1, j0, j1, wi, wj)) return 0.0;
+    auto v = [&](int i, int j) { return double(lv[static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i)]); };
+    return (1.0 - wj) * ((1.0 - wi) * v(i0, j0) + wi * v(i1, j0)) + wj * ((1.0 - wi) * v(i0, j1) + wi * v(i1, j1));
+  };
+  const std::size_t layer = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
+  // beam holds tau' while the sweep runs (levels above top_level: 0), then exp(-tau').
+  std::fill(beam.begin(), beam.end(), 0.0f);
+  constexpr int stride = 8;
+  // Per column, the number of levels m (1..stride) after which the upstream point lies nearest to
+  // grid nodes: the bilinear reading of the optical depth there smears least per level (the smear
+  // of one reading is frac (1 - frac) cells squared in each direction).
+  std::vector<std::uint8_t> hop(shift.size(), 1);
+  for (std::size_t c = 0; c < shift.size(); ++c) {
+    double best = 1e30;
+    // At most 64 pieces of path per node: a low sun's long steps take one level at a time.
+    const int most = std::clamp(64 / std::max(shift[c].sub, 1), 1, stride);
+    for (int m = 1; m <= most; ++m) {
+      auto f = [](double x) {
+        const double r = x - std::floor(x);
+        return r * (1.0 - r);
+      };
+      const double smear = (f(m * shift[c].di) + f(m * shift[c].dj)) / m;
+      if (smear < best - 1e-12) best = smear, hop[c] = static_cast<std::uint8_t>(m);
+    }
+  }
+  for (int k = top_level; k >= 0; --k) {
+    parallel_ranges(static_cast<std::size_t>(ny), 16, [&](std::size_t jb, std::size_t je, unsigned) {
+      for (std::size_t j = jb; j < je; ++j) {
+        for (int i = 0; i < nx; ++i) {
+          const std::size_t c = j * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
+          const Shift& sh = shift[c];
+          const int m = std::min(int(hop[c]), nz - 1 - k);
+          double tau = 0.0;
+          if (!sh.lit) {
+            tau = 1e30;
+          } else if (m > 0) {
+            // The path up m levels (midpoints of sub pieces per level, linear between levels), then
+            // the optical depth already reached at the upstream point on level k + m.
+            double sum = 0.0;
+            const int pieces = sh.sub * m;
+            for (int q = 0; q < pieces; ++q) {
+              const double t = (q + 0.5) / sh.sub;  // levels above k
+              const int lo = std::min(static_cast<int>(t), m - 1);
+              const double w = t - lo;
+              const double fi = i + t * sh.di, fj = double(j) + t * sh.dj;
+              const float* s0 = scaled.data() + static_cast<std::size_t>(k + lo) * layer;
+              sum += (1.0 - w) * level_value(s0, fi, fj) + w * level_value(s0 + layer, fi, fj);
+            }
+            tau = sum / sh.sub * sh.path + (k + m <= top_level ? level_value(beam.data() + static_cast<std::size_t>(k + m) * layer, i + m * sh.di, double(j) + m * sh.dj) : 0.0);
+          }
+          beam[static_cast<std::size_t>(k) * layer + c] = static_cast<float>(std::min(tau, 1e30));
+        }
+      }
+    });
+  }
+  for (std::size_t n = 0; n <= static_cast<std::size_t>(top_level) * layer + layer - 1 && n < beam.size(); ++n) beam[n] = static_cast<float>(std::exp(-std::min(double(beam[n]), 700.0)));
+  for (std::size_t n = static_cast<std::size_t>(top_level + 1) * layer; n < beam.size(); ++n) beam[n] = 1.0f;
+  return beam;
+}
+
 MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
   const auto t0 = std::chrono::steady_clock::now();
   const VolumeGrid& grid = v.grid;
@@ -98,14 +328,13 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
   MsSource out;
   out.i0.assign(grid.points(), 0.0f);
   out.i1.assign(grid.points(), 0.0f);
-  std::vector<double> sigma(static_cast<std::size_t>(nz)), g(static_cast<std::size_t>(nz));
   const glm::dvec3 to_sun = glm::length(key.to_sun) > 0.0 ? glm::normalize(key.to_sun) : glm::dvec3(0.0);
+  // The medium shown, per node: extinction, asymmetry and the delta-scaled extinction the beam
+  // meets; and the highest level with cloud (the beam is whole above the level over it).
+  std::vector<float> sig(grid.points(), 0.0f), gn(grid.points(), 0.0f), scaled(grid.points(), 0.0f);
+  int top_level = -1;
   for (int j = 0; j < ny; ++j) {
     for (int i = 0; i < nx; ++i) {
-      const double lat = grid.lat_deg.at(j), lon = grid.lon_deg.at(i);
-      const double mu0 = glm::dot(geo::sphere_enu(lat, lon).up, to_sun);
-      if (!(mu0 > 0.0)) continue;  // night: no source
-      bool any = false;
       // The column's ground, as the march's band test reads it at a node (the column map's second channel).
       const std::size_t col = grid.column(i, j);
       const double ground = kColumnMapChannels * col + 1 < v.column_maps.size() ? double(v.column_maps[kColumnMapChannels * col + 1]) : 0.0;
@@ -114,18 +343,48 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
         const bool shown = key.mask.shown(grid.alt_m.at(k), ground);
         const double sl = shown && !key.mask.hide_liquid ? std::max(0.0, double(v.extinction.liquid_per_m[idx])) : 0.0;
         const double si = shown && !key.mask.hide_ice ? std::max(0.0, double(v.extinction.ice_per_m[idx])) : 0.0;
-        sigma[static_cast<std::size_t>(k)] = sl + si;
-        g[static_cast<std::size_t>(k)] = sl + si > 0.0 ? (sl * key.liquid_g + si * key.ice_g) / (sl + si) : 0.0;
-        any = any || sl + si > 0.0;
-      }
-      if (!any) continue;  // a clear column holds no diffuse light from cloud (the sky is the air's)
-      const TwoStreamColumn c = two_stream_column(sigma.data(), g.data(), nz, grid.alt_m.step, mu0, key.ground_albedo);
-      for (int k = 0; k < nz; ++k) {
-        out.i0[grid.index(i, j, k)] = static_cast<float>(c.i0[static_cast<std::size_t>(k)]);
-        out.i1[grid.index(i, j, k)] = static_cast<float>(c.i1[static_cast<std::size_t>(k)]);
+        if (!(sl + si > 0.0)) continue;
+        sig[idx] = static_cast<float>(sl + si);
+        gn[idx] = static_cast<float>((sl * key.liquid_g + si * key.ice_g) / (sl + si));
+        scaled[idx] = static_cast<float>(sl * (1.0 - key.liquid_g * key.liquid_g) + si * (1.0 - key.ice_g * key.ice_g));
+        top_level = std::max(top_level, std::min(k + 1, nz - 1));
       }
     }
   }
+  if (top_level < 0) {
+    out.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return out;
+  }
+  // The sun's beam through the cloud in three dimensions: light that enters a cloud's sunlit side
+  // feeds its columns as light through the top does (docs/physics.md, "The columns lit by the
+  // beam in three dimensions").
+  const std::vector<float> beam_node = sun_beam_field(grid, scaled, to_sun, top_level);
+  parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
+    std::vector<double> sigma(static_cast<std::size_t>(nz)), g(static_cast<std::size_t>(nz)), leak(static_cast<std::size_t>(nz), 0.0),
+        beam(static_cast<std::size_t>(nz));
+    for (std::size_t jj = jb; jj < je; ++jj) {
+      const int j = static_cast<int>(jj);
+      for (int i = 0; i < nx; ++i) {
+        const double mu0 = glm::dot(geo::sphere_enu(grid.lat_deg.at(j), grid.lon_deg.at(i)).up, to_sun);
+        if (!(mu0 > 0.0)) continue;  // night: no source
+        bool any = false;
+        for (int k = 0; k < nz; ++k) {
+          const std::size_t idx = grid.index(i, j, k), K = static_cast<std::size_t>(k);
+          sigma[K] = sig[idx];
+          g[K] = gn[idx];
+          beam[K] = beam_node[idx];
+          any = any || sig[idx] > 0.0f;
+        }
+        if (!any) continue;  // a clear column holds no diffuse light from cloud (the sky is the air's)
+        const TwoStreamColumn c = two_stream_column_general(sigma.data(), g.data(), leak.data(), beam.data(), nz, grid.alt_m.step, mu0,
+                                                            key.ground_albedo);
+        for (int k = 0; k < nz; ++k) {
+          out.i0[grid.index(i, j, k)] = static_cast<float>(c.i0[static_cast<std::size_t>(k)]);
+          out.i1[grid.index(i, j, k)] = static_cast<float>(c.i1[static_cast<std::size_t>(k)]);
+        }
+      }
+    }
+  });
   out.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

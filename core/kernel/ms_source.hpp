@@ -40,6 +40,22 @@ enum class TwoStreamClosure { Eddington, Quadrature };
 TwoStreamColumn two_stream_column(const double* sigma_per_m, const double* g, int n, double dz_m, double mu0,
                                   double ground_albedo, TwoStreamClosure closure = TwoStreamClosure::Quadrature);
 
+// The same column with a leakage (1/m, light lost out of the column's sides, per node) and the
+// sun's scaled beam given per node (irradiance normal to the beam, 0..1: the 3-D sun march's
+// exp(-(1 - g^2) tau_sun)) instead of the plane-parallel exp(-tau'/mu0): layers solved by the
+// adding method (quadrature closure). With no leakage and the plane-parallel beam it is
+// two_stream_column's quadrature solution.
+TwoStreamColumn two_stream_column_general(const double* sigma_per_m, const double* g, const double* leak_per_m,
+                                          const double* beam, int n, double dz_m, double mu0, double ground_albedo);
+
+// The sun's delta-scaled beam exp(-tau') at every node (0..1), tau' the optical depth of the scaled
+// extinction `scaled` (1/m, the grid's layout) toward the sun: swept down from level top_level
+// (above it the beam is 1), each node's tau' the upstream point's on the level above (bilinear,
+// the sun's direction taken in the column's local frame) plus the path between the levels
+// (midpoints, linear between the two levels' values). Outside a regional grid is clear air; the sun
+// below the horizon gives 0.
+std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<float>& scaled, const glm::dvec3& to_sun, int top_level);
+
 // The source over a prepared volume: i0 and i1 per grid node (the grid's layout), as R32F textures.
 struct MsSource {
   std::vector<float> i0, i1;
@@ -61,6 +77,9 @@ struct MsSourceKey {
 // the constant ground_albedo where the globe is drawn, else 0).
 MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun);
 
+// Each grid column with cloud is one two_stream_column_general, fed by the 3-D beam of
+// sun_beam_field through the medium shown (a sunlit side lights its columns as a top does), with no
+// leakage; columns run on the machine's cores.
 MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key);
 
 // The forward peak of a phase function p(mu) (normalised over the sphere, mu the cosine of the

@@ -5,18 +5,21 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <random>
 #include <vector>
 
+#include "geo/geodesy.hpp"
 #include "kernel/march_kernel.hpp"
 #include "kernel/ms_source.hpp"
 #include "physics/physics.hpp"
 #include "settings/march_settings.hpp"
 #include "support/bubble_scene.hpp"
 #include "volume/grid_mean.hpp"
+#include "volume/sampler.hpp"
 
 namespace cv::core {
 namespace {
@@ -148,6 +151,176 @@ TEST(TwoStream, NoNanOrInfAtExtremes) {
   std::vector<double> s(5, std::nan("")), g(5, 0.85);
   const TwoStreamColumn bad = two_stream_column(s.data(), g.data(), 5, 10.0, 0.5, 0.0);
   for (std::size_t k = 0; k < bad.i0.size(); ++k) EXPECT_TRUE(std::isfinite(bad.i0[k]) && std::isfinite(bad.i1[k]));
+}
+
+// The general column (leakage, a beam given per node) with no leakage and the plane-parallel beam
+// exp(-tau'/mu0) is the closed-form quadrature column, node for node: a layered column with clear
+// gaps, two phases' asymmetries and a grey ground, at optical depths up to 10^4.
+TEST(TwoStream, TheGeneralColumnIsTheClosedFormWithoutLeakage) {
+  for (double scale : {0.01, 1.0, 30.0, 1000.0}) {
+    for (double mu0 : {1.0, 0.45, 0.05}) {
+      const int n = 60;
+      const double dz = 100.0;
+      std::vector<double> s(n), g(n), leak(n, 0.0), beam(n);
+      for (int k = 0; k < n; ++k) {
+        const bool gap = k > 20 && k < 27;
+        s[static_cast<std::size_t>(k)] = gap ? 0.0 : scale * 1e-3 * (1.0 + 0.7 * std::sin(0.3 * k));
+        g[static_cast<std::size_t>(k)] = k > 40 ? 0.75 : 0.86;
+      }
+      double tau = 0.0;  // scaled, from the top, as the closed form takes it
+      beam[n - 1] = 1.0;
+      for (int k = n - 2; k >= 0; --k) {
+        const std::size_t K = static_cast<std::size_t>(k);
+        const double st = s[K] + s[K + 1];
+        const double gl = st > 0.0 ? (s[K + 1] * g[K + 1] + s[K] * g[K]) / st : 0.0;
+        tau += (1.0 - gl * gl) * 0.5 * st * dz;
+        beam[K] = std::exp(-tau / mu0);
+      }
+      const TwoStreamColumn a = two_stream_column(s.data(), g.data(), n, dz, mu0, 0.3);
+      const TwoStreamColumn b = two_stream_column_general(s.data(), g.data(), leak.data(), beam.data(), n, dz, mu0, 0.3);
+      for (std::size_t k = 0; k < a.i0.size(); ++k) {
+        EXPECT_NEAR(b.i0[k], a.i0[k], 1e-9 + 1e-7 * std::abs(a.i0[k])) << scale << " " << mu0 << " node " << k;
+        EXPECT_NEAR(b.i1[k], a.i1[k], 1e-9 + 1e-7 * std::abs(a.i1[k])) << scale << " " << mu0 << " node " << k;
+      }
+      EXPECT_NEAR(b.reflected, a.reflected, 1e-9) << scale << " " << mu0;
+      EXPECT_NEAR(b.transmitted, a.transmitted, 1e-9) << scale << " " << mu0;
+    }
+  }
+}
+
+// Leakage takes light out of the column and never adds any: over a black ground reflected plus
+// transmitted light stays below the incident, falls as the leakage grows, and every node's mean
+// radiance falls with it; a beam from the side (larger below than above) stays finite and positive.
+TEST(TwoStream, LeakageOnlyTakesLightOut) {
+  const int n = 40;
+  const double dz = 200.0, mu0 = 0.6;
+  std::vector<double> s(n, 0.02), g(n, 0.86), beam(n);
+  for (int k = 0; k < n; ++k) beam[static_cast<std::size_t>(k)] = std::exp(-(1.0 - 0.86 * 0.86) * 0.02 * dz * (n - 1 - k) / mu0);
+  TwoStreamColumn last = two_stream_column_general(s.data(), g.data(), std::vector<double>(n, 0.0).data(), beam.data(), n, dz, mu0, 0.0);
+  EXPECT_NEAR(last.reflected + last.transmitted, 1.0, 1e-9);
+  for (double l : {1e-6, 1e-5, 1e-4, 1e-3, 1e-1, 10.0}) {
+    const std::vector<double> leak(n, l);
+    const TwoStreamColumn c = two_stream_column_general(s.data(), g.data(), leak.data(), beam.data(), n, dz, mu0, 0.0);
+    EXPECT_LT(c.reflected + c.transmitted, last.reflected + last.transmitted) << l;
+    EXPECT_GT(c.reflected, 0.0) << l;
+    for (std::size_t k = 0; k < c.i0.size(); ++k) {
+      EXPECT_LE(c.i0[k], last.i0[k] * (1.0 + 1e-12) + 1e-300) << l << " node " << k;
+      EXPECT_GE(c.i0[k], 0.0) << l << " node " << k;
+    }
+    last = c;
+  }
+  // Lit from the side: the beam grows downward, the top is dark; and extremes of every input.
+  for (double scale : {0.0, 1e-9, 1.0, 1e4}) {
+    for (double side : {0.0, 1e-300, 0.5, 1.0}) {
+      std::vector<double> ss(n, 0.02 * scale), b2(n), leak(n, 1e-4 * scale);
+      for (int k = 0; k < n; ++k) b2[static_cast<std::size_t>(k)] = k < n / 2 ? side : 0.0;
+      const TwoStreamColumn c = two_stream_column_general(ss.data(), g.data(), leak.data(), b2.data(), n, dz, mu0, 0.2);
+      for (std::size_t k = 0; k < c.i0.size(); ++k) {
+        ASSERT_TRUE(std::isfinite(c.i0[k]) && std::isfinite(c.i1[k]) && c.i0[k] >= 0.0) << scale << " " << side << " node " << k;
+      }
+      EXPECT_LE(c.reflected * mu0, 1.0);
+    }
+  }
+}
+
+// The 3-D beam's sweep against a straight march along the ray to the sun (VolumeSampler, the
+// march's own trilinear reading, in steps of 20 m): optical depths within 0.1 + 3 % at every node
+// of a blob of cloud and around it, for suns from four sides and two heights; on a regional grid
+// whose edge is clear air, and on a global one whose longitudes wrap across the seam. The blob is
+// 3.6 cells across, so a shadow's edge smeared by the bilinear reading shows: reading every level
+// (no hops) misses by up to 0.49 (0.86 against 0.37).
+double marched_depth(const VolumeGrid& grid, const std::vector<float>& scaled, int i, int j, int k, const glm::dvec3& to_sun) {
+  const VolumeSampler sampler(grid, scaled);
+  const glm::dvec3 p0 = geo::sphere_to_ecef({grid.lat_deg.at(j), grid.lon_deg.at(i), grid.alt_m.at(k)}, grid.earth_radius_m);
+  double tau = 0.0;
+  const double step = 20.0;
+  for (int n = 0; n < 1000000; ++n) {
+    const geo::Geodetic q = geo::ecef_to_sphere(p0 + to_sun * ((n + 0.5) * step), grid.earth_radius_m);
+    if (q.alt_m > grid.alt_m.last()) break;
+    tau += sampler.sample(q.lat_deg, q.lon_deg, q.alt_m, 0.0) * step;
+  }
+  return tau;
+}
+
+TEST(TwoStream, TheBeamsSweepFollowsTheRayToTheSun) {
+  for (bool global : {false, true}) {
+    VolumeGrid grid;
+    grid.lon_deg = global ? RegularAxis{-180.0, 0.05, 7200} : RegularAxis{-0.3, 0.01, 61};
+    grid.lat_deg = global ? RegularAxis{-2.0, 0.05, 81} : RegularAxis{-0.3, 0.01, 61};
+    grid.alt_m = {0.0, 250.0, 25};
+    std::vector<float> scaled(grid.points(), 0.0f);
+    // A blob 4 km across (global: 40 km, across the seam at 180 degrees), 1-4 km up, 2e-3 /m at its
+    // heart (global: 2e-4).
+    const double c_lon = global ? 179.95 : 0.0, radius_km = global ? 20.0 : 2.0, peak = global ? 2e-4 : 2e-3;
+    for (int k = 0; k < grid.alt_m.count; ++k) {
+      for (int j = 0; j < grid.lat_deg.count; ++j) {
+        for (int i = 0; i < grid.lon_deg.count; ++i) {
+          double dl = grid.lon_deg.at(i) - c_lon;
+          dl -= 360.0 * std::round(dl / 360.0);
+          const double dx = dl * 111.195, dy = grid.lat_deg.at(j) * 111.195, dz = (grid.alt_m.at(k) - 2500.0) / 1000.0;
+          const double r2 = (dx * dx + dy * dy) / (radius_km * radius_km) + dz * dz / 2.25;
+          if (r2 < 1.0) scaled[grid.index(i, j, k)] = static_cast<float>(peak * (1.0 - r2));
+        }
+      }
+    }
+    for (double zenith : {30.0, 60.0}) {
+      for (double azimuth : {0.0, 90.0, 180.0, 270.0}) {
+        // The sun's direction in the blob's local frame, then in Earth-centred coordinates.
+        const geo::EnuFrame f = geo::sphere_enu(0.0, c_lon);
+        const double z = zenith * 3.14159265358979 / 180.0, a = azimuth * 3.14159265358979 / 180.0;
+        const glm::dvec3 to_sun = std::cos(z) * f.up + std::sin(z) * (std::sin(a) * f.east + std::cos(a) * f.north);
+        const std::vector<float> beam = sun_beam_field(grid, scaled, to_sun, grid.alt_m.count - 1);
+        int checked = 0;
+        for (int k = 2; k < grid.alt_m.count; k += 3) {
+          for (int dj = -12; dj <= 12; dj += 3) {
+            for (int di = -12; di <= 12; di += 3) {
+              const int j = grid.lat_deg.count / 2 + dj;
+              int i = global ? static_cast<int>(std::lround((c_lon - grid.lon_deg.start) / grid.lon_deg.step)) + di : grid.lon_deg.count / 2 + di;
+              if (global) i = ((i % grid.lon_deg.count) + grid.lon_deg.count) % grid.lon_deg.count;
+              const double want = marched_depth(grid, scaled, i, j, k, to_sun);
+              const double got = -std::log(std::max<double>(beam[grid.index(i, j, k)], 1e-300));
+              ASSERT_NEAR(got, want, 0.1 + 0.03 * want) << (global ? "global" : "regional") << " sun " << zenith << "/" << azimuth
+                                                          << " node " << i << " " << j << " " << k;
+              ++checked;
+            }
+          }
+        }
+        EXPECT_GT(checked, 50);
+      }
+    }
+  }
+}
+
+// Lit from the side: under a low sun the node on a cloud's sunlit side, below its top, keeps most
+// of the beam where the plane-parallel column would have it through the whole depth above
+// (exp(-3 / 0.34) = 1.5e-4), the far side and the lee keep little, clear air upstream all of it;
+// each as the straight march finds it. The sun below the horizon gives no beam anywhere.
+TEST(TwoStream, TheBeamLightsASunlitSide) {
+  VolumeGrid grid;
+  grid.lon_deg = {-0.2, 0.01, 41};
+  grid.lat_deg = {-0.2, 0.01, 41};
+  grid.alt_m = {0.0, 200.0, 31};
+  std::vector<float> scaled(grid.points(), 0.0f);
+  for (int k = 5; k <= 25; ++k) {
+    for (int j = 15; j <= 25; ++j) {
+      for (int i = 15; i <= 25; ++i) scaled[grid.index(i, j, k)] = 0.001f;  // a tower 11 km across, 4 km tall
+    }
+  }
+  const geo::EnuFrame f = geo::sphere_enu(0.0, 0.0);
+  const double z = 70.0 * 3.14159265358979 / 180.0;
+  const glm::dvec3 from_east = std::cos(z) * f.up + std::sin(z) * f.east;
+  const std::vector<float> beam = sun_beam_field(grid, scaled, from_east, grid.alt_m.count - 1);
+  const auto at = [&](int i, int j, int k) { return double(beam[grid.index(i, j, k)]); };
+  EXPECT_GT(at(25, 20, 10), 0.3);   // the east face, 3 km below the top
+  EXPECT_LT(at(15, 20, 10), 1e-3);  // the west face: 8 km of the tower (optical depth 9) toward the sun
+  EXPECT_LT(at(10, 20, 8), 0.02);   // in the tower's lee
+  EXPECT_EQ(at(35, 20, 10), 1.0);   // clear air east of it
+  for (const auto& n : {std::array<int, 3>{25, 20, 10}, {15, 20, 10}, {10, 20, 8}, {20, 20, 15}, {24, 18, 6}}) {
+    const double want = marched_depth(grid, scaled, n[0], n[1], n[2], from_east);
+    EXPECT_NEAR(-std::log(std::max(at(n[0], n[1], n[2]), 1e-300)), want, 0.1 + 0.03 * want) << n[0] << " " << n[1] << " " << n[2];
+  }
+  const std::vector<float> night = sun_beam_field(grid, scaled, -f.up, grid.alt_m.count - 1);
+  for (float b : night) ASSERT_EQ(b, 0.0f);
 }
 
 }  // namespace
