@@ -37,16 +37,12 @@ enum class TwoStreamClosure { Eddington, Quadrature };
 // asymmetry g at n nodes spaced dz_m apart (bottom first), the sun at cosine mu0 > 0 to the
 // vertical, a Lambertian ground of albedo ground_albedo (0..1) below the lowest node. Closed form for
 // single-scattering albedo 1 (no eigenvalues, no exponential growth): stable for any optical depth.
+// beam: the sun's delta-scaled beam per node (irradiance normal to the beam per unit incident,
+// 0..1; sun_beam_field gives it in 3-D, so light through a sunlit side feeds the column), or null
+// for the plane-parallel exp(-tau'/mu0) through the column from its top.
 TwoStreamColumn two_stream_column(const double* sigma_per_m, const double* g, int n, double dz_m, double mu0,
-                                  double ground_albedo, TwoStreamClosure closure = TwoStreamClosure::Quadrature);
-
-// The same column with a leakage (1/m, light lost out of the column's sides, per node) and the
-// sun's scaled beam given per node (irradiance normal to the beam, 0..1: the 3-D sun march's
-// exp(-(1 - g^2) tau_sun)) instead of the plane-parallel exp(-tau'/mu0): layers solved by the
-// adding method (quadrature closure). With no leakage and the plane-parallel beam it is
-// two_stream_column's quadrature solution.
-TwoStreamColumn two_stream_column_general(const double* sigma_per_m, const double* g, const double* leak_per_m,
-                                          const double* beam, int n, double dz_m, double mu0, double ground_albedo);
+                                  double ground_albedo, TwoStreamClosure closure = TwoStreamClosure::Quadrature,
+                                  const double* beam = nullptr);
 
 // The sun's delta-scaled beam exp(-tau') at every node (0..1), tau' the optical depth of the scaled
 // extinction `scaled` (1/m, the grid's layout) toward the sun: swept down from level top_level
@@ -77,9 +73,9 @@ struct MsSourceKey {
 // the constant ground_albedo where the globe is drawn, else 0).
 MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun);
 
-// Each grid column with cloud is one two_stream_column_general, fed by the 3-D beam of
-// sun_beam_field through the medium shown (a sunlit side lights its columns as a top does), with no
-// leakage; columns run on the machine's cores.
+// Each grid column with cloud is one two_stream_column, fed by the 3-D beam of sun_beam_field
+// through the medium shown (a sunlit side lights its columns as a top does); columns run on the
+// machine's cores.
 MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key);
 
 // The forward peak of a phase function p(mu) (normalised over the sphere, mu the cosine of the
