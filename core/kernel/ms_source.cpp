@@ -192,8 +192,8 @@ std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<floa
     return (1.0 - wj) * ((1.0 - wi) * v(i0, j0) + wi * v(i1, j0)) + wj * ((1.0 - wi) * v(i0, j1) + wi * v(i1, j1));
   };
   const std::size_t layer = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
-  // beam holds tau' while the sweep runs (levels above top_level: 0), then exp(-tau').
-  std::fill(beam.begin(), beam.end(), 0.0f);
+  // beam holds tau' on the levels swept while the sweep runs (each is written before a level below
+  // reads it), then exp(-tau'); above top_level it stays 1.
   constexpr int stride = 8;
   // Per column, the number of levels m (1..stride) after which the upstream point lies nearest to
   // grid nodes: the bilinear reading of the optical depth there smears least per level (the smear
@@ -260,8 +260,10 @@ std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<floa
       }
     });
   }
-  for (std::size_t n = 0; n <= static_cast<std::size_t>(top_level) * layer + layer - 1 && n < beam.size(); ++n) beam[n] = static_cast<float>(std::exp(-std::min(double(beam[n]), 700.0)));
-  for (std::size_t n = static_cast<std::size_t>(top_level + 1) * layer; n < beam.size(); ++n) beam[n] = 1.0f;
+  const std::size_t swept = static_cast<std::size_t>(top_level + 1) * layer;
+  parallel_ranges(swept, std::size_t(1) << 16, [&](std::size_t b, std::size_t e, unsigned) {
+    for (std::size_t n = b; n < e; ++n) beam[n] = static_cast<float>(std::exp(-std::min(double(beam[n]), 700.0)));
+  });
   return beam;
 }
 
