@@ -89,8 +89,9 @@ TwoStreamColumn two_stream_column(const double* sigma, const double* g, int n, d
         i1 = d * e1 * (1.0 - z * (0.5 - z / 6.0));
         i2 = d * d * e1 * (0.5 - z * (1.0 / 6.0 - z / 24.0));
       } else {
-        i1 = d * (e1 - e2) / z;
-        i2 = d * d * (e1 * (z - 1.0) + e2) / (z * z);
+        const double iz = 1.0 / z;  // 0 for a beam gone within the layer (mu0 -> 0: z = inf)
+        i1 = d * (e1 - e2) * iz;
+        i2 = d * d * (e1 * (1.0 - iz) + e2 * iz) * iz;
       }
     }
     ie2[K] = i2;

@@ -134,7 +134,7 @@ TEST(TwoStream, ThickerIsBrighterAndLayersCompose) {
 
 TEST(TwoStream, NoNanOrInfAtExtremes) {
   for (double tau : {0.0, 1e-9, 1e4, 1e7}) {
-    for (double mu0 : {1.0, 1e-3, 1e-9}) {
+    for (double mu0 : {1.0, 1e-3, 1e-9, 1e-300, 5e-324}) {
       for (double a : {0.0, 0.5, 1.0}) {
         const TwoStreamColumn c = homogeneous(tau, 0.999, mu0, a);
         for (std::size_t k = 0; k < c.i0.size(); ++k) {
