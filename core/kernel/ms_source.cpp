@@ -276,24 +276,27 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
   out.i0.assign(grid.points(), 0.0f);
   out.i1.assign(grid.points(), 0.0f);
   const glm::dvec3 to_sun = glm::length(key.to_sun) > 0.0 ? glm::normalize(key.to_sun) : glm::dvec3(0.0);
-  // The medium shown, per node: extinction, asymmetry and the delta-scaled extinction the beam
-  // meets; and the highest level with cloud (the beam is whole above the level over it).
-  std::vector<float> sig(grid.points(), 0.0f), gn(grid.points(), 0.0f), scaled(grid.points(), 0.0f);
+  // The medium shown at a node (the layer mask and the hidden phases as the march reads them):
+  // liquid and ice extinction.
+  auto shown_at = [&](int i, int j, int k, double& sl, double& si) {
+    // The column's ground, as the march's band test reads it at a node (the column map's second channel).
+    const std::size_t col = grid.column(i, j), idx = grid.index(i, j, k);
+    const double ground = kColumnMapChannels * col + 1 < v.column_maps.size() ? double(v.column_maps[kColumnMapChannels * col + 1]) : 0.0;
+    const bool shown = key.mask.shown(grid.alt_m.at(k), ground);
+    sl = shown && !key.mask.hide_liquid ? std::max(0.0, double(v.extinction.liquid_per_m[idx])) : 0.0;
+    si = shown && !key.mask.hide_ice ? std::max(0.0, double(v.extinction.ice_per_m[idx])) : 0.0;
+  };
+  // The delta-scaled extinction the beam meets, and the highest level with cloud (the beam is whole
+  // above the level over it).
+  std::vector<float> scaled(grid.points(), 0.0f);
   int top_level = -1;
   for (int k = 0; k < nz; ++k) {
     for (int j = 0; j < ny; ++j) {
       for (int i = 0; i < nx; ++i) {
-        // The column's ground, as the march's band test reads it at a node (the column map's second channel).
-        const std::size_t col = grid.column(i, j);
-        const double ground = kColumnMapChannels * col + 1 < v.column_maps.size() ? double(v.column_maps[kColumnMapChannels * col + 1]) : 0.0;
-        const std::size_t idx = grid.index(i, j, k);
-        const bool shown = key.mask.shown(grid.alt_m.at(k), ground);
-        const double sl = shown && !key.mask.hide_liquid ? std::max(0.0, double(v.extinction.liquid_per_m[idx])) : 0.0;
-        const double si = shown && !key.mask.hide_ice ? std::max(0.0, double(v.extinction.ice_per_m[idx])) : 0.0;
+        double sl, si;
+        shown_at(i, j, k, sl, si);
         if (!(sl + si > 0.0)) continue;
-        sig[idx] = static_cast<float>(sl + si);
-        gn[idx] = static_cast<float>((sl * key.liquid_g + si * key.ice_g) / (sl + si));
-        scaled[idx] = static_cast<float>(sl * (1.0 - key.liquid_g * key.liquid_g) + si * (1.0 - key.ice_g * key.ice_g));
+        scaled[grid.index(i, j, k)] = static_cast<float>(sl * (1.0 - key.liquid_g * key.liquid_g) + si * (1.0 - key.ice_g * key.ice_g));
         top_level = std::max(top_level, std::min(k + 1, nz - 1));
       }
     }
@@ -315,11 +318,13 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
         if (!(mu0 > 0.0)) continue;  // night: no source
         bool any = false;
         for (int k = 0; k < nz; ++k) {
-          const std::size_t idx = grid.index(i, j, k), K = static_cast<std::size_t>(k);
-          sigma[K] = sig[idx];
-          g[K] = gn[idx];
-          beam[K] = beam_node[idx];
-          any = any || sig[idx] > 0.0f;
+          const std::size_t K = static_cast<std::size_t>(k);
+          double sl, si;
+          shown_at(i, j, k, sl, si);
+          sigma[K] = sl + si;
+          g[K] = sl + si > 0.0 ? (sl * key.liquid_g + si * key.ice_g) / (sl + si) : 0.0;
+          beam[K] = beam_node[grid.index(i, j, k)];
+          any = any || sl + si > 0.0;
         }
         if (!any) continue;  // a clear column holds no diffuse light from cloud (the sky is the air's)
         const TwoStreamColumn c = two_stream_column(sigma.data(), g.data(), nz, grid.alt_m.step, mu0, key.ground_albedo,
