@@ -215,7 +215,7 @@ AddingColumn adding_column(const std::vector<double>& s, const std::vector<doubl
 // The closed form with the beam given per node: the plane-parallel beam passed explicitly is the
 // column without one, and beams of any profile (a sunlit side's beam growing downward, a shadow's
 // gap, a constant beam) are the adding solution's fluxes at every node, on a layered column with
-// clear gaps, two phases' asymmetries and a grey ground, at optical depths from 0.6 to 6e4.
+// clear gaps, two phases' asymmetries and a grey ground, at optical depths from 0.05 to 5e3.
 TEST(TwoStream, TheColumnTakesAnyBeamProfile) {
   const double pi = 3.14159265358979323846;
   for (double scale : {0.01, 1.0, 30.0, 1000.0}) {
