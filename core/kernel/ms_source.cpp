@@ -11,6 +11,7 @@
 #include "io/parallel.hpp"
 #include "kernel/ms_beam.glsl"
 #include "physics/physics.hpp"
+#include "volume/sampler.hpp"
 
 namespace cv::core {
 namespace {
@@ -139,6 +140,7 @@ std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<floa
   if (nx < 1 || ny < 1 || nz < 1 || scaled.size() != grid.points()) return beam;
   const glm::dvec3 to_sun = glm::length(to_sun_in) > 0.0 ? glm::normalize(to_sun_in) : glm::dvec3(0.0, 0.0, 1.0);
   const bool wraps = grid.wraps_lon();
+  const bool global_lat = VolumeSampler(grid, scaled).global_lat();  // rows to the poles: latitude clamps, as the march reads
   const double d2r = kPi / 180.0, dz = std::abs(grid.alt_m.step);
   top_level = std::clamp(top_level, 0, nz - 1);
   // Per column: the upstream point's shift per level in index units, the path per level (m) and its
@@ -176,7 +178,7 @@ std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<floa
       return false;
     }
     if (fj < 0.0 || fj > ny - 1) {
-      if (!(grid.lat_deg.at(0) <= -89.0 || grid.lat_deg.last() >= 89.0 || grid.lat_deg.at(0) >= 89.0 || grid.lat_deg.last() <= -89.0)) return false;
+      if (!global_lat) return false;
       fj = std::clamp(fj, 0.0, double(ny - 1));
     }
     i0 = std::min(static_cast<int>(fi), nx - 1), j0 = std::min(static_cast<int>(fj), ny - 1);
