@@ -46,10 +46,12 @@ TwoStreamColumn two_stream_column(const double* sigma_per_m, const double* g, in
 
 // The sun's delta-scaled beam exp(-tau') at every node (0..1), tau' the optical depth of the scaled
 // extinction `scaled` (1/m, the grid's layout) toward the sun: swept down from level top_level
-// (above it the beam is 1), each node's tau' the upstream point's on the level above (bilinear,
-// the sun's direction taken in the column's local frame) plus the path between the levels
-// (midpoints, linear between the two levels' values). Outside a regional grid is clear air; the sun
-// below the horizon gives 0.
+// (above it the beam is 1), each node's tau' the upstream point's on a level 1 to 8 above (bilinear,
+// the sun's direction taken in the column's local frame; per column the hop whose upstream point
+// falls nearest to nodes, so the readings smear a shadow's edge least, with at most 64 pieces of
+// path per node) plus the path between (the trapezoid, points between levels linear between the
+// two levels' values). Outside a regional grid is clear air; latitude clamps at the edge rows of a
+// grid whose rows reach both poles; the sun below the horizon gives 0.
 std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<float>& scaled, const glm::dvec3& to_sun, int top_level);
 
 // The source over a prepared volume: i0 and i1 per grid node (the grid's layout), as R32F textures.
@@ -77,6 +79,16 @@ MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun);
 // through the medium shown (a sunlit side lights its columns as a top does); columns run on the
 // machine's cores.
 MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key);
+
+// A source built ahead for a volume (PreparedVolume::ms_prebuilt) and the key it was built for.
+struct PrebuiltMsSource {
+  MsSourceKey key;
+  MsSource source;
+};
+
+// The source a march of v needs for `key`: v's prebuilt one where its key is the same (no work),
+// else built now. `built` says which (true: built here).
+std::shared_ptr<const MsSource> ms_source_for(const PreparedVolume& v, const MsSourceKey& key, bool* built = nullptr);
 
 // The forward peak of a phase function p(mu) (normalised over the sphere, mu the cosine of the
 // scattering angle) that holds the share f of its scattering, cut at the level c (1/sr): the
