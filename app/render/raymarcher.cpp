@@ -222,7 +222,9 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
   if (s.medium.ms_two_stream) {  // the two-stream source, for this time step and sun
     const core::MsSourceKey key = core::ms_source_key(s, params.u_to_sun);
     if (!ms_[0] || ms_volume_ != &v || !(key == ms_key_)) {
-      const core::MsSource src = core::build_ms_source(v, key);
+      bool built = true;
+      const std::shared_ptr<const core::MsSource> ms = core::ms_source_for(v, key, &built);  // built ahead by the viewer's prefetcher, or now
+      const core::MsSource& src = *ms;
       if (!ms_[0]) {
         glCreateTextures(GL_TEXTURE_3D, 2, ms_);
         const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
@@ -234,7 +236,8 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
       glTextureSubImage3D(ms_[1], 0, 0, 0, 0, grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count, GL_RED, GL_FLOAT,
                           src.i1.data());
       check_gl("uploading the two-stream source");
-      ms_volume_ = &v, ms_key_ = key, ms_build_ms_ = src.build_ms;
+      ms_volume_ = &v, ms_key_ = key, ms_build_ms_ = src.build_ms, ms_built_here_ = built;
+      ++ms_count_[built ? 0 : 1];
     }
   }
   // The droplets' beam table (core::ms_peaks, remembered there per droplet size): always bound, since

@@ -166,6 +166,11 @@ class GpuRaymarcher {
   // Wall time of the last build of the two-stream source (ms; 0 before any), rebuilt only when the
   // time step, the sun or the medium's phases change.
   double ms_source_build_ms() const { return ms_build_ms_; }
+  // Whether the source in use was built on this thread (false: the volume's prebuilt one), and how
+  // many sources were built here and taken prebuilt so far.
+  bool ms_source_built_here() const { return ms_built_here_; }
+  std::size_t ms_sources_built_here() const { return ms_count_[0]; }
+  std::size_t ms_sources_taken_prebuilt() const { return ms_count_[1]; }
 
  private:
   static constexpr int kStatCounters = 8;  // 64-bit counters in the Stats buffer (CV_STAT_COUNT, kernel/march_stats.glsl)
@@ -198,6 +203,8 @@ class GpuRaymarcher {
   core::MsSourceKey ms_key_;
   const core::PreparedVolume* ms_volume_ = nullptr;
   double ms_build_ms_ = 0.0;
+  bool ms_built_here_ = true;
+  std::size_t ms_count_[2] = {0, 0};  // sources built here, taken prebuilt
   GLuint ms_beam_buffer_ = 0;         // the droplets' beam table (CV_SSBO_MS_BEAM)
   std::shared_ptr<const core::MsBeamTable> ms_beam_uploaded_;  // the table it holds
   GLuint column_tau_ = 0;           // the column maps (RGBA32F): optical depth (the octave gate), ground, cloud type

@@ -4,9 +4,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "geo/geodesy.hpp"
 #include "geo/solar.hpp"
+#include "kernel/ms_source.hpp"
+#include "scene/frame_spec.hpp"
 #include "scene/instant.hpp"
 #include "scene_source.hpp"
 #include "volume/grid_mean.hpp"
@@ -97,7 +100,8 @@ double local_solar_time_h(double lon_deg, std::int64_t unix_s) {
 }
 
 std::size_t prepared_bytes(const core::PreparedVolume& v) {
-  return (v.extinction.liquid_per_m.size() + v.extinction.ice_per_m.size() + v.columns.tau.size()) * sizeof(float) +
+  const std::size_t source = v.ms_prebuilt ? v.ms_prebuilt->source.i0.size() + v.ms_prebuilt->source.i1.size() : 0;
+  return (v.extinction.liquid_per_m.size() + v.extinction.ice_per_m.size() + v.columns.tau.size() + source) * sizeof(float) +
          v.pyramid_packed.size() * sizeof(glm::vec2);
 }
 
@@ -116,8 +120,13 @@ Prefetcher::~Prefetcher() {
   worker_.join();
 }
 
-void Prefetcher::want(const std::vector<std::int64_t>& instants, core::TimeInterpolation mode, bool detail_drift) {
+void Prefetcher::want(const std::vector<std::int64_t>& instants, core::TimeInterpolation mode, bool detail_drift,
+                      const core::Scene* source_scene) {
+  // The scene copied outside the lock (the worker copies the pointer only).
+  std::shared_ptr<const core::Scene> scene =
+      source_scene && source_scene->render.march.medium.ms_two_stream ? std::make_shared<const core::Scene>(*source_scene) : nullptr;
   std::lock_guard<std::mutex> lock(mutex_);
+  source_scene_ = std::move(scene);
   if (mode != mode_ || detail_drift != drift_) ready_.clear();  // prepared for another mode: not what is shown now
   mode_ = mode;
   drift_ = detail_drift;
@@ -169,9 +178,11 @@ void Prefetcher::run() {
     }
     const core::TimeInterpolation mode = mode_;
     const bool drift = drift_;
+    const std::shared_ptr<const core::Scene> source_scene = source_scene_;
     lock.unlock();
     Ready r;
     std::string error;
+    double source_ms = -1.0;
     const auto t0 = std::chrono::steady_clock::now();
     try {
       const core::Instant at = core::instant_at_time(volume_.times, core::format_iso_utc(todo), scene_.data.path);
@@ -184,7 +195,24 @@ void Prefetcher::run() {
         e0 = core::interpolate_extinction(volume_.grid, e0, e1, w0, w1, at.gap_s, at.fraction, mode, &r.report);
       }
       e0.detail_drift_cells = std::move(d);
-      r.volume = std::make_shared<const core::PreparedVolume>(core::prepare_volume(volume_.grid, std::move(e0), drift));  // the weather textures for the modelled cloud only
+      auto prepared = std::make_shared<core::PreparedVolume>(core::prepare_volume(volume_.grid, std::move(e0), drift));  // the weather textures for the modelled cloud only
+      if (source_scene) {
+        try {
+          // The two-stream source for the sun at this instant, with the key the render thread's march
+          // will ask for: the scene resolved at the instant as the viewer resolves it. A scene that
+          // does not resolve (a sun being typed) leaves the source to the render thread.
+          core::Scene at_instant = *source_scene;
+          at_instant.time.valid_utc = core::format_iso_utc(todo);
+          const core::FrameSpec spec = core::resolve_frame(at_instant, volume_);
+          auto pre = std::make_shared<core::PrebuiltMsSource>();
+          pre->key = core::ms_source_key(spec.march, core::march_params(*prepared, spec.march_camera, spec.sun, spec.march).u_to_sun);
+          pre->source = core::build_ms_source(*prepared, pre->key);
+          source_ms = pre->source.build_ms;
+          prepared->ms_prebuilt = std::move(pre);
+        } catch (const std::invalid_argument&) {
+        }
+      }
+      r.volume = std::move(prepared);
     } catch (const std::exception& e) {
       error = e.what();
     }
@@ -211,6 +239,7 @@ void Prefetcher::run() {
     ready_[todo] = std::move(r);
     ++stats_.prepared;
     stats_.last_prepare_ms = ms;
+    if (source_ms >= 0.0) ++stats_.sources, stats_.last_source_ms = source_ms;
     changed_.notify_all();
   }
 }

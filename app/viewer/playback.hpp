@@ -54,7 +54,9 @@ struct PrefetchStats {
   std::size_t max_resident = 0;
   std::size_t hits = 0, misses = 0;  // instants found ready / not ready when shown
   std::size_t prepared = 0;          // instants the worker prepared
-  double last_prepare_ms = 0.0;
+  double last_prepare_ms = 0.0;      // the last instant's preparation, its source included
+  std::size_t sources = 0;           // two-stream sources the worker built ahead
+  double last_source_ms = 0.0;       // the last one's build
 };
 
 // The longitude where the camera's centre ray meets the sphere of radius r0_m (the camera's own
@@ -76,8 +78,13 @@ class Prefetcher {
 
   // The instants wanted, most urgent first; those beyond max_resident are ignored. Resident instants
   // not wanted are evicted as room is needed. `detail_drift`: the media carry the modelled cloud's
-  // wind displacement (core::DetailDrift).
-  void want(const std::vector<std::int64_t>& instants, core::TimeInterpolation mode, bool detail_drift = false);
+  // wind displacement (core::DetailDrift). `source_scene` (the scene shown; null: none): where its
+  // march uses the two-stream source, each instant prepared from now on carries the source for the
+  // sun at that instant and the scene's medium (PreparedVolume::ms_prebuilt), built on the worker's
+  // thread, so the render thread does not build it while the forecast plays. A scene changed since
+  // (another sun mode, droplet size or layer mask) only makes the render thread build its own.
+  void want(const std::vector<std::int64_t>& instants, core::TimeInterpolation mode, bool detail_drift = false,
+            const core::Scene* source_scene = nullptr);
   // The prepared instant if ready (counted as a hit), else nullptr (a miss). `wait`: block until ready.
   std::shared_ptr<const core::PreparedVolume> get(std::int64_t t, bool wait, core::TimeInterpolationReport* report = nullptr);
   PrefetchStats stats() const;
@@ -97,6 +104,7 @@ class Prefetcher {
   std::vector<std::int64_t> wanted_;
   core::TimeInterpolation mode_ = core::TimeInterpolation::Auto;
   bool drift_ = false;
+  std::shared_ptr<const core::Scene> source_scene_;  // the scene the sources are built for (null: none)
   core::DetailDrift detail_drift_;  // the worker's alone
   std::map<std::int64_t, Ready> ready_;
   PrefetchStats stats_;

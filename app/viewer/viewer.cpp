@@ -799,7 +799,7 @@ int run_viewer(const ViewerOptions& o) {
         wanted.insert(wanted.end(), next.begin(), next.end());
       }
       const bool drift = s.scene.render.march.medium.modelled;
-      prefetch->want(wanted, s.scene.time.interpolation, drift);
+      prefetch->want(wanted, s.scene.time.interpolation, drift, &s.scene);  // the two-stream sources built ahead too
       core::TimeInterpolationReport interp;
       const bool first_ask = want_t != shown_instant || drift != shown_drift;
       auto v = first_ask ? prefetch->get(want_t, (o.frames > 0 && !o.realtime) || !have_volume, &interp) : nullptr;
@@ -825,9 +825,10 @@ int run_viewer(const ViewerOptions& o) {
       }
       const PrefetchStats ps = prefetch->stats();
       char text[200];
-      std::snprintf(text, sizeof text, "prefetch: %zu/%zu instants resident, %.1f MB, hits %zu, misses %zu (%.0f %%), last %.0f ms",
+      std::snprintf(text, sizeof text, "prefetch: %zu/%zu instants resident, %.1f MB, hits %zu, misses %zu (%.0f %%), last %.0f ms%s",
                     ps.resident, ps.max_resident, double(ps.resident_bytes) / 1e6, ps.hits, ps.misses,
-                    ps.hits + ps.misses ? 100.0 * double(ps.hits) / double(ps.hits + ps.misses) : 0.0, ps.last_prepare_ms);
+                    ps.hits + ps.misses ? 100.0 * double(ps.hits) / double(ps.hits + ps.misses) : 0.0, ps.last_prepare_ms,
+                    ps.sources ? (" (its two-stream source " + std::to_string(static_cast<int>(std::lround(ps.last_source_ms))) + " ms)").c_str() : "");
       stats.prefetch = text;
     } else {  // the scene's instant: between steps the medium is interpolated once per instant (core::PreparedVolumeCache)
       core::Instant at;
@@ -1109,6 +1110,9 @@ int run_viewer(const ViewerOptions& o) {
       }
       if (budget.on()) std::printf("frame budget %g ms: ended on %s\n", s.scene.render.budget_ms, budget.status().c_str());
       if (!stats.prefetch.empty()) std::printf("%s\n", stats.prefetch.c_str());
+      if (prefetch && (main_view.renderer.raymarcher().ms_sources_built_here() || main_view.renderer.raymarcher().ms_sources_taken_prebuilt()))
+        std::printf("two-stream sources of view 0: %zu taken as the prefetcher built them, %zu built on the render thread\n",
+                    main_view.renderer.raymarcher().ms_sources_taken_prebuilt(), main_view.renderer.raymarcher().ms_sources_built_here());
     }
     win->swap_buffers();
     if (frame == 0) after_first = clock::now(), cpu_after_first = std::clock();

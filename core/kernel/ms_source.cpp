@@ -342,6 +342,13 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
   return out;
 }
 
+std::shared_ptr<const MsSource> ms_source_for(const PreparedVolume& v, const MsSourceKey& key, bool* built) {
+  const bool ahead = v.ms_prebuilt && v.ms_prebuilt->key == key;
+  if (built) *built = !ahead;
+  if (ahead) return std::shared_ptr<const MsSource>(v.ms_prebuilt, &v.ms_prebuilt->source);
+  return std::make_shared<const MsSource>(build_ms_source(v, key));
+}
+
 MsPeak ms_peak(const std::function<double(double)>& phase, double f) {
   // The phase on cosines packed geometrically toward the forward direction (a droplet's peak is
   // narrower than a degree: 1 - mu down to 1e-10), integrated by the trapezoid in mu.

@@ -25,6 +25,8 @@ namespace cv::core {
 // Floats per column of PreparedVolume::column_maps.
 inline constexpr std::size_t kColumnMapChannels = 4;
 
+struct PrebuiltMsSource;  // kernel/ms_source.hpp
+
 struct PreparedVolume {
   VolumeGrid grid;
   GridMeanExtinction extinction;
@@ -51,6 +53,11 @@ struct PreparedVolume {
   // blend: nothing moves).
   double time_s = std::numeric_limits<double>::quiet_NaN();
   AngularFlow flow;
+  // The two-stream source built ahead for one key (the viewer's prefetcher builds it on its thread
+  // for the sun at this instant, so playback does not build it on the render thread), or null. The
+  // marches take it where their key matches (ms_source_for) and build their own otherwise. Set
+  // before the volume is shared, never after.
+  std::shared_ptr<const PrebuiltMsSource> ms_prebuilt;
 };
 
 // With `weather` false the weather textures are left out (weather.nx == 0, the column maps' type

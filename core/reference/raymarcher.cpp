@@ -42,11 +42,11 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   const MediumMask hidden = medium_mask(s);
   const std::vector<float> masked_columns = hidden.any() ? column_maps_for(v, hidden) : std::vector<float>{};
   k.u_column_tau = {(hidden.any() ? masked_columns : v.column_maps).data(), {v.columns.nx, v.columns.ny}, int(kColumnMapChannels)};
-  MsSource ms;  // the two-stream source, built as the GPU's (core/kernel/ms_source)
+  std::shared_ptr<const MsSource> ms;  // the two-stream source, as the GPU's (core/kernel/ms_source)
   if (s.medium.ms_two_stream) {
-    ms = build_ms_source(v, ms_source_key(s, k.u_to_sun));
-    k.u_ms_i0 = {ms.i0.data(), n};
-    k.u_ms_i1 = {ms.i1.data(), n};
+    ms = ms_source_for(v, ms_source_key(s, k.u_to_sun));
+    k.u_ms_i0 = {ms->i0.data(), n};
+    k.u_ms_i1 = {ms->i1.data(), n};
   }
   const MsPeaks peaks = s.medium.ms_two_stream ? ms_peaks(s) : MsPeaks{};  // holds the droplets' beam table
   if (peaks.beam) k.u_ms_beam_table = peaks.beam->values.data();

@@ -2,7 +2,12 @@
 // file's steps, the instants prefetching asks for; and the local solar time.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "geo/solar.hpp"
+#include "scene_source.hpp"
+#include "kernel/ms_source.hpp"
+#include "render/frame_renderer.hpp"
 #include "scene/instant.hpp"
 #include "viewer/playback.hpp"
 
@@ -61,6 +66,59 @@ TEST(LocalSolarTime, IsNoonUnderTheSun) {
   EXPECT_NEAR(local_solar_time_h(lon, t), 12.0, 1e-9);
   EXPECT_NEAR(local_solar_time_h(lon + 90.0, t), 18.0, 1e-9);
   EXPECT_NEAR(local_solar_time_h(lon - 180.0, t), 0.0, 1e-9);
+}
+
+// Playback takes each instant's two-stream source as the prefetcher built it on its own thread: for
+// the sun at that instant and with the key the render thread's march asks for (the scene resolved
+// at the instant as the viewer resolves it), the same numbers a build on the render thread gives.
+TEST(Prefetcher, BuildsEachInstantsSourceForItsOwnSun) {
+  core::Scene scene;
+  scene.data.path = CV_SAMPLE_FILE;
+  scene.width = 64, scene.height = 36;
+  ASSERT_TRUE(scene.render.march.medium.ms_two_stream);  // the default model
+  const core::CloudVolume vol = importers::load_scene_volume(scene, 2);
+  ASSERT_GE(vol.times.size(), 2u);
+  const std::int64_t t0 = vol.times[0].unix_s, t1 = (vol.times[0].unix_s + vol.times[1].unix_s) / 2;  // a step, and between two
+  Prefetcher prefetch(scene, 4);
+  prefetch.want({t0, t1}, core::TimeInterpolation::Auto, false, &scene);
+  glm::dvec3 suns[2];
+  for (int n = 0; n < 2; ++n) {
+    const std::int64_t t = n ? t1 : t0;
+    const std::shared_ptr<const core::PreparedVolume> v = prefetch.get(t, true);
+    ASSERT_TRUE(v);
+    ASSERT_TRUE(v->ms_prebuilt) << "instant " << t;
+    core::Scene at = scene;
+    at.time.valid_utc = core::format_iso_utc(t);
+    const core::FrameSpec spec = render::resolve_frame(at, vol);
+    const core::MsSourceKey key = core::ms_source_key(spec.march, core::march_params(*v, spec.march_camera, spec.sun, spec.march).u_to_sun);
+    EXPECT_TRUE(v->ms_prebuilt->key == key) << "instant " << t;
+    suns[n] = key.to_sun;
+    bool built = true;
+    const std::shared_ptr<const core::MsSource> taken = core::ms_source_for(*v, key, &built);
+    EXPECT_FALSE(built);
+    EXPECT_EQ(taken.get(), &v->ms_prebuilt->source);
+    const core::MsSource fresh = core::build_ms_source(*v, key);
+    EXPECT_EQ(fresh.i0, taken->i0);
+    EXPECT_EQ(fresh.i1, taken->i1);
+    EXPECT_GT(*std::max_element(taken->i0.begin(), taken->i0.end()), 0.0f);  // the sample's cloud is lit
+    // Another medium (a droplet size that changes the phase's mean cosine) is built, not taken.
+    core::MsSourceKey other = key;
+    other.liquid_g += 0.01;
+    EXPECT_NE(core::ms_source_for(*v, other, &built).get(), &v->ms_prebuilt->source);
+    EXPECT_TRUE(built);
+  }
+  EXPECT_GT(glm::length(suns[0] - suns[1]), 1e-3);  // 90 minutes apart: the sun has moved
+  EXPECT_EQ(prefetch.stats().sources, 2u);
+  // No scene, or a scene on the octave model: no source built ahead.
+  Prefetcher none(scene, 1);
+  none.want({t0}, core::TimeInterpolation::Auto, false, nullptr);
+  EXPECT_FALSE(none.get(t0, true)->ms_prebuilt);
+  core::Scene octaves = scene;
+  octaves.render.march.medium.ms_two_stream = false;
+  Prefetcher octave(octaves, 1);
+  octave.want({t0}, core::TimeInterpolation::Auto, false, &octaves);
+  EXPECT_FALSE(octave.get(t0, true)->ms_prebuilt);
+  EXPECT_EQ(octave.stats().sources, 0u);
 }
 
 }  // namespace
