@@ -133,16 +133,23 @@ MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun) {
   return k;
 }
 
-// The sun's delta-scaled beam per node, swept down level by level (see the header).
-std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<float>& scaled, const glm::dvec3& to_sun_in, int top_level) {
+namespace {
+// sun_beam_field into `beam` (grid.points() floats, none of them `scaled`'s): the levels above
+// top_level are set to 1, every node at or below it is written.
+void sweep_sun_beam(const VolumeGrid& grid, const float* scaled, const glm::dvec3& to_sun_in, int top_level, float* beam) {
   const int nx = grid.lon_deg.count, ny = grid.lat_deg.count, nz = grid.alt_m.count;
-  std::vector<float> beam(grid.points(), 1.0f);
-  if (nx < 1 || ny < 1 || nz < 1 || scaled.size() != grid.points()) return beam;
+  if (nx < 1 || ny < 1 || nz < 1) {
+    std::fill(beam, beam + grid.points(), 1.0f);
+    return;
+  }
   const glm::dvec3 to_sun = glm::length(to_sun_in) > 0.0 ? glm::normalize(to_sun_in) : glm::dvec3(0.0, 0.0, 1.0);
   const bool wraps = grid.wraps_lon();
-  const bool global_lat = VolumeSampler(grid, scaled).global_lat();  // rows to the poles: latitude clamps, as the march reads
+  static const std::vector<float> kNoField;
+  const bool global_lat = VolumeSampler(grid, kNoField).global_lat();  // rows to the poles: latitude clamps, as the march reads
   const double d2r = kPi / 180.0, dz = std::abs(grid.alt_m.step);
   top_level = std::clamp(top_level, 0, nz - 1);
+  const std::size_t layer = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
+  std::fill(beam + static_cast<std::size_t>(top_level + 1) * layer, beam + grid.points(), 1.0f);
   // Per column: the upstream point's shift per level in index units, the path per level (m) and its
   // sub-samples, or mu0 <= 0 (the sun down: no beam).
   struct Shift {
@@ -194,7 +201,6 @@ std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<floa
     auto v = [&](int i, int j) { return double(lv[static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i)]); };
     return (1.0 - wj) * ((1.0 - wi) * v(i0, j0) + wi * v(i1, j0)) + wj * ((1.0 - wi) * v(i0, j1) + wi * v(i1, j1));
   };
-  const std::size_t layer = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
   // beam holds tau' on the levels swept while the sweep runs (each is written before a level below
   // reads it), then exp(-tau'); above top_level it stays 1.
   constexpr int stride = 8;
@@ -244,7 +250,7 @@ std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<floa
               const int lo = std::min(q / sh.sub, m - 1), rem = q - lo * sh.sub;  // level below the point, and sub-steps past it
               const double t = double(q) / sh.sub;
               const double fi = i + t * sh.di, fj = double(j) + t * sh.dj;
-              const float* s0 = scaled.data() + static_cast<std::size_t>(k + lo) * layer;
+              const float* s0 = scaled + static_cast<std::size_t>(k + lo) * layer;
               double v;
               if (rem == 0) {
                 v = level_value(s0, fi, fj);
@@ -256,7 +262,7 @@ std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<floa
               }
               sum += q == pieces ? 0.5 * v : v;
             }
-            tau = sum / sh.sub * sh.path + (k + m <= top_level ? level_value(beam.data() + static_cast<std::size_t>(k + m) * layer, i + m * sh.di, double(j) + m * sh.dj) : 0.0);
+            tau = sum / sh.sub * sh.path + (k + m <= top_level ? level_value(beam + static_cast<std::size_t>(k + m) * layer, i + m * sh.di, double(j) + m * sh.dj) : 0.0);
           }
           beam[static_cast<std::size_t>(k) * layer + c] = static_cast<float>(std::min(tau, 1e30));
         }
@@ -267,6 +273,13 @@ std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<floa
   parallel_ranges(swept, std::size_t(1) << 16, [&](std::size_t b, std::size_t e, unsigned) {
     for (std::size_t n = b; n < e; ++n) beam[n] = static_cast<float>(std::exp(-std::min(double(beam[n]), 700.0)));
   });
+}
+}  // namespace
+
+// The sun's delta-scaled beam per node, swept down level by level (see the header).
+std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<float>& scaled, const glm::dvec3& to_sun, int top_level) {
+  std::vector<float> beam(grid.points(), 1.0f);
+  if (scaled.size() == grid.points()) sweep_sun_beam(grid, scaled.data(), to_sun, top_level, beam.data());
   return beam;
 }
 
@@ -274,9 +287,8 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
   const auto t0 = std::chrono::steady_clock::now();
   const VolumeGrid& grid = v.grid;
   const int nx = grid.lon_deg.count, ny = grid.lat_deg.count, nz = grid.alt_m.count;
+  const std::size_t layer = static_cast<std::size_t>(std::max(nx, 0)) * static_cast<std::size_t>(std::max(ny, 0));
   MsSource out;
-  out.i0.assign(grid.points(), 0.0f);
-  out.i1.assign(grid.points(), 0.0f);
   const glm::dvec3 to_sun = glm::length(key.to_sun) > 0.0 ? glm::normalize(key.to_sun) : glm::dvec3(0.0);
   // The medium shown at a node (the layer mask and the hidden phases as the march reads them):
   // liquid and ice extinction.
@@ -288,21 +300,32 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
     sl = shown && !key.mask.hide_liquid ? std::max(0.0, double(v.extinction.liquid_per_m[idx])) : 0.0;
     si = shown && !key.mask.hide_ice ? std::max(0.0, double(v.extinction.ice_per_m[idx])) : 0.0;
   };
-  // The delta-scaled extinction the beam meets, and the highest level with cloud (the beam is whole
-  // above the level over it).
-  std::vector<float> scaled(grid.points(), 0.0f);
-  int top_level = -1;
-  for (int k = 0; k < nz; ++k) {
-    for (int j = 0; j < ny; ++j) {
-      for (int i = 0; i < nx; ++i) {
-        double sl, si;
-        shown_at(i, j, k, sl, si);
-        if (!(sl + si > 0.0)) continue;
-        scaled[grid.index(i, j, k)] = static_cast<float>(sl * (1.0 - key.liquid_g * key.liquid_g) + si * (1.0 - key.ice_g * key.ice_g));
-        top_level = std::max(top_level, std::min(k + 1, nz - 1));
+  // The two outputs hold the build's scratch until the columns overwrite them, so a global grid's
+  // build makes no arrays beyond its output (fresh pages cost more than the arithmetic here): i0
+  // holds the delta-scaled extinction the beam meets, i1 the beam (sun_beam_field). Each column
+  // reads its own beam before it writes its i0 and i1; a column left out is zeroed.
+  out.i0.assign(grid.points(), 0.0f);
+  out.i1.assign(grid.points(), 0.0f);
+  float* scaled = out.i0.data();
+  float* beam = out.i1.data();
+  // The scaled extinction, and the highest level with cloud (the beam is whole above the level
+  // over it), rows on the machine's cores.
+  std::vector<int> row_top(static_cast<std::size_t>(std::max(ny, 0)), -1);
+  parallel_ranges(static_cast<std::size_t>(std::max(ny, 0)), 8, [&](std::size_t jb, std::size_t je, unsigned) {
+    for (std::size_t jj = jb; jj < je; ++jj) {
+      const int j = static_cast<int>(jj);
+      for (int k = 0; k < nz; ++k) {
+        for (int i = 0; i < nx; ++i) {
+          double sl, si;
+          shown_at(i, j, k, sl, si);
+          if (!(sl + si > 0.0)) continue;
+          scaled[grid.index(i, j, k)] = static_cast<float>(sl * (1.0 - key.liquid_g * key.liquid_g) + si * (1.0 - key.ice_g * key.ice_g));
+          row_top[jj] = std::max(row_top[jj], std::min(k + 1, nz - 1));
+        }
       }
     }
-  }
+  });
+  const int top_level = row_top.empty() ? -1 : *std::max_element(row_top.begin(), row_top.end());
   if (top_level < 0) {
     out.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return out;
@@ -310,14 +333,21 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
   // The sun's beam through the cloud in three dimensions: light that enters a cloud's sunlit side
   // feeds its columns as light through the top does (docs/physics.md, "The columns lit by the
   // beam in three dimensions").
-  const std::vector<float> beam_node = sun_beam_field(grid, scaled, to_sun, top_level);
+  sweep_sun_beam(grid, scaled, to_sun, top_level, beam);
   parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
-    std::vector<double> sigma(static_cast<std::size_t>(nz)), g(static_cast<std::size_t>(nz)), beam(static_cast<std::size_t>(nz));
+    std::vector<double> sigma(static_cast<std::size_t>(nz)), g(static_cast<std::size_t>(nz)), col_beam(static_cast<std::size_t>(nz));
     for (std::size_t jj = jb; jj < je; ++jj) {
       const int j = static_cast<int>(jj);
       for (int i = 0; i < nx; ++i) {
+        const std::size_t c = jj * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
+        auto clear = [&] {  // no source here: the scratch goes
+          for (int k = 0; k < nz; ++k) out.i0[c + static_cast<std::size_t>(k) * layer] = 0.0f, out.i1[c + static_cast<std::size_t>(k) * layer] = 0.0f;
+        };
         const double mu0 = glm::dot(geo::sphere_enu(grid.lat_deg.at(j), grid.lon_deg.at(i)).up, to_sun);
-        if (!(mu0 > 0.0)) continue;  // night: no source
+        if (!(mu0 > 0.0)) {  // night: no source
+          clear();
+          continue;
+        }
         bool any = false;
         for (int k = 0; k < nz; ++k) {
           const std::size_t K = static_cast<std::size_t>(k);
@@ -325,15 +355,18 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
           shown_at(i, j, k, sl, si);
           sigma[K] = sl + si;
           g[K] = sl + si > 0.0 ? (sl * key.liquid_g + si * key.ice_g) / (sl + si) : 0.0;
-          beam[K] = beam_node[grid.index(i, j, k)];
+          col_beam[K] = beam[grid.index(i, j, k)];
           any = any || sl + si > 0.0;
         }
-        if (!any) continue;  // a clear column holds no diffuse light from cloud (the sky is the air's)
-        const TwoStreamColumn c = two_stream_column(sigma.data(), g.data(), nz, grid.alt_m.step, mu0, key.ground_albedo,
-                                                    TwoStreamClosure::Quadrature, beam.data());
+        if (!any) {  // a clear column holds no diffuse light from cloud (the sky is the air's)
+          clear();
+          continue;
+        }
+        const TwoStreamColumn tc = two_stream_column(sigma.data(), g.data(), nz, grid.alt_m.step, mu0, key.ground_albedo,
+                                                     TwoStreamClosure::Quadrature, col_beam.data());
         for (int k = 0; k < nz; ++k) {
-          out.i0[grid.index(i, j, k)] = static_cast<float>(c.i0[static_cast<std::size_t>(k)]);
-          out.i1[grid.index(i, j, k)] = static_cast<float>(c.i1[static_cast<std::size_t>(k)]);
+          out.i0[grid.index(i, j, k)] = static_cast<float>(tc.i0[static_cast<std::size_t>(k)]);
+          out.i1[grid.index(i, j, k)] = static_cast<float>(tc.i1[static_cast<std::size_t>(k)]);
         }
       }
     }
