@@ -179,8 +179,10 @@ void sweep_sun_beam(const VolumeGrid& grid, const float* scaled, const glm::dvec
   // latitude clamps at the edge rows.
   auto column_of = [&](double fi, double fj, int& i0, int& i1, int& j0, int& j1, double& wi, double& wj) {
     if (wraps) {
-      fi = std::fmod(fi, double(nx));
-      if (fi < 0.0) fi += nx;
+      if (fi < 0.0 || fi >= nx) {  // fmod only off the grid: most points are on it
+        fi = std::fmod(fi, double(nx));
+        if (fi < 0.0) fi += nx;
+      }
     } else if (fi < 0.0 || fi > nx - 1) {
       return false;
     }
