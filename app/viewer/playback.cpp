@@ -6,6 +6,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <unistd.h>
+
 #include "geo/geodesy.hpp"
 #include "geo/solar.hpp"
 #include "kernel/ms_source.hpp"
@@ -105,8 +107,16 @@ std::size_t prepared_bytes(const core::PreparedVolume& v) {
          v.pyramid_packed.size() * sizeof(glm::vec2);
 }
 
-Prefetcher::Prefetcher(const core::Scene& scene, std::size_t max_resident)
-    : scene_(scene), volume_(importers::load_scene_volume(scene, 2)), max_resident_(std::max<std::size_t>(1, max_resident)) {
+namespace {
+std::size_t quarter_of_memory() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? static_cast<std::size_t>(pages) * static_cast<std::size_t>(page) / 4 : std::size_t(4) << 30;
+}
+}  // namespace
+
+Prefetcher::Prefetcher(const core::Scene& scene, std::size_t max_resident, std::size_t max_bytes)
+    : scene_(scene), volume_(importers::load_scene_volume(scene, 2)), max_resident_(std::max<std::size_t>(1, max_resident)),
+      max_bytes_(max_bytes ? max_bytes : quarter_of_memory()) {
   stats_.max_resident = max_resident_;
   worker_ = std::thread([this] { run(); });
 }
@@ -235,6 +245,15 @@ void Prefetcher::run() {
         }
       if (victim == ready_.end()) victim = ready_.begin();
       ready_.erase(victim);
+    }
+    // The bound in bytes, in instants of this size (the first measures them; never under 2, so the
+    // next instant can be prepared while one is shown). Nothing is ready before the first.
+    if (stats_.prepared == 0 && r.volume) {
+      const std::size_t fits = std::max<std::size_t>(2, max_bytes_ / std::max<std::size_t>(1, prepared_bytes(*r.volume)));
+      if (fits < max_resident_) {
+        max_resident_ = stats_.max_resident = fits;
+        if (wanted_.size() > fits) wanted_.resize(fits);
+      }
     }
     ready_[todo] = std::move(r);
     ++stats_.prepared;

@@ -51,7 +51,7 @@ struct Playhead {
 struct PrefetchStats {
   std::size_t resident = 0;        // prepared instants held
   std::size_t resident_bytes = 0;  // their memory
-  std::size_t max_resident = 0;
+  std::size_t max_resident = 0;    // the bound in instants (lowered to fit the bound in bytes)
   std::size_t hits = 0, misses = 0;  // instants found ready / not ready when shown
   std::size_t prepared = 0;          // instants the worker prepared
   double last_prepare_ms = 0.0;      // the last instant's preparation, its source included
@@ -71,7 +71,10 @@ std::size_t prepared_bytes(const core::PreparedVolume& v);
 class Prefetcher {
  public:
   // Opens its own copy of the scene's data (the viewer's CloudVolume stays on the render thread).
-  Prefetcher(const core::Scene& scene, std::size_t max_resident);
+  // At most max_resident instants stay prepared, and fewer (never under 2) where that many would
+  // hold more than max_bytes (0: a quarter of the machine's memory), as the first instant prepared
+  // measures them: a global 0.25-degree instant with its two-stream source holds about 0.8 GB.
+  Prefetcher(const core::Scene& scene, std::size_t max_resident, std::size_t max_bytes = 0);
   ~Prefetcher();
   Prefetcher(const Prefetcher&) = delete;
   Prefetcher& operator=(const Prefetcher&) = delete;
@@ -98,7 +101,8 @@ class Prefetcher {
   void run();
   core::Scene scene_;
   core::CloudVolume volume_;
-  std::size_t max_resident_;
+  std::size_t max_resident_;  // the bound in instants, lowered to fit max_bytes_ once an instant is measured
+  std::size_t max_bytes_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   std::vector<std::int64_t> wanted_;

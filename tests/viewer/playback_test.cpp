@@ -121,5 +121,40 @@ TEST(Prefetcher, BuildsEachInstantsSourceForItsOwnSun) {
   EXPECT_EQ(octave.stats().sources, 0u);
 }
 
+// A bound in bytes lowers the bound in instants to what fits, measured on the first instant, but
+// never under two; a generous one leaves it.
+TEST(Prefetcher, KeepsToItsBoundInBytes) {
+  core::Scene scene;
+  scene.data.path = CV_SAMPLE_FILE;
+  scene.width = 64, scene.height = 36;
+  const core::CloudVolume vol = importers::load_scene_volume(scene, 2);
+  ASSERT_GE(vol.times.size(), 4u);
+  std::vector<std::int64_t> four;
+  for (std::size_t k = 0; k < 4; ++k) four.push_back(vol.times[k].unix_s);
+  Prefetcher tight(scene, 6, 1);
+  tight.want(four, core::TimeInterpolation::Auto, false, &scene);
+  ASSERT_TRUE(tight.get(four[0], true));
+  EXPECT_EQ(tight.stats().max_resident, 2u);
+  ASSERT_TRUE(tight.get(four[1], true));
+  EXPECT_FALSE(tight.get(four[2], false));  // beyond the bound: not prepared
+  EXPECT_LE(tight.stats().resident, 2u);
+  // Room for three instants with their sources.
+  std::size_t each = 0;
+  {
+    Prefetcher one(scene, 1);
+    one.want({four[0]}, core::TimeInterpolation::Auto, false, &scene);
+    each = prepared_bytes(*one.get(four[0], true));
+  }
+  ASSERT_GT(each, 0u);
+  Prefetcher three(scene, 6, 3 * each + each / 2);
+  three.want(four, core::TimeInterpolation::Auto, false, &scene);
+  ASSERT_TRUE(three.get(four[0], true));
+  EXPECT_EQ(three.stats().max_resident, 3u);
+  Prefetcher roomy(scene, 6, std::size_t(1) << 40);
+  roomy.want(four, core::TimeInterpolation::Auto, false, &scene);
+  ASSERT_TRUE(roomy.get(four[3], true));
+  EXPECT_EQ(roomy.stats().max_resident, 6u);
+}
+
 }  // namespace
 }  // namespace cv::viewer
