@@ -196,13 +196,28 @@ void sweep_sun_beam(const VolumeGrid& grid, const float* scaled, const glm::dvec
     j1 = std::min(j0 + 1, ny - 1);
     return true;
   };
-  auto level_value = [&](const float* lv, double fi, double fj) {
-    int i0, i1, j0, j1;
-    double wi, wj;
-    if (!column_of(fi, fj, i0, i1, j0, j1, wi, wj)) return 0.0;
-    auto v = [&](int i, int j) { return double(lv[static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i)]); };
-    return (1.0 - wj) * ((1.0 - wi) * v(i0, j0) + wi * v(i1, j0)) + wj * ((1.0 - wi) * v(i0, j1) + wi * v(i1, j1));
+  // A point's bilinear reading, found once and read on any level (the last point of a path reads
+  // the extinction and the optical depth already reached there).
+  struct Tap {
+    std::size_t c00 = 0, c10 = 0, c01 = 0, c11 = 0;
+    double wi = 0.0, wj = 0.0;
+    bool in = false;
+    double on(const float* lv) const {
+      if (!in) return 0.0;
+      return (1.0 - wj) * ((1.0 - wi) * double(lv[c00]) + wi * double(lv[c10])) + wj * ((1.0 - wi) * double(lv[c01]) + wi * double(lv[c11]));
+    }
   };
+  auto tap_at = [&](double fi, double fj) {
+    Tap t;
+    int i0, i1, j0, j1;
+    if (!column_of(fi, fj, i0, i1, j0, j1, t.wi, t.wj)) return t;
+    const std::size_t r0 = static_cast<std::size_t>(j0) * static_cast<std::size_t>(nx), r1 = static_cast<std::size_t>(j1) * static_cast<std::size_t>(nx);
+    t.c00 = r0 + static_cast<std::size_t>(i0), t.c10 = r0 + static_cast<std::size_t>(i1);
+    t.c01 = r1 + static_cast<std::size_t>(i0), t.c11 = r1 + static_cast<std::size_t>(i1);
+    t.in = true;
+    return t;
+  };
+  auto level_value = [&](const float* lv, double fi, double fj) { return tap_at(fi, fj).on(lv); };
   // beam holds tau' on the levels swept while the sweep runs (each is written before a level below
   // reads it), then exp(-tau'); above top_level it stays 1.
   constexpr int stride = 8;
@@ -248,7 +263,7 @@ void sweep_sun_beam(const VolumeGrid& grid, const float* scaled, const glm::dvec
             // them), then the optical depth already reached at the upstream point on level k + m.
             const int pieces = sh.sub * m;
             double sum = 0.5 * double(scaled[static_cast<std::size_t>(k) * layer + c]);
-            for (int q = 1; q <= pieces; ++q) {
+            for (int q = 1; q < pieces; ++q) {
               const int lo = std::min(q / sh.sub, m - 1), rem = q - lo * sh.sub;  // level below the point, and sub-steps past it
               const double t = double(q) / sh.sub;
               const double fi = i + t * sh.di, fj = double(j) + t * sh.dj;
@@ -262,9 +277,13 @@ void sweep_sun_beam(const VolumeGrid& grid, const float* scaled, const glm::dvec
                 const double w = double(rem) / sh.sub;
                 v = (1.0 - w) * level_value(s0, fi, fj) + w * level_value(s0 + layer, fi, fj);
               }
-              sum += q == pieces ? 0.5 * v : v;
+              sum += v;
             }
-            tau = sum / sh.sub * sh.path + (k + m <= top_level ? level_value(beam + static_cast<std::size_t>(k + m) * layer, i + m * sh.di, double(j) + m * sh.dj) : 0.0);
+            // The last point, on level k + m: its extinction ends the path, its optical depth adds.
+            const Tap last = tap_at(i + m * sh.di, double(j) + m * sh.dj);
+            const std::size_t up = static_cast<std::size_t>(k + m) * layer;
+            sum += 0.5 * last.on(scaled + up);
+            tau = sum / sh.sub * sh.path + (k + m <= top_level ? last.on(beam + up) : 0.0);
           }
           beam[static_cast<std::size_t>(k) * layer + c] = static_cast<float>(std::min(tau, 1e30));
         }
