@@ -668,7 +668,9 @@ int cmd_render(const std::vector<std::string>& args) {
                 instant.iso_utc.c_str(), instant.step0, a.iso_utc.c_str(), instant.step1, b.iso_utc.c_str(), instant.fraction,
                 instant.gap_s / 3600.0, core::time_interpolation_name(interp.used));
     if (interp.used == core::TimeInterpolation::Advected) {
-      std::printf(" (%d trajectory sub-step(s), winds up to %.3g cells over the gap%s)", interp.substeps, interp.max_courant,
+      std::printf(" (up to %d trajectory sub-step(s)", interp.substeps);
+      if (interp.stride > 1) std::printf(", trajectories on every %d-th node of longitude and latitude", interp.stride);
+      std::printf(", winds up to %.3g cells over the gap%s)", interp.max_courant,
                   interp.vertical_wind ? ", vertical wind included" : ", no vertical wind in the file");
     }
     std::printf(": %.1f ms on the CPU, once per instant (each frame of an animation at a new instant pays it)\n", interp.cost_ms);

@@ -27,7 +27,8 @@ StepWinds step_winds(const TimeStepData& data);
 struct TimeInterpolationReport {
   TimeInterpolation used = TimeInterpolation::Nearest;  // after Auto and the fallback are decided
   std::string warning;       // not empty when `advected` fell back to `linear` (no winds)
-  int substeps = 0;          // trajectory sub-steps per neighbour (advected)
+  int substeps = 0;          // the most trajectory sub-steps any trajectory took (advected)
+  int stride = 1;            // trajectories on every stride-th node of each horizontal axis (advected)
   double max_courant = 0.0;  // the largest wind over the gap, in grid cells (advected)
   bool vertical_wind = false;
   // Per neighbour (earlier, later) and species (liquid, ice): the factor (<= 1) that brought the
@@ -40,6 +41,13 @@ struct TimeInterpolationReport {
 // trajectory accuracy but not stability (every value is interpolated from the source field).
 constexpr int kMaxAdvectionSubsteps = 64;
 
+// Trajectories run on every node of grids up to this many columns (256 x 256); on larger grids on
+// every stride-th node of longitude and latitude (every level), the smallest stride that keeps
+// the lattice within it, and the nodes between take the bilinear blend of their lattice nodes'
+// displacements (docs/physics.md, "Between forecast steps"). A global 0.25-degree grid: stride 4.
+constexpr int kMaxTrajectoryColumns = 65536;
+int trajectory_stride(const VolumeGrid& grid);
+
 // The extinction at `fraction` (0: the earlier step e0, 1: the later e1) of a gap of gap_s seconds.
 // Auto is advected where both steps have horizontal winds, else linear; advected without winds
 // falls back to linear and says so in report.warning. Never negative; finite for any winds and gap.
@@ -49,10 +57,13 @@ GridMeanExtinction interpolate_extinction(const VolumeGrid& grid, const GridMean
 
 // One field carried by the (time-interpolated) winds from step `from` (0 or 1) to `fraction`:
 // trilinear at the departure (from 0) or arrival (from 1) point of each node's trajectory, which
-// runs in sub-steps of the midpoint rule. Exposed for tests; interpolate_extinction uses it.
+// runs in sub-steps of the midpoint rule of at most a cell each where the wind allows (at most
+// kMaxAdvectionSubsteps), on the lattice of trajectory_stride. *substeps: the most any trajectory
+// took. stride 0: trajectory_stride(grid); 1: every node's own trajectory. Exposed for tests;
+// interpolate_extinction carries its fields the same way.
 std::vector<float> advect_field(const VolumeGrid& grid, const std::vector<float>& field, const StepWinds& w0,
                                 const StepWinds& w1, double gap_s, double fraction, int from, int* substeps = nullptr,
-                                double* max_courant = nullptr);
+                                double* max_courant = nullptr, int stride = 0);
 
 // The winds at an instant as the angular motion they give a point, in degrees of longitude and
 // latitude per second (u / ((R + z) cos lat), v / (R + z)), box-averaged onto every `stride`-th

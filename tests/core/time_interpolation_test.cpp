@@ -169,6 +169,105 @@ TEST(TimeInterpolation, AStiffCaseStaysFiniteAndNonNegative) {
   }
 }
 
+// A blob carried 16 rows north and 4 levels up over the gap arrives there whole: the rows and
+// levels beyond a trajectory's reach of any cloud are skipped, and the reach must cover this.
+TEST(TimeInterpolation, AdvectedCarriesABlobAcrossRowsAndLevels) {
+  VolumeGrid g;
+  g.lon_deg = {0.0, 0.5, 32};
+  g.lat_deg = {-8.0, 0.5, 33};
+  g.alt_m = {1000.0, 500.0, 9};
+  std::vector<float> f(g.points(), 0.0f);
+  for (int k = 0; k < 9; ++k)
+    for (int j = 0; j < 33; ++j)
+      for (int i = 0; i < 32; ++i) {
+        const double r2 = (i - 16.0) * (i - 16.0) + (j - 8.0) * (j - 8.0) + 4.0 * (k - 2.0) * (k - 2.0);
+        f[g.index(i, j, k)] = static_cast<float>(1e-3 * std::max(0.0, 1.0 - r2 / 9.0));  // 0 beyond 3 cells
+      }
+  const double gap_s = 6 * 3600.0;
+  const double v = 16.0 * (g.earth_radius_m + 2000.0) * (0.5 * kPi / 180.0) / gap_s, w = 4.0 * 500.0 / gap_s;
+  StepWinds winds;
+  winds.u.assign(g.points(), 0.0f), winds.v.assign(g.points(), static_cast<float>(v)), winds.w.assign(g.points(), static_cast<float>(w));
+  int substeps = 0;
+  const std::vector<float> moved = advect_field(g, f, winds, winds, gap_s, 1.0, 0, &substeps);
+  std::size_t best = 0;
+  for (std::size_t p = 1; p < moved.size(); ++p)
+    if (moved[p] > moved[best]) best = p;
+  const int bi = static_cast<int>(best % 32), bj = static_cast<int>(best / 32 % 33), bk = static_cast<int>(best / (32 * 33));
+  EXPECT_EQ(bi, 16);
+  EXPECT_LE(std::abs(bj - 24), 1) << "16 rows north of row 8";
+  EXPECT_LE(std::abs(bk - 6), 1) << "4 levels above level 2";
+  EXPECT_GT(moved[best], 0.8e-3) << "the blob arrives whole";
+  EXPECT_GE(substeps, 16) << "at most a cell per sub-step";
+  // Nothing is left where the blob was.
+  EXPECT_LT(moved[g.index(16, 8, 2)], 1e-6);
+}
+
+// On grids above kMaxTrajectoryColumns the trajectories run on a lattice and the nodes between
+// blend their displacements: on smooth winds that is the nodes' own trajectories to a small part of
+// a cell (the blend's error is the lattice spacing squared times the displacement's curvature:
+// about 0.01 cell here, against features 10 cells wide).
+TEST(TimeInterpolation, TheTrajectoryLatticeMatchesEveryNodesOwnTrajectoryOnSmoothWinds) {
+  VolumeGrid g;
+  g.lon_deg = {0.0, 0.5, 512};
+  g.lat_deg = {-64.0, 0.5, 256};
+  g.alt_m = {1000.0, 1000.0, 2};
+  ASSERT_EQ(trajectory_stride(g), 2);
+  std::vector<float> f(g.points());
+  StepWinds w;
+  w.u.resize(g.points()), w.v.resize(g.points());
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 256; ++j)
+      for (int i = 0; i < 512; ++i) {
+        const std::size_t p = g.index(i, j, k);
+        f[p] = static_cast<float>(1e-3 * std::max(0.0, std::sin(0.3 * i) * std::sin(0.25 * j)));
+        w.u[p] = static_cast<float>(15.0 + 10.0 * std::sin(2.0 * kPi * i / 256.0));
+        w.v[p] = static_cast<float>(5.0 * std::cos(2.0 * kPi * j / 128.0));
+      }
+  int n_lattice = 0, n_nodes = 0;
+  const std::vector<float> lattice = advect_field(g, f, w, w, 6 * 3600.0, 0.5, 0, &n_lattice);
+  const std::vector<float> nodes = advect_field(g, f, w, w, 6 * 3600.0, 0.5, 0, &n_nodes, nullptr, 1);
+  EXPECT_GE(n_nodes, 4) << "the winds move the field about 5 cells' lengths of latitude";
+  double worst = 0.0, sum = 0.0, moved = 0.0;
+  for (std::size_t p = 0; p < f.size(); ++p) {
+    worst = std::max(worst, double(std::abs(lattice[p] - nodes[p])));
+    sum += std::abs(lattice[p] - nodes[p]);
+    moved += std::abs(nodes[p] - f[p]);
+  }
+  EXPECT_LT(worst, 1e-5) << "1 % of the field's largest value";
+  EXPECT_LT(sum, 1e-3 * moved) << "the lattice's difference is a thousandth of the motion itself";
+  std::printf("lattice against every node: largest difference %.3g, summed %.3g of the motion's\n", worst, sum / moved);
+}
+
+// A global grid on a lattice (its polar rows' zonal winds are thousands of cells over the gap):
+// finite, non-negative, never above the source's largest.
+TEST(TimeInterpolation, AGlobalLatticeWithPolarRowsStaysBounded) {
+  VolumeGrid g;
+  g.lon_deg = {0.0, 0.5, 720};
+  g.lat_deg = {-90.0, 0.5, 361};
+  g.alt_m = {1000.0, 1000.0, 2};
+  ASSERT_TRUE(g.wraps_lon());
+  ASSERT_GT(trajectory_stride(g), 1);
+  std::vector<float> f(g.points());
+  for (std::size_t p = 0; p < f.size(); ++p) f[p] = static_cast<float>(1e-3 * std::max(0.0, std::sin(0.05 * double(p))));
+  StepWinds w0 = uniform(g, 40.0, 20.0), w1 = uniform(g, -30.0, 60.0);
+  w0.u[g.index(3, 360, 1)] = std::numeric_limits<float>::quiet_NaN();
+  w1.v[g.index(700, 0, 0)] = std::numeric_limits<float>::infinity();
+  TimeInterpolationReport r;
+  const GridMeanExtinction out = interpolate_extinction(g, {f, f}, {f, {}}, w0, w1, 12 * 3600.0, 0.4, TimeInterpolation::Advected, &r);
+  EXPECT_EQ(r.stride, trajectory_stride(g));
+  EXPECT_GT(r.max_courant, 1e3) << "the polar rows";
+  EXPECT_LE(r.substeps, kMaxAdvectionSubsteps);
+  const double peak = *std::max_element(f.begin(), f.end());
+  for (const std::vector<float>* field : {&out.liquid_per_m, &out.ice_per_m}) {
+    ASSERT_EQ(field->size(), g.points());
+    for (float v : *field) {
+      ASSERT_TRUE(std::isfinite(v));
+      ASSERT_GE(v, 0.0f);
+      ASSERT_LE(v, peak * (1.0 + 1e-6));
+    }
+  }
+}
+
 std::vector<ValidTime> three_hourly(int n) {
   std::vector<ValidTime> t;
   for (int i = 0; i < n; ++i) {
