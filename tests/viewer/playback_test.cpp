@@ -7,6 +7,7 @@
 #include "geo/solar.hpp"
 #include "scene_source.hpp"
 #include "kernel/ms_source.hpp"
+#include "kernel/volume_cache.hpp"
 #include "render/frame_renderer.hpp"
 #include "scene/instant.hpp"
 #include "viewer/playback.hpp"
@@ -119,6 +120,32 @@ TEST(Prefetcher, BuildsEachInstantsSourceForItsOwnSun) {
   octave.want({t0}, core::TimeInterpolation::Auto, false, &octaves);
   EXPECT_FALSE(octave.get(t0, true)->ms_prebuilt);
   EXPECT_EQ(octave.stats().sources, 0u);
+}
+
+// The prefetcher keeps the last two steps' media and winds for the instants between them; each
+// instant it prepares is the medium the render path prepares (PreparedVolumeCache), bit for bit,
+// through instants that share steps, a step itself, and a return to an earlier pair.
+TEST(Prefetcher, PreparesEachInstantAsTheRenderPathDoes) {
+  core::Scene scene;
+  scene.data.path = CV_SAMPLE_FILE;
+  scene.width = 64, scene.height = 36;
+  core::CloudVolume vol = importers::load_scene_volume(scene, 2);
+  ASSERT_GE(vol.times.size(), 3u);
+  const std::int64_t a = vol.times[0].unix_s, b = vol.times[1].unix_s, c = vol.times[2].unix_s;
+  const std::vector<std::int64_t> order = {a + (b - a) / 4, (a + b) / 2, b, (b + c) / 2, a + (b - a) / 3};
+  Prefetcher prefetch(scene, 1);
+  core::PreparedVolumeCache cache;
+  for (std::int64_t t : order) {
+    prefetch.want({t}, core::TimeInterpolation::Auto);
+    const std::shared_ptr<const core::PreparedVolume> got = prefetch.get(t, true);
+    ASSERT_TRUE(got) << prefetch.error();
+    const core::Instant at = core::instant_at_time(vol.times, core::format_iso_utc(t), scene.data.path);
+    const std::shared_ptr<const core::PreparedVolume> want = cache.get(scene.data.path, vol, at, core::TimeInterpolation::Auto);
+    EXPECT_EQ(got->extinction.liquid_per_m, want->extinction.liquid_per_m) << core::format_iso_utc(t);
+    EXPECT_EQ(got->extinction.ice_per_m, want->extinction.ice_per_m) << core::format_iso_utc(t);
+    EXPECT_EQ(got->extinction.fraction, want->extinction.fraction) << core::format_iso_utc(t);
+    EXPECT_FALSE(got->extinction.liquid_per_m.empty());
+  }
 }
 
 // A bound in bytes lowers the bound in instants to what fits, measured on the first instant, but
