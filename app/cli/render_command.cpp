@@ -669,7 +669,7 @@ int cmd_render(const std::vector<std::string>& args) {
                 instant.gap_s / 3600.0, core::time_interpolation_name(interp.used));
     if (interp.used == core::TimeInterpolation::Advected) {
       std::printf(" (up to %d trajectory sub-step(s)", interp.substeps);
-      if (interp.stride > 1) std::printf(", trajectories on every %d-th node of longitude and latitude", interp.stride);
+      if (interp.stride > 1) std::printf(", trajectories every %d nodes along longitude and latitude", interp.stride);
       std::printf(", winds up to %.3g cells over the gap%s)", interp.max_courant,
                   interp.vertical_wind ? ", vertical wind included" : ", no vertical wind in the file");
     }
