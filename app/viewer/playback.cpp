@@ -171,29 +171,6 @@ std::string Prefetcher::error() const {
   return error_;
 }
 
-std::shared_ptr<const Prefetcher::StepMedium> Prefetcher::step_medium(std::size_t step, bool winds) {
-  for (std::size_t i = 0; i < media_.size(); ++i) {
-    if (media_[i]->step != step || (winds && !media_[i]->has_winds)) continue;
-    std::shared_ptr<const StepMedium> m = media_[i];
-    media_.erase(media_.begin() + static_cast<std::ptrdiff_t>(i));
-    media_.push_back(m);  // the most recent last
-    return m;
-  }
-  auto m = std::make_shared<StepMedium>();
-  m->step = step;
-  const core::TimeStepData& data = volume_.step(step);
-  m->medium = core::grid_mean_extinction(volume_.grid, data);
-  if (winds) m->winds = core::step_winds(data), m->has_winds = true;
-  for (std::size_t i = 0; i < media_.size(); ++i)
-    if (media_[i]->step == step) {
-      media_.erase(media_.begin() + static_cast<std::ptrdiff_t>(i));
-      break;
-    }
-  media_.push_back(m);
-  if (media_.size() > 2) media_.erase(media_.begin());
-  return m;
-}
-
 void Prefetcher::run() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stop_) {
@@ -222,11 +199,12 @@ void Prefetcher::run() {
       std::vector<double> d = drift ? detail_drift_.at(volume_, at) : std::vector<double>{};  // may load earlier steps: first
       core::GridMeanExtinction e0;
       if (at.between()) {
-        const std::shared_ptr<const StepMedium> m0 = step_medium(at.step0, true), m1 = step_medium(at.step1, true);
+        const std::shared_ptr<const core::StepMedium> m0 = media_.get(scene_.data.path, volume_, at.step0, true);
+        const std::shared_ptr<const core::StepMedium> m1 = media_.get(scene_.data.path, volume_, at.step1, true);
         e0 = core::interpolate_extinction(volume_.grid, m0->medium, m1->medium, m0->winds, m1->winds, at.gap_s, at.fraction, mode,
                                           &r.report);
       } else {
-        e0 = step_medium(at.step0, false)->medium;
+        e0 = media_.get(scene_.data.path, volume_, at.step0, false)->medium;
       }
       e0.detail_drift_cells = std::move(d);
       auto prepared = std::make_shared<core::PreparedVolume>(core::prepare_volume(volume_.grid, std::move(e0), drift));  // the weather textures for the modelled cloud only

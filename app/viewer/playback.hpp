@@ -17,6 +17,7 @@
 #include "frame/camera.hpp"
 #include "kernel/detail_drift.hpp"
 #include "kernel/prepared_volume.hpp"
+#include "kernel/volume_cache.hpp"
 #include "scene/scene.hpp"
 #include "volume/cloud_volume.hpp"
 #include "volume/time_interpolation.hpp"
@@ -110,17 +111,7 @@ class Prefetcher {
   bool drift_ = false;
   std::shared_ptr<const core::Scene> source_scene_;  // the scene the sources are built for (null: none)
   core::DetailDrift detail_drift_;  // the worker's alone
-  // The worker's alone: the last two steps' media and winds, so the instants between two steps
-  // (and the next pair, which shares one) do not derive them again (a global 0.25-degree step's
-  // took 4-6 s per instant).
-  struct StepMedium {
-    std::size_t step = 0;
-    core::GridMeanExtinction medium;
-    core::StepWinds winds;
-    bool has_winds = false;
-  };
-  std::vector<std::shared_ptr<const StepMedium>> media_;
-  std::shared_ptr<const StepMedium> step_medium(std::size_t step, bool winds);
+  core::StepMediaCache media_;     // the worker's alone: the last two steps' media and winds
   std::map<std::int64_t, Ready> ready_;
   PrefetchStats stats_;
   std::string error_;

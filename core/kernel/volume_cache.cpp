@@ -5,6 +5,30 @@
 
 namespace cv::core {
 
+std::shared_ptr<const StepMedium> StepMediaCache::get(const std::string& source, CloudVolume& volume, std::size_t step, bool winds) {
+  if (source != source_ || &volume != volume_) media_.clear(), source_ = source, volume_ = &volume;
+  for (std::size_t i = 0; i < media_.size(); ++i) {
+    if (media_[i]->step != step || (winds && !media_[i]->has_winds)) continue;
+    std::shared_ptr<const StepMedium> m = media_[i];
+    media_.erase(media_.begin() + static_cast<std::ptrdiff_t>(i));
+    media_.push_back(m);
+    return m;
+  }
+  auto m = std::make_shared<StepMedium>();
+  m->step = step;
+  const TimeStepData& data = volume.step(step);
+  m->medium = grid_mean_extinction(volume.grid, data);
+  if (winds) m->winds = step_winds(data), m->has_winds = true;
+  for (std::size_t i = 0; i < media_.size(); ++i)
+    if (media_[i]->step == step) {  // held without its winds: replaced
+      media_.erase(media_.begin() + static_cast<std::ptrdiff_t>(i));
+      break;
+    }
+  media_.push_back(m);
+  if (media_.size() > 2) media_.erase(media_.begin());
+  return m;
+}
+
 std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string& source, CloudVolume& volume, const Instant& at,
                                                                TimeInterpolation mode, TimeInterpolationReport* report,
                                                                bool detail_drift) {
@@ -26,10 +50,12 @@ std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string
   // The drift first: it may load earlier steps. Then each step's medium and winds taken before the
   // next step is loaded (which may evict it).
   std::vector<double> drift = detail_drift ? drift_.at(volume, at) : std::vector<double>{};
-  const GridMeanExtinction e0 = grid_mean_extinction(volume.grid, volume.step(at.step0));
-  const StepWinds w0 = step_winds(volume.step(at.step0));
-  const GridMeanExtinction e1 = grid_mean_extinction(volume.grid, volume.step(at.step1));
-  const StepWinds w1 = step_winds(volume.step(at.step1));
+  const std::shared_ptr<const StepMedium> m0 = media_.get(source, volume, at.step0, true);
+  const std::shared_ptr<const StepMedium> m1 = media_.get(source, volume, at.step1, true);
+  const GridMeanExtinction& e0 = m0->medium;
+  const StepWinds& w0 = m0->winds;
+  const GridMeanExtinction& e1 = m1->medium;
+  const StepWinds& w1 = m1->winds;
   Entry e;
   e.source = source, e.step = at.step0, e.step1 = at.step1, e.fraction = at.fraction, e.mode = mode, e.drift = detail_drift;
   GridMeanExtinction mixed = interpolate_extinction(volume.grid, e0, e1, w0, w1, at.gap_s, at.fraction, mode, &e.report);

@@ -16,6 +16,27 @@
 
 namespace cv::core {
 
+// The last two steps' grid-mean extinction and winds, for the instants between them (and the next
+// pair, which shares one): derived once per step, not once per instant (a global 0.25-degree step's
+// took 4-6 s).
+struct StepMedium {
+  std::size_t step = 0;
+  GridMeanExtinction medium;
+  StepWinds winds;  // empty unless asked for
+  bool has_winds = false;
+};
+class StepMediaCache {
+ public:
+  // Step `step` of `volume` (named by `source`), with its winds where `winds`: from the cache or
+  // derived now. Another volume or source empties the cache first.
+  std::shared_ptr<const StepMedium> get(const std::string& source, CloudVolume& volume, std::size_t step, bool winds);
+
+ private:
+  std::string source_;
+  const CloudVolume* volume_ = nullptr;
+  std::vector<std::shared_ptr<const StepMedium>> media_;  // most recently used last
+};
+
 class PreparedVolumeCache {
  public:
   static constexpr std::size_t kResident = 2;
@@ -51,6 +72,7 @@ class PreparedVolumeCache {
   std::vector<Entry> entries_;  // most recently used last
   std::size_t prepared_ = 0;
   DetailDrift drift_;
+  StepMediaCache media_;
 };
 
 }  // namespace cv::core

@@ -122,9 +122,10 @@ TEST(Prefetcher, BuildsEachInstantsSourceForItsOwnSun) {
   EXPECT_EQ(octave.stats().sources, 0u);
 }
 
-// The prefetcher keeps the last two steps' media and winds for the instants between them; each
-// instant it prepares is the medium the render path prepares (PreparedVolumeCache), bit for bit,
-// through instants that share steps, a step itself, and a return to an earlier pair.
+// The prefetcher and the render path (PreparedVolumeCache) keep the last two steps' media and winds
+// for the instants between them (core::StepMediaCache); each instant either prepares is the medium
+// derived from the steps themselves, bit for bit, through instants that share steps, a step
+// itself, and a return to an earlier pair.
 TEST(Prefetcher, PreparesEachInstantAsTheRenderPathDoes) {
   core::Scene scene;
   scene.data.path = CV_SAMPLE_FILE;
@@ -140,11 +141,21 @@ TEST(Prefetcher, PreparesEachInstantAsTheRenderPathDoes) {
     const std::shared_ptr<const core::PreparedVolume> got = prefetch.get(t, true);
     ASSERT_TRUE(got) << prefetch.error();
     const core::Instant at = core::instant_at_time(vol.times, core::format_iso_utc(t), scene.data.path);
-    const std::shared_ptr<const core::PreparedVolume> want = cache.get(scene.data.path, vol, at, core::TimeInterpolation::Auto);
-    EXPECT_EQ(got->extinction.liquid_per_m, want->extinction.liquid_per_m) << core::format_iso_utc(t);
-    EXPECT_EQ(got->extinction.ice_per_m, want->extinction.ice_per_m) << core::format_iso_utc(t);
-    EXPECT_EQ(got->extinction.fraction, want->extinction.fraction) << core::format_iso_utc(t);
-    EXPECT_FALSE(got->extinction.liquid_per_m.empty());
+    // The medium derived here from the steps themselves, without either cache.
+    core::GridMeanExtinction direct = core::grid_mean_extinction(vol.grid, vol.step(at.step0));
+    if (at.between()) {
+      const core::StepWinds w0 = core::step_winds(vol.step(at.step0));
+      const core::GridMeanExtinction e1 = core::grid_mean_extinction(vol.grid, vol.step(at.step1));
+      const core::StepWinds w1 = core::step_winds(vol.step(at.step1));
+      direct = core::interpolate_extinction(vol.grid, direct, e1, w0, w1, at.gap_s, at.fraction, core::TimeInterpolation::Auto);
+    }
+    const std::shared_ptr<const core::PreparedVolume> cached = cache.get(scene.data.path, vol, at, core::TimeInterpolation::Auto);
+    for (const core::GridMeanExtinction* e : {&got->extinction, &cached->extinction}) {
+      EXPECT_EQ(e->liquid_per_m, direct.liquid_per_m) << core::format_iso_utc(t);
+      EXPECT_EQ(e->ice_per_m, direct.ice_per_m) << core::format_iso_utc(t);
+      EXPECT_EQ(e->fraction, direct.fraction) << core::format_iso_utc(t);
+    }
+    EXPECT_FALSE(direct.liquid_per_m.empty());
   }
 }
 
