@@ -973,24 +973,58 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
     std::vector<double> thick;
     std::optional<double> median_thickness;
     if (zv || ghv) {
-      // The whole step's heights at once (freed below: the steps read bands of rows).
-      Slab s;
-      read_slab_into(s, *S, zv ? *zv : *ghv, S->steps.front(), nullptr, true);
-      // Each column's level heights, bottom up, to `visit(raw value, height, thickness below or NaN)`.
+      const NcVar& hv = zv ? *zv : *ghv;
+      // The heights are read a band of file rows at a time into the slab the steps read them into
+      // (the whole step's heights at once were 200 MB of fresh memory for a global file, most of
+      // this probe's time), and each band's rows are split over the cores.
+      Slab& s = S->scratch[static_cast<std::size_t>(zv ? Role::Geopotential : Role::GeopotentialHeight)];
+      const int nx = probe.lon_deg.count, ny = probe.lat_deg.count;
+      constexpr int kProbeBandRows = 32;
+      const int nbands = (S->lat_hi - S->lat_lo) / kProbeBandRows + 1;
+      // Each output row reads one file row: the output rows grouped by that row's band.
+      std::vector<std::vector<int>> band_rows(static_cast<std::size_t>(nbands));
+      auto file_row = [&](int y) {
+        const std::size_t yy = static_cast<std::size_t>(y);
+        return S->lat.w[yy] == 1.0 ? S->lat.j1[yy] : S->lat.j0[yy];
+      };
+      for (int y = 0; y < ny; ++y) band_rows[static_cast<std::size_t>((file_row(y) - S->lat_lo) / kProbeBandRows)].push_back(y);
+      // What a part of each band's rows gathers, in a copy on its own thread's stack while it runs.
+      struct ProbePart {
+        double zmin = 1e30, zmax = -1e30;
+        std::vector<std::uint32_t> bins;  // thicknesses counted in 1 m bins
+        std::vector<double> in_bin;       // the thicknesses in the median's bin (second pass)
+        bool bad = false;                 // a height out of range: the first one met
+        double bad_raw = 0.0, bad_z = 0.0;
+      };
+      std::vector<ProbePart> part(core::worker_count());
+      // Each column's level heights, bottom up, to `visit(part, raw value, height, thickness below
+      // or NaN)`; a part's calls come level by level over its rows, each column's in order up.
       auto heights = [&](auto&& visit) {
-        for (int y = 0; y < probe.lat_deg.count; ++y) {
-          for (int x = 0; x < probe.lon_deg.count; ++x) {
-            double prev = kNaN;
+        std::vector<std::vector<double>> prevs(part.size());
+        for (int b = 0; b < nbands; ++b) {
+          const std::vector<int>& rows = band_rows[static_cast<std::size_t>(b)];
+          if (rows.empty()) continue;
+          const int j_lo = S->lat_lo + b * kProbeBandRows, j_hi = std::min(S->lat_hi, j_lo + kProbeBandRows - 1);
+          read_slab_into(s, *S, hv, S->steps.front(), nullptr, true, j_lo, j_hi);
+          core::parallel_ranges(rows.size(), 1, [&](std::size_t r0, std::size_t r1, unsigned p) {
+            ProbePart local = std::move(part[p]);
+            std::vector<double>& prev = prevs[p];  // each column's last height below
+            prev.assign((r1 - r0) * static_cast<std::size_t>(nx), kNaN);
             for (std::size_t l = 0; l < S->levels.size(); ++l) {
-              const std::size_t yy = static_cast<std::size_t>(y);
-              const int row = S->lat.w[yy] == 1.0 ? S->lat.j1[yy] : S->lat.j0[yy];  // a row the read holds
-              const double raw = s.at(S->lon.src[static_cast<std::size_t>(x)], row, S->levels[l]);
-              const double zz = physics::f64::geopotential_to_height_m(zv ? raw : kG0 * raw, vol.grid.earth_radius_m);
-              if (std::isnan(zz)) continue;
-              visit(raw, zz, !std::isnan(prev) && zz > prev ? zz - prev : kNaN);
-              prev = zz;
+              for (std::size_t r = r0; r < r1; ++r) {
+                const int row = file_row(rows[r]);
+                double* pv = prev.data() + (r - r0) * static_cast<std::size_t>(nx);
+                for (int x = 0; x < nx; ++x) {
+                  const double raw = s.at(S->lon.src[static_cast<std::size_t>(x)], row, S->levels[l]);
+                  const double zz = physics::f64::geopotential_to_height_m(zv ? raw : kG0 * raw, vol.grid.earth_radius_m);
+                  if (std::isnan(zz)) continue;
+                  visit(local, raw, zz, !std::isnan(pv[x]) && zz > pv[x] ? zz - pv[x] : kNaN);
+                  pv[x] = zz;
+                }
+              }
             }
-          }
+            part[p] = std::move(local);
+          });
         }
       };
       // The median thickness exactly (the element a full sort would put in the middle) without
@@ -998,26 +1032,40 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
       // median's bin.
       constexpr double kBinM = 1.0;
       constexpr std::size_t kBins = 200000;  // thicknesses up to 200 km: the heights are checked to 100 km
+      for (ProbePart& q : part) q.bins.assign(kBins, 0);
+      heights([&](ProbePart& q, double raw, double zz, double t) {
+        if (!(zz >= -1000.0 && zz <= 1.0e5)) {
+          if (!q.bad) q.bad = true, q.bad_raw = raw, q.bad_z = zz;
+          return;
+        }
+        q.zmin = std::min(q.zmin, zz);
+        q.zmax = std::max(q.zmax, zz);
+        if (!std::isnan(t)) ++q.bins[std::min(kBins - 1, static_cast<std::size_t>(t / kBinM))];
+      });
+      for (const ProbePart& q : part) {
+        if (q.bad) {
+          throw ImportError(path + ": variable '" + hv.name + "' has value " + fmt(q.bad_raw) + " (a height of " +
+                            fmt(q.bad_z) + " m), expected a height between -1 km and 100 km");
+        }
+      }
       std::vector<std::size_t> bins(kBins, 0);
       std::size_t n_thick = 0;
-      heights([&](double raw, double zz, double t) {
-        if (zz < -1000.0 || zz > 1.0e5) {
-          throw ImportError(path + ": variable '" + (zv ? zv : ghv)->name + "' has value " + fmt(raw) + " (a height of " +
-                            fmt(zz) + " m), expected a height between -1 km and 100 km");
-        }
-        zmin = std::min(zmin, zz);
-        zmax = std::max(zmax, zz);
-        if (!std::isnan(t)) ++bins[std::min(kBins - 1, static_cast<std::size_t>(t / kBinM))], ++n_thick;
-      });
+      for (ProbePart& q : part) {
+        zmin = std::min(zmin, q.zmin);
+        zmax = std::max(zmax, q.zmax);
+        for (std::size_t i = 0; i < kBins; ++i) bins[i] += q.bins[i], n_thick += q.bins[i];
+        std::vector<std::uint32_t>().swap(q.bins);
+      }
       if (n_thick) {
         const std::size_t mid = n_thick / 2;  // the index of the median in sorted order
         std::size_t below = 0, bin = 0;
         while (below + bins[bin] <= mid) below += bins[bin++];
+        heights([&](ProbePart& q, double, double, double t) {
+          if (!std::isnan(t) && std::min(kBins - 1, static_cast<std::size_t>(t / kBinM)) == bin) q.in_bin.push_back(t);
+        });
         std::vector<double> in_bin;
         in_bin.reserve(bins[bin]);
-        heights([&](double, double, double t) {
-          if (!std::isnan(t) && std::min(kBins - 1, static_cast<std::size_t>(t / kBinM)) == bin) in_bin.push_back(t);
-        });
+        for (const ProbePart& q : part) in_bin.insert(in_bin.end(), q.in_bin.begin(), q.in_bin.end());
         const auto at = in_bin.begin() + static_cast<std::ptrdiff_t>(mid - below);
         std::nth_element(in_bin.begin(), at, in_bin.end());
         median_thickness = *at;

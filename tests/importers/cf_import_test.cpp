@@ -369,6 +369,15 @@ TEST_F(CfImport, AbsurdValuesAreRejected) {
   z.packed = false;
   z.z_override = -1e30;
   expect_import_error(write(z, "z.nc"), {"'z'", "expected"});
+  // One height out of range among 100 rows: the altitude probe reads the heights in bands of rows
+  // on every core, and still names the one value.
+  SynthOptions one;
+  one.packed = false;
+  one.lats.clear();
+  for (int k = 0; k < 100; ++k) one.lats.push_back(89.1 - 1.8 * k);
+  one.z_bad_row = 70;
+  one.z_bad_value = 5.0e6;  // m2 s-2: about 510 km up
+  expect_import_error(write(one, "z_one.nc"), {"'z'", "value 5e+06", "a height of", "expected a height between -1 km and 100 km"});
 }
 
 TEST_F(CfImport, BrokenAndUnsupportedFiles) {

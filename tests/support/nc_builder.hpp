@@ -87,6 +87,8 @@ struct SynthOptions {
   std::string cc_standard_name;  // set to find the variable by standard_name
   double cc_override = -1.0;     // when >= 0, every cc value (absurd-value tests)
   double z_override = NAN;       // when set, every geopotential value
+  int z_bad_row = -1;            // when >= 0, the geopotential at this stored row, level 1 and
+  double z_bad_value = NAN;      // column 2 (every step) is z_bad_value instead
   double clwc_noise = 0.0;       // subtract this from the clear points (tiny negatives after unpacking)
   bool with_cloud = true;
   nc_type coord_type = NC_FLOAT;  // of longitude and latitude
@@ -148,6 +150,7 @@ inline void write_synth(const std::string& path, const SynthOptions& o) {
           const std::size_t p = at(t, k, j, i);
           const double hpa = o.levels_hpa[static_cast<std::size_t>(k)];
           fields[0].v[p] = std::isnan(o.z_override) ? 9.80665 * isa_height_m(hpa * 100.0) : o.z_override;
+          if (j == o.z_bad_row && k == 1 && i == 2) fields[0].v[p] = o.z_bad_value;
           fields[1].v[p] = 260.0;
           fields[2].v[p] = 1e-3;
           fields[3].v[p] = 10.0 + o.lats[static_cast<std::size_t>(j)] / 10.0;
