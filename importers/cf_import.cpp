@@ -486,7 +486,8 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
       const bool fresh = halves.capacity() < grid.points();
       core::reserve_exact(halves, grid.points());
       if (fresh) core::populate_pages(halves.data(), grid.points() * sizeof(std::uint16_t));
-      halves.resize(grid.points());  // every node is written by its row's place_row
+      // Not zeroed first (HalfBuffer): every node is written by its row's place_row, on every core.
+      halves.resize(grid.points());
     } else if (on) {
       halves.clear();
       halves.shrink_to_fit();

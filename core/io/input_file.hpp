@@ -64,10 +64,10 @@ void require_within_memory_limit(const std::string& source, const std::string& w
 // page faults, but with the kernel's usual defrag setting ("madvise") each fault in an advised
 // region compacts memory synchronously, and once the page cache had fragmented memory the global
 // import took 14 s instead of 10 (docs/BENCHMARKS.md, "Import: direct writes").
-template <typename T>
-void reserve_exact(std::vector<T>& v, std::size_t n) {
+template <typename T, typename A>
+void reserve_exact(std::vector<T, A>& v, std::size_t n) {
   if (v.capacity() >= n) return;
-  std::vector<T>().swap(v);
+  std::vector<T, A>().swap(v);
   v.reserve(n);
 }
 

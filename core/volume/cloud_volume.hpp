@@ -9,7 +9,11 @@
 #include <functional>
 #include <list>
 #include <map>
+#include <memory>
+#include <new>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "volume/import_report.hpp"
@@ -88,13 +92,37 @@ inline float half_field_scale(Field f) {
   return f == Field::ExtinctionLiquid || f == Field::ExtinctionIce ? 1000.0f : 1.0f;
 }
 
+// An allocator whose construction without a value leaves the value uninitialised, so a resize of a
+// buffer its owner writes whole next writes no zeros first (a global step's half floats are 670 MB:
+// zeroing them was one core's first touch of every fresh page, a second in this VM's imports).
+template <typename T, typename A = std::allocator<T>>
+struct DefaultInitAllocator : A {
+  using A::A;
+  DefaultInitAllocator() = default;
+  template <typename U>
+  struct rebind {
+    using other = DefaultInitAllocator<U, typename std::allocator_traits<A>::template rebind_alloc<U>>;
+  };
+  template <typename U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    std::allocator_traits<A>::construct(static_cast<A&>(*this), p, std::forward<Args>(args)...);
+  }
+};
+
+// A field's half floats (TimeStepData::halves); resize() leaves new values uninitialised.
+using HalfBuffer = std::vector<std::uint16_t, DefaultInitAllocator<std::uint16_t>>;
+
 struct TimeStepData {
   std::array<std::vector<float>, kFieldCount> fields;
   // A field held as half floats of its value x half_field_scale instead of `fields` (whose vector
   // is then empty): only the import on its way to a float16 .cvvol asks a reader for these
   // (importers' ImportOptions::half_fields), which halves the step's memory and leaves write_cvvol
   // no conversion. derive_maps and write_cvvol read either; nothing else is given such a step.
-  std::array<std::vector<std::uint16_t>, kFieldCount> halves;
+  std::array<HalfBuffer, kFieldCount> halves;
   // Per column, the ground's altitude (m) where the file gives terrain; empty (or NaN in a column)
   // where it does not. Low/mid/high cover is measured from here.
   std::vector<float> ground_m;

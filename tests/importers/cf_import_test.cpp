@@ -590,7 +590,7 @@ TEST_F(CfImport, HalfFieldsAreTheFloatFieldsAsTheVolumeStoresThem) {
         ASSERT_EQ(df.fields[kk].size(), n);
         ASSERT_EQ(dh.halves[kk].size(), n);
         const float scale = core::half_field_scale(field);
-        std::vector<std::uint16_t> want(n);
+        core::HalfBuffer want(n);
         core::floats_to_halves(df.fields[kk].data(), scale, want.data(), n);
         EXPECT_TRUE(want == dh.halves[kk]) << core::field_name(field) << " at step " << t;
         widened.fields[kk].resize(n);

@@ -173,7 +173,7 @@ TEST(RealFiles, HalfFieldsAreTheFloatImportAsTheVolumeStoresIt) {
           continue;
         }
         ASSERT_EQ(dh.halves[kk].size(), n) << core::field_name(static_cast<core::Field>(k));
-        std::vector<std::uint16_t> want(n);
+        core::HalfBuffer want(n);
         core::floats_to_halves(df.fields[kk].data(), core::half_field_scale(static_cast<core::Field>(k)), want.data(), n);
         EXPECT_TRUE(want == dh.halves[kk]) << core::field_name(static_cast<core::Field>(k)) << " at step " << t;
         compared += n;
