@@ -256,7 +256,7 @@ TEST(TimeInterpolation, AGlobalLatticeWithPolarRowsStaysBounded) {
   const GridMeanExtinction out = interpolate_extinction(g, {f, f}, {f, {}}, w0, w1, 12 * 3600.0, 0.4, TimeInterpolation::Advected, &r);
   EXPECT_EQ(r.stride, trajectory_stride(g));
   EXPECT_GT(r.max_courant, 1e3) << "the polar rows";
-  EXPECT_LE(r.substeps, kMaxAdvectionSubsteps);
+  EXPECT_LT(r.substeps, kMaxAdvectionSubsteps) << "sub-steps count cells on the ground: the polar rows' thousand index cells do not drive them to the cap";
   const double peak = *std::max_element(f.begin(), f.end());
   for (const std::vector<float>* field : {&out.liquid_per_m, &out.ice_per_m}) {
     ASSERT_EQ(field->size(), g.points());
