@@ -229,6 +229,7 @@ void Prefetcher::run() {
       error = e.what();
     }
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const std::size_t held = volume_.resident_bytes() + media_.bytes();  // the worker's alone: read unlocked
     lock.lock();
     if (!error.empty()) {
       error_ = error;
@@ -248,10 +249,14 @@ void Prefetcher::run() {
       if (victim == ready_.end()) victim = ready_.begin();
       ready_.erase(victim);
     }
-    // The bound in bytes, in instants of this size (the first measures them; never under 2, so the
-    // next instant can be prepared while one is shown). Nothing is ready before the first.
-    if (stats_.prepared == 0 && r.volume) {
-      const std::size_t fits = std::max<std::size_t>(2, max_bytes_ / std::max<std::size_t>(1, prepared_bytes(*r.volume)));
+    // The bound in bytes, in instants of this size, after what the worker holds besides them (its
+    // steps and media, which grow from one step's to two as playback goes between steps): measured
+    // at every instant, so the bound only falls; never under 2, so the next instant can be prepared
+    // while one is shown.
+    if (r.volume) {
+      stats_.held_bytes = held;
+      const std::size_t room = max_bytes_ > held ? max_bytes_ - held : 0;
+      const std::size_t fits = std::max<std::size_t>(2, room / std::max<std::size_t>(1, prepared_bytes(*r.volume)));
       if (fits < max_resident_) {
         max_resident_ = stats_.max_resident = fits;
         if (wanted_.size() > fits) wanted_.resize(fits);

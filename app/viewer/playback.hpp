@@ -53,6 +53,7 @@ struct PrefetchStats {
   std::size_t resident = 0;        // prepared instants held
   std::size_t resident_bytes = 0;  // their memory
   std::size_t max_resident = 0;    // the bound in instants (lowered to fit the bound in bytes)
+  std::size_t held_bytes = 0;      // what the worker holds besides them (decoded steps, their media), at the last instant
   std::size_t hits = 0, misses = 0;  // instants found ready / not ready when shown
   std::size_t prepared = 0;          // instants the worker prepared
   double last_prepare_ms = 0.0;      // the last instant's preparation, its source included
@@ -73,8 +74,10 @@ class Prefetcher {
  public:
   // Opens its own copy of the scene's data (the viewer's CloudVolume stays on the render thread).
   // At most max_resident instants stay prepared, and fewer (never under 2) where that many would
-  // hold more than max_bytes (0: a quarter of the machine's memory), as the first instant prepared
-  // measures them: a global 0.25-degree instant with its two-stream source holds about 0.8 GB.
+  // hold more than max_bytes (0: a quarter of the machine's memory) less what the worker holds
+  // besides them (its decoded steps and their media and winds), as measured when each instant is
+  // prepared: a global 0.25-degree instant with its two-stream source holds about 0.8 GB, the two
+  // steps and their media about 5 GB by their arrays' sizes.
   Prefetcher(const core::Scene& scene, std::size_t max_resident, std::size_t max_bytes = 0);
   ~Prefetcher();
   Prefetcher(const Prefetcher&) = delete;

@@ -824,9 +824,10 @@ int run_viewer(const ViewerOptions& o) {
         }
       }
       const PrefetchStats ps = prefetch->stats();
-      char text[200];
-      std::snprintf(text, sizeof text, "prefetch: %zu/%zu instants resident, %.1f MB, hits %zu, misses %zu (%.0f %%), last %.0f ms%s",
-                    ps.resident, ps.max_resident, double(ps.resident_bytes) / 1e6, ps.hits, ps.misses,
+      char text[240];
+      std::snprintf(text, sizeof text,
+                    "prefetch: %zu/%zu instants resident, %.1f MB (steps and media %.1f MB), hits %zu, misses %zu (%.0f %%), last %.0f ms%s",
+                    ps.resident, ps.max_resident, double(ps.resident_bytes) / 1e6, double(ps.held_bytes) / 1e6, ps.hits, ps.misses,
                     ps.hits + ps.misses ? 100.0 * double(ps.hits) / double(ps.hits + ps.misses) : 0.0, ps.last_prepare_ms,
                     ps.sources ? (" (its two-stream source " + std::to_string(static_cast<int>(std::lround(ps.last_source_ms))) + " ms)").c_str() : "");
       stats.prefetch = text;

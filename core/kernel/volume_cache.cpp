@@ -29,6 +29,18 @@ std::shared_ptr<const StepMedium> StepMediaCache::get(const std::string& source,
   return m;
 }
 
+std::size_t StepMediaCache::bytes() const {
+  std::size_t b = 0;
+  for (const auto& m : media_) {
+    for (const std::vector<float>* a : {&m->medium.liquid_per_m, &m->medium.ice_per_m, &m->medium.ground_m, &m->medium.fraction,
+                                        &m->medium.lapse_k_per_km, &m->winds.u, &m->winds.v, &m->winds.w}) {
+      b += a->size() * sizeof(float);
+    }
+    b += m->medium.detail_drift_cells.size() * sizeof(double);
+  }
+  return b;
+}
+
 std::shared_ptr<const PreparedVolume> PreparedVolumeCache::get(const std::string& source, CloudVolume& volume, const Instant& at,
                                                                TimeInterpolation mode, TimeInterpolationReport* report,
                                                                bool detail_drift) {

@@ -30,6 +30,8 @@ class StepMediaCache {
   // Step `step` of `volume` (named by `source`), with its winds where `winds`: from the cache or
   // derived now. Another volume or source empties the cache first.
   std::shared_ptr<const StepMedium> get(const std::string& source, CloudVolume& volume, std::size_t step, bool winds);
+  // The memory of the media held.
+  std::size_t bytes() const;
 
  private:
   std::string source_;

@@ -159,6 +159,13 @@ void CloudVolume::set_loader(Loader loader, std::size_t cache_steps) {
 
 void CloudVolume::put(std::size_t index, TimeStepData data) { pinned_[index] = std::move(data); }
 
+std::size_t CloudVolume::resident_bytes() const {
+  std::size_t b = spare_.bytes();
+  for (const auto* held : {&pinned_, &cache_})
+    for (const auto& [index, data] : *held) b += data.bytes();
+  return b;
+}
+
 const TimeStepData& CloudVolume::step(std::size_t index) {
   if (index >= times.size()) {
     throw std::out_of_range("time step " + std::to_string(index) + " of " + std::to_string(times.size()));

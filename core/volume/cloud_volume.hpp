@@ -197,6 +197,8 @@ class CloudVolume {
   const TimeStepData& step(std::size_t index);
   bool is_loaded(std::size_t index) const { return pinned_.count(index) || cache_.count(index); }
   std::size_t loaded_steps() const { return pinned_.size() + cache_.size(); }
+  // The memory of the steps held: loaded, and the last evicted one's arrays kept for reuse.
+  std::size_t resident_bytes() const;
 
  private:
   Loader loader_;

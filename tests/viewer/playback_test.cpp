@@ -176,18 +176,33 @@ TEST(Prefetcher, KeepsToItsBoundInBytes) {
   ASSERT_TRUE(tight.get(four[1], true));
   EXPECT_FALSE(tight.get(four[2], false));  // beyond the bound: not prepared
   EXPECT_LE(tight.stats().resident, 2u);
-  // Room for three instants with their sources.
-  std::size_t each = 0;
+  // Room for three instants with their sources, besides what the worker holds for the first: its
+  // decoded step and that step's medium.
+  std::size_t each = 0, held = 0;
   {
     Prefetcher one(scene, 1);
     one.want({four[0]}, core::TimeInterpolation::Auto, false, &scene);
     each = prepared_bytes(*one.get(four[0], true));
+    held = one.stats().held_bytes;
   }
   ASSERT_GT(each, 0u);
-  Prefetcher three(scene, 6, 3 * each + each / 2);
-  three.want(four, core::TimeInterpolation::Auto, false, &scene);
+  core::CloudVolume copy = importers::load_scene_volume(scene, 2);
+  const std::size_t step_bytes = copy.step(0).bytes();
+  EXPECT_GE(held, step_bytes) << "the decoded step is counted";
+  EXPECT_GE(held, step_bytes + 2 * copy.grid.points() * sizeof(float)) << "and its medium";
+  const std::size_t bound = held + 3 * each + each / 2;
+  Prefetcher three(scene, 6, bound);
+  three.want({four[0]}, core::TimeInterpolation::Auto, false, &scene);
   ASSERT_TRUE(three.get(four[0], true));
+  EXPECT_EQ(three.stats().held_bytes, held);
   EXPECT_EQ(three.stats().max_resident, 3u);
+  // A second step decoded, and its medium: the bound falls by what they hold.
+  three.want({four[0], four[1]}, core::TimeInterpolation::Auto, false, &scene);
+  ASSERT_TRUE(three.get(four[1], true));
+  const PrefetchStats s2 = three.stats();
+  EXPECT_GT(s2.held_bytes, held + step_bytes) << "two steps and two media";
+  EXPECT_EQ(s2.max_resident, std::min<std::size_t>(3, std::max<std::size_t>(2, (bound - std::min(bound, s2.held_bytes)) / each)));
+  EXPECT_EQ(s2.max_resident, 2u) << "a second step and medium take more than half an instant's room";
   Prefetcher roomy(scene, 6, std::size_t(1) << 40);
   roomy.want(four, core::TimeInterpolation::Auto, false, &scene);
   ASSERT_TRUE(roomy.get(four[3], true));
