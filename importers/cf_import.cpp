@@ -819,6 +819,10 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
                        "ice_water_mixing_ratio, GRIB 0-1-23/84) or snow";
     if (!options.diagnose_cloud) {
       if (t && (rh || q)) what += "; the file has temperature and humidity: --diagnose-cloud diagnoses a cloud from them";
+      else if (t || rh || q) {
+        what += std::string("; nor can one be diagnosed (--diagnose-cloud needs temperature and relative or specific humidity, "
+                            "and the file has ") + (t ? "no humidity" : "no temperature") + ")";
+      }
       if (!L.precipitation.empty()) what += " (precipitation alone, '" + L.precipitation.front() + "', is not cloud)";
       throw ImportError(what);
     }

@@ -120,6 +120,14 @@ TEST(RealFiles, DiagnosedCloudWhereTheFileHasHumidity) {
   EXPECT_NE(info.find("importable with --diagnose-cloud: yes"), std::string::npos) << info;
   REAL_FILE(gfs, "GFS_global.nc");
   try {
+    importers::import_file(gfs);
+    ADD_FAILURE() << "GFS has no cloud field";
+  } catch (const importers::ImportError& e) {
+    // Without the flag, the message says at once that a diagnosis would not help either.
+    EXPECT_NE(std::string(e.what()).find("nor can one be diagnosed"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("the file has no humidity"), std::string::npos) << e.what();
+  }
+  try {
     importers::import_file(gfs, o);
     ADD_FAILURE() << "GFS has no humidity";
   } catch (const importers::ImportError& e) {
