@@ -996,7 +996,7 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
       // What a part of each band's rows gathers, in a copy on its own thread's stack while it runs.
       struct ProbePart {
         double zmin = 1e30, zmax = -1e30;
-        std::vector<std::uint32_t> bins;  // thicknesses counted in 1 m bins
+        std::vector<std::uint64_t> bins;  // thicknesses counted in 1 m bins (64 bits: no count can wrap)
         std::vector<double> in_bin;       // the thicknesses in the median's bin (second pass)
         bool bad = false;                 // a height out of range: the first one met
         double bad_raw = 0.0, bad_z = 0.0;
@@ -1059,7 +1059,7 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
         zmin = std::min(zmin, q.zmin);
         zmax = std::max(zmax, q.zmax);
         for (std::size_t i = 0; i < kBins; ++i) bins[i] += q.bins[i], n_thick += q.bins[i];
-        std::vector<std::uint32_t>().swap(q.bins);
+        std::vector<std::uint64_t>().swap(q.bins);
       }
       if (n_thick) {
         const std::size_t mid = n_thick / 2;  // the index of the median in sorted order
