@@ -50,6 +50,23 @@ void legendre(double x, int l_max, double* p) {
   for (int l = 2; l <= l_max; ++l) p[l] = ((2.0 * l - 1.0) * x * p[l - 1] - (l - 1.0) * p[l - 2]) / l;
 }
 
+// The normalised associated Legendre functions Lambda_l^m(x) = sqrt((l - m)! / (l + m)!) P_l^m(x),
+// without the Condon-Shortley sign, for l = m .. l_max (p[l]; p[l] = 0 for l < m): with them the
+// addition theorem reads P_l(cos Theta) = sum_m (2 - delta_m0) Lambda_l^m(mu) Lambda_l^m(mu') cos(m dphi).
+void legendre_m(double x, int m, int l_max, double* p) {
+  for (int l = 0; l <= l_max && l < m; ++l) p[l] = 0.0;
+  if (m > l_max) return;
+  double mm = 1.0;
+  const double s = std::sqrt(std::max(0.0, 1.0 - x * x));
+  for (int k = 1; k <= m; ++k) mm *= std::sqrt((2.0 * k - 1.0) / (2.0 * k)) * s;
+  p[m] = mm;
+  if (m + 1 <= l_max) p[m + 1] = x * std::sqrt(2.0 * m + 1.0) * mm;
+  for (int l = m + 2; l <= l_max; ++l) {
+    p[l] = ((2.0 * l - 1.0) * x * p[l - 1] - std::sqrt((l - 1.0) * (l - 1.0) - double(m) * m) * p[l - 2]) /
+           std::sqrt(double(l) * l - double(m) * m);
+  }
+}
+
 // Dense n x n matrices, row-major.
 using Mat = std::vector<double>;
 
@@ -247,6 +264,26 @@ double SlabSolution::reflection(double mu, double mu0) const {
   return r_[k] + r_ss_fix_[k];
 }
 
+double SlabSolution::reflection(double mu, double mu0, double dphi) const {
+  if (r_modes_.size() < 2) throw std::invalid_argument("slab solution: solved for the azimuthal mean only (SlabOptions::azimuth_modes)");
+  const int n = static_cast<int>(mu_.size());
+  const std::size_t k = static_cast<std::size_t>(index(mu)) * n + static_cast<std::size_t>(index(mu0));
+  double r = 0.0, truncated = 0.0;
+  for (std::size_t m = 0; m < r_modes_.size(); ++m) {
+    const double c = (m == 0 ? 1.0 : 2.0) * std::cos(static_cast<double>(m) * dphi);
+    r += c * r_modes_[m][k];
+    truncated += c * p_refl_modes_[m][k];
+  }
+  if (tms_) {
+    // TMS at this azimuth: single scattering with the whole phase function instead of the truncated one.
+    const double s1 = std::sqrt(std::max(0.0, 1.0 - mu * mu)), s0 = std::sqrt(std::max(0.0, 1.0 - mu0 * mu0));
+    const double cos_theta = std::clamp(-mu * mu0 + s1 * s0 * std::cos(dphi), -1.0, 1.0);
+    const double geom = -std::expm1(-scaled_tau * (1.0 / mu + 1.0 / mu0)) / (mu + mu0) / 4.0;
+    r += geom * (omega_ / (1.0 - f_ * omega_) * 4.0 * kPi * phase_value_(cos_theta) - omega_s_ * truncated);
+  }
+  return r;
+}
+
 double SlabSolution::diffuse_transmission(double mu, double mu0) const {
   const int n = static_cast<int>(mu_.size());
   return t_[static_cast<std::size_t>(index(mu)) * n + static_cast<std::size_t>(index(mu0))];
@@ -297,67 +334,86 @@ SlabSolution solve_slab(const SlabProblem& prob, const SlabOptions& opt) {
   for (int l = 0; l < L; ++l) chi_s[static_cast<std::size_t>(l)] = (chi[static_cast<std::size_t>(l)] - f) / (1.0 - f);
   s.truncated_fraction = f;
   s.scaled_tau = tau_s;
-  // The m = 0 kernels in 4 pi normalisation: sum (2l + 1) chi_l P_l(mu) P_l(+-mu0).
+  // The kernels of Fourier mode m in 4 pi normalisation: sum over l of (2l + 1) chi_l Lambda_l^m(mu)
+  // Lambda_l^m(+-mu0) (Lambda_l^0 = P_l), and each mode's reflection and transmission by doubling.
+  // Every mode's adding equations have the m = 0 form (the azimuth integrals of the cosine series
+  // give each mode alone), so one routine serves them all.
+  const int modes = opt.azimuth_modes <= 0 ? L : std::min(opt.azimuth_modes, L);
   std::vector<double> pl(static_cast<std::size_t>(n) * L);
-  for (int i = 0; i < n; ++i) legendre(s.mu_[static_cast<std::size_t>(i)], L - 1, &pl[static_cast<std::size_t>(i) * L]);
-  Mat p_refl(static_cast<std::size_t>(n) * n), p_tran(static_cast<std::size_t>(n) * n);
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      double sr = 0.0, st = 0.0;
-      for (int l = 0; l < L; ++l) {
-        const double term = (2.0 * l + 1.0) * chi_s[static_cast<std::size_t>(l)] * pl[static_cast<std::size_t>(i) * L + l] *
-                            pl[static_cast<std::size_t>(j) * L + l];
-        st += term;
-        sr += (l % 2 ? -term : term);
-      }
-      p_refl[static_cast<std::size_t>(i) * n + j] = sr;
-      p_tran[static_cast<std::size_t>(i) * n + j] = st;
-    }
-  }
+  Mat eye(static_cast<std::size_t>(n) * n, 0.0);
+  for (int i = 0; i < n; ++i) eye[static_cast<std::size_t>(i) * n + i] = 1.0;
   // The thin starting layer: tau_s / 2^k at most opt.thin_layer thick, single scattering only.
   int k = 0;
-  double t = tau_s;
-  while (t > opt.thin_layer) {
-    t *= 0.5;
+  double t0 = tau_s;
+  while (t0 > opt.thin_layer) {
+    t0 *= 0.5;
     ++k;
   }
   s.doublings = k;
-  Mat r(static_cast<std::size_t>(n) * n), tr(static_cast<std::size_t>(n) * n);
-  for (int i = 0; i < n; ++i) {
-    const double mu = s.mu_[static_cast<std::size_t>(i)];
-    for (int j = 0; j < n; ++j) {
-      const double mu0 = s.mu_[static_cast<std::size_t>(j)];
-      const std::size_t ij = static_cast<std::size_t>(i) * n + j;
-      r[ij] = omega_s / 4.0 * p_refl[ij] * -std::expm1(-t * (1.0 / mu + 1.0 / mu0)) / (mu + mu0);
-      // (exp(-t/mu) - exp(-t/mu0)) / (mu - mu0) = -exp(-t/mu) expm1(t/mu - t/mu0) / (mu - mu0).
-      const double a = t / mu, b = t / mu0;
-      const double diff = std::abs(mu - mu0) < 1e-12 ? std::exp(-a) * t / (mu * mu0) : -std::exp(-a) * std::expm1(a - b) / (mu - mu0);
-      tr[ij] = omega_s / 4.0 * p_tran[ij] * diff;
+  Mat r, tr;
+  for (int m = 0; m < modes; ++m) {
+    for (int i = 0; i < n; ++i) legendre_m(s.mu_[static_cast<std::size_t>(i)], m, L - 1, &pl[static_cast<std::size_t>(i) * L]);
+    Mat p_refl(static_cast<std::size_t>(n) * n), p_tran(static_cast<std::size_t>(n) * n);
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        double sr = 0.0, st = 0.0;
+        for (int l = m; l < L; ++l) {
+          const double term = (2.0 * l + 1.0) * chi_s[static_cast<std::size_t>(l)] * pl[static_cast<std::size_t>(i) * L + l] *
+                              pl[static_cast<std::size_t>(j) * L + l];
+          st += term;
+          sr += ((l + m) % 2 ? -term : term);  // Lambda_l^m(-x) = (-1)^(l + m) Lambda_l^m(x)
+        }
+        p_refl[static_cast<std::size_t>(i) * n + j] = sr;
+        p_tran[static_cast<std::size_t>(i) * n + j] = st;
+      }
     }
+    double t = t0;
+    r.assign(static_cast<std::size_t>(n) * n, 0.0);
+    tr.assign(static_cast<std::size_t>(n) * n, 0.0);
+    for (int i = 0; i < n; ++i) {
+      const double mu = s.mu_[static_cast<std::size_t>(i)];
+      for (int j = 0; j < n; ++j) {
+        const double mu0 = s.mu_[static_cast<std::size_t>(j)];
+        const std::size_t ij = static_cast<std::size_t>(i) * n + j;
+        r[ij] = omega_s / 4.0 * p_refl[ij] * -std::expm1(-t * (1.0 / mu + 1.0 / mu0)) / (mu + mu0);
+        // (exp(-t/mu) - exp(-t/mu0)) / (mu - mu0) = -exp(-t/mu) expm1(t/mu - t/mu0) / (mu - mu0).
+        const double a = t / mu, b = t / mu0;
+        const double diff = std::abs(mu - mu0) < 1e-12 ? std::exp(-a) * t / (mu * mu0) : -std::exp(-a) * std::expm1(a - b) / (mu - mu0);
+        tr[ij] = omega_s / 4.0 * p_tran[ij] * diff;
+      }
+    }
+    // Doubling: two identical layers (a homogeneous layer is the same seen from either side).
+    std::vector<double> e(static_cast<std::size_t>(n));
+    for (int d = 0; d < k; ++d) {
+      for (int i = 0; i < n; ++i) e[static_cast<std::size_t>(i)] = std::exp(-t / s.mu_[static_cast<std::size_t>(i)]);
+      const Mat rm = scale_cols(r, s.weight_, n), tm = scale_cols(tr, s.weight_, n);  // R M, T M
+      const Mat rmr = mul(rm, r, n);                                                  // R M R
+      Mat a = eye;
+      const Mat rmrm = scale_cols(rmr, s.weight_, n);
+      for (std::size_t q = 0; q < a.size(); ++q) a[q] -= rmrm[q];
+      // D = (I - R M R M)^-1 (T + R M R E), U = R E + R M D.
+      const Mat dn = solve(a, add(tr, scale_cols(rmr, e, n)), n);
+      const Mat up = add(scale_cols(r, e, n), mul(rm, dn, n));
+      // R' = R + E U + T M U, T' = E D + T E + T M D.
+      Mat r2 = add(add(r, scale_rows(up, e, n)), mul(tm, up, n));
+      Mat t2 = add(add(scale_rows(dn, e, n), scale_cols(tr, e, n)), mul(tm, dn, n));
+      r = std::move(r2);
+      tr = std::move(t2);
+      t *= 2.0;
+    }
+    if (m == 0) {
+      s.p_refl0_ = p_refl;
+      s.t_ = tr;
+      s.r_ = r;
+    }
+    s.r_modes_.push_back(std::move(r));
+    s.p_refl_modes_.push_back(std::move(p_refl));
   }
-  // Doubling: two identical layers (a homogeneous layer is the same seen from either side).
-  Mat eye(static_cast<std::size_t>(n) * n, 0.0);
-  for (int i = 0; i < n; ++i) eye[static_cast<std::size_t>(i) * n + i] = 1.0;
-  std::vector<double> e(static_cast<std::size_t>(n));
-  for (int d = 0; d < k; ++d) {
-    for (int i = 0; i < n; ++i) e[static_cast<std::size_t>(i)] = std::exp(-t / s.mu_[static_cast<std::size_t>(i)]);
-    const Mat rm = scale_cols(r, s.weight_, n), tm = scale_cols(tr, s.weight_, n);  // R M, T M
-    const Mat rmr = mul(rm, r, n);                                                  // R M R
-    Mat a = eye;
-    const Mat rmrm = scale_cols(rmr, s.weight_, n);
-    for (std::size_t q = 0; q < a.size(); ++q) a[q] -= rmrm[q];
-    // D = (I - R M R M)^-1 (T + R M R E), U = R E + R M D.
-    const Mat dn = solve(a, add(tr, scale_cols(rmr, e, n)), n);
-    const Mat up = add(scale_cols(r, e, n), mul(rm, dn, n));
-    // R' = R + E U + T M U, T' = E D + T E + T M D.
-    Mat r2 = add(add(r, scale_rows(up, e, n)), mul(tm, up, n));
-    Mat t2 = add(add(scale_rows(dn, e, n), scale_cols(tr, e, n)), mul(tm, dn, n));
-    r = std::move(r2);
-    tr = std::move(t2);
-    t *= 2.0;
-  }
-  s.r_ = std::move(r);
-  s.t_ = std::move(tr);
+  s.omega_ = omega;
+  s.f_ = f;
+  s.omega_s_ = omega_s;
+  s.tms_ = opt.tms;
+  s.phase_value_ = prob.phase.value;
   s.direct_.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) s.direct_[static_cast<std::size_t>(i)] = std::exp(-tau_s / s.mu_[static_cast<std::size_t>(i)]);
   // TMS: in R at the extra directions, single scattering with the truncated phase is replaced by
@@ -369,7 +425,7 @@ SlabSolution solve_slab(const SlabProblem& prob, const SlabOptions& opt) {
         const double mu = s.mu_[static_cast<std::size_t>(i)], mu0 = s.mu_[static_cast<std::size_t>(j)];
         const double geom = -std::expm1(-tau_s * (1.0 / mu + 1.0 / mu0)) / (mu + mu0) / 4.0;
         const double exact = omega / (1.0 - f * omega) * azimuthal_mean(prob.phase.value, mu, mu0);
-        s.r_ss_fix_[static_cast<std::size_t>(i) * n + j] = geom * (exact - omega_s * p_refl[static_cast<std::size_t>(i) * n + j]);
+        s.r_ss_fix_[static_cast<std::size_t>(i) * n + j] = geom * (exact - omega_s * s.p_refl0_[static_cast<std::size_t>(i) * n + j]);
       }
     }
   }

@@ -8,9 +8,10 @@
 // unit area normal to it falls on the top at mu0 = cos(zenith angle). The reflected radiance is
 // I(mu) = mu0 F R(mu, mu0) and the diffusely transmitted one mu0 F T(mu, mu0); the plane albedo is
 // A(mu0) = 2 int_0^1 R(mu, mu0) mu dmu. With the irradiance E = pi F normal to the beam, the
-// radiance per unit irradiance is I / E = mu0 R / pi. Only the azimuthal mean (Fourier term m = 0)
-// is computed: it is all a plane albedo needs, and at nadir (mu = 1) the radiance does not depend on
-// azimuth, so it is the whole radiance there.
+// radiance per unit irradiance is I / E = mu0 R / pi. By default only the azimuthal mean (Fourier
+// term m = 0) is computed: it is all a plane albedo needs, and at nadir (mu = 1) the radiance does not
+// depend on azimuth, so it is the whole radiance there. SlabOptions::azimuth_modes asks for the other
+// modes too, for the reflection at any azimuth (oblique views).
 #pragma once
 
 #include <functional>
@@ -58,12 +59,22 @@ struct SlabOptions {
   bool delta_m = true;         // Wiscombe (1977): truncate the forward peak at 2 * streams moments
   bool tms = true;             // Nakajima & Tanaka (1988): exact single scattering in R at mu_extra
   double thin_layer = 1.0e-13;  // the doubling starts from single scattering in a layer at most this thick
+  // Fourier modes in azimuth solved: 1 = the azimuthal mean alone (all a plane albedo or a nadir
+  // radiance needs); 0 or more than 2 * streams = every mode the truncated phase has (2 * streams),
+  // for the reflection at any azimuth.
+  int azimuth_modes = 1;
 };
 
 class SlabSolution {
  public:
   // Reflection and diffuse transmission functions (m = 0) at two of the problem's mu_extra.
   double reflection(double mu, double mu0) const;
+  // The reflection function at an azimuth (needs SlabOptions::azimuth_modes other than 1): dphi is the
+  // angle between the horizontal parts of the reflected light's direction of travel and the sun's
+  // beam's, so dphi = 0 is light that travels on in the sun's azimuth (a camera looking toward the
+  // sun) and dphi = pi light sent back toward the sun. I / E = mu0 R / pi as above.
+  double reflection(double mu, double mu0, double dphi) const;
+  double radiance(double mu, double mu0, double dphi) const { return mu0 * reflection(mu, mu0, dphi) / 3.14159265358979323846; }
   double diffuse_transmission(double mu, double mu0) const;
   // Reflected and transmitted (direct + diffuse) flux over the incident, mu0 one of mu_extra.
   double plane_albedo(double mu0) const;
@@ -83,6 +94,12 @@ class SlabSolution {
   std::vector<double> r_, t_;        // n x n, row = outgoing, column = incident
   std::vector<double> r_ss_fix_;     // TMS correction added to R (extra rows and columns only)
   std::vector<double> direct_;       // exp(-tau* / mu) per node
+  // Per Fourier mode m: R_m and the truncated phase's reflection kernel (for TMS at an azimuth).
+  std::vector<std::vector<double>> r_modes_, p_refl_modes_;
+  std::vector<double> p_refl0_;
+  double omega_ = 1.0, f_ = 0.0, omega_s_ = 1.0;
+  bool tms_ = true;
+  std::function<double(double)> phase_value_;
 };
 
 SlabSolution solve_slab(const SlabProblem& p, const SlabOptions& o = {});
