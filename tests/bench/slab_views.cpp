@@ -31,16 +31,6 @@
 namespace {
 using namespace cv::test::slab;
 
-cv::core::Camera oblique(double view_zenith_deg, double azimuth_deg) {
-  cv::core::Camera cam;
-  cam.alt_m = 2500.0;
-  cam.heading_deg = azimuth_deg;  // the sun is to the north (sun_at_zenith_angle)
-  cam.pitch_deg = -(90.0 - view_zenith_deg);
-  cam.fov_deg = 1e-3;
-  cam.width = 1;
-  cam.height = 2;  // a row per thread for the Monte Carlo
-  return cam;
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -110,23 +100,14 @@ int main(int argc, char** argv) {
         for (double v : views) {
           for (double az : azimuths) {
             if (v == 0.0 && az != azimuths.front()) continue;  // nadir has no azimuth
-            const cv::core::Camera cam = oblique(v, az);
-            cv::core::MonteCarloSettings mc;
-            mc.seed = seed;
-            mc.max_bounces = max_bounces;
-            mc.threads = 2;
+            const cv::core::Camera cam = oblique_camera(v, az);
             cv::core::MarchSettings mm = m;
             mm.quality.anti_alias = false;
             // The mean radiance over the pixels and its standard error.
             auto monte_carlo = [&](const cv::core::GridMeanExtinction& medium, const cv::core::MarchSettings& settings, double& se) {
-              const cv::core::MonteCarloImage img = cv::core::render_monte_carlo(s.grid, medium, cam, sun, settings, mc, spp);
-              double mean = 0.0, var = 0.0;
-              for (std::size_t i = 0; i < img.sum.size(); ++i) {
-                mean += img.mean(i).y / static_cast<double>(img.sum.size());
-                var += img.standard_error(i).y * img.standard_error(i).y;
-              }
-              se = std::sqrt(var) / static_cast<double>(img.sum.size());
-              return mean;
+              const Estimate e = mc_view_radiance(s, medium, settings, cam, z, spp, seed, max_bounces);
+              se = e.se;
+              return e.mean;
             };
             double se = 0.0;
             const double ref = monte_carlo(s.medium, mm, se);

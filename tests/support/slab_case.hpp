@@ -140,23 +140,18 @@ inline core::Sun sun_at_zenith_angle(double theta0_deg) {
   return sun;
 }
 
-// Reflected radiance at nadir over (0, 0), per unit irradiance normal to the sun's rays (I / E), from
-// the renderer's pixels: a camera 10 km up looking straight down, 1 x `rows` pixels of 1e-3 degree
-// field (a row per thread), their means averaged.
-inline Estimate mc_nadir_radiance(const ImportedSlab& s, const core::MarchSettings& m, double theta0_deg, int spp,
-                                  std::uint64_t seed, int rows = 2) {
-  core::Camera cam;
-  cam.alt_m = 10000.0;
-  cam.pitch_deg = -90.0;
-  cam.fov_deg = 1e-3;
-  cam.width = 1;
-  cam.height = rows;
+// Reflected radiance per unit irradiance normal to the sun's rays (I / E), from the renderer's pixels
+// of `cam` (1 x rows pixels of 1e-3 degree field, a row per thread), their means averaged; `medium`
+// is the slab's own or a variant of it.
+inline Estimate mc_view_radiance(const ImportedSlab& s, const core::GridMeanExtinction& medium, const core::MarchSettings& m,
+                                 const core::Camera& cam, double theta0_deg, int spp, std::uint64_t seed,
+                                 int max_bounces = 1000000) {
   core::MonteCarloSettings mc;
   mc.seed = seed;
-  mc.max_bounces = 1000000;
-  mc.threads = static_cast<unsigned>(rows);
+  mc.max_bounces = max_bounces;
+  mc.threads = static_cast<unsigned>(cam.height);
   const auto t0 = std::chrono::steady_clock::now();
-  const core::MonteCarloImage img = core::render_monte_carlo(s.grid, s.medium, cam, sun_at_zenith_angle(theta0_deg), m, mc, spp);
+  const core::MonteCarloImage img = core::render_monte_carlo(s.grid, medium, cam, sun_at_zenith_angle(theta0_deg), m, mc, spp);
   Estimate e;
   e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   double var = 0.0;
@@ -169,6 +164,35 @@ inline Estimate mc_nadir_radiance(const ImportedSlab& s, const core::MarchSettin
   e.truncated = img.stats.truncated;
   e.scatterings = img.stats.scatterings;
   return e;
+}
+
+// Reflected radiance at nadir over (0, 0): a camera 10 km up looking straight down.
+inline Estimate mc_nadir_radiance(const ImportedSlab& s, const core::MarchSettings& m, double theta0_deg, int spp,
+                                  std::uint64_t seed, int rows = 2) {
+  core::Camera cam;
+  cam.alt_m = 10000.0;
+  cam.pitch_deg = -90.0;
+  cam.fov_deg = 1e-3;
+  cam.width = 1;
+  cam.height = rows;
+  return mc_view_radiance(s, s.medium, m, cam, theta0_deg, spp, seed);
+}
+
+// A camera over (0, 0) that sees the slab's top at view zenith angle view_zenith_deg, heading
+// heading_deg from the sun's azimuth (0: looking toward the sun; the sun is to the north). It stands
+// 2.5 km up, half a kilometre above the top, so that even an 85-degree view meets the top within
+// 6 km, where the Earth's curvature turns the view by 0.06 degrees (from 10 km up the top lies about
+// 100 km off at 85 degrees, 0.9 degrees turned, and the curved slab's radiance there is 1-10 % below
+// the plane-parallel one).
+inline core::Camera oblique_camera(double view_zenith_deg, double heading_deg, int rows = 2) {
+  core::Camera cam;
+  cam.alt_m = 2500.0;
+  cam.heading_deg = heading_deg;
+  cam.pitch_deg = -(90.0 - view_zenith_deg);
+  cam.fov_deg = 1e-3;
+  cam.width = 1;
+  cam.height = rows;
+  return cam;
 }
 
 // Plane albedo and transmission by the analog estimator: paths started just above the top at (0, 0)
