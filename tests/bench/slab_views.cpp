@@ -1,8 +1,8 @@
 // Benchmark (not a test): the multiple-scattering models on a plane-parallel slab seen at oblique
 // angles, against the Monte Carlo reference on the same imported slab (the slab check of issue 11
-// validates that reference against the adding-doubling solver at nadir; the solver's every azimuthal
-// mode gives it off nadir too, printed beside it: the imported slab lies on the curved Earth, so at
-// grazing views the two part by a few per cent, docs/BENCHMARKS.md). It separates the models' angular
+// validates that reference against the adding-doubling solver at nadir and, with every azimuthal
+// mode, at oblique views; the solver's radiance is printed beside the Monte Carlo's, docs/BENCHMARKS.md,
+// "The slab solver at every azimuth"). It separates the models' angular
 // error from the 3-D effects of the standard scenes: a deck seen at a grazing angle toward the sun
 // (stratocumulus) and a view from inside a cloud are oblique views of a nearly plane-parallel cloud.
 //   bench_slab_views [--phase hg|mie|both] [--tau 1,2,...] [--zenith SUN,...] [--view V,...]
@@ -48,9 +48,9 @@ int main(int argc, char** argv) {
       "                        [--azimuth A,...] [--spp N] [--seed S] [--max-bounces N] [--delta-scaled [--delta-f F]]\n"
       "                        [--exact-streams N]\n"
       "  the octave sum and the two-stream source against the Monte Carlo on a slab seen obliquely\n"
-      "  (and the adding-doubling solver with every azimuthal mode, N streams per hemisphere, 32 by default;\n"
-      "  the Monte Carlo against it in its own column)\n"
-      "  (view zenith V at the cloud top, heading A from the sun's azimuth: 0 toward the sun);\n"
+      "  (view zenith V at the cloud top, heading A from the sun's azimuth: 0 toward the sun), and the\n"
+      "  adding-doubling solver's radiance there (every azimuthal mode, N streams per hemisphere, 32 by\n"
+      "  default) with the Monte Carlo against it;\n"
       "  --max-bounces cuts the Monte Carlo's paths (the light of the first N orders of scattering);\n"
       "  --delta-scaled (HG only) also solves the delta-Eddington problem the two-stream's diffuse path\n"
       "  assumes (extinction (1 - g^2) sigma, HG g / (1 + g)) by the same Monte Carlo: the error that\n"
