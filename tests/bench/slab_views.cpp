@@ -66,6 +66,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_slab_views: --delta-f: expected one share from 0 to below 0.85 (the slab's g), with --delta-scaled\n");
     return 2;
   }
+  if (exact_streams < 2 || exact_streams > 256) {
+    std::fprintf(stderr, "bench_slab_views: --exact-streams: found %d, expected 2 to 256 streams per hemisphere\n", exact_streams);
+    return 2;
+  }
   if (delta_scaled && phases != "hg") {
     std::fprintf(stderr, "bench_slab_views: --delta-scaled: found --phase %s, expected --phase hg (the droplets' phase has no free mean cosine to scale)\n",
                  phases.c_str());
