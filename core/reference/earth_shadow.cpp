@@ -70,6 +70,21 @@ double smallest_sun_cosine(const VolumeGrid& grid, const glm::dvec3& to_sun) {
   return std::cos(std::min(largest + spacing + kFloatMargin, kPi));
 }
 
+double largest_sun_cosine(const VolumeGrid& grid, const glm::dvec3& to_sun) {
+  Box b;
+  if (!domain_box(grid, b)) return 1.0;
+  const glm::dvec3 sun = glm::normalize(to_sun);
+  // The smallest angle from the subsolar point over a box lies on its boundary unless the
+  // subsolar point is inside it.
+  if (in_box(b, std::asin(std::clamp(sun.z, -1.0, 1.0)) / kDeg, std::atan2(sun.y, sun.x) / kDeg)) return 1.0;
+  double smallest = kPi;
+  const double spacing = visit_boundary(b, [&](double lat_deg, double lon_deg) {
+    const glm::dvec3 u = geo::sphere_to_ecef({lat_deg, lon_deg, 0.0}, 1.0);
+    smallest = std::min(smallest, std::acos(std::clamp(glm::dot(u, sun), -1.0, 1.0)));
+  });
+  return std::cos(std::max(smallest - spacing - kFloatMargin, 0.0));
+}
+
 bool layer_in_earth_shadow(const VolumeGrid& grid, const CloudLayer& layer, const glm::dvec3& to_sun) {
   Box b;
   if (layer.empty || !domain_box(grid, b)) return false;

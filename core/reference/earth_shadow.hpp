@@ -27,4 +27,12 @@ bool layer_in_earth_shadow(const VolumeGrid& grid, const CloudLayer& layer, cons
 // (max_sun_march_steps), so a high sun does not size llvmpipe's dispatches for a grazing one.
 double smallest_sun_cosine(const VolumeGrid& grid, const glm::dvec3& to_sun);
 
+// An upper bound of the cosine between the local vertical and the sun direction over the grid's
+// domain (the border cell included): the highest the sun stands anywhere over the data. 1 for
+// global grids and when the subsolar point is inside the box. Sampled as above, with the smallest
+// angle lowered by the spacing and the float margin. Tells a render whose whole domain is at dawn
+// or dusk (the sun within a few degrees of the horizon everywhere), where the image is mostly
+// twilight.
+double largest_sun_cosine(const VolumeGrid& grid, const glm::dvec3& to_sun);
+
 }  // namespace cv::core

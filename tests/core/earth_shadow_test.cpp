@@ -103,6 +103,36 @@ TEST(EarthShadow, TheSmallestSunCosineBoundsEveryPointOfTheDomain) {
   EXPECT_EQ(smallest_sun_cosine(global, sun_at(55.0, 177.5, 0.0, 0.0)), -1.0);
 }
 
+// The highest sun over the domain bounds every point's sun cosine from above (it tells a render
+// that its whole domain is at dawn or dusk), stays within the sampling margin of the true highest,
+// and is 1 where the sun can stand overhead (global grid, subsolar point inside).
+TEST(EarthShadow, TheLargestSunCosineBoundsEveryPointOfTheDomain) {
+  VolumeGrid g;
+  g.lon_deg = {170.0, 0.5, 31};  // across the date line
+  g.lat_deg = {50.0, 0.5, 21};
+  g.alt_m = {0.0, 500.0, 25};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (double azimuth : {0.0, 120.0, 250.0}) {
+    for (double theta : {20.0, 60.0, 85.0, 90.0, 95.0, 170.0}) {
+      const glm::dvec3 sun = sun_at(55.0, 177.5, theta, azimuth);
+      const double bound = largest_sun_cosine(g, sun);
+      double highest = -1.0;
+      for (int n = 0; n < 20000; ++n) {
+        const double lon = 169.5 + 16.0 * u(rng), lat = 49.5 + 11.0 * u(rng);
+        const glm::dvec3 up = geo::sphere_to_ecef({lat, lon, 0.0}, 1.0);
+        highest = std::max(highest, glm::dot(up, sun));
+      }
+      EXPECT_GE(bound, highest) << "theta " << theta << " azimuth " << azimuth;
+      EXPECT_LT(bound, highest + 0.01) << "theta " << theta << " azimuth " << azimuth;
+    }
+  }
+  EXPECT_EQ(largest_sun_cosine(g, sun_at(55.0, 177.5, 0.0, 0.0)), 1.0);  // subsolar point at the centre
+  VolumeGrid global = g;
+  global.lon_deg = {0.0, 1.0, 360};
+  EXPECT_EQ(largest_sun_cosine(global, sun_at(55.0, 177.5, 180.0, 0.0)), 1.0);
+}
+
 TEST(EarthShadow, NightLeavesTheReferenceImageAsThePerSampleTestMadeIt) {
   StandardScene sc = standard_scene("cumulus_field", 32, 18);
   sc.sun = sun_just_down(sc);
