@@ -52,11 +52,6 @@ using clock = std::chrono::steady_clock;
 // reported as it finishes (a 1920x1080 frame takes about 15 s on llvmpipe, see docs/BENCHMARKS.md).
 constexpr double kTilePixels = 262144.0;
 
-// Below this sun elevation everywhere over the data (degrees) a render says its domain is at dawn or
-// dusk: the clouds are lit at a grazing angle through the air's reddest light, the automatic exposure
-// brightens a twilight sky, and a first-time user sees a pale frame without knowing why.
-constexpr double kTwilightElevationDeg = 5.0;
-
 bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
@@ -851,12 +846,11 @@ int cmd_render(const std::vector<std::string>& args) {
   if (scene_sun_mode != core::SunMode::LocalNoon && !prepared->layer.empty) {
     const glm::dvec3 to_sun =
         glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, g.earth_radius_m));
-    // The sun's highest elevation anywhere over the data (an upper bound, degrees).
-    const double highest_deg = 90.0 - std::acos(std::clamp(core::largest_sun_cosine(g, to_sun), -1.0, 1.0)) * 180.0 / 3.14159265358979323846;
+    const double highest_deg = core::highest_sun_elevation_deg(g, to_sun);
     if (!ra.reference && core::layer_in_earth_shadow(g, prepared->layer, to_sun)) {
       std::printf("hint: at %s the whole cloud layer is in the Earth's shadow, so the image is dark; --sun-mode local_noon "
                   "(sun.mode \"local_noon\") keeps the clouds lit for teaching\n", vt.iso_utc.c_str());
-    } else if (highest_deg < kTwilightElevationDeg) {
+    } else if (highest_deg < core::kTwilightElevationDeg) {
       std::printf("hint: at %s the sun stands at most %.1f degrees above the horizon anywhere over the data (dawn or dusk "
                   "there), so the clouds are lit at a grazing angle through reddened air and the image is mostly twilight; "
                   "--sun-mode local_noon (sun.mode \"local_noon\") keeps the clouds lit for teaching\n",

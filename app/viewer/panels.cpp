@@ -92,6 +92,7 @@ void data_panel(ViewerState& s, const PanelContext& ctx) {
   if (n > 1 && s.timeline) time_controls(s);
   ImGui::TextWrapped("valid time: %s", ctx.instant_text.c_str());
   if (!ctx.time_warning.empty()) ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.4f, 1.0f), "%s", ctx.time_warning.c_str());
+  if (!ctx.sun_note.empty()) ImGui::TextWrapped("%s", ctx.sun_note.c_str());
   if (ImGui::TreeNode("import report")) {
     ImGui::BeginChild("report", ImVec2(0, 160), true, ImGuiWindowFlags_HorizontalScrollbar);
     ImGui::TextUnformatted(s.import_report.c_str());
@@ -145,6 +146,7 @@ void sun_panel(ViewerState& s, PanelContext& ctx) {
   slider_double("irradiance", &s.scene.sun.irradiance, 0.0, 10.0, "%.2f");
   ImGui::Text("sun overhead at %.2f, %.2f", ctx.sun.subsolar_lat_deg, ctx.sun.subsolar_lon_deg);
   if (!ctx.sun_error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.5f, 0.4f, 1.0f), "%s", ctx.sun_error.c_str());
+  if (!ctx.sun_note.empty()) ImGui::TextWrapped("%s", ctx.sun_note.c_str());
 }
 
 // Whether a row's setting is on (a true bool, a non-zero number): rows that need it show only then.

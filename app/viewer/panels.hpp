@@ -39,6 +39,7 @@ struct PanelContext {
   core::Camera home;            // the automatic framing, for "reset view"
   core::Sun sun;                // as resolved this frame
   std::string sun_error;        // why the typed date/time was not used, or empty
+  std::string sun_note;         // the sun low over the whole domain (dawn, dusk or night), or empty
   double goto_lat_deg = 0.0, goto_lon_deg = 0.0, goto_alt_m = 10000.0;
   std::string scene_path = "scene.json";
   std::string scene_message;    // result of the last load/save

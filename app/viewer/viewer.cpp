@@ -22,6 +22,8 @@
 #include "importer.hpp"
 #include "io/output_file.hpp"
 #include "noise/noise.hpp"
+#include "geo/geodesy.hpp"
+#include "reference/earth_shadow.hpp"
 #include "render/albedo_map.hpp"
 #include "render/context.hpp"
 #include "render/machine_id.hpp"
@@ -538,6 +540,7 @@ int run_viewer(const ViewerOptions& o) {
   std::int64_t shown_instant = INT64_MIN;  // the instant whose medium is on the GPU
   bool shown_drift = false;                 // whether it carries the modelled cloud's wind displacement
   bool have_volume = false;
+  std::string printed_sun_note;  // the sun note last printed to the terminal (printed when it changes)
   s.scene.width = o.width;
   s.scene.height = o.height;
   // As `render` does: the quality preset's settings, the view step from the grid's vertical spacing.
@@ -879,6 +882,20 @@ int run_viewer(const ViewerOptions& o) {
       main_view.spec = render::resolve_frame(s.scene, s.volume);
       ctx.sun = main_view.spec.sun;
       ctx.sun_error.clear();
+      // A domain at dawn, dusk or night shows a pale or dark frame: say why, and what lights it.
+      ctx.sun_note.clear();
+      if (s.scene.sun.mode != core::SunMode::LocalNoon) {
+        const double highest = core::highest_sun_elevation_deg(
+            g, glm::normalize(geo::sphere_to_ecef({ctx.sun.subsolar_lat_deg, ctx.sun.subsolar_lon_deg, 0.0}, g.earth_radius_m)));
+        if (highest < core::kTwilightElevationDeg) {
+          char text[200];
+          std::snprintf(text, sizeof text, "the sun stands at most %.1f degrees above the horizon over the data (%s there): "
+                        "'local noon (teaching)' keeps the clouds lit", highest, highest < 0.0 ? "night or twilight" : "dawn or dusk");
+          ctx.sun_note = text;
+        }
+      }
+      if (ctx.sun_note != printed_sun_note && !ctx.sun_note.empty()) std::printf("note: %s\n", ctx.sun_note.c_str());
+      printed_sun_note = ctx.sun_note;
     } catch (const std::invalid_argument& e) {
       ctx.sun_error = e.what();
       main_view.spec = resolve(s.scene, s.volume);

@@ -85,6 +85,10 @@ double largest_sun_cosine(const VolumeGrid& grid, const glm::dvec3& to_sun) {
   return std::cos(std::max(smallest - spacing - kFloatMargin, 0.0));
 }
 
+double highest_sun_elevation_deg(const VolumeGrid& grid, const glm::dvec3& to_sun) {
+  return 90.0 - std::acos(std::clamp(largest_sun_cosine(grid, to_sun), -1.0, 1.0)) / kDeg;
+}
+
 bool layer_in_earth_shadow(const VolumeGrid& grid, const CloudLayer& layer, const glm::dvec3& to_sun) {
   Box b;
   if (layer.empty || !domain_box(grid, b)) return false;

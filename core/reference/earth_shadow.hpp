@@ -35,4 +35,13 @@ double smallest_sun_cosine(const VolumeGrid& grid, const glm::dvec3& to_sun);
 // twilight.
 double largest_sun_cosine(const VolumeGrid& grid, const glm::dvec3& to_sun);
 
+// Below this elevation everywhere over the data (degrees), the domain is at dawn or dusk: the clouds
+// are lit at a grazing angle through the air's reddest light and the automatic exposure brightens a
+// twilight sky, so `render` and the viewer say so and name the teaching sun (local noon).
+constexpr double kTwilightElevationDeg = 5.0;
+
+// The highest the sun stands over the grid's domain, degrees above the horizon (an upper bound,
+// from largest_sun_cosine).
+double highest_sun_elevation_deg(const VolumeGrid& grid, const glm::dvec3& to_sun);
+
 }  // namespace cv::core
