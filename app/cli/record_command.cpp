@@ -20,10 +20,12 @@
 #include <glm/glm.hpp>
 
 #include "cli_common.hpp"
+#include "geo/geodesy.hpp"
 #include "io/input_file.hpp"
 #include "io/output_file.hpp"
 #include "kernel/volume_cache.hpp"
 #include "overlays/overlays.hpp"
+#include "reference/earth_shadow.hpp"
 #include "render/context.hpp"
 #include "render/frame_renderer.hpp"
 #include "render/image_output.hpp"
@@ -414,6 +416,7 @@ int cmd_record(const std::vector<std::string>& args) {
   core::PreparedVolumeCache volumes;
   overlays::OverlayBuilder builder;
   std::string warned;
+  bool sun_was_low = false;  // the last frame rendered had the sun low over all the data
 
   // Frame k's linear image, through the one frame renderer: the scene at the path's time for k,
   // its jitter indices k * accumulate onwards.
@@ -424,6 +427,18 @@ int cmd_record(const std::vector<std::string>& args) {
     core::TimeInterpolationReport rep;
     renderer.use_volume(volumes.get(scene.data.path, vol, instant, at.time.interpolation, &rep, at.render.march.medium.modelled));
     if (!rep.warning.empty() && rep.warning != warned) std::printf("warning: %s\n", (warned = rep.warning).c_str());
+    // Frames whose whole domain has the sun low (dawn, dusk or night there) come out pale or dark:
+    // said once where such a run of frames begins.
+    const bool low_sun = at.sun.mode != core::SunMode::LocalNoon &&
+                         core::highest_sun_elevation_deg(vol.grid, glm::normalize(geo::sphere_to_ecef(
+                             {frame.sun.subsolar_lat_deg, frame.sun.subsolar_lon_deg, 0.0}, vol.grid.earth_radius_m))) <
+                             core::kTwilightElevationDeg;
+    if (low_sun && !sun_was_low) {
+      std::printf("hint: from frame %d (%s) the sun stands under %g degrees above the horizon over all the data (dawn, dusk or "
+                  "night there), so those frames are twilight or dark; sun.mode \"local_noon\" keeps the clouds lit for teaching\n",
+                  k, instant.iso_utc.c_str(), core::kTwilightElevationDeg);
+    }
+    sun_was_low = low_sun;
     if (!at.overlays.empty()) {
       try {
         renderer.set_overlays(overlays::OverlayBuilder::draws(builder.build(at.overlays, vol, instant.step0, frame.march_camera)));
