@@ -3,8 +3,10 @@
 // test; it does say so on the night side; and night leaves the reference image as it was.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include <glm/glm.hpp>
 
@@ -76,23 +78,33 @@ TEST(EarthShadow, NeverCallsALitLayerDark) {
 // The lowest sun over the domain bounds every point's sun cosine from below (it sizes llvmpipe's
 // dispatches for the longest sun march), stays within the sampling margin of the true lowest, and
 // is -1 where the sun can be anywhere (global grid, antisolar point inside).
-TEST(EarthShadow, TheSmallestSunCosineBoundsEveryPointOfTheDomain) {
+// The sun cosines over 20 000 random points of the box below and its border cell (lowest, highest).
+std::pair<double, double> sampled_sun_cosines(std::mt19937& rng, const glm::dvec3& sun) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double lowest = 1.0, highest = -1.0;
+  for (int n = 0; n < 20000; ++n) {
+    const double lon = 169.5 + 16.0 * u(rng), lat = 49.5 + 11.0 * u(rng);
+    const double c = glm::dot(geo::sphere_to_ecef({lat, lon, 0.0}, 1.0), sun);
+    lowest = std::min(lowest, c), highest = std::max(highest, c);
+  }
+  return {lowest, highest};
+}
+VolumeGrid box_across_the_date_line() {
   VolumeGrid g;
-  g.lon_deg = {170.0, 0.5, 31};  // across the date line
+  g.lon_deg = {170.0, 0.5, 31};
   g.lat_deg = {50.0, 0.5, 21};
   g.alt_m = {0.0, 500.0, 25};
+  return g;
+}
+
+TEST(EarthShadow, TheSmallestSunCosineBoundsEveryPointOfTheDomain) {
+  const VolumeGrid g = box_across_the_date_line();
   std::mt19937 rng(9);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
   for (double azimuth : {0.0, 120.0, 250.0}) {
     for (double theta : {0.0, 20.0, 60.0, 85.0, 95.0}) {
       const glm::dvec3 sun = sun_at(55.0, 177.5, theta, azimuth);
       const double bound = smallest_sun_cosine(g, sun);
-      double lowest = 1.0;
-      for (int n = 0; n < 20000; ++n) {
-        const double lon = 169.5 + 16.0 * u(rng), lat = 49.5 + 11.0 * u(rng);
-        const glm::dvec3 up = geo::sphere_to_ecef({lat, lon, 0.0}, 1.0);
-        lowest = std::min(lowest, glm::dot(up, sun));
-      }
+      const double lowest = sampled_sun_cosines(rng, sun).first;
       EXPECT_LE(bound, lowest) << "theta " << theta << " azimuth " << azimuth;
       EXPECT_GT(bound, lowest - 0.01) << "theta " << theta << " azimuth " << azimuth;
     }
@@ -107,22 +119,13 @@ TEST(EarthShadow, TheSmallestSunCosineBoundsEveryPointOfTheDomain) {
 // that its whole domain is at dawn or dusk), stays within the sampling margin of the true highest,
 // and is 1 where the sun can stand overhead (global grid, subsolar point inside).
 TEST(EarthShadow, TheLargestSunCosineBoundsEveryPointOfTheDomain) {
-  VolumeGrid g;
-  g.lon_deg = {170.0, 0.5, 31};  // across the date line
-  g.lat_deg = {50.0, 0.5, 21};
-  g.alt_m = {0.0, 500.0, 25};
+  const VolumeGrid g = box_across_the_date_line();
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
   for (double azimuth : {0.0, 120.0, 250.0}) {
     for (double theta : {20.0, 60.0, 85.0, 90.0, 95.0, 170.0}) {
       const glm::dvec3 sun = sun_at(55.0, 177.5, theta, azimuth);
       const double bound = largest_sun_cosine(g, sun);
-      double highest = -1.0;
-      for (int n = 0; n < 20000; ++n) {
-        const double lon = 169.5 + 16.0 * u(rng), lat = 49.5 + 11.0 * u(rng);
-        const glm::dvec3 up = geo::sphere_to_ecef({lat, lon, 0.0}, 1.0);
-        highest = std::max(highest, glm::dot(up, sun));
-      }
+      const double highest = sampled_sun_cosines(rng, sun).second;
       EXPECT_GE(bound, highest) << "theta " << theta << " azimuth " << azimuth;
       EXPECT_LT(bound, highest + 0.01) << "theta " << theta << " azimuth " << azimuth;
     }
