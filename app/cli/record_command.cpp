@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -320,7 +321,8 @@ const char* record_usage() {
          "                           through its end), then an H.264 yuv420p MP4 through the ffmpeg program; frames\n"
          "                           already whole are skipped, so a stopped run resumes; the same scene and frame\n"
          "                           give the same bytes (each frame's jitter from its number); auto exposure is\n"
-         "                           taken from frame 0 for every frame, so the video does not flicker;\n"
+         "                           one for every frame, so the video does not flicker: the least of the automatic\n"
+         "                           exposures of the first, the last and three frames between (the brightest sets it);\n"
          "                           OUT_frames/record.json holds the settings: frames of other ones are refused\n"
          "         [--quality reference [--spp N] [--target-error E]]  each frame by the GPU path tracer (clouds and\n"
          "                           the ground, lit by the sun and the sky): N samples per pixel at most (64), fewer once\n"
@@ -468,12 +470,21 @@ int cmd_record(const std::vector<std::string>& args) {
 
   std::optional<double> exposure;
   if (!scene.render.auto_exposure) exposure = scene.render.exposure;
-  if (!exposure) {  // from frame 0 for every frame and every range, so ranges rendered apart match
-    std::vector<glm::vec4> marched;
-    core::FrameSpec f0;
-    render_frame(0, &marched, f0);
-    exposure = render::auto_exposure(marched);
-    std::printf("exposure %.6g (auto, from frame 0, for every frame)\n", *exposure);
+  // The probed frames of this range, kept for the loop (their images are the loop's to the bit).
+  std::map<int, std::pair<core::FrameSpec, std::vector<glm::vec4>>> probed;
+  if (!exposure) {  // from the same frames of the whole path for every range, so ranges rendered apart match
+    std::vector<std::optional<double>> probes;
+    std::string which;
+    for (const int k : render::exposure_probe_frames(count)) {
+      std::vector<glm::vec4> marched;
+      core::FrameSpec fk;
+      std::vector<glm::vec4> pixels = render_frame(k, &marched, fk);
+      if (k >= first && k <= last) probed[k] = {fk, std::move(pixels)};
+      probes.push_back(render::auto_exposure_if_lit(marched));
+      which += (which.empty() ? "" : ", ") + std::to_string(k);
+    }
+    exposure = render::sequence_exposure(probes);
+    std::printf("exposure %.6g (auto, for every frame: the least of the automatic exposures of frames %s)\n", *exposure, which.c_str());
   }
   if (r.reference) {
     std::printf("recording %s: %d frames (%.3g s at %.6g fps), %d..%d here, %dx%d, quality reference: the GPU path tracer, up to %d "
@@ -523,7 +534,13 @@ int cmd_record(const std::vector<std::string>& args) {
     }
     const auto t0 = clock::now();
     core::FrameSpec frame;
-    const std::vector<glm::vec4> pixels = render_frame(k, nullptr, frame);
+    std::vector<glm::vec4> pixels;
+    if (auto kept = probed.find(k); kept != probed.end()) {
+      frame = kept->second.first;
+      pixels = std::move(kept->second.second);
+    } else {
+      pixels = render_frame(k, nullptr, frame);
+    }
     render::check_finite_pixels(pixels, frame.camera.width, file.string());
     render::ToneSettings tone;
     tone.exposure = *exposure;

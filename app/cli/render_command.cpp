@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -584,41 +585,67 @@ int render_series(const RenderArgs& ra, core::Scene scene) {
               instants.size(), scene.data.path.c_str(), ra.times_from.c_str(), ra.times_to.c_str(), static_cast<long long>(ra.every_s),
               scene.width, scene.height, scene.render.quality.c_str(), core::time_interpolation_name(scene.time.interpolation),
               core::sun_mode_name(scene.sun.mode), ra.out.c_str());
-  std::optional<double> exposure;  // automatic: from the first instant, so the sequence does not flicker
-  if (!scene.render.auto_exposure) exposure = scene.render.exposure;
-  int written = 0, skipped = 0, dark = 0;
   std::string warned;
+  // Frame i's instant prepared on the GPU and its frame resolved (the sun at the instant).
+  struct Prepared {
+    core::Instant at;
+    core::TimeInterpolationReport rep;
+    core::FrameSpec frame;
+  };
+  auto prepare = [&](std::size_t i) {
+    Prepared p;
+    scene.time.valid_utc = core::format_iso_utc(instants[i]);
+    p.at = core::scene_instant(scene, vol, scene.data.path);
+    renderer.use_volume(volumes.get(scene.data.path, vol, p.at, scene.time.interpolation, &p.rep, scene.render.march.medium.modelled));
+    if (!p.rep.warning.empty() && warned != p.rep.warning) std::printf("warning: %s\n", (warned = p.rep.warning).c_str());
+    p.frame = render::resolve_frame(scene, vol);
+    return p;
+  };
+  check_view_steps(prepare(0).frame.march.quality.view_step_m, g.earth_radius_m, g.alt_m.last());
+  // One exposure for the whole sequence, so it does not flicker and a resumed run matches: given,
+  // or the least automatic exposure of a few frames spread over it (render::sequence_exposure),
+  // whose images are kept for the loop below.
+  std::optional<double> exposure;
+  std::map<std::size_t, std::vector<glm::vec4>> probed;
+  if (!scene.render.auto_exposure) {
+    exposure = scene.render.exposure;
+  } else {
+    std::vector<std::optional<double>> probes;
+    std::string which;
+    for (const int k : render::exposure_probe_frames(static_cast<int>(instants.size()))) {
+      const Prepared p = prepare(static_cast<std::size_t>(k));
+      std::vector<glm::vec4> marched;
+      probed[static_cast<std::size_t>(k)] = renderer.render(p.frame, {}, {}, &marched);
+      probes.push_back(render::auto_exposure_if_lit(marched));
+      which += (which.empty() ? "" : ", ") + std::to_string(k);
+    }
+    exposure = render::sequence_exposure(probes);
+    std::printf("exposure %.4g (auto, for every frame: the least of the automatic exposures of frames %s, each putting the 99th "
+                "percentile of its lit pixels' luminance at 0.8; --exposure E sets it)\n", *exposure, which.c_str());
+  }
+  int written = 0, skipped = 0, dark = 0;
   for (std::size_t i = 0; i < instants.size(); ++i) {
     char name[32];
     std::snprintf(name, sizeof name, "frame_%05zu.png", i);
     const fs::path path = fs::path(ra.out) / name;
     const std::string iso = core::format_iso_utc(instants[i]);
-    if (complete_png(path) && exposure) {
+    if (complete_png(path)) {
       ++skipped;
       std::printf("frame %zu/%zu %s: %s already written, skipped\n", i + 1, instants.size(), iso.c_str(), path.c_str());
       continue;
     }
     const auto t0 = clock::now();
-    scene.time.valid_utc = iso;
-    const core::Instant at = core::scene_instant(scene, vol, scene.data.path);
-    core::TimeInterpolationReport rep;
-    renderer.use_volume(volumes.get(scene.data.path, vol, at, scene.time.interpolation, &rep, scene.render.march.medium.modelled));
-    if (!rep.warning.empty() && warned != rep.warning) std::printf("warning: %s\n", (warned = rep.warning).c_str());
-    const core::FrameSpec frame = render::resolve_frame(scene, vol);
-    if (i == 0) check_view_steps(frame.march.quality.view_step_m, g.earth_radius_m, g.alt_m.last());
-    std::vector<glm::vec4> marched;
-    const std::vector<glm::vec4> pixels = renderer.render(frame, {}, {}, &marched);
-    if (!exposure) exposure = render::auto_exposure(marched);
-    const auto prepared_layer = renderer.raymarcher().last_stats().sun_down;
-    const bool in_shadow = prepared_layer || (scene.sun.mode != core::SunMode::LocalNoon &&
+    const Prepared p = prepare(i);
+    const core::Instant& at = p.at;
+    const core::TimeInterpolationReport& rep = p.rep;
+    const core::FrameSpec& frame = p.frame;
+    const auto kept = probed.find(i);
+    const std::vector<glm::vec4> pixels = kept != probed.end() ? std::move(kept->second) : renderer.render(frame, {}, {}, nullptr);
+    // Decided for this frame's own sun (a probed frame's image may have been marched before others).
+    const bool in_shadow = scene.sun.mode != core::SunMode::LocalNoon &&
         core::layer_in_earth_shadow(g, volumes.get(scene.data.path, vol, at, scene.time.interpolation, nullptr, scene.render.march.medium.modelled)->layer,
-                                    glm::normalize(geo::sphere_to_ecef({frame.sun.subsolar_lat_deg, frame.sun.subsolar_lon_deg, 0.0}, g.earth_radius_m))));
+                                    glm::normalize(geo::sphere_to_ecef({frame.sun.subsolar_lat_deg, frame.sun.subsolar_lon_deg, 0.0}, g.earth_radius_m)));
     dark += in_shadow ? 1 : 0;
-    if (complete_png(path)) {  // rendered only for the sequence's exposure
-      ++skipped;
-      std::printf("frame %zu/%zu %s: %s already written, skipped (rendered for the exposure)\n", i + 1, instants.size(), iso.c_str(), path.c_str());
-      continue;
-    }
     render::ToneSettings tone;
     tone.exposure = *exposure;
     if (frame.march.features.atmosphere || frame.march.features.globe) tone.background = glm::dvec3(0.0);

@@ -58,14 +58,36 @@ std::vector<glm::vec4> upscale_linear(const std::vector<glm::vec4>& in, int iw, 
   return out;
 }
 
-double auto_exposure(const std::vector<glm::vec4>& linear) {
+double auto_exposure(const std::vector<glm::vec4>& linear) { return auto_exposure_if_lit(linear).value_or(kDefaultExposure); }
+
+std::vector<int> exposure_probe_frames(int n) {
+  std::vector<int> k;
+  if (n <= 0) return k;
+  if (n <= 5) {
+    for (int i = 0; i < n; ++i) k.push_back(i);
+    return k;
+  }
+  for (int q = 0; q <= 4; ++q) k.push_back(static_cast<int>((static_cast<long long>(n - 1) * q + 2) / 4));
+  k.erase(std::unique(k.begin(), k.end()), k.end());
+  return k;
+}
+
+double sequence_exposure(const std::vector<std::optional<double>>& probe_exposures) {
+  std::optional<double> least;
+  for (const auto& e : probe_exposures) {
+    if (e && (!least || *e < *least)) least = e;
+  }
+  return least.value_or(kDefaultExposure);
+}
+
+std::optional<double> auto_exposure_if_lit(const std::vector<glm::vec4>& linear) {
   std::vector<double> y;
   y.reserve(linear.size());
   for (const auto& p : linear) {
     const double l = 0.2126 * p.x + 0.7152 * p.y + 0.0722 * p.z;
     if (std::isfinite(l) && l > 0.0) y.push_back(l);
   }
-  if (y.empty()) return kDefaultExposure;
+  if (y.empty()) return std::nullopt;
   const std::size_t k = std::min(y.size() - 1, static_cast<std::size_t>(0.99 * static_cast<double>(y.size())));
   std::nth_element(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(k), y.end());
   // filmic(x) = 0.8: (2.51 - 2.43 t) x^2 + (0.03 - 0.59 t) x - 0.14 t = 0, its positive root.

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <string>
+#include <optional>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -30,6 +31,16 @@ std::vector<glm::vec4> upscale_linear(const std::vector<glm::vec4>& in, int iw, 
 // (the top 1 %) does not darken the rest. An image with no lit pixel gets kDefaultExposure.
 inline constexpr double kDefaultExposure = 4.0;
 double auto_exposure(const std::vector<glm::vec4>& linear);
+// The same, or nothing when the image has no lit pixel (night over the whole frame).
+std::optional<double> auto_exposure_if_lit(const std::vector<glm::vec4>& linear);
+
+// A sequence of n frames (a time series, a flyover) is exposed once for all its frames, so it does
+// not flicker and frame ranges rendered apart match. Its automatic exposure is the least of the
+// automatic exposures of these frames: the first, the last and three evenly between (all of them
+// when n <= 5), so the brightest of them sets it and a sequence that begins at dawn is not washed
+// out by midday. Frames with no lit pixel are left out; none lit: kDefaultExposure.
+std::vector<int> exposure_probe_frames(int n);
+double sequence_exposure(const std::vector<std::optional<double>>& probe_exposures);
 
 // Throws std::runtime_error "WHAT: N of M pixels came out not finite (the first at x X, y Y),
 // expected finite radiance; nothing written" when any channel of a pixel is NaN or infinite, so

@@ -122,4 +122,19 @@ cmp -s "$work/g/v_frames/frame_00000.vdb" "$work/g/v_frames/frame_00001.vdb" && 
 cmp -s "$work/a/v_frames/frame_00001.png" "$work/g/v_frames/frame_00001.png" || fail "--vdb changed a frame's pixels"
 out=$("$cv" record "$work/fly.json" -o "$work/g/v.mp4" --fps 10 --frames 0:2 --vdb 2>&1) || fail "--vdb rerun failed: $out"
 echo "$out" | grep -q "wrote 0 OpenVDB file(s)" || fail "the rerun wrote OpenVDB files again: $out"
+# The automatic exposure: one for all frames from the same spread frames whatever the range, and
+# the probed frames' kept images are the loop's own: frames 0:10 and 11:20 rendered apart equal one run.
+scene "$work/auto.json" "$K0, $K1, $K2" ""
+sed -i 's/"exposure": 6/"exposure": "auto"/' "$work/auto.json"
+mkdir -p "$work/h" "$work/i"
+out=$("$cv" record "$work/auto.json" -o "$work/h/v.mp4" --fps 10 2>&1) || fail "auto exposure run failed: $out"
+echo "$out" | grep -q "exposure [0-9.e+-]* (auto, for every frame: the least of the automatic exposures of frames 0, 5, 10, 15, 20)" ||
+  fail "no automatic exposure line: $out"
+for range in 0:10 11:20; do
+  "$cv" record "$work/auto.json" -o "$work/i/v.mp4" --fps 10 --frames $range > /dev/null 2>&1 || fail "auto exposure --frames $range failed"
+done
+for f in "$work"/h/v_frames/*.png; do
+  cmp -s "$f" "$work/i/v_frames/$(basename "$f")" || fail "$(basename "$f") differs between one run and ranges with auto exposure"
+done
+echo "automatic exposure: ranges equal one run"
 echo "record end to end passed"

@@ -301,6 +301,28 @@ TEST(ImageOutput, AutoExposurePutsTheBrightCloudsAtPointEight) {
   EXPECT_EQ(auto_exposure({}), kDefaultExposure);
 }
 
+// A sequence is exposed from its first and last frames and three evenly between (all of them up to
+// five), and the brightest lit one sets the exposure (the least): a series from dawn into the day is
+// exposed for the day. Unlit frames are left out; a sequence with none lit keeps the default.
+TEST(ImageOutput, ASequenceIsExposedForItsBrightestProbedFrame) {
+  EXPECT_EQ(exposure_probe_frames(0), std::vector<int>{});
+  EXPECT_EQ(exposure_probe_frames(1), std::vector<int>{0});
+  EXPECT_EQ(exposure_probe_frames(3), (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(exposure_probe_frames(5), (std::vector<int>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(exposure_probe_frames(6), (std::vector<int>{0, 1, 3, 4, 5}));
+  EXPECT_EQ(exposure_probe_frames(101), (std::vector<int>{0, 25, 50, 75, 100}));
+  const std::vector<glm::vec4> dawn(100, glm::vec4(0.001f, 0.001f, 0.001f, 0.0f)), noon(100, glm::vec4(0.1f, 0.1f, 0.1f, 0.0f));
+  const std::vector<glm::vec4> night(100, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  ASSERT_TRUE(auto_exposure_if_lit(dawn).has_value());
+  EXPECT_FALSE(auto_exposure_if_lit(night).has_value());
+  EXPECT_DOUBLE_EQ(*auto_exposure_if_lit(noon), auto_exposure(noon));
+  EXPECT_DOUBLE_EQ(sequence_exposure({auto_exposure_if_lit(dawn), auto_exposure_if_lit(noon), auto_exposure_if_lit(night)}),
+                   auto_exposure(noon));
+  EXPECT_DOUBLE_EQ(sequence_exposure({auto_exposure_if_lit(night), auto_exposure_if_lit(dawn)}), auto_exposure(dawn));
+  EXPECT_EQ(sequence_exposure({auto_exposure_if_lit(night)}), kDefaultExposure);
+  EXPECT_EQ(sequence_exposure({}), kDefaultExposure);
+}
+
 // A frame with a NaN or an infinite channel is refused before anything is written, and the
 // message names the input, the count and the first pixel's place (issue 13: "N pixels were not
 // finite" used to leave the PNG written).
