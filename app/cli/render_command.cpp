@@ -586,37 +586,49 @@ int render_series(const RenderArgs& ra, core::Scene scene) {
               scene.width, scene.height, scene.render.quality.c_str(), core::time_interpolation_name(scene.time.interpolation),
               core::sun_mode_name(scene.sun.mode), ra.out.c_str());
   std::string warned;
-  // Frame i's instant prepared on the GPU and its frame resolved (the sun at the instant).
+  // Frame i's instant prepared on the GPU, its frame resolved (the sun at the instant), and whether
+  // the whole cloud layer is then in the Earth's shadow.
   struct Prepared {
     core::Instant at;
     core::TimeInterpolationReport rep;
     core::FrameSpec frame;
+    bool in_shadow = false;
+    double probe_s = 0.0;  // the time a probed frame took before the loop (its preparation and march)
   };
+  bool steps_checked = false;
   auto prepare = [&](std::size_t i) {
     Prepared p;
     scene.time.valid_utc = core::format_iso_utc(instants[i]);
     p.at = core::scene_instant(scene, vol, scene.data.path);
-    renderer.use_volume(volumes.get(scene.data.path, vol, p.at, scene.time.interpolation, &p.rep, scene.render.march.medium.modelled));
+    const auto prepared = volumes.get(scene.data.path, vol, p.at, scene.time.interpolation, &p.rep, scene.render.march.medium.modelled);
+    renderer.use_volume(prepared);
     if (!p.rep.warning.empty() && warned != p.rep.warning) std::printf("warning: %s\n", (warned = p.rep.warning).c_str());
     p.frame = render::resolve_frame(scene, vol);
+    if (!steps_checked) check_view_steps(p.frame.march.quality.view_step_m, g.earth_radius_m, g.alt_m.last());
+    steps_checked = true;
+    p.in_shadow = scene.sun.mode != core::SunMode::LocalNoon &&
+                  core::layer_in_earth_shadow(g, prepared->layer, glm::normalize(geo::sphere_to_ecef(
+                      {p.frame.sun.subsolar_lat_deg, p.frame.sun.subsolar_lon_deg, 0.0}, g.earth_radius_m)));
     return p;
   };
-  check_view_steps(prepare(0).frame.march.quality.view_step_m, g.earth_radius_m, g.alt_m.last());
   // One exposure for the whole sequence, so it does not flicker and a resumed run matches: given,
   // or the least automatic exposure of a few frames spread over it (render::sequence_exposure),
   // whose images are kept for the loop below.
   std::optional<double> exposure;
-  std::map<std::size_t, std::vector<glm::vec4>> probed;
+  std::map<std::size_t, std::pair<Prepared, std::vector<glm::vec4>>> probed;
   if (!scene.render.auto_exposure) {
     exposure = scene.render.exposure;
   } else {
     std::vector<std::optional<double>> probes;
     std::string which;
     for (const int k : render::exposure_probe_frames(static_cast<int>(instants.size()))) {
-      const Prepared p = prepare(static_cast<std::size_t>(k));
+      const auto t_probe = clock::now();
+      Prepared p = prepare(static_cast<std::size_t>(k));
       std::vector<glm::vec4> marched;
-      probed[static_cast<std::size_t>(k)] = renderer.render(p.frame, {}, {}, &marched);
+      std::vector<glm::vec4> pixels = renderer.render(p.frame, {}, {}, &marched);
+      p.probe_s = seconds_since(t_probe);
       probes.push_back(render::auto_exposure_if_lit(marched));
+      probed[static_cast<std::size_t>(k)] = {std::move(p), std::move(pixels)};
       which += (which.empty() ? "" : ", ") + std::to_string(k);
     }
     exposure = render::sequence_exposure(probes);
@@ -635,16 +647,19 @@ int render_series(const RenderArgs& ra, core::Scene scene) {
       continue;
     }
     const auto t0 = clock::now();
-    const Prepared p = prepare(i);
+    Prepared p;
+    std::vector<glm::vec4> pixels;
+    if (auto kept = probed.find(i); kept != probed.end()) {
+      p = std::move(kept->second.first);
+      pixels = std::move(kept->second.second);
+    } else {
+      p = prepare(i);
+      pixels = renderer.render(p.frame, {}, {}, nullptr);
+    }
     const core::Instant& at = p.at;
     const core::TimeInterpolationReport& rep = p.rep;
     const core::FrameSpec& frame = p.frame;
-    const auto kept = probed.find(i);
-    const std::vector<glm::vec4> pixels = kept != probed.end() ? std::move(kept->second) : renderer.render(frame, {}, {}, nullptr);
-    // Decided for this frame's own sun (a probed frame's image may have been marched before others).
-    const bool in_shadow = scene.sun.mode != core::SunMode::LocalNoon &&
-        core::layer_in_earth_shadow(g, volumes.get(scene.data.path, vol, at, scene.time.interpolation, nullptr, scene.render.march.medium.modelled)->layer,
-                                    glm::normalize(geo::sphere_to_ecef({frame.sun.subsolar_lat_deg, frame.sun.subsolar_lon_deg, 0.0}, g.earth_radius_m)));
+    const bool in_shadow = p.in_shadow;
     dark += in_shadow ? 1 : 0;
     render::ToneSettings tone;
     tone.exposure = *exposure;
@@ -654,7 +669,7 @@ int render_series(const RenderArgs& ra, core::Scene scene) {
     ++written;
     std::printf("frame %zu/%zu %s: %s, %s%s %.1f ms, %.2f s in all%s\n", i + 1, instants.size(), iso.c_str(), path.c_str(),
                 at.between() ? "interpolated " : "at a step", at.between() ? core::time_interpolation_name(rep.used) : "",
-                rep.cost_ms, seconds_since(t0), in_shadow ? " (dark: the cloud layer is in the Earth's shadow)" : "");
+                rep.cost_ms, seconds_since(t0) + p.probe_s, in_shadow ? " (dark: the cloud layer is in the Earth's shadow)" : "");
     std::fflush(stdout);
   }
   std::printf("wrote %d frame(s), skipped %d already written, in %.1f s; exposure %.4g\n", written, skipped, seconds_since(t_start), *exposure);
