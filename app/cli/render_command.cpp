@@ -889,10 +889,11 @@ int cmd_render(const std::vector<std::string>& args) {
     const glm::dvec3 to_sun =
         glm::normalize(geo::sphere_to_ecef({sun.subsolar_lat_deg, sun.subsolar_lon_deg, 0.0}, g.earth_radius_m));
     const double highest_deg = core::highest_sun_elevation_deg(g, to_sun);
-    if (!ra.reference && core::layer_in_earth_shadow(g, prepared->layer, to_sun)) {
+    const bool in_shadow = core::layer_in_earth_shadow(g, prepared->layer, to_sun);
+    if (in_shadow && !ra.reference) {
       std::printf("hint: at %s the whole cloud layer is in the Earth's shadow, so the image is dark; --sun-mode local_noon "
                   "(sun.mode \"local_noon\") keeps the clouds lit for teaching\n", vt.iso_utc.c_str());
-    } else if (highest_deg < core::kTwilightElevationDeg) {
+    } else if (!in_shadow && highest_deg < core::kTwilightElevationDeg) {
       std::printf("hint: at %s the sun stands at most %.1f degrees above the horizon anywhere over the data (dawn or dusk "
                   "there), so the clouds are lit at a grazing angle through reddened air and the image is mostly twilight; "
                   "--sun-mode local_noon (sun.mode \"local_noon\") keeps the clouds lit for teaching\n",
