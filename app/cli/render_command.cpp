@@ -894,10 +894,9 @@ int cmd_render(const std::vector<std::string>& args) {
       std::printf("hint: at %s the whole cloud layer is in the Earth's shadow, so the image is dark; --sun-mode local_noon "
                   "(sun.mode \"local_noon\") keeps the clouds lit for teaching\n", vt.iso_utc.c_str());
     } else if (!in_shadow && highest_deg < core::kTwilightElevationDeg) {
-      std::printf("hint: at %s the sun stands at most %.1f degrees above the horizon anywhere over the data (dawn or dusk "
-                  "there), so the clouds are lit at a grazing angle through reddened air and the image is mostly twilight; "
-                  "--sun-mode local_noon (sun.mode \"local_noon\") keeps the clouds lit for teaching\n",
-                  vt.iso_utc.c_str(), highest_deg);
+      std::printf("hint: at %s %s, so the clouds are lit at a grazing angle through reddened air and the image is mostly "
+                  "twilight; --sun-mode local_noon (sun.mode \"local_noon\") keeps the clouds lit for teaching\n",
+                  vt.iso_utc.c_str(), core::low_sun_words(highest_deg).c_str());
     }
   }
   if (ms.octave_terms_full > ms.octave_terms) {

@@ -887,12 +887,7 @@ int run_viewer(const ViewerOptions& o) {
       if (s.scene.sun.mode != core::SunMode::LocalNoon) {
         const double highest = core::highest_sun_elevation_deg(
             g, glm::normalize(geo::sphere_to_ecef({ctx.sun.subsolar_lat_deg, ctx.sun.subsolar_lon_deg, 0.0}, g.earth_radius_m)));
-        if (highest < core::kTwilightElevationDeg) {
-          char text[200];
-          std::snprintf(text, sizeof text, "the sun stands at most %.1f degrees above the horizon over the data (%s there): "
-                        "'local noon (teaching)' keeps the clouds lit", highest, highest < 0.0 ? "night or twilight" : "dawn or dusk");
-          ctx.sun_note = text;
-        }
+        if (highest < core::kTwilightElevationDeg) ctx.sun_note = core::low_sun_words(highest) + ": 'local noon (teaching)' keeps the clouds lit";
       }
       if (ctx.sun_note != printed_sun_note && !ctx.sun_note.empty()) std::printf("note: %s\n", ctx.sun_note.c_str());
       printed_sun_note = ctx.sun_note;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include <glm/glm.hpp>
 
@@ -87,6 +88,17 @@ double largest_sun_cosine(const VolumeGrid& grid, const glm::dvec3& to_sun) {
 
 double highest_sun_elevation_deg(const VolumeGrid& grid, const glm::dvec3& to_sun) {
   return 90.0 - std::acos(std::clamp(largest_sun_cosine(grid, to_sun), -1.0, 1.0)) / kDeg;
+}
+
+std::string low_sun_words(double highest_deg) {
+  char text[160];
+  if (highest_deg >= 0.0) {
+    std::snprintf(text, sizeof text, "the sun stands at most %.1f degrees above the horizon over the data (dawn or dusk there)", highest_deg);
+  } else {
+    std::snprintf(text, sizeof text, "the sun stands below the horizon over all the data, at least %.1f degrees below it (%s there)",
+                  -highest_deg, highest_deg >= -18.0 ? "twilight" : "night");
+  }
+  return text;
 }
 
 bool layer_in_earth_shadow(const VolumeGrid& grid, const CloudLayer& layer, const glm::dvec3& to_sun) {

@@ -3,6 +3,8 @@
 // light still applies). Decided once per frame on the CPU, conservatively.
 #pragma once
 
+#include <string>
+
 #include <glm/vec3.hpp>
 
 #include "volume/grid_mean.hpp"
@@ -43,5 +45,10 @@ constexpr double kTwilightElevationDeg = 5.0;
 // The highest the sun stands over the grid's domain, degrees above the horizon (an upper bound,
 // from largest_sun_cosine).
 double highest_sun_elevation_deg(const VolumeGrid& grid, const glm::dvec3& to_sun);
+
+// How a tool says where the sun stands, from that highest elevation: "the sun stands at most 0.8
+// degrees above the horizon over the data (dawn or dusk there)", or below the horizon everywhere
+// (twilight down to 18 degrees below it, night further down).
+std::string low_sun_words(double highest_deg);
 
 }  // namespace cv::core

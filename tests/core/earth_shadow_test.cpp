@@ -136,6 +136,14 @@ TEST(EarthShadow, TheLargestSunCosineBoundsEveryPointOfTheDomain) {
   EXPECT_EQ(largest_sun_cosine(global, sun_at(55.0, 177.5, 180.0, 0.0)), 1.0);
 }
 
+// The words for where the sun stands: above the horizon (dawn or dusk), below it to 18 degrees
+// (twilight), further down (night).
+TEST(EarthShadow, TheLowSunIsSaidAsDawnTwilightOrNight) {
+  EXPECT_EQ(low_sun_words(0.8), "the sun stands at most 0.8 degrees above the horizon over the data (dawn or dusk there)");
+  EXPECT_EQ(low_sun_words(-3.25), "the sun stands below the horizon over all the data, at least 3.2 degrees below it (twilight there)");
+  EXPECT_EQ(low_sun_words(-42.8), "the sun stands below the horizon over all the data, at least 42.8 degrees below it (night there)");
+}
+
 TEST(EarthShadow, NightLeavesTheReferenceImageAsThePerSampleTestMadeIt) {
   StandardScene sc = standard_scene("cumulus_field", 32, 18);
   sc.sun = sun_just_down(sc);
