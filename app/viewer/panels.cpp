@@ -215,7 +215,11 @@ void quality_panel(ViewerState& s, const PanelContext& ctx) {
   ImGui::SliderInt("accumulate (frames)", &r.accumulate, 1, 1024, "%d", ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
   if (ImGui::Checkbox("automatic exposure", &r.auto_exposure) && !r.auto_exposure) r.exposure = ctx.auto_exposure;
   if (r.auto_exposure) {
-    ImGui::Text("exposure %.3g (the 99th percentile of lit pixels at 0.8)", ctx.auto_exposure);
+    if (ctx.exposure_held) {
+      ImGui::Text("exposure %.3g, held while playing (the brightest frame played)", ctx.auto_exposure);
+    } else {
+      ImGui::Text("exposure %.3g (the 99th percentile of lit pixels at 0.8)", ctx.auto_exposure);
+    }
   } else {
     slider_double("exposure", &r.exposure, 1e-3, 1e4, "%.3g", ImGuiSliderFlags_Logarithmic);
   }

@@ -44,6 +44,7 @@ struct PanelContext {
   std::string scene_path = "scene.json";
   std::string scene_message;    // result of the last load/save
   double auto_exposure = 4.0;   // what the automatic exposure chose, shown while it is on
+  bool exposure_held = false;   // ...held over the frames played (the forecast is playing)
   std::string budget_text;      // the frame budget's candidate and its source, when the budget is on
   std::string instant_text;     // the scene's instant, and how the medium there was made
   std::string time_warning;     // why `advected` fell back to `linear` (no winds), shown on screen

@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -47,6 +48,22 @@ struct Playhead {
   // The next `n` instants after the shown one, as playback will need them (wrapping on loop).
   std::vector<std::int64_t> upcoming(int n) const;
   bool still() const { return last_s <= first_s; }
+};
+
+// The automatic exposure held while a forecast plays: the least of the frames' own exposures since
+// play began, frames with no lit pixel left out (a sequence is exposed for its brightest frame, as
+// `render --times` and `record` take it). Frame by frame, the exposure lifted a fading afternoon back
+// to noon's brightness and a dawn's first light to white; held, the day's light is seen to change.
+// The viewer starts a new hold when play starts and when anything but the time changes.
+struct ExposureHold {
+  std::optional<double> least;
+  // The exposure to show, given this frame's own (nullopt: nothing lit) and `fallback` for when no
+  // frame of the hold was lit yet.
+  double update(std::optional<double> own, double fallback) {
+    if (own && (!least || *own < *least)) least = own;
+    return least.value_or(fallback);
+  }
+  void reset() { least.reset(); }
 };
 
 struct PrefetchStats {

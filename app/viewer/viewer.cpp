@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include "importer.hpp"
 #include "io/output_file.hpp"
@@ -157,6 +158,10 @@ struct ViewGpu {
   core::MonteCarloImage paths;
   bool path_mode = false;
   double auto_exposure = render::kDefaultExposure;
+  // While the forecast plays: the exposure held over the frames since play began, and the scene it
+  // was taken with (a change of anything but the time starts a new hold).
+  ExposureHold exposure_hold;
+  core::Scene hold_scene;
   core::FrameSpec spec;
   // Temporal reprojection (ViewerState::reproject): made when first used; the sparse frame's index,
   // and whether the medium or the settings changed this frame (the camera's motion it finds itself).
@@ -1036,7 +1041,24 @@ int run_viewer(const ViewerOptions& o) {
           std::vector<glm::vec4> mean(static_cast<std::size_t>(v.presenter.width()) * v.presenter.height());
           glGetTextureImage(v.presenter.mean_texture(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(mean.size() * sizeof(glm::vec4)),
                             mean.data());
-          v.auto_exposure = render::auto_exposure(mean);
+          const std::optional<double> own = render::auto_exposure_if_lit(mean);
+          if (s.play.playing && !s.play.still()) {
+            // Held while playing: a new hold where play began or anything but the time changed.
+            core::Scene untimed = sc;
+            untimed.time = v.hold_scene.time;
+            untimed.time_step = v.hold_scene.time_step;
+            untimed.sun.datetime_utc = v.hold_scene.sun.datetime_utc;
+            if (!v.exposure_hold.least || !same_march(untimed, v.hold_scene)) v.exposure_hold.reset();
+            v.hold_scene = sc;
+            v.auto_exposure = v.exposure_hold.update(own, render::kDefaultExposure);
+            if (o.frames > 0 && i == 0) {
+              std::printf("frame %d: exposure %.6g held while playing (this frame's own %s)\n", frame, v.auto_exposure,
+                          own ? std::to_string(*own).c_str() : "none: nothing lit");
+            }
+          } else {
+            v.exposure_hold.reset();
+            v.auto_exposure = own.value_or(render::kDefaultExposure);
+          }
         }
       }
       render::ToneSettings tone;
@@ -1046,6 +1068,7 @@ int run_viewer(const ViewerOptions& o) {
       tones.push_back(tone);
     }
     ctx.auto_exposure = main_view.auto_exposure;
+    ctx.exposure_held = s.play.playing && !s.play.still();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (n_views > 1) {  // a grid of three leaves a cell empty
       glViewport(0, 0, fbw, fbh);

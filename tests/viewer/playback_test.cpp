@@ -43,6 +43,20 @@ TEST(Playhead, PlaysOnAGridOfInstantsAndLoopsOrStops) {
   EXPECT_TRUE(p.upcoming(2).empty());
 }
 
+// Played through an afternoon into dusk, the exposure stays at the brightest frame's instead of
+// lifting each darker frame back up; frames with nothing lit do not move it; a new hold starts over.
+TEST(ExposureHold, HoldsTheBrightestFramesExposureAndLeavesUnlitFramesOut) {
+  ExposureHold h;
+  EXPECT_DOUBLE_EQ(h.update(std::nullopt, 4.0), 4.0);  // nothing lit yet: the fallback
+  EXPECT_DOUBLE_EQ(h.update(2.0, 4.0), 2.0);
+  EXPECT_DOUBLE_EQ(h.update(3.0, 4.0), 2.0);           // a darker frame (a larger exposure of its own)
+  EXPECT_DOUBLE_EQ(h.update(1.5, 4.0), 1.5);           // a brighter one
+  EXPECT_DOUBLE_EQ(h.update(std::nullopt, 4.0), 1.5);  // night: nothing lit
+  EXPECT_DOUBLE_EQ(h.update(80.0, 4.0), 1.5);
+  h.reset();
+  EXPECT_DOUBLE_EQ(h.update(80.0, 4.0), 80.0);
+}
+
 TEST(Playhead, StepsToTheFilesStepsAndAOneStepFileIsAStill) {
   const auto times = three_hourly(3);
   Playhead p;
