@@ -3,7 +3,10 @@
 // reflected radiance per unit irradiance from the CPU kernel (the GPU runs the same kernel), the
 // octave sum at the scene defaults (4 octaves, gate on) and the two-stream source, as the relative
 // error against the solver. The slab is written as NetCDF and imported as in the slab check.
-//   bench_slab_models [--phase hg|mie|both] [--tau 1,2,...] [--zenith 0,30,...] [--octaves N]
+// --ground-albedo A puts a Lambertian ground of albedo A under the slab (the globe drawn, no air): the
+// solver's radiance then takes the ground's light by the adding of a Lambertian surface
+// (SlabSolution::nadir_radiance_over_ground).
+//   bench_slab_models [--phase hg|mie|both] [--tau 1,2,...] [--zenith 0,30,...] [--octaves N] [--ground-albedo A]
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -14,41 +17,33 @@
 
 #include "bench/bench_args.hpp"
 #include "physics/slab_solver.hpp"
-#include "reference/raymarcher.hpp"
 #include "support/scratch_dir.hpp"
 #include "support/slab_case.hpp"
 
 namespace {
 using namespace cv::test::slab;
 constexpr double kPi = 3.14159265358979323846;
-
-
-// The kernel's nadir radiance over (0, 0): a camera 10 km up looking straight down, one pixel.
-double nadir(const ImportedSlab& s, cv::core::MarchSettings m, double theta0) {
-  cv::core::Camera cam;
-  cam.alt_m = 10000.0;
-  cam.pitch_deg = -90.0;
-  cam.fov_deg = 1e-3;
-  cam.width = cam.height = 1;
-  m.quality.view_step_m = 5.0;
-  m.quality.sun_steps = 256;
-  const cv::core::ReferenceImage r = cv::core::render_reference(s.grid, s.medium, cam, sun_at_zenith_angle(theta0), m);
-  return r.radiance[0].y;
-}
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string phases = "both";
   int octaves = 4;
+  std::vector<double> grounds{0.0};
   std::vector<double> taus{1, 2, 5, 10, 20, 50, 100}, zeniths{0, 30, 60};
   namespace ba = cv::bench_args;
   const int code = ba::parse("bench_slab_models",
-                             "usage: bench_slab_models [--phase hg|mie|both] [--tau 1,2,...] [--zenith 0,30,...] [--octaves N]\n"
+                             "usage: bench_slab_models [--phase hg|mie|both] [--tau 1,2,...] [--zenith 0,30,...] [--octaves N] [--ground-albedo A]\n"
                              "  the octave sum and the two-stream source against the adding-doubling solver at nadir\n",
                              argc, argv,
                              {ba::one_of("--phase", phases, {"hg", "mie", "both"}), ba::numbers("--tau", taus),
-                              ba::numbers("--zenith", zeniths), ba::integer("--octaves", octaves)});
+                              ba::numbers("--zenith", zeniths), ba::integer("--octaves", octaves),
+                              ba::numbers("--ground-albedo", grounds)});
   if (code >= 0) return code;
+  if (grounds.size() != 1 || !(grounds[0] >= 0.0 && grounds[0] < 1.0)) {
+    std::fprintf(stderr, "bench_slab_models: --ground-albedo: expected one albedo in 0..1 (below 1)\n");
+    return 2;
+  }
+  const double ground = grounds[0];
   // The process's own folder (removed at exit): two runs at once never share a file.
   const std::filesystem::path dir = cv::test_support::scratch_dir();
   std::vector<SlabPhase> which;
@@ -64,6 +59,10 @@ int main(int argc, char** argv) {
       const ImportedSlab s = import_slab(path, ph);
       cv::core::MarchSettings m = march_for(ph, s);
       m.quality.octaves = octaves;
+      if (ground > 0.0) {
+        m.features.globe = true;
+        m.medium.ground_albedo = glm::dvec3(ground);
+      }
       slabcheck::SlabProblem p;
       p.tau = tau;
       p.phase = phase;
@@ -73,10 +72,11 @@ int main(int argc, char** argv) {
       o.streams = ph == SlabPhase::HG085 ? 32 : 128;
       const slabcheck::SlabSolution sol = solve_slab(p, o);
       for (double z : zeniths) {
-        const double ref = sol.nadir_radiance(std::cos(z * kPi / 180.0));
+        const double mu0 = std::cos(z * kPi / 180.0);
+        const double ref = sol.nadir_radiance_over_ground(mu0, ground);
         cv::core::MarchSettings two = m;
         two.medium.ms_two_stream = true;
-        const double a = nadir(s, m, z), b = nadir(s, two, z);
+        const double a = march_nadir_radiance(s, m, z), b = march_nadir_radiance(s, two, z);
         std::printf("| %s | %g | %g | %.5f | %+.1f %% | %+.1f %% |\n", phase_name(ph), tau, z, ref, 100.0 * (a / ref - 1.0),
                     100.0 * (b / ref - 1.0));
         std::fflush(stdout);

@@ -303,6 +303,24 @@ double SlabSolution::total_transmission(double mu0) const {
   return t;
 }
 
+double SlabSolution::spherical_albedo() const {
+  const int n = static_cast<int>(mu_.size());
+  double s = 0.0;
+  for (int j = 0; j < n; ++j) {
+    const double wj = weight_[static_cast<std::size_t>(j)];
+    if (wj == 0.0) continue;
+    double a = 0.0;
+    for (int i = 0; i < n; ++i) a += weight_[static_cast<std::size_t>(i)] * r_[static_cast<std::size_t>(i) * n + j];
+    s += wj * a;
+  }
+  return s;
+}
+
+double SlabSolution::nadir_radiance_over_ground(double mu0, double ground) const {
+  return nadir_radiance(mu0) +
+         ground / 3.14159265358979323846 * mu0 * total_transmission(mu0) * total_transmission(1.0) / (1.0 - ground * spherical_albedo());
+}
+
 SlabSolution solve_slab(const SlabProblem& prob, const SlabOptions& opt) {
   if (opt.streams < 2) throw std::invalid_argument("solve_slab: at least 2 streams per hemisphere");
   if (!(prob.tau > 0.0) || !(prob.omega > 0.0 && prob.omega <= 1.0)) throw std::invalid_argument("solve_slab: tau > 0, 0 < omega <= 1");

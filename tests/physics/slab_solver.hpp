@@ -81,6 +81,15 @@ class SlabSolution {
   double total_transmission(double mu0) const;
   // I / E at nadir, mu0 one of mu_extra and 1 among them too.
   double nadir_radiance(double mu0) const { return mu0 * reflection(1.0, mu0) / 3.14159265358979323846; }
+  // The spherical albedo s = 2 int_0^1 A(mu) mu dmu (the plane albedo over the quadrature's nodes):
+  // the share of isotropic light the slab reflects, from above or, homogeneous, from below.
+  double spherical_albedo() const;
+  // I / E at nadir with a Lambertian ground of albedo `ground` under the slab, by the adding of a
+  // Lambertian surface (van de Hulst 1980; Liou 2002, section 6.3): the ground takes
+  // mu0 T(mu0) / (1 - ground s) of the irradiance (the slab sends part of what the ground
+  // reflects back down), and its radiance reaches the top at nadir through T(1), T the total
+  // (direct and diffuse) transmission: nadir_radiance(mu0) + (ground / pi) mu0 T(mu0) T(1) / (1 - ground s).
+  double nadir_radiance_over_ground(double mu0, double ground) const;
 
   // What was solved, for the reports.
   double truncated_fraction = 0.0;  // delta-M's f

@@ -18,6 +18,7 @@
 #include "geo/geodesy.hpp"
 #include "importer.hpp"
 #include "reference/monte_carlo.hpp"
+#include "reference/raymarcher.hpp"
 #include "support/cf_writer.hpp"
 #include "volume/grid_mean.hpp"
 
@@ -164,6 +165,19 @@ inline Estimate mc_view_radiance(const ImportedSlab& s, const core::GridMeanExti
   e.truncated = img.stats.truncated;
   e.scatterings = img.stats.scatterings;
   return e;
+}
+
+// The march kernel's (CPU) reflected radiance per unit irradiance at nadir over (0, 0): a camera
+// 10 km up looking straight down, one pixel, 5 m view steps and 256 sun steps.
+inline double march_nadir_radiance(const ImportedSlab& s, core::MarchSettings m, double theta0_deg) {
+  core::Camera cam;
+  cam.alt_m = 10000.0;
+  cam.pitch_deg = -90.0;
+  cam.fov_deg = 1e-3;
+  cam.width = cam.height = 1;
+  m.quality.view_step_m = 5.0;
+  m.quality.sun_steps = 256;
+  return core::render_reference(s.grid, s.medium, cam, sun_at_zenith_angle(theta0_deg), m).radiance[0].y;
 }
 
 // Reflected radiance at nadir over (0, 0): a camera 10 km up looking straight down.
