@@ -14,4 +14,9 @@ namespace cv::importers {
 // import errors throw as import_file does. cache_steps: time steps kept decoded.
 core::CloudVolume load_scene_volume(const core::Scene& scene, std::size_t cache_steps);
 
+// The loud note a volume with a diagnosed cloud (data.diagnose_cloud, `--diagnose-cloud`) carries
+// in its report: printed on stderr as "COMMAND: DIAGNOSED CLOUD ...", by every command that opens
+// such a file, so no picture of an invented cloud goes out without it being said.
+void print_diagnosed_cloud_note(const core::CloudVolume& volume, const char* command);
+
 }  // namespace cv::importers

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "importer.hpp"
+#include "scene_source.hpp"
 #include "io/input_file.hpp"
 #include "io/output_file.hpp"
 #include "scene/framing.hpp"
@@ -70,7 +71,9 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
        "  view INPUT [--size WxH] [--time ISO|N] [--play H] [--scale S] [--hide-ui] [--frame-budget MS]\n"
        "             [--compare FILE[@T] | @T ...] [--layout grid|swipe] [--unlinked] [--frames N --screenshot OUT.png]\n"
        "             [--section LAT,LON,LAT,LON[,FIELD]] [--series LAT,LON] [--quality reference [--spp N]]\n"
-       "             [--reproject] [--orbit PX]\n"
+       "             [--reproject] [--orbit PX] [--diagnose-cloud [--rh-critical RH]]\n"
+       "                           --diagnose-cloud: a file with temperature and humidity but no cloud field gets\n"
+       "                           a cloud diagnosed from relative humidity (as import's), said on stderr\n"
        "                           --time: an instant (UTC) or a step; --play H: start playing at H forecast\n"
        "                           hours per second (the timeline is in the data panel); with --frames it moves\n"
        "                           one instant per frame and waits for each, unless --realtime (wall time, no wait)\n"
@@ -293,9 +296,7 @@ int cmd_import(const std::vector<std::string>& args) {
   // A float16 volume alone needs nothing of a step but its half floats: the reader makes them.
   o.half_fields = encoding == cv::core::CvvolEncoding::Float16 && !vti && !vdb;
   cv::core::CloudVolume vol = cv::importers::import_file(input, o);
-  for (const auto& w : vol.report.warnings) {
-    if (w.rfind("DIAGNOSED CLOUD", 0) == 0) std::fprintf(stderr, "cloudviewer import: %s\n", w.c_str());
-  }
+  cv::importers::print_diagnosed_cloud_note(vol, "cloudviewer import");
   for (std::size_t t = 0; t < vol.times.size(); ++t) {
     for (const char* ext : {".vti", ".vdb"}) {
       if ((std::string(ext) == ".vti" && !vti) || (std::string(ext) == ".vdb" && !vdb)) continue;

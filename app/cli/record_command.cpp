@@ -378,6 +378,7 @@ int cmd_record(const std::vector<std::string>& args) {
 
   // The data, and every weather time the path asks for, before any frame.
   core::CloudVolume vol = importers::load_scene_volume(scene, 2);
+  importers::print_diagnosed_cloud_note(vol, "cloudviewer record");
   const auto& g = vol.grid;
   if (g.lon_deg.count < 2 || g.lat_deg.count < 2 || g.alt_m.count < 2) {
     throw UsageError{"cloudviewer record: " + scene.data.path + ": the volume is too small to render (at least 2 points along each axis)"};

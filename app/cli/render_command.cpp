@@ -228,13 +228,13 @@ void check_outputs(const RenderArgs& r, const core::Scene& scene) {
 // The options, applied to `scene` in the order given (later ones win).
 RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& scene) {
   RenderArgs r;
-  // Every option but --no-sky and the table's Bool flags (--no-skip) takes a value; the one argument that is no
+  // Every option but --no-sky, --diagnose-cloud and the table's Bool flags (--no-skip) takes a value; the one argument that is no
   // option's value is the input. It is read first so that a scene file's settings are the base the options override.
   std::vector<std::pair<std::string, std::string>> options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     const core::SettingRow* row = march_flag(a);
-    if (a == "--no-sky" || (row && row->kind == core::SettingKind::Bool)) {  // the flags without a value
+    if (a == "--no-sky" || a == "--diagnose-cloud" || (row && row->kind == core::SettingKind::Bool)) {  // the flags without a value
       options.emplace_back(a, "");
     } else if (!a.empty() && a[0] == '-') {
       if (i + 1 >= args.size()) throw UsageError{"cloudviewer render: " + a + ": expected a value after it"};
@@ -390,6 +390,13 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
       scene.data.levels_hpa = std::array<double, 2>{l[0], l[1]};
     } else if (a == "--stride") {
       scene.data.horizontal_stride = parse_int(a, v, 1, 1000000, "an integer >= 1");
+    } else if (a == "--diagnose-cloud") {
+      scene.data.diagnose_cloud = true;
+    } else if (a == "--rh-critical") {
+      scene.data.rh_critical = parse_number(a, v);
+      if (!(scene.data.rh_critical >= 0.5 && scene.data.rh_critical < 1.0)) {
+        throw UsageError{"cloudviewer render: --rh-critical: found '" + v + "', expected a critical relative humidity 0.5 <= RH < 1"};
+      }
     } else {
       throw UsageError{"cloudviewer render: unknown option '" + a + "'"};
     }
@@ -462,6 +469,9 @@ const char* render_usage() {
         "                           them): N samples per pixel at most (1024),\n"
         "                           fewer once the image's mean relative standard error is E\n"
         "         [--exposure E|auto] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N]\n"
+        "         [--diagnose-cloud [--rh-critical RH]]  data.diagnose_cloud: a file with temperature and humidity but\n"
+        "                           no cloud field gets a cloud diagnosed from relative humidity (Sundqvist, RH_c 0.8),\n"
+        "                           said on stderr\n"
         "         [--no-sky]  clouds on black: no air, globe or ambient sky light\n"
         "         [--layer low|mid|high|all]  the layer mask's band: below 2 km, 2-6 km, from 6 km above the ground, or\n"
         "                           everything (sets layer_bottom_m and layer_top_m, below; docs/scene.md)\n"
@@ -565,6 +575,7 @@ bool complete_png(const fs::path& path) {
 int render_series(const RenderArgs& ra, core::Scene scene) {
   const auto t_start = clock::now();
   core::CloudVolume vol = importers::load_scene_volume(scene, 2);
+  importers::print_diagnosed_cloud_note(vol, "cloudviewer render");
   const auto& g = vol.grid;
   if (g.lon_deg.count < 2 || g.lat_deg.count < 2 || g.alt_m.count < 2) {
     throw UsageError{"cloudviewer render: " + scene.data.path + ": the volume is too small to render (at least 2 points along each axis)"};
@@ -685,6 +696,7 @@ int cmd_render(const std::vector<std::string>& args) {
   if (!ra.times_from.empty()) return render_series(ra, scene);
   auto t0 = clock::now();
   core::CloudVolume vol = importers::load_scene_volume(scene, 2);  // an instant between steps needs both
+  importers::print_diagnosed_cloud_note(vol, "cloudviewer render");
   if (scene.time.valid_utc.empty() && static_cast<std::size_t>(scene.time_step) >= vol.times.size()) {
     throw UsageError{"cloudviewer render: --time (time_step): found " + std::to_string(scene.time_step) + ", the input has " +
                      std::to_string(vol.times.size()) + " time step(s)"};

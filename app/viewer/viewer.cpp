@@ -424,6 +424,19 @@ int cmd_view(const std::vector<std::string>& args) {
         o.path_spp = parse_int("--spp", next(), 1, 1000000);
       } else if (a == "--reproject") {
         o.reproject = true;
+      } else if (a == "--diagnose-cloud") {
+        o.diagnose_cloud = true;
+      } else if (a == "--rh-critical") {
+        const std::string v = next();
+        std::size_t used = 0;
+        try {
+          o.rh_critical = std::stod(v, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != v.size() || !(o.rh_critical >= 0.5 && o.rh_critical < 1.0)) {
+          throw ViewerInputError("cloudviewer view: --rh-critical: found '" + v + "', expected a critical relative humidity 0.5 <= RH < 1");
+        }
       } else if (a == "--orbit") {
         const std::string v = next();
         std::size_t used = 0;
@@ -484,8 +497,11 @@ int run_viewer(const ViewerOptions& o) {
   } else {
     s.scene.data.path = o.input;
   }
+  if (o.diagnose_cloud) s.scene.data.diagnose_cloud = true;
+  if (o.rh_critical > 0.0) s.scene.data.rh_critical = o.rh_critical;
   try {
     s.volume = importers::load_scene_volume(s.scene, 2);
+    importers::print_diagnosed_cloud_note(s.volume, "cloudviewer view");
   } catch (const core::SceneError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;

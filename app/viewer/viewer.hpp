@@ -32,6 +32,8 @@ struct ViewerOptions {
   bool path_trace = false;           // --quality reference: the progressive path tracer from the first frame
   int path_spp = 0;                  // --spp N: its samples per pixel (0: the state's default)
   bool reproject = false;            // --reproject: temporal reprojection (ViewerState::reproject)
+  bool diagnose_cloud = false;       // --diagnose-cloud: a cloud from relative humidity where a file has none
+  double rh_critical = 0.0;          // --rh-critical RH (0: the scene's)
   double orbit_px = 0.0;             // --orbit PX: the globe dragged PX pixels to the right every frame (a scripted orbit)
 };
 

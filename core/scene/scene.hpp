@@ -23,6 +23,10 @@ struct DataSource {
   std::optional<std::array<double, 2>> levels_hpa;  // min, max pressure of the levels read
   int horizontal_stride = 1;
   double dz_m = 0.0;  // vertical spacing of the resampled grid; 0: the importer's default
+  // A file with temperature and humidity but no cloud field: a cloud diagnosed from relative
+  // humidity (importers' ImportOptions::diagnose_cloud), with the scheme's critical humidity.
+  bool diagnose_cloud = false;
+  double rh_critical = 0.8;
 };
 
 // How the sun is placed: where it stood at the data's valid time (the scene's instant), at a given

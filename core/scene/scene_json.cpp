@@ -145,7 +145,7 @@ class Reader {
 constexpr double kHuge = 1e300;  // "any finite number" as a range
 
 void read_data(const Reader& r, DataSource& d) {
-  r.only({"path", "region_deg", "levels_hpa", "horizontal_stride", "dz_m"});
+  r.only({"path", "region_deg", "levels_hpa", "horizontal_stride", "dz_m", "diagnose_cloud", "rh_critical"});
   r.string("path", d.path);
   d.region_deg = r.numbers<4>("region_deg", "[west, east, south, north] in degrees, or null");
   if (d.region_deg) {
@@ -160,6 +160,8 @@ void read_data(const Reader& r, DataSource& d) {
   }
   r.integer("horizontal_stride", d.horizontal_stride, 1, 1000000);
   r.number("dz_m", d.dz_m, 0.0, 1e5, "a vertical spacing in metres 0..100000 (0: the importer's default)");
+  r.boolean("diagnose_cloud", d.diagnose_cloud);
+  r.number("rh_critical", d.rh_critical, 0.5, 0.999999, "a critical relative humidity 0.5 <= RH < 1");
 }
 
 void read_camera(const Reader& r, Camera& c) {
@@ -487,6 +489,10 @@ std::string scene_to_json(const Scene& s) {
   ojson data = {{"path", s.data.path}, {"horizontal_stride", s.data.horizontal_stride}, {"dz_m", s.data.dz_m}};
   data["region_deg"] = s.data.region_deg ? ojson(*s.data.region_deg) : ojson(nullptr);
   data["levels_hpa"] = s.data.levels_hpa ? ojson(*s.data.levels_hpa) : ojson(nullptr);
+  if (s.data.diagnose_cloud) {  // written only when asked for, so scenes of files with cloud read as before
+    data["diagnose_cloud"] = true;
+    data["rh_critical"] = s.data.rh_critical;
+  }
   root["data"] = data;
   root["time_step"] = s.time_step;
   root["time"] = {{"valid_utc", s.time.valid_utc}, {"interpolation", time_interpolation_name(s.time.interpolation)}};

@@ -31,6 +31,8 @@ Scene full_scene() {
   s.data.levels_hpa = std::array<double, 2>{150.0, 987.654321};
   s.data.horizontal_stride = 3;
   s.data.dz_m = 250.0;
+  s.data.diagnose_cloud = true;
+  s.data.rh_critical = 0.85;
   s.time_step = 4;
   s.time.valid_utc = "2024-01-15T04:30:00Z";
   s.time.interpolation = TimeInterpolation::Linear;
@@ -68,6 +70,8 @@ void expect_equal(const Scene& a, const Scene& b) {
   EXPECT_EQ(a.data.levels_hpa, b.data.levels_hpa);
   EXPECT_EQ(a.data.horizontal_stride, b.data.horizontal_stride);
   EXPECT_EQ(a.data.dz_m, b.data.dz_m);
+  EXPECT_EQ(a.data.diagnose_cloud, b.data.diagnose_cloud);
+  EXPECT_EQ(a.data.rh_critical, b.data.rh_critical);
   EXPECT_EQ(a.time_step, b.time_step);
   EXPECT_EQ(a.time.valid_utc, b.time.valid_utc);
   EXPECT_EQ(a.time.interpolation, b.time.interpolation);
@@ -186,6 +190,8 @@ TEST(SceneJson, OutOfRangeValuesAreRefused) {
             "scene.json: sun.datetime_utc: found \"2024-02-30T00:00:00Z\", expected a UTC date-time YYYY-MM-DDThh:mm:ssZ");
   EXPECT_EQ(error_of(R"({"version": 1, "render": {"quality": "ultra"}})"),
             "scene.json: render.quality: found \"ultra\", expected one of low, default, high, custom");
+  EXPECT_EQ(error_of(R"({"version": 1, "data": {"diagnose_cloud": true, "rh_critical": 1}})"),
+            "scene.json: data.rh_critical: found 1, expected a critical relative humidity 0.5 <= RH < 1");
   EXPECT_EQ(error_of(R"({"version": 1, "render": {"budget_ms": -5}})"),
             "scene.json: render.budget_ms: found -5, expected a frame-time budget in ms 0..1e7 (0: off)");
 }
