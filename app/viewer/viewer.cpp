@@ -17,6 +17,7 @@
 #include <ctime>
 #include <filesystem>
 #include <map>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -334,6 +335,18 @@ ExtraView open_view(const core::ViewSource& source, const std::string& option, V
   v.view_step_ratio = vol.grid.alt_m.step / s.volume.grid.alt_m.step;
   return v;
 }
+// The whole of v as a number, or NaN (which fails every range check) where it is not one.
+double number_or_nan(const std::string& v) {
+  std::size_t used = 0;
+  double x = 0.0;
+  try {
+    x = std::stod(v, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  return used == v.size() && used > 0 ? x : std::numeric_limits<double>::quiet_NaN();
+}
+
 }  // namespace
 
 int cmd_view(const std::vector<std::string>& args) {
@@ -360,13 +373,7 @@ int cmd_view(const std::vector<std::string>& args) {
         o.time_given = true;
       } else if (a == "--play") {
         const std::string v = next();
-        try {
-          std::size_t used = 0;
-          o.play_h_per_s = std::stod(v, &used);
-          if (used != v.size()) o.play_h_per_s = -1.0;
-        } catch (const std::exception&) {
-          o.play_h_per_s = -1.0;
-        }
+        o.play_h_per_s = number_or_nan(v);
         if (!(o.play_h_per_s > 0.0 && o.play_h_per_s <= 1000.0)) {
           throw ViewerInputError("cloudviewer view: --play: found '" + v + "', expected forecast hours per second of wall time, > 0 and <= 1000");
         }
@@ -375,25 +382,13 @@ int cmd_view(const std::vector<std::string>& args) {
       } else if (a == "--scale") {
         o.scale_given = true;
         const std::string v = next();
-        try {
-          std::size_t used = 0;
-          o.scale = std::stod(v, &used);
-          if (used != v.size()) o.scale = -1.0;
-        } catch (const std::exception&) {
-          o.scale = -1.0;
-        }
+        o.scale = number_or_nan(v);
         if (!(o.scale >= 0.1 && o.scale <= 1.0)) {
           throw ViewerInputError("cloudviewer view: --scale: found '" + v + "', expected a resolution scale in 0.1..1");
         }
       } else if (a == "--frame-budget") {
         const std::string v = next();
-        try {
-          std::size_t used = 0;
-          o.frame_budget_ms = std::stod(v, &used);
-          if (used != v.size()) o.frame_budget_ms = -1.0;
-        } catch (const std::exception&) {
-          o.frame_budget_ms = -1.0;
-        }
+        o.frame_budget_ms = number_or_nan(v);
         if (!(o.frame_budget_ms >= 0.0 && o.frame_budget_ms <= 1e7)) {
           throw ViewerInputError("cloudviewer view: --frame-budget: found '" + v + "', expected a frame time in ms 0..1e7 (0: off)");
         }
@@ -428,24 +423,14 @@ int cmd_view(const std::vector<std::string>& args) {
         o.diagnose_cloud = true;
       } else if (a == "--rh-critical") {
         const std::string v = next();
-        std::size_t used = 0;
-        try {
-          o.rh_critical = std::stod(v, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (used != v.size() || !(o.rh_critical >= 0.5 && o.rh_critical < 1.0)) {
+        o.rh_critical = number_or_nan(v);
+        if (!(o.rh_critical >= 0.5 && o.rh_critical < 1.0)) {
           throw ViewerInputError("cloudviewer view: --rh-critical: found '" + v + "', expected a critical relative humidity 0.5 <= RH < 1");
         }
       } else if (a == "--orbit") {
         const std::string v = next();
-        std::size_t used = 0;
-        try {
-          o.orbit_px = std::stod(v, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (used != v.size() || !(std::abs(o.orbit_px) <= 1000.0)) {
+        o.orbit_px = number_or_nan(v);
+        if (!(std::abs(o.orbit_px) <= 1000.0)) {
           throw ViewerInputError("cloudviewer view: --orbit: found '" + v + "', expected pixels of drag per frame in -1000..1000");
         }
       } else if (a == "--section" || a == "--series") {
