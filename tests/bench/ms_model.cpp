@@ -9,6 +9,9 @@
 // luminance (top row first) for the reference and both models, to see where in a view they differ.
 // --reference-dir DIR keeps the references in DIR with their sums (app/bench/reference_cache, the
 // files `cloudviewer bench --out DIR` keeps): a later run reads them, and a larger --spp extends them.
+// --ground-albedo A draws the globe under the clouds (still no air and no sky light) as a Lambertian
+// ground of albedo A, in the reference (its paths bounce off it) and the march alike; references
+// with a ground are not kept in --reference-dir (they would be taken for the clouds-only ones).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -30,21 +33,34 @@ int main(int argc, char** argv) {
   int w = 32, h = 18, spp = 256, max_bounces = 0;
   bool rows = false;
   std::string ref_dir;
+  std::vector<double> grounds{0.0};
   std::vector<std::string> scenes;
   namespace ba = cv::bench_args;
   const int code = ba::parse("bench_ms_model",
-                             "usage: bench_ms_model [--size WxH] [--spp N] [--max-bounces N] [--rows] [--reference-dir DIR] [SCENE...]\n"
+                             "usage: bench_ms_model [--size WxH] [--spp N] [--max-bounces N] [--rows] [--reference-dir DIR] [--ground-albedo A]\n"
+                             "         [SCENE...]\n"
                              "  octave sum and two-stream source against the Monte Carlo reference, clouds only\n"
                              "  --max-bounces N  cut the reference's paths at N scattering events (1: single scattering,\n"
                              "                   against one octave)\n"
                              "  --rows           print each image row's mean luminance: reference, octaves, two-stream\n"
                              "  --reference-dir DIR  read the references from DIR and save them there with their sums\n"
-                             "                   (as `cloudviewer bench --out DIR`): a larger --spp extends a saved one\n",
+                             "                   (as `cloudviewer bench --out DIR`): a larger --spp extends a saved one\n"
+                             "  --ground-albedo A  a Lambertian ground of albedo A under the clouds (no air), in both\n",
                              argc, argv,
                              {ba::size("--size", w, h), ba::integer("--spp", spp), ba::integer("--max-bounces", max_bounces),
-                              ba::flag("--rows", rows), ba::folder("--reference-dir", ref_dir)},
+                              ba::flag("--rows", rows), ba::folder("--reference-dir", ref_dir),
+                              ba::numbers("--ground-albedo", grounds)},
                              &scenes);
   if (code >= 0) return code;
+  if (grounds.size() != 1 || !(grounds[0] >= 0.0 && grounds[0] < 1.0)) {
+    std::fprintf(stderr, "bench_ms_model: --ground-albedo: expected one albedo in 0..1 (below 1)\n");
+    return 2;
+  }
+  const double ground = grounds[0];
+  if (ground > 0.0 && !ref_dir.empty()) {
+    std::fprintf(stderr, "bench_ms_model: --ground-albedo: found it with --reference-dir, expected one or the other (the saved references are clouds only)\n");
+    return 2;
+  }
   if (scenes.empty()) {
     for (const auto& n : cv::bench::standard_scene_names()) if (n != "clear_sky") scenes.push_back(n);
   }
@@ -63,6 +79,11 @@ int main(int argc, char** argv) {
     cv::core::MarchSettings m = sc.march;
     m.features.atmosphere = m.features.globe = false;
     m.medium.ambient = 0.0, m.medium.noise_amount = 0.0;
+    if (ground > 0.0) {
+      m.features.globe = true;
+      m.medium.ground_texture = "none";
+      m.medium.ground_albedo = glm::dvec3(ground);
+    }
     // The march renders one frame through pixel centres: the reference takes the same rays (as
     // `bench` does), so the error is the transport's, not a box filter's against point samples.
     m.quality.anti_alias = false;
