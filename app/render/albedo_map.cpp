@@ -38,21 +38,25 @@ constexpr std::array<MapSurfaceEntry, static_cast<std::size_t>(MapSurface::Count
     {"water (the map's sea)", {122.0f, 172.0f, 207.0f}, {0.0f, 0.0f, 0.0f}},
 }};
 
+constexpr std::size_t kWater = static_cast<std::size_t>(MapSurface::Water);
+constexpr std::size_t kSnow = static_cast<std::size_t>(MapSurface::Snow);
+constexpr double kLightnessScale = 40.0;
+
 // Squared distances of a colour to each type's: chroma (the colour less its mean) over 4 levels,
-// lightness (the mean) over 40, so the relief shading moves a colour little.
-std::array<double, kSurfaces.size()> distances(glm::vec3 c) {
+// lightness (the mean) over 40, so the relief shading moves a colour little. A colour darker than
+// the ice sheets' is measured against snow over `snow_darker` levels instead (snow_lightness_scale).
+std::array<double, kSurfaces.size()> distances(glm::vec3 c, double snow_darker = kLightnessScale) {
   std::array<double, kSurfaces.size()> d{};
   const double m = (c.x + c.y + c.z) / 3.0;
   for (std::size_t k = 0; k < kSurfaces.size(); ++k) {
     const glm::vec3 a = kSurfaces[k].map_srgb;
     const double ma = (a.x + a.y + a.z) / 3.0;
     const glm::dvec3 dc = (glm::dvec3(c) - m) - (glm::dvec3(a) - ma);
-    d[k] = glm::dot(dc, dc) / (4.0 * 4.0) + (m - ma) * (m - ma) / (40.0 * 40.0);
+    const double scale = k == kSnow && m < ma ? snow_darker : kLightnessScale;
+    d[k] = glm::dot(dc, dc) / (4.0 * 4.0) + (m - ma) * (m - ma) / (scale * scale);
   }
   return d;
 }
-
-constexpr std::size_t kWater = static_cast<std::size_t>(MapSurface::Water);
 
 }  // namespace
 
@@ -63,8 +67,15 @@ MapSurface nearest_map_surface(glm::vec3 srgb) {
   return static_cast<MapSurface>(std::min_element(d.begin(), d.end()) - d.begin());
 }
 
-glm::vec3 land_albedo_of_map_colour(glm::vec3 srgb) {
-  const auto d = distances(srgb);
+double snow_lightness_scale(double lat_deg) {
+  const double a = std::abs(lat_deg);
+  if (!(a > 55.0)) return 10.0;  // NaN too
+  if (a >= 65.0) return kLightnessScale;
+  return 10.0 + (a - 55.0) / 10.0 * (kLightnessScale - 10.0);
+}
+
+glm::vec3 land_albedo_of_map_colour(glm::vec3 srgb, double lat_deg) {
+  const auto d = distances(srgb, snow_lightness_scale(lat_deg));
   if (std::min_element(d.begin(), d.end()) - d.begin() == static_cast<std::ptrdiff_t>(kWater)) return map_surface(MapSurface::Grass).albedo;
   // Gaussian weights, relative to the nearest land type (so a colour far from all still has one).
   double dmin = 1e300;
@@ -136,7 +147,8 @@ core::AlbedoMap load_albedo_map(const std::string& path, bool map_colours, const
   for (std::size_t i = 0; i < n; ++i) {
     const glm::vec3 c(px[3 * i], px[3 * i + 1], px[3 * i + 2]);
     sea[i] = nearest_map_surface(c) == MapSurface::Water;
-    const glm::vec3 a = land_albedo_of_map_colour(c);
+    const double lat = 90.0 - (static_cast<double>(i / static_cast<std::size_t>(w)) + 0.5) * 180.0 / h;
+    const glm::vec3 a = land_albedo_of_map_colour(c, lat);
     for (int k = 0; k < 3; ++k) m.rgba[4 * i + k] = a[k];
   }
   std::vector<char> unfilled = sea;

@@ -51,8 +51,16 @@ MapSurface nearest_map_surface(glm::vec3 srgb);
 // by the colour's closeness to theirs, times the colour's lightness against theirs (the relief
 // shading) within 0.75..1.25; at most 0.97. Every result lies in the span of the types' albedos
 // widened by that factor. A colour nearest the map's sea colour stands for no land: grass (the
-// loader gives such texels the land of their neighbours where they have any).
-glm::vec3 land_albedo_of_map_colour(glm::vec3 srgb);
+// loader gives such texels the land of their neighbours where they have any). A colour darker than
+// the ice sheets' is read as snow only as far as the latitude allows (snow_lightness_scale).
+glm::vec3 land_albedo_of_map_colour(glm::vec3 srgb, double lat_deg);
+
+// How many levels of 255 below the ice sheets' lightness a map colour may lie and still be read as
+// snow, by latitude: 40 (as every other type) poleward of 65 degrees, 10 equatorward of 55, linear
+// between. The relief paints high ground the same grey-blue at 33 N (the Tibetan plateau, free of
+// snow most of the year) and at 80 N (Ellesmere Island, under snow ten months); the colour cannot
+// tell them apart, the latitude can (docs/physics.md, "The ground: land albedo and water").
+double snow_lightness_scale(double lat_deg);
 
 // The texture a scene's ground_texture setting names: empty means the Natural Earth relief where it
 // is installed (else the constant albedo), "none" the constant albedo, anything else is a path.

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "render/albedo_map.hpp"
 #include "render/land_sea_mask.hpp"
@@ -85,6 +86,15 @@ TEST(GroundMap, LandColoursBecomeTheAlbedosOfTheirSurfaceTypes) {
     EXPECT_GT(a.y, 0.8f);
     EXPECT_LE(a.y, 0.97f);
   }
+  // The Tibetan plateau, painted the same grey-blue as snow-covered Arctic islands: its alpine
+  // steppe and bare ground (the tundra and rock type, 0.15-0.20 broadband), not a blend with snow.
+  // It was 0.33-0.47 green before the latitude bound on snow (snow_lightness_scale).
+  for (const auto& [lat, lon] : {std::pair{33.0, 88.0}, std::pair{31.0, 85.0}, std::pair{35.0, 92.0}, std::pair{30.0, 88.0}}) {
+    const glm::vec3 a = land_at(m, lat, lon);
+    std::printf("Tibet (%.0f N, %.0f E) albedo %.3f %.3f %.3f\n", lat, lon, a.x, a.y, a.z);
+    EXPECT_GT(a.y, 0.07f) << lat << " " << lon;
+    EXPECT_LT(a.y, 0.25f) << lat << " " << lon;
+  }
   // Every texel's land albedo stays in the span of the types' albedos, with the relief's shading.
   float lo = 1.0f, hi = 0.0f;
   for (std::size_t i = 0; i < m.rgba.size(); i += 4) {
@@ -93,6 +103,26 @@ TEST(GroundMap, LandColoursBecomeTheAlbedosOfTheirSurfaceTypes) {
   std::printf("land albedo over the map: %.3f .. %.3f\n", lo, hi);
   EXPECT_GE(lo, 0.75f * 0.025f);
   EXPECT_LE(hi, 0.97f);
+}
+
+TEST(GroundMap, GreyHighGroundIsSnowOnlyTowardThePoles) {
+  // The relief's grey of high ground (the Tibetan plateau's texel at 33 N, 88 E; Svalbard's and
+  // Ellesmere's are within a few levels of it): tundra and rock at low latitudes, a blend with snow
+  // poleward of 65 degrees as before, between the two from 55 to 65.
+  const glm::vec3 grey(213, 214, 215);
+  const float at_33 = render::land_albedo_of_map_colour(grey, 33.0).y, at_60 = render::land_albedo_of_map_colour(grey, -60.0).y,
+              at_80 = render::land_albedo_of_map_colour(grey, 80.0).y;
+  std::printf("grey high ground: green albedo %.3f at 33 N, %.3f at 60 S, %.3f at 80 N\n", at_33, at_60, at_80);
+  const float rock = render::map_surface(render::MapSurface::Tundra).albedo.y;
+  EXPECT_LT(at_33, 1.5f * rock);
+  EXPECT_GT(at_80, 0.3f);
+  EXPECT_GT(at_60, at_33);
+  EXPECT_LT(at_60, at_80);
+  EXPECT_EQ(render::snow_lightness_scale(std::nan("")), render::snow_lightness_scale(0.0));
+  // The ice sheets' own colour is snow at any latitude (the bound is on colours darker than it).
+  for (double lat : {0.0, 45.0, 72.0, -80.0}) {
+    EXPECT_GT(render::land_albedo_of_map_colour(render::map_surface(render::MapSurface::Snow).map_srgb, lat).y, 0.85f) << lat;
+  }
 }
 
 TEST(GroundMap, TheRasteriserCoversFractionsAndNestsLakesAndIslands) {
