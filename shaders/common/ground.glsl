@@ -21,6 +21,17 @@ CV_FN real3 ground_radiance(real3 albedo, real mu_s, real3 t_sun, real3 e_sky) {
   return albedo / CV_PI * (t_sun * max(mu_s, real(0)) + e_sky);
 }
 
+// The share of an isotropic sky's irradiance that a conservative cloud column of vertical optical
+// depth tau (its mean cosine g) passes to the ground, direct and diffuse: the spherical
+// transmittance, in the two-stream's form 1 / (1 + gamma1 (1 - f) tau) with Eddington's
+// coefficient gamma1 (1 - f) = (3 / 4)(1 - g). Against the adding-doubling solver's 1 - s (s the
+// spherical albedo) for Henyey-Greenstein 0.75 and 0.85 and droplets of 10 and 20 um at optical
+// depths 0.5-100 it is within +0.4..+4.6 %; the quadrature's sqrt(3) / 2 in place of 3 / 4 was
+// -12.5..+2.2 % (`SlabCheck.TheSkysLightThroughACloudIsTheSlabsSphericalTransmittance`).
+CV_FN real sky_through_cloud(real tau, real g) {
+  return real(1.0) / (real(1.0) + real(0.75) * (real(1.0) - g) * max(tau, real(0.0)));
+}
+
 // ---- Water: Fresnel reflection, the Cox-Munk sun glint and the light from the water body ----
 // (docs/physics.md, "Ground albedo"). Cosines are with the local vertical; nu_sv is the cosine
 // between the directions to the sun and to the viewer (both away from the surface).

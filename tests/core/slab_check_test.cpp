@@ -365,4 +365,45 @@ TEST_F(SlabCheck, TheTwoStreamMarchLightsTheGroundUnderTheCloud) {
   }
 }
 
+TEST(SlabCheckSky, TheSkysLightThroughACloudIsTheSlabsSphericalTransmittance) {
+  // The two-stream march lights the ground under a cloud with the sky's irradiance times
+  // sky_through_cloud(tau, g) (docs/physics.md, "The ground under the clouds"). For an isotropic
+  // sky over a conservative slab and a black ground the exact share is the slab's spherical
+  // transmittance, 1 - s (s its spherical albedo), which the adding-doubling solver gives without
+  // any of the renderer's code. The phases the renderer uses for ice (HG) and droplets (the Mie fit,
+  // its mean cosine as the march takes it), optical depths from thin to opaque.
+  namespace p64 = cv::physics::f64;
+  struct Case {
+    const char* name;
+    slabcheck::PhaseFunction phase;
+    double g;
+  };
+  const Case cases[] = {
+      {"HG 0.75", slabcheck::henyey_greenstein_phase(0.75), 0.75},
+      {"HG 0.85", slabcheck::henyey_greenstein_phase(0.85), 0.85},
+      {"Mie 10 um", slabcheck::approximate_mie_phase(10.0), p64::mie_mean_cosine(p64::mie_params(10.0))},
+      {"Mie 20 um", slabcheck::approximate_mie_phase(20.0), p64::mie_mean_cosine(p64::mie_params(20.0))},
+  };
+  for (const Case& c : cases) {
+    for (double tau : {0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0}) {
+      slabcheck::SlabProblem p;
+      p.tau = tau;
+      p.phase = c.phase;
+      p.mu_extra = {1.0};
+      const double exact = 1.0 - solve_slab(p).spherical_albedo();
+      const double got = p64::sky_through_cloud(tau, c.g);
+      std::printf("%-9s (g %.4f) tau %5.1f: spherical transmittance %.4f, sky_through_cloud %.4f (%+.1f %%)\n", c.name, c.g, tau, exact, got,
+                  100.0 * (got / exact - 1.0));
+      EXPECT_NEAR(got / exact, 1.0, 0.05) << c.name << ", tau " << tau;
+    }
+  }
+  // No optical depth or mean cosine gives more than the sky or a negative share.
+  for (double tau : {0.0, 1e-30, 1e30, -1.0}) {
+    for (double g : {-1.0, 0.0, 0.99, 1.0}) {
+      const double t = p64::sky_through_cloud(tau, g);
+      EXPECT_TRUE(t >= 0.0 && t <= 1.0) << tau << " " << g;
+    }
+  }
+}
+
 }  // namespace
