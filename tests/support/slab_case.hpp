@@ -168,8 +168,10 @@ inline Estimate mc_view_radiance(const ImportedSlab& s, const core::GridMeanExti
 }
 
 // The march kernel's (CPU) reflected radiance per unit irradiance at nadir over (0, 0): a camera
-// 10 km up looking straight down, one pixel, 5 m view steps and 256 sun steps.
-inline double march_nadir_radiance(const ImportedSlab& s, core::MarchSettings m, double theta0_deg) {
+// 10 km up looking straight down, one pixel, 5 m view steps and 256 sun steps; the globe takes its
+// ground from `ground` where given (else the constant ground_albedo).
+inline double march_nadir_radiance(const ImportedSlab& s, core::MarchSettings m, double theta0_deg,
+                                   const core::AlbedoMap* ground = nullptr) {
   core::Camera cam;
   cam.alt_m = 10000.0;
   cam.pitch_deg = -90.0;
@@ -177,7 +179,7 @@ inline double march_nadir_radiance(const ImportedSlab& s, core::MarchSettings m,
   cam.width = cam.height = 1;
   m.quality.view_step_m = 5.0;
   m.quality.sun_steps = 256;
-  return core::render_reference(s.grid, s.medium, cam, sun_at_zenith_angle(theta0_deg), m).radiance[0].y;
+  return core::render_reference(s.grid, s.medium, cam, sun_at_zenith_angle(theta0_deg), m, nullptr, ground).radiance[0].y;
 }
 
 // Reflected radiance at nadir over (0, 0): a camera 10 km up looking straight down.
