@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <map>
+#include <utility>
 #include <memory>
 #include <mutex>
 
@@ -138,6 +140,7 @@ core::AlbedoMap load_albedo_map(const std::string& path, bool map_colours, const
     for (std::size_t i = 0; i < n; ++i) {
       for (int k = 0; k < 3; ++k) m.rgba[4 * i + k] = lut[px[3 * i + k]];
     }
+    m.id = core::albedo_map_id(m);
     return m;
   }
   // Land: each colour's surface type. Texels of the map's sea colour take the mean land of their
@@ -194,7 +197,19 @@ core::AlbedoMap load_albedo_map(const std::string& path, bool map_colours, const
     std::call_once(said, [&] { std::fprintf(stderr, "cloudviewer: %s; water is where the ground image has the map's sea colour\n", why.c_str()); });
     for (std::size_t i = 0; i < n; ++i) m.rgba[4 * i + 3] = sea[i] ? 1.0f : 0.0f;
   }
+  m.id = core::albedo_map_id(m);
   return m;
+}
+
+std::shared_ptr<const core::AlbedoMap> shared_albedo_map(const std::string& path, bool map_colours) {
+  static std::mutex lock;
+  static std::map<std::pair<std::string, bool>, std::weak_ptr<const core::AlbedoMap>> loaded;
+  std::lock_guard<std::mutex> hold(lock);
+  auto& slot = loaded[{path, map_colours}];
+  if (auto held = slot.lock()) return held;
+  auto map = std::make_shared<const core::AlbedoMap>(load_albedo_map(path, map_colours));
+  slot = map;
+  return map;
 }
 
 std::string resolve_ground_texture(const std::string& setting) {

@@ -3,6 +3,7 @@
 // the CPU reference alike.
 #pragma once
 
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -61,6 +62,10 @@ glm::vec3 land_albedo_of_map_colour(glm::vec3 srgb, double lat_deg);
 // snow most of the year) and at 80 N (Ellesmere Island, under snow ten months); the colour cannot
 // tell them apart, the latitude can (docs/physics.md, "The ground: land albedo and water").
 double snow_lightness_scale(double lat_deg);
+
+// load_albedo_map(path, map_colours) shared: a map still held by someone (the renderer, the
+// viewer's prefetcher) is not loaded again. Throws as load_albedo_map does.
+std::shared_ptr<const core::AlbedoMap> shared_albedo_map(const std::string& path, bool map_colours);
 
 // The texture a scene's ground_texture setting names: empty means the Natural Earth relief where it
 // is installed (else the constant albedo), "none" the constant albedo, anything else is a path.

@@ -183,7 +183,8 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
 bool GpuRaymarcher::prepare_ground(const core::MarchSettings& s) {
   const bool textured = s.features.globe && !s.medium.ground_texture.empty();
   if (textured && (s.medium.ground_texture != ground_path_ || s.medium.ground_map_colours != ground_map_colours_)) {
-    const core::AlbedoMap map = load_albedo_map(s.medium.ground_texture, s.medium.ground_map_colours);
+    ground_map_ = shared_albedo_map(s.medium.ground_texture, s.medium.ground_map_colours);
+    const core::AlbedoMap& map = *ground_map_;
     if (ground_) glDeleteTextures(1, &ground_);
     glCreateTextures(GL_TEXTURE_2D, 1, &ground_);
     glTextureStorage2D(ground_, 1, GL_RGBA32F, map.width, map.height);
@@ -220,7 +221,7 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
     column_mask_ = hidden;
   }
   if (s.medium.ms_two_stream) {  // the two-stream source, for this time step and sun
-    const core::MsSourceKey key = core::ms_source_key(s, params.u_to_sun);
+    const core::MsSourceKey key = core::ms_source_key(s, params.u_to_sun, textured ? ground_map_.get() : nullptr);
     if (!ms_[0] || ms_volume_ != &v || !(key == ms_key_)) {
       bool built = true;
       const std::shared_ptr<const core::MsSource> ms = core::ms_source_for(v, key, &built);  // built ahead by the viewer's prefetcher, or now

@@ -215,6 +215,7 @@ class GpuRaymarcher {
   GLuint state_[4] = {0, 0, 0, 0};  // march state (radiance, depths), cloud depth, two-stream transmittance
   int state_w_ = 0, state_h_ = 0;
   int ground_w_ = 0, ground_h_ = 0;
+  std::shared_ptr<const core::AlbedoMap> ground_map_;  // the map ground_ holds, for the two-stream columns' ground
   std::string ground_path_;
   bool ground_map_colours_ = false;  // the ground model ground_ was loaded with
   GLuint pyramid_buffer_ = 0, stats_buffer_ = 0;

@@ -11,6 +11,8 @@
 #include "geo/geodesy.hpp"
 #include "geo/solar.hpp"
 #include "kernel/ms_source.hpp"
+#include "render/albedo_map.hpp"
+#include "render/frame_renderer.hpp"
 #include "scene/frame_spec.hpp"
 #include "scene/instant.hpp"
 #include "scene_source.hpp"
@@ -215,9 +217,19 @@ void Prefetcher::run() {
           // does not resolve (a sun being typed) leaves the source to the render thread.
           core::Scene at_instant = *source_scene;
           at_instant.time.valid_utc = core::format_iso_utc(todo);
-          const core::FrameSpec spec = core::resolve_frame(at_instant, volume_);
+          const core::FrameSpec spec = render::resolve_frame(at_instant, volume_);  // the ground texture resolved as the renderer has it
           auto pre = std::make_shared<core::PrebuiltMsSource>();
-          pre->key = core::ms_source_key(spec.march, core::march_params(*prepared, spec.march_camera, spec.sun, spec.march).u_to_sun);
+          // The ground map the renderer draws (shared: loaded once), so the key is the one it asks for.
+          std::shared_ptr<const core::AlbedoMap> ground;
+          if (spec.march.features.globe && !spec.march.medium.ground_texture.empty()) {
+            try {
+              ground = render::shared_albedo_map(spec.march.medium.ground_texture, spec.march.medium.ground_map_colours);
+            } catch (const std::exception&) {  // the render thread says what is wrong with the image
+            }
+          }
+          pre->key = core::ms_source_key(spec.march, core::march_params(*prepared, spec.march_camera, spec.sun, spec.march).u_to_sun,
+                                         ground.get());
+          pre->ground = ground;
           pre->source = core::build_ms_source(*prepared, pre->key);
           source_ms = pre->source.build_ms;
           prepared->ms_prebuilt = std::move(pre);

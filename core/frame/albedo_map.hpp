@@ -2,6 +2,7 @@
 // and finds the water; core reads no images).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 namespace cv::core {
@@ -12,6 +13,12 @@ namespace cv::core {
 struct AlbedoMap {
   int width = 0, height = 0;
   std::vector<float> rgba;
+  // What the map holds, for keys that must tell maps apart (the two-stream source's): a hash of its
+  // size and texels (albedo_map_id). 0: not given, the map's address tells it apart.
+  std::uint64_t id = 0;
 };
+
+// A hash of the map's size and texels (FNV-1a over their bytes), never 0.
+std::uint64_t albedo_map_id(const AlbedoMap& m);
 
 }  // namespace cv::core

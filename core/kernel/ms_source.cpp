@@ -122,7 +122,7 @@ TwoStreamColumn two_stream_column(const double* sigma, const double* g, int n, d
   return c;
 }
 
-MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun) {
+MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun, const AlbedoMap* ground) {
   MsSourceKey k;
   k.to_sun = to_sun;
   const physics::f64::MieParams mie = physics::f64::mie_params(s.medium.droplet_diameter_um);
@@ -130,7 +130,33 @@ MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun) {
   k.ice_g = s.medium.ice_g;
   k.ground_albedo = s.features.globe ? (s.medium.ground_albedo.x + s.medium.ground_albedo.y + s.medium.ground_albedo.z) / 3.0 : 0.0;
   k.mask = medium_mask(s);
+  if (s.features.globe && ground && ground->width > 0 && ground->height > 0 &&
+      ground->rgba.size() == 4 * static_cast<std::size_t>(ground->width) * static_cast<std::size_t>(ground->height)) {
+    k.ground = ground;
+    k.ground_id = ground->id;
+  }
   return k;
+}
+
+double column_ground_albedo(const AlbedoMap& map, double lat_deg, double lon_deg) {
+  namespace p = physics::f64;
+  constexpr double kRad = 3.14159265358979323846 / 180.0;
+  if (!std::isfinite(lat_deg) || !std::isfinite(lon_deg)) return 0.0;
+  lon_deg = std::fmod(lon_deg, 360.0);  // a huge longitude would lose the texel to rounding
+  const glm::dvec4 c = p::equirect_texel(std::clamp(lat_deg, -90.0, 90.0) * kRad, lon_deg * kRad, map.width, map.height);
+  const int x0 = std::clamp(static_cast<int>(c.x), 0, map.width - 1), y0 = std::clamp(static_cast<int>(c.y), 0, map.height - 1);
+  const int x1 = (x0 + 1) % map.width, y1 = std::min(y0 + 1, map.height - 1);
+  auto texel = [&](int x, int y) {
+    const std::size_t i = 4 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(map.width) + static_cast<std::size_t>(x));
+    return glm::dvec4(map.rgba[i], map.rgba[i + 1], map.rgba[i + 2], map.rgba[i + 3]);
+  };
+  const glm::dvec4 t = glm::mix(glm::mix(texel(x0, y0), texel(x1, y0), c.z), glm::mix(texel(x0, y1), texel(x1, y1), c.z), c.w);
+  const double land = (t.x + t.y + t.z) / 3.0;
+  const glm::dvec3 body = p::CV_WATER_BODY;
+  const double water = p::CV_WATER_DIFFUSE_FRESNEL + (body.x + body.y + body.z) / 3.0;
+  const double w = std::clamp(t.w, 0.0, 1.0);
+  const double a = (1.0 - w) * land + w * water;
+  return std::isfinite(a) ? std::clamp(a, 0.0, 0.99) : 0.0;
 }
 
 namespace {
@@ -383,7 +409,9 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
           clear();
           continue;
         }
-        const TwoStreamColumn tc = two_stream_column(sigma.data(), g.data(), nz, grid.alt_m.step, mu0, key.ground_albedo,
+        // The column's ground: the map's under it where the march draws one, else the constant.
+        const double ground_albedo = key.ground ? column_ground_albedo(*key.ground, grid.lat_deg.at(j), grid.lon_deg.at(i)) : key.ground_albedo;
+        const TwoStreamColumn tc = two_stream_column(sigma.data(), g.data(), nz, grid.alt_m.step, mu0, ground_albedo,
                                                      TwoStreamClosure::Quadrature, col_beam.data());
         for (int k = 0; k < nz; ++k) {
           out.i0[grid.index(i, j, k)] = static_cast<float>(tc.i0[static_cast<std::size_t>(k)]);

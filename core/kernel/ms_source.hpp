@@ -13,6 +13,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "frame/albedo_map.hpp"
 #include "kernel/prepared_volume.hpp"
 
 namespace cv::core {
@@ -68,12 +69,29 @@ struct MsSourceKey {
   // The layer mask and the hidden phases: cloud the march leaves out (medium_in) holds and passes
   // no diffuse light either, so a hidden layer does not shade the layer shown.
   MediumMask mask;
-  bool operator==(const MsSourceKey&) const = default;
+  // The globe's ground map, where the march draws one: each column's ground then takes the map's
+  // albedo under it (land and water) instead of the constant ground_albedo. Told apart by its id
+  // (AlbedoMap::id), else its address; the map must outlive any build from this key.
+  const AlbedoMap* ground = nullptr;
+  std::uint64_t ground_id = 0;
+  bool operator==(const MsSourceKey& o) const {
+    const bool same_ground = (ground == nullptr) == (o.ground == nullptr) &&
+                             (ground_id != 0 || o.ground_id != 0 ? ground_id == o.ground_id : ground == o.ground);
+    return to_sun == o.to_sun && liquid_g == o.liquid_g && ice_g == o.ice_g && ground_albedo == o.ground_albedo && mask == o.mask &&
+           same_ground;
+  }
 };
 
 // The key of the source a march with these settings and this sun needs (ground albedo: the mean of
-// the constant ground_albedo where the globe is drawn, else 0).
-MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun);
+// the constant ground_albedo where the globe is drawn, else 0; the ground map where the globe is
+// drawn from one, as the march is given it).
+MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun, const AlbedoMap* ground = nullptr);
+
+// The albedo a column's two-stream ground takes at (lat, lon) in degrees from a ground map: its
+// land's mean over red, green and blue, and water's diffuse albedo (Fresnel's under isotropic
+// light and the water body's light) by the texel's water fraction, read bilinearly as the march
+// reads the map.
+double column_ground_albedo(const AlbedoMap& map, double lat_deg, double lon_deg);
 
 // Each grid column with cloud is one two_stream_column, fed by the 3-D beam of sun_beam_field
 // through the medium shown (a sunlit side lights its columns as a top does); columns run on the
@@ -84,6 +102,7 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key);
 struct PrebuiltMsSource {
   MsSourceKey key;
   MsSource source;
+  std::shared_ptr<const AlbedoMap> ground;  // the ground map key.ground points to, held while this is
 };
 
 // The source a march of v needs for `key`: v's prebuilt one where its key is the same (no work),

@@ -44,7 +44,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   k.u_column_tau = {(hidden.any() ? masked_columns : v.column_maps).data(), {v.columns.nx, v.columns.ny}, int(kColumnMapChannels)};
   std::shared_ptr<const MsSource> ms;  // the two-stream source, as the GPU's (core/kernel/ms_source)
   if (s.medium.ms_two_stream) {
-    ms = ms_source_for(v, ms_source_key(s, k.u_to_sun));
+    ms = ms_source_for(v, ms_source_key(s, k.u_to_sun, ground_map));
     k.u_ms_i0 = {ms->i0.data(), n};
     k.u_ms_i1 = {ms->i1.data(), n};
   }

@@ -479,6 +479,42 @@ TEST(MediumMask, TheColumnDepthsAreThoseOfWhatIsShown) {
 // The forward peak's cut (ms_peak_cut) for Henyey-Greenstein against its closed form: the share of
 // scattering at cosines above mu_c is (1 - g^2)/(2g) (1/(1 - g) - 1/sqrt(1 + g^2 - 2 g mu_c)), and
 // the phase falls monotonically, so the cut c = p(mu_c) where that share less c 2 pi (1 - mu_c) is f.
+// The column's ground from a ground map: land's mean albedo, water's diffuse albedo by the water
+// fraction, bilinear between texel centres as the march reads the map; the key tells maps apart by
+// what they hold, and only where the globe is drawn.
+TEST(TwoStream, EachColumnsGroundIsTheGroundMapsAlbedoUnderIt) {
+  AlbedoMap map;  // 2 x 2: west land (0.2, 0.4, 0.6), east all water; texel centres at lon -90 and 90
+  map.width = 2;
+  map.height = 2;
+  map.rgba = {0.2f, 0.4f, 0.6f, 0.0f, 0.5f, 0.5f, 0.5f, 1.0f, 0.2f, 0.4f, 0.6f, 0.0f, 0.5f, 0.5f, 0.5f, 1.0f};
+  namespace p = physics::f64;
+  const double water = p::CV_WATER_DIFFUSE_FRESNEL + (p::CV_WATER_BODY.x + p::CV_WATER_BODY.y + p::CV_WATER_BODY.z) / 3.0;
+  EXPECT_NEAR(column_ground_albedo(map, 0.0, -90.0), 0.4, 1e-6);
+  EXPECT_NEAR(column_ground_albedo(map, 0.0, 90.0), water, 1e-6);
+  // Half way the texels mix as the march's ground_at mixes them (land colour and water fraction),
+  // then the water's share: land (0.35, 0.45, 0.55), water 0.5.
+  const double half = 0.5 * 0.45 + 0.5 * water;
+  EXPECT_NEAR(column_ground_albedo(map, 0.0, 0.0), half, 1e-6);
+  EXPECT_NEAR(column_ground_albedo(map, 45.0, 180.0), half, 1e-6);  // across the date line
+  for (double v : {std::numeric_limits<double>::quiet_NaN(), 1e30, -1e30}) {
+    const double a = column_ground_albedo(map, v, v);
+    EXPECT_TRUE(a >= 0.0 && a < 1.0) << v;
+  }
+  MarchSettings s;
+  s.features.globe = true;
+  const glm::dvec3 sun(0.0, 0.0, 1.0);
+  AlbedoMap same = map, other = map;
+  map.id = albedo_map_id(map), same.id = albedo_map_id(same);
+  other.rgba[0] = 0.3f;
+  other.id = albedo_map_id(other);
+  EXPECT_NE(map.id, other.id);
+  EXPECT_TRUE(ms_source_key(s, sun, &map) == ms_source_key(s, sun, &same));  // the same texels: the same source
+  EXPECT_FALSE(ms_source_key(s, sun, &map) == ms_source_key(s, sun, &other));
+  EXPECT_FALSE(ms_source_key(s, sun, &map) == ms_source_key(s, sun));
+  s.features.globe = false;  // no globe: no ground, whatever the map
+  EXPECT_TRUE(ms_source_key(s, sun, &map) == ms_source_key(s, sun));
+}
+
 TEST(TwoStream, PeakCutOfHenyeyGreensteinMatchesItsClosedForm) {
   constexpr double kPi = 3.14159265358979323846;
   auto hg = [](double mu, double g) { return (1.0 - g * g) / (4.0 * kPi * std::pow(1.0 + g * g - 2.0 * g * mu, 1.5)); };
