@@ -8,6 +8,7 @@
 #include "scene_source.hpp"
 #include "kernel/ms_source.hpp"
 #include "kernel/volume_cache.hpp"
+#include "render/albedo_map.hpp"
 #include "render/frame_renderer.hpp"
 #include "scene/instant.hpp"
 #include "viewer/playback.hpp"
@@ -105,7 +106,14 @@ TEST(Prefetcher, BuildsEachInstantsSourceForItsOwnSun) {
     core::Scene at = scene;
     at.time.valid_utc = core::format_iso_utc(t);
     const core::FrameSpec spec = render::resolve_frame(at, vol);
-    const core::MsSourceKey key = core::ms_source_key(spec.march, core::march_params(*v, spec.march_camera, spec.sun, spec.march).u_to_sun);
+    // The ground map the renderer draws and gives the columns (GpuRaymarcher::prepare_ground).
+    std::shared_ptr<const core::AlbedoMap> ground;
+    if (spec.march.features.globe && !spec.march.medium.ground_texture.empty()) {
+      ground = render::shared_albedo_map(spec.march.medium.ground_texture, spec.march.medium.ground_map_colours);
+    }
+    const core::MsSourceKey key =
+        core::ms_source_key(spec.march, core::march_params(*v, spec.march_camera, spec.sun, spec.march).u_to_sun, ground.get());
+    EXPECT_EQ(key.ground != nullptr, ground != nullptr);
     EXPECT_TRUE(v->ms_prebuilt->key == key) << "instant " << t;
     suns[n] = key.to_sun;
     bool built = true;
