@@ -1,8 +1,6 @@
 // The ground map's identity (frame/albedo_map.hpp).
 #include "frame/albedo_map.hpp"
 
-#include <cstring>
-
 namespace cv::core {
 
 std::uint64_t albedo_map_id(const AlbedoMap& m) {

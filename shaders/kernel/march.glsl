@@ -916,6 +916,8 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, real behind_t, 
     real3 n = normalize(pg);
     real mu_sg = dot(u_to_sun, n);
     real nu_sg = length(cross(u_to_sun, n));
+    real3 ll = ecef_to_sphere(pg, u_r0);
+    real4 g = ground_at(ll.x, ll.y);
     real3 sun_air = real3(mu_sg > real(0.0) ? real(1.0) : real(0.0));
     real3 e_sky = real3(0.0);
     if (kAtmosphere) {
@@ -932,7 +934,8 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, real behind_t, 
       // the sun's rays passes), the column's diffuse light going down at its lowest node,
       // pi I0 - (2 pi / 3) I1 per unit irradiance, and the sky's light through the column, of which a
       // conservative layer passes its spherical transmittance (sky_through_cloud: Eddington's
-      // coefficient, within 5 % of the slab solver's). Before, the beam alone through the true optical depth made a
+      // coefficient, within 5 % of the slab solver's), with what the ground under it sends back up and
+      // the cloud returns (sky_through_cloud_to_ground). Before, the beam alone through the true optical depth made a
       // cloud of optical depth 1 over land of albedo 0.3 render 62-68 % dark at nadir.
       real g_liquid = mie_mean_cosine(mie_params(u_droplet_um));
       shadow = transmittance(cloud_sun_depth_weighted(pg, real(0.0), mu_sg, nu_sg, real(1.0) - g_liquid * g_liquid,
@@ -941,10 +944,8 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, real behind_t, 
       real i1;
       ms_source_at(pg, u_grid_start.z, i0, i1);
       real down = max(CV_PI * i0 - real(2.0) * CV_PI / real(3.0) * i1, real(0.0));
-      e_sky = e_sky * sky_through_cloud(column_tau(pg), g_liquid) + sun_air * down;
+      e_sky = e_sky * sky_through_cloud_to_ground(column_tau(pg), g_liquid, ground_diffuse_albedo(real3(g), g.w)) + sun_air * down;
     }
-    real3 ll = ecef_to_sphere(pg, u_r0);
-    real4 g = ground_at(ll.x, ll.y);
     // Water (g.w > 0) needs the view: the cosine toward the camera and between camera and sun.
     real mu_vg = -dot(d, n);
     real nu_svg = -dot(d, u_to_sun);
