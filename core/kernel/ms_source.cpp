@@ -159,6 +159,27 @@ double column_ground_albedo(const AlbedoMap& map, double lat_deg, double lon_deg
   return std::isfinite(a) ? std::clamp(a, 0.0, 0.99) : 0.0;
 }
 
+double column_ground_albedo(const AlbedoMap& map, double lat_deg, double lon_deg, double dlat_deg, double dlon_deg) {
+  if (map.width <= 0 || map.height <= 0) return 0.0;
+  constexpr double kRad = 3.14159265358979323846 / 180.0;
+  const double span_lat = std::isfinite(dlat_deg) ? std::clamp(std::abs(dlat_deg), 0.0, 180.0) : 0.0;
+  const double span_lon = std::isfinite(dlon_deg) ? std::clamp(std::abs(dlon_deg), 0.0, 360.0) : 0.0;
+  // Lattice points per axis: one per texel the footprint spans, at least one, at most 32.
+  auto points = [](double span, double texel) { return std::clamp(static_cast<int>(std::ceil(span / texel - 1e-9)), 1, 32); };
+  const int n_lat = points(span_lat, 180.0 / map.height), n_lon = points(span_lon, 360.0 / map.width);
+  if (n_lat == 1 && n_lon == 1) return column_ground_albedo(map, lat_deg, lon_deg);
+  double sum = 0.0, weight = 0.0;
+  for (int a = 0; a < n_lat; ++a) {
+    const double lat = std::clamp(lat_deg + span_lat * ((a + 0.5) / n_lat - 0.5), -90.0, 90.0);
+    const double w = std::max(std::cos(lat * kRad), 0.0);
+    for (int b = 0; b < n_lon; ++b) {
+      sum += w * column_ground_albedo(map, lat, lon_deg + span_lon * ((b + 0.5) / n_lon - 0.5));
+      weight += w;
+    }
+  }
+  return weight > 0.0 ? sum / weight : column_ground_albedo(map, lat_deg, lon_deg);
+}
+
 namespace {
 // sun_beam_field into `beam` (grid.points() floats, none of them `scaled`'s): the levels above
 // top_level are set to 1, every node at or below it is written.
@@ -409,8 +430,10 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
           clear();
           continue;
         }
-        // The column's ground: the map's under it where the march draws one, else the constant.
-        const double ground_albedo = key.ground ? column_ground_albedo(*key.ground, grid.lat_deg.at(j), grid.lon_deg.at(i)) : key.ground_albedo;
+        // The column's ground: the map's under its footprint where the march draws one, else the constant.
+        const double ground_albedo = key.ground ? column_ground_albedo(*key.ground, grid.lat_deg.at(j), grid.lon_deg.at(i), grid.lat_deg.step,
+                                                                       grid.lon_deg.step)
+                                                : key.ground_albedo;
         const TwoStreamColumn tc = two_stream_column(sigma.data(), g.data(), nz, grid.alt_m.step, mu0, ground_albedo,
                                                      TwoStreamClosure::Quadrature, col_beam.data());
         for (int k = 0; k < nz; ++k) {

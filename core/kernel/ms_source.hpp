@@ -92,6 +92,12 @@ MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun, cons
 // light and the water body's light) by the texel's water fraction, read bilinearly as the march
 // reads the map.
 double column_ground_albedo(const AlbedoMap& map, double lat_deg, double lon_deg);
+// The same over a column's footprint, (lat, lon) +- half of (dlat, dlon) degrees: the area's mean
+// (weighted by the cosine of the latitude), from the point values on a lattice no coarser than
+// the map's texels, at most 32 x 32 points; a footprint within one texel is its centre's value.
+// A coarse grid's column over a coast takes the share of land and sea under it, not the side its
+// centre falls on.
+double column_ground_albedo(const AlbedoMap& map, double lat_deg, double lon_deg, double dlat_deg, double dlon_deg);
 
 // Each grid column with cloud is one two_stream_column, fed by the 3-D beam of sun_beam_field
 // through the medium shown (a sunlit side lights its columns as a top does); columns run on the

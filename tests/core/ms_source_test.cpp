@@ -515,6 +515,56 @@ TEST(TwoStream, EachColumnsGroundIsTheGroundMapsAlbedoUnderIt) {
   EXPECT_TRUE(ms_source_key(s, sun, &map) == ms_source_key(s, sun));
 }
 
+// A coarse grid's column takes the mean of the map under its footprint: a column over a coast gets
+// the shares of land and sea under it, where its centre alone would make it all one or the other.
+TEST(TwoStream, ACoarseColumnsGroundIsTheMeanOfTheMapUnderItsFootprint) {
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  AlbedoMap map;  // 36 x 18 (10-degree texels): land of albedo 0.4 west of 0, water east of it
+  map.width = 36;
+  map.height = 18;
+  map.rgba.assign(4 * 36 * 18, 0.0f);
+  for (int y = 0; y < 18; ++y) {
+    for (int x = 0; x < 36; ++x) {
+      float* t = map.rgba.data() + 4 * (y * 36 + x);
+      const bool west = x < 18;  // texel centres at -175..-5
+      t[0] = t[1] = t[2] = west ? 0.4f : 0.5f;
+      t[3] = west ? 0.0f : 1.0f;
+    }
+  }
+  namespace p = physics::f64;
+  const double water = p::CV_WATER_DIFFUSE_FRESNEL + (p::CV_WATER_BODY.x + p::CV_WATER_BODY.y + p::CV_WATER_BODY.z) / 3.0;
+  // A 60-degree column centred 15 degrees west of the coast: 45 degrees of land, 15 of sea. Its
+  // centre is land (0.4); its footprint, with the map's bilinear ramp across the coast, is close
+  // to 3/4 land (the ramp is antisymmetric about the coast, so the shares stay 45 and 15).
+  const double area = column_ground_albedo(map, 0.0, -15.0, 10.0, 60.0);
+  EXPECT_NEAR(column_ground_albedo(map, 0.0, -15.0), 0.4, 1e-6);
+  EXPECT_NEAR(area, 0.75 * 0.4 + 0.25 * water, 0.005) << "the centre's value alone is 0.4";
+  // A footprint within a texel is its centre's value, as before.
+  EXPECT_DOUBLE_EQ(column_ground_albedo(map, 0.0, -15.0, 0.25, 0.25), column_ground_albedo(map, 0.0, -15.0));
+  // Across the date line the footprint wraps: of 160..200 (-160) the half west of 180 is the map's
+  // water, the half east of it (-180..-160) its land.
+  const double seam = column_ground_albedo(map, 0.0, 180.0, 10.0, 40.0);
+  EXPECT_NEAR(seam, 0.5 * 0.4 + 0.5 * water, 0.005);
+  // Toward a pole the cosine weights the footprint's rows: a map with snow (0.8) north of 60 N and
+  // 0.2 south of it, a column from 40 to 80 N, has 35 % of its area in the snow (sin 80 - sin 60
+  // over sin 80 - sin 40): 0.41, where equal rows would give 0.5.
+  AlbedoMap band = map;
+  for (int y = 0; y < 18; ++y) {
+    for (int x = 0; x < 36; ++x) {
+      float* t = band.rgba.data() + 4 * (y * 36 + x);
+      t[0] = t[1] = t[2] = y < 3 ? 0.8f : 0.2f;  // rows 0-2: 90..60 N
+      t[3] = 0.0f;
+    }
+  }
+  const double north = column_ground_albedo(band, 60.0, 0.0, 40.0, 10.0);
+  EXPECT_NEAR(north, 0.2 + 0.6 * (std::sin(80.0 * kDeg) - std::sin(60.0 * kDeg)) / (std::sin(80.0 * kDeg) - std::sin(40.0 * kDeg)), 0.01);
+  // Nothing out of range or not finite comes out.
+  for (double v : {std::numeric_limits<double>::quiet_NaN(), 1e30, -1e30, 0.0}) {
+    const double a = column_ground_albedo(map, v, v, v, v);
+    EXPECT_TRUE(a >= 0.0 && a < 1.0) << v;
+  }
+}
+
 TEST(TwoStream, PeakCutOfHenyeyGreensteinMatchesItsClosedForm) {
   constexpr double kPi = 3.14159265358979323846;
   auto hg = [](double mu, double g) { return (1.0 - g * g) / (4.0 * kPi * std::pow(1.0 + g * g - 2.0 * g * mu, 1.5)); };
