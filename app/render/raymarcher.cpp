@@ -153,12 +153,13 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
   // The octave gate's column optical depths (texelFetch: interpolated in the kernel).
   const core::ColumnDepth& columns = volume->columns;
   if (column_tau_) glDeleteTextures(1, &column_tau_);
-  glCreateTextures(GL_TEXTURE_2D, 1, &column_tau_);
+  glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &column_tau_);
   // Four channels: the optical depth, the ground's altitude (the layer masks) and the modelled
-  // cloud's type memberships (cumuliform, cirriform).
+  // cloud's type memberships (cumuliform, cirriform); a second layer: the ice's optical depth.
   static_assert(core::kColumnMapChannels == 4);
-  glTextureStorage2D(column_tau_, 1, GL_RGBA32F, columns.nx, columns.ny);
-  glTextureSubImage2D(column_tau_, 0, 0, 0, columns.nx, columns.ny, GL_RGBA, GL_FLOAT, volume->column_maps.data());
+  const int column_layers = static_cast<int>(core::kColumnMapLayers);
+  glTextureStorage3D(column_tau_, 1, GL_RGBA32F, columns.nx, columns.ny, column_layers);
+  glTextureSubImage3D(column_tau_, 0, 0, 0, 0, columns.nx, columns.ny, column_layers, GL_RGBA, GL_FLOAT, volume->column_maps.data());
   check_gl("uploading the column optical depths");
   column_mask_ = core::MediumMask{};
   // The two-stream source belongs to a time step: built again, at this size, when a march needs it.
@@ -216,7 +217,8 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
   // The octave gate's column depths of what the march shows: made again when the mask changes.
   if (const core::MediumMask hidden = core::medium_mask(s); !(hidden == column_mask_)) {
     const std::vector<float> maps = core::column_maps_for(v, hidden);
-    glTextureSubImage2D(column_tau_, 0, 0, 0, v.columns.nx, v.columns.ny, GL_RGBA, GL_FLOAT, maps.data());
+    glTextureSubImage3D(column_tau_, 0, 0, 0, 0, v.columns.nx, v.columns.ny, static_cast<int>(core::kColumnMapLayers), GL_RGBA, GL_FLOAT,
+                        maps.data());
     check_gl("uploading the masked column optical depths");
     column_mask_ = hidden;
   }

@@ -38,6 +38,16 @@ inline glm::dvec4 texelFetch(const sampler2D& t, glm::ivec2 p, int) {
   if (t.channels == 3) return glm::dvec4(t.texels[i], t.texels[i + 1], t.texels[i + 2], 1.0);
   return glm::dvec4(t.texels[i], t.texels[i + 1], t.texels[i + 2], t.texels[i + 3]);
 }
+// A 2-D array texture: `size.z` layers of size.x x size.y texels, layer after layer.
+struct sampler2DArray {
+  const float* texels = nullptr;
+  glm::ivec3 size{0};
+  int channels = 1;
+};
+inline glm::dvec4 texelFetch(const sampler2DArray& t, glm::ivec3 p, int) {
+  const sampler2D layer{t.texels + static_cast<std::size_t>(p.z) * t.size.y * t.size.x * t.channels, {t.size.x, t.size.y}, t.channels};
+  return texelFetch(layer, glm::ivec2(p.x, p.y), 0);
+}
 inline glm::ivec3 textureSize(const sampler3D& t, int) { return t.size; }
 inline glm::ivec2 textureSize(const sampler2D& t, int) { return t.size; }
 
@@ -51,7 +61,8 @@ using namespace cv::physics::f64;
 
 struct MarchKernel : MarchParams {
   sampler3D u_liquid, u_ice, u_noise_low, u_noise_high, u_ms_i0, u_ms_i1, u_fraction;
-  sampler2D u_column_tau, u_jitter_mask, u_ground, u_depth, u_opaque, u_tl_distance, u_tl_color, u_detail_table, u_detail_shift;
+  sampler2DArray u_column_tau;
+  sampler2D u_jitter_mask, u_ground, u_depth, u_opaque, u_tl_distance, u_tl_color, u_detail_table, u_detail_shift;
   const glm::vec2* u_min_max = nullptr;
   const float* u_ms_beam_table = nullptr;  // the droplets' beam table (ms_beam_table), read by the two-stream march with the Mie phase
   // The program switches (compile-time constants on the GPU).

@@ -18,6 +18,34 @@
 
 namespace cv::core {
 
+namespace {
+// The ice's part of each column's optical depth, of the medium the mask shows, into the column
+// map's second layer (.r): column_depth's trapezoid, in the same order.
+void fill_ice_depths(const PreparedVolume& v, const MediumMask& mask, std::vector<float>& maps) {
+  const VolumeGrid& g = v.grid;
+  const int nz = g.alt_m.count;
+  const std::size_t columns = static_cast<std::size_t>(g.lon_deg.count) * static_cast<std::size_t>(g.lat_deg.count);
+  if (maps.size() < kColumnMapLayers * kColumnMapChannels * columns) return;
+  const std::vector<float>& ice = v.extinction.ice_per_m;
+  float* layer = maps.data() + kColumnMapChannels * columns;
+  for (int y = 0; y < g.lat_deg.count; ++y) {
+    for (int x = 0; x < g.lon_deg.count; ++x) {
+      const std::size_t c = g.column(x, y);
+      const double ground = maps[kColumnMapChannels * c + 1];
+      double sum = 0.0;
+      if (!ice.empty() && !mask.hide_ice) {
+        for (int k = 0; k < nz; ++k) {
+          if (mask.any() && !mask.shown(g.alt_m.at(k), ground)) continue;
+          const double s = std::max(0.0, double(ice[g.index(x, y, k)]));
+          sum += k == 0 || k == nz - 1 ? 0.5 * s : s;
+        }
+      }
+      layer[kColumnMapChannels * c] = nz > 1 ? static_cast<float>(sum * g.alt_m.step) : 0.0f;
+    }
+  }
+}
+}  // namespace
+
 PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinction, bool weather) {
   PreparedVolume v;
   v.grid = grid;
@@ -40,7 +68,7 @@ PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinct
   v.wraps = grid.wraps_lon();
   v.global_lat = VolumeSampler(grid, e.liquid_per_m).global_lat();
   v.columns = column_depth(grid, e.liquid_per_m, e.ice_per_m);
-  v.column_maps.assign(kColumnMapChannels * v.columns.tau.size(), 0.0f);
+  v.column_maps.assign(kColumnMapLayers * kColumnMapChannels * v.columns.tau.size(), 0.0f);
   const std::vector<float> types = detail_type_memberships(grid, v.weather);
   for (std::size_t c = 0; c < v.columns.tau.size(); ++c) {
     v.column_maps[kColumnMapChannels * c] = v.columns.tau[c];
@@ -49,6 +77,7 @@ PreparedVolume prepare_volume(const VolumeGrid& grid, GridMeanExtinction extinct
     v.column_maps[kColumnMapChannels * c + 2] = types[2 * c];
     v.column_maps[kColumnMapChannels * c + 3] = types[2 * c + 1];
   }
+  fill_ice_depths(v, MediumMask{}, v.column_maps);
   v.pyramid = ExtinctionPyramid(grid, e.liquid_per_m, e.ice_per_m);
   int offset = 0;
   const auto& levels = v.pyramid.levels();
@@ -313,6 +342,7 @@ std::vector<float> column_maps_for(const PreparedVolume& v, const MediumMask& ma
       out[kColumnMapChannels * c] = nz > 1 ? static_cast<float>(sum * g.alt_m.step) : 0.0f;
     }
   }
+  fill_ice_depths(v, mask, out);
   return out;
 }
 

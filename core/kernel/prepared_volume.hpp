@@ -22,8 +22,9 @@
 
 namespace cv::core {
 
-// Floats per column of PreparedVolume::column_maps.
+// Floats per column of each layer of PreparedVolume::column_maps, and its layers.
 inline constexpr std::size_t kColumnMapChannels = 4;
+inline constexpr std::size_t kColumnMapLayers = 2;
 
 struct PrebuiltMsSource;  // kernel/ms_source.hpp
 
@@ -37,7 +38,9 @@ struct PreparedVolume {
   // Per column, (optical depth, ground altitude m (0 without terrain), cumuliform and cirriform
   // memberships of the weather textures, spread into clear columns next to cloud) interleaved: the
   // kernel's four-channel u_column_tau (the octave gate reads .r, the layer masks .g, the modelled
-  // cloud's type .b and .a).
+  // cloud's type .b and .a). Then a second layer of four channels per column: the ice's part of
+  // the optical depth (.r; the two-stream's sky light under a column takes each phase's mean cosine),
+  // and three unused. u_column_tau is a two-layer 2-D array texture of these.
   std::vector<float> column_maps;
   ExtinctionPyramid pyramid;
   std::vector<glm::vec2> pyramid_packed;  // every level's (min, max), finest first, as the GPU reads them

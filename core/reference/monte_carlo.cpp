@@ -122,7 +122,7 @@ MonteCarloRenderer::MonteCarloRenderer(const VolumeGrid& grid, const GridMeanExt
   k.kNoise = march.medium.noise_amount > 0.0;
   k.kModelled = march.medium.modelled;
   // The column maps: the ground (layer masks) and the modelled cloud's type per column.
-  k.u_column_tau = {volume_->column_maps.data(), {volume_->columns.nx, volume_->columns.ny}, int(kColumnMapChannels)};
+  k.u_column_tau = {volume_->column_maps.data(), {volume_->columns.nx, volume_->columns.ny, int(kColumnMapLayers)}, int(kColumnMapChannels)};
   if (k.kModelled) {  // the modelled cloud: the cover per node and the table over the noise tiles
     if (k.u_has_fraction) k.u_fraction = {volume_->extinction.fraction.data(), n};
     k.u_detail_table = {noise->detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_ROWS}, 2};

@@ -41,7 +41,8 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   // The octave gate's column depths of what the march shows (the prepared map when nothing is hidden).
   const MediumMask hidden = medium_mask(s);
   const std::vector<float> masked_columns = hidden.any() ? column_maps_for(v, hidden) : std::vector<float>{};
-  k.u_column_tau = {(hidden.any() ? masked_columns : v.column_maps).data(), {v.columns.nx, v.columns.ny}, int(kColumnMapChannels)};
+  k.u_column_tau = {(hidden.any() ? masked_columns : v.column_maps).data(), {v.columns.nx, v.columns.ny, int(kColumnMapLayers)},
+                    int(kColumnMapChannels)};
   std::shared_ptr<const MsSource> ms;  // the two-stream source, as the GPU's (core/kernel/ms_source)
   if (s.medium.ms_two_stream) {
     ms = ms_source_for(v, ms_source_key(s, k.u_to_sun, ground_map));

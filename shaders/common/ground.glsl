@@ -28,9 +28,11 @@ CV_FN real3 ground_radiance(real3 albedo, real mu_s, real3 t_sun, real3 e_sky) {
 // spherical albedo) for Henyey-Greenstein 0.75 and 0.85 and droplets of 10 and 20 um at optical
 // depths 0.5-100 it is within +0.4..+4.6 %; the quadrature's sqrt(3) / 2 in place of 3 / 4 was
 // -12.5..+2.2 % (`SlabCheckSky.TheSkysLightThroughACloudIsTheSlabsSphericalTransmittance`).
-CV_FN real sky_through_cloud(real tau, real g) {
-  return real(1.0) / (real(1.0) + real(0.75) * (real(1.0) - g) * max(tau, real(0.0)));
-}
+// In terms of x = (1 - g) tau, summed over a column's layers and phases (a conservative two-stream
+// layer's 1 / t - 1 is proportional to it, so layers of different g add their x):
+// 1 / (1 + (3 / 4) x).
+CV_FN real sky_share_of_depth(real x) { return real(1.0) / (real(1.0) + real(0.75) * max(x, real(0.0))); }
+CV_FN real sky_through_cloud(real tau, real g) { return sky_share_of_depth((real(1.0) - g) * max(tau, real(0.0))); }
 
 // The share of an isotropic sky's irradiance at a conservative cloud column's top that reaches a
 // ground of diffuse albedo `a` under it: the spherical transmittance t = sky_through_cloud(tau, g),
@@ -40,10 +42,13 @@ CV_FN real sky_through_cloud(real tau, real g) {
 // that is 2.2 times the black ground's t over snow (0.8), 1.05 times over the sea (0.07). Against
 // the solver's spherical albedo it is within +0.2..+4.3 %
 // (`SlabCheckSky.TheSkysLightOnTheGroundUnderACloudIncludesWhatTheCloudReturns`).
-CV_FN real3 sky_through_cloud_to_ground(real tau, real g, real3 a) {
-  real t = sky_through_cloud(tau, g);
+CV_FN real3 sky_to_ground_of_depth(real x, real3 a) {
+  real t = sky_share_of_depth(x);
   real s = real(1.0) - t;
   return real3(t) / (real3(1.0) - clamp(a, real3(0.0), real3(0.99)) * s);
+}
+CV_FN real3 sky_through_cloud_to_ground(real tau, real g, real3 a) {
+  return sky_to_ground_of_depth((real(1.0) - g) * max(tau, real(0.0)), a);
 }
 
 // ---- Water: Fresnel reflection, the Cox-Munk sun glint and the light from the water body ----

@@ -27,7 +27,9 @@ void load_march_params() {
 // The prepared volume and the other textures, fetched texel by texel (interpolated in the kernel).
 layout(binding = CV_TEX_LIQUID) uniform sampler3D u_liquid;  // grid-mean extinction, 1/m (cf x in-cloud)
 layout(binding = CV_TEX_ICE) uniform sampler3D u_ice;
-layout(binding = CV_TEX_COLUMN_TAU) uniform sampler2D u_column_tau;  // per column: vertical optical depth (r), ground altitude m (g), cumuliform (b) and cirriform (a) memberships
+// Per column, layer 0: vertical optical depth (r), ground altitude m (g), cumuliform (b) and cirriform
+// (a) memberships; layer 1: the ice's part of the optical depth (r).
+layout(binding = CV_TEX_COLUMN_TAU) uniform sampler2DArray u_column_tau;
 layout(binding = CV_TEX_JITTER_MASK) uniform sampler2D u_jitter_mask;  // blue-noise rank / n^2, tiled
 layout(binding = CV_TEX_GROUND) uniform sampler2D u_ground;  // linear albedo, equirectangular
 layout(binding = CV_TEX_NOISE_LOW) uniform sampler3D u_noise_low;    // Perlin-Worley, periodic, [0, 1]

@@ -89,8 +89,9 @@ CV_FN void erode_at(real3 p, CV_INOUT(real) sl, CV_INOUT(real) si) {
 // The column map at grid index f, bilinear with the 3-D fetch's horizontal rules (wrap, pole clamp,
 // regional border 0), from the prepared volume's column map (u_column_tau, four channels): the
 // column's vertical optical depth (x), the ground's altitude in metres (y), and the weather
-// textures' cumuliform (z) and cirriform (w) memberships (core/kernel/weather_textures).
-CV_FN real4 column_texel(real3 f) {
+// textures' cumuliform (z) and cirriform (w) memberships (core/kernel/weather_textures); layer 1
+// holds the ice's part of the optical depth (x).
+CV_FN real4 column_texel_of(real3 f, int layer) {
   ivec2 n = ivec2(u_grid_count);
   real wx;
   real wy;
@@ -98,12 +99,13 @@ CV_FN real4 column_texel(real3 f) {
   int y0 = volume_fetch_index(f.y, n.y, wy);
   int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
   int y1 = y0 + 1;
-  real4 t00 = x0 < 0 || x0 >= n.x || y0 < 0 || y0 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec2(x0, y0), 0));
-  real4 t10 = x1 < 0 || x1 >= n.x || y0 < 0 || y0 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec2(x1, y0), 0));
-  real4 t01 = x0 < 0 || x0 >= n.x || y1 < 0 || y1 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec2(x0, y1), 0));
-  real4 t11 = x1 < 0 || x1 >= n.x || y1 < 0 || y1 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec2(x1, y1), 0));
+  real4 t00 = x0 < 0 || x0 >= n.x || y0 < 0 || y0 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec3(x0, y0, layer), 0));
+  real4 t10 = x1 < 0 || x1 >= n.x || y0 < 0 || y0 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec3(x1, y0, layer), 0));
+  real4 t01 = x0 < 0 || x0 >= n.x || y1 < 0 || y1 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec3(x0, y1, layer), 0));
+  real4 t11 = x1 < 0 || x1 >= n.x || y1 < 0 || y1 >= n.y ? real4(0.0) : real4(texelFetch(u_column_tau, ivec3(x1, y1, layer), 0));
   return mix(mix(t00, t10, wx), mix(t01, t11, wx), wy);
 }
+CV_FN real4 column_texel(real3 f) { return column_texel_of(f, 0); }
 
 // The column's optical depth (x) and ground altitude (y) at grid index f.
 CV_FN real2 column_map(real3 f) {
@@ -214,6 +216,18 @@ CV_FN real column_tau(real3 p) {
   real3 f;
   if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, u_grid_start.z, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return real(0.0);
   return column_map(f).x;
+}
+
+// The column's vertical optical depth at p as the sky's light through it sees it: each phase's
+// part times 1 - its mean cosine (liquid g_liquid, ice g_ice), the depth that sets a conservative
+// layer's spherical transmittance (sky_share_of_depth).
+CV_FN real column_diffusion_depth(real3 p, real g_liquid, real g_ice) {
+  real3 g = ecef_to_sphere(p, u_r0);
+  real3 f;
+  if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, u_grid_start.z, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return real(0.0);
+  real tau = column_texel_of(f, 0).x;
+  real tau_ice = min(max(column_texel_of(f, 1).x, real(0.0)), max(tau, real(0.0)));
+  return (real(1.0) - g_liquid) * max(tau - tau_ice, real(0.0)) + (real(1.0) - g_ice) * tau_ice;
 }
 
 CV_FN real node_sum(int x, int y, int z) { return node(u_liquid, x, y, z) + node(u_ice, x, y, z); }
@@ -934,8 +948,8 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, real behind_t, 
       // the sun's rays passes), the column's diffuse light going down at its lowest node,
       // pi I0 - (2 pi / 3) I1 per unit irradiance, and the sky's light through the column, of which a
       // conservative layer passes its spherical transmittance (sky_through_cloud: Eddington's
-      // coefficient, within 5 % of the slab solver's), with what the ground under it sends back up and
-      // the cloud returns (sky_through_cloud_to_ground). Before, the beam alone through the true optical depth made a
+      // coefficient, within 5 % of the slab solver's; liquid and ice each with their own mean cosine),
+      // with what the ground under it sends back up and the cloud returns (sky_to_ground_of_depth). Before, the beam alone through the true optical depth made a
       // cloud of optical depth 1 over land of albedo 0.3 render 62-68 % dark at nadir.
       real g_liquid = mie_mean_cosine(mie_params(u_droplet_um));
       shadow = transmittance(cloud_sun_depth_weighted(pg, real(0.0), mu_sg, nu_sg, real(1.0) - g_liquid * g_liquid,
@@ -944,7 +958,8 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, real behind_t, 
       real i1;
       ms_source_at(pg, u_grid_start.z, i0, i1);
       real down = max(CV_PI * i0 - real(2.0) * CV_PI / real(3.0) * i1, real(0.0));
-      e_sky = e_sky * sky_through_cloud_to_ground(column_tau(pg), g_liquid, ground_diffuse_albedo(real3(g), g.w)) + sun_air * down;
+      real x_sky = column_diffusion_depth(pg, g_liquid, u_ice_g);
+      e_sky = e_sky * sky_to_ground_of_depth(x_sky, ground_diffuse_albedo(real3(g), g.w)) + sun_air * down;
     }
     // Water (g.w > 0) needs the view: the cosine toward the camera and between camera and sun.
     real mu_vg = -dot(d, n);

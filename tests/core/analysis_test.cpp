@@ -338,7 +338,7 @@ class LayerMask : public ::testing::Test {
     const glm::ivec3 n(g.lon_deg.count, g.lat_deg.count, g.alt_m.count);
     k.u_liquid = {prep_.extinction.liquid_per_m.data(), n};
     k.u_ice = {prep_.extinction.ice_per_m.data(), n};
-    k.u_column_tau = {prep_.column_maps.data(), {prep_.columns.nx, prep_.columns.ny}, int(core::kColumnMapChannels)};
+    k.u_column_tau = {prep_.column_maps.data(), {prep_.columns.nx, prep_.columns.ny, int(core::kColumnMapLayers)}, int(core::kColumnMapChannels)};
     return k;
   }
   static core::MarchSettings band(const std::string& name, bool sea_level = false) {
@@ -630,3 +630,62 @@ TEST_F(Compare, TheCommonGridIsTheCoarserOverTheOverlapAndDisjointGridsHaveNone)
 }
 
 }  // namespace
+
+// The column map's second layer holds the ice's part of each column's optical depth, so the
+// two-stream's sky light under a column takes each phase's mean cosine: (1 - g_l) tau_l +
+// (1 - g_i) tau_i, not the droplets' g for all of it (which let through 1.5 times the sky's light
+// under ice of optical depth 10). Hidden ice and layer masks take it out as they take out the total.
+TEST(ColumnMap, TheSkysDepthTakesEachPhasesMeanCosine) {
+  core::VolumeGrid g;
+  g.lon_deg = {10.0, 1.0, 4};
+  g.lat_deg = {20.0, 1.0, 3};
+  g.alt_m = {1000.0, 500.0, 5};
+  core::GridMeanExtinction e;
+  e.liquid_per_m.assign(g.points(), 0.0f);
+  e.ice_per_m.assign(g.points(), 0.0f);
+  for (int k = 0; k < 5; ++k) {
+    e.ice_per_m[g.index(1, 1, k)] = 2.5e-3f;     // ice alone: optical depth 4 x 500 m x 2.5e-3 = 5
+    e.liquid_per_m[g.index(2, 1, k)] = 2.5e-3f;  // liquid alone: 5
+    e.ice_per_m[g.index(3, 1, k)] = 1.0e-3f;     // both: ice 2, liquid 3
+    e.liquid_per_m[g.index(3, 1, k)] = 1.5e-3f;
+  }
+  const core::PreparedVolume v = core::prepare_volume(g, e);
+  const std::size_t columns = static_cast<std::size_t>(g.columns());
+  ASSERT_EQ(v.column_maps.size(), core::kColumnMapLayers * core::kColumnMapChannels * columns);
+  auto ice_depth = [&](const std::vector<float>& maps, int x, int y) { return maps[core::kColumnMapChannels * (columns + g.column(x, y))]; };
+  EXPECT_NEAR(ice_depth(v.column_maps, 1, 1), 5.0, 1e-5);
+  EXPECT_EQ(ice_depth(v.column_maps, 2, 1), 0.0f);
+  EXPECT_NEAR(ice_depth(v.column_maps, 3, 1), 2.0, 1e-5);
+  EXPECT_EQ(ice_depth(v.column_maps, 0, 1), 0.0f);
+  // The kernel's depth for the sky at the ground under each column.
+  core::MarchSettings s;
+  kernel::f64::MarchKernel k;
+  static_cast<kernel::MarchParams&>(k) = core::march_params(v, core::Camera{}, core::Sun{}, s);
+  k.u_column_tau = {v.column_maps.data(), {v.columns.nx, v.columns.ny, int(core::kColumnMapLayers)}, int(core::kColumnMapChannels)};
+  const double gl = 0.88, gi = 0.75;
+  auto depth_at = [&](int x) {
+    const glm::dvec3 p = geo::sphere_to_ecef({g.lat_deg.at(1), g.lon_deg.at(x), 0.0}, g.earth_radius_m);
+    return k.column_diffusion_depth(p, gl, gi);
+  };
+  EXPECT_NEAR(depth_at(1), (1.0 - gi) * 5.0, 1e-5);
+  EXPECT_NEAR(depth_at(2), (1.0 - gl) * 5.0, 1e-5);
+  EXPECT_NEAR(depth_at(3), (1.0 - gl) * 3.0 + (1.0 - gi) * 2.0, 1e-5);
+  EXPECT_NEAR(depth_at(0), 0.0, 1e-9);  // a clear column (its neighbour's weight is rounding)
+  // Under ice of optical depth 5 the sky's share is that of ice's g: 1 / (1 + 0.75 x 0.25 x 5).
+  EXPECT_NEAR(cv::physics::f64::sky_share_of_depth(depth_at(1)), 1.0 / (1.0 + 0.75 * 0.25 * 5.0), 1e-6);
+  // Hidden ice: no ice depth; a band above the cloud: none of either.
+  core::MediumMask no_ice;
+  no_ice.hide_ice = true;
+  const std::vector<float> hidden = core::column_maps_for(v, no_ice);
+  EXPECT_EQ(ice_depth(hidden, 1, 1), 0.0f);
+  EXPECT_EQ(ice_depth(hidden, 3, 1), 0.0f);
+  EXPECT_NEAR(hidden[core::kColumnMapChannels * g.column(3, 1)], 3.0, 1e-5);  // the liquid's part stays
+  core::MediumMask above;
+  above.band = true;
+  above.sea_level = true;
+  above.bottom_m = 5000.0;
+  above.top_m = 9000.0;
+  const std::vector<float> high = core::column_maps_for(v, above);
+  EXPECT_EQ(ice_depth(high, 1, 1), 0.0f);
+  EXPECT_EQ(high[core::kColumnMapChannels * g.column(1, 1)], 0.0f);
+}

@@ -185,7 +185,7 @@ struct DetailField {
     k.u_liquid = {v->extinction.liquid_per_m.data(), n};
     k.u_ice = {v->extinction.ice_per_m.data(), n};
     k.u_fraction = {v->extinction.fraction.data(), n};
-    k.u_column_tau = {v->column_maps.data(), {v->columns.nx, v->columns.ny}, int(kColumnMapChannels)};
+    k.u_column_tau = {v->column_maps.data(), {v->columns.nx, v->columns.ny, int(kColumnMapLayers)}, int(kColumnMapChannels)};
     k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
     k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
     k.u_detail_table = {noise.detail.data(), {CV_DETAIL_COVERS + 1, CV_DETAIL_ROWS}, 2};

@@ -62,7 +62,7 @@ kernel::f64::MarchKernel modelled_kernel(const core::PreparedVolume& v, const co
   k.u_liquid = {v.extinction.liquid_per_m.data(), n};
   k.u_ice = {v.extinction.ice_per_m.data(), n};
   k.u_fraction = {v.extinction.fraction.data(), n};
-  k.u_column_tau = {v.column_maps.data(), {v.columns.nx, v.columns.ny}, int(core::kColumnMapChannels)};
+  k.u_column_tau = {v.column_maps.data(), {v.columns.nx, v.columns.ny, int(core::kColumnMapLayers)}, int(core::kColumnMapChannels)};
   const core::ErosionNoise& noise = shared_noise();
   k.u_noise_low = {noise.low.texels.data(), glm::ivec3(noise.low.n)};
   k.u_noise_high = {noise.high.texels.data(), glm::ivec3(noise.high.n)};
@@ -259,8 +259,8 @@ TEST(ModelledCloud, AtAConstantCoverATileKeepsTheMeanAndTheCover) {
   k.u_detail_tiles = {2, 3, 1};
   k.u_detail_amount = 1.0;
   // The cloud type per column (cumuliform, cirriform memberships): each type alone, and a blend.
-  std::vector<float> columns(4 * 16, 0.0f);
-  k.u_column_tau = {columns.data(), {4, 4}, 4};
+  std::vector<float> columns(2 * 4 * 16, 0.0f);  // two layers; the second (the ice's depth) unused here
+  k.u_column_tau = {columns.data(), {4, 4, 2}, 4};
   const glm::vec2 types[4] = {{0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}, {0.3f, 0.2f}};
   const char* type_names[4] = {"stratiform", "cumuliform", "cirriform", "blend"};
   const std::vector<float> still(8, 0.0f), drifted = {0.0f, 0.0f, 0.31f, -0.77f, 1.58f, 0.23f, 0.0f, 0.0f};
