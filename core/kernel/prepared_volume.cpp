@@ -27,22 +27,26 @@ void fill_ice_depths(const PreparedVolume& v, const MediumMask& mask, std::vecto
   const std::size_t columns = static_cast<std::size_t>(g.lon_deg.count) * static_cast<std::size_t>(g.lat_deg.count);
   if (maps.size() < kColumnMapLayers * kColumnMapChannels * columns) return;
   const std::vector<float>& ice = v.extinction.ice_per_m;
-  float* layer = maps.data() + kColumnMapChannels * columns;
-  for (int y = 0; y < g.lat_deg.count; ++y) {
-    for (int x = 0; x < g.lon_deg.count; ++x) {
-      const std::size_t c = g.column(x, y);
-      const double ground = maps[kColumnMapChannels * c + 1];
-      double sum = 0.0;
-      if (!ice.empty() && !mask.hide_ice) {
-        for (int k = 0; k < nz; ++k) {
-          if (mask.any() && !mask.shown(g.alt_m.at(k), ground)) continue;
-          const double s = std::max(0.0, double(ice[g.index(x, y, k)]));
-          sum += k == 0 || k == nz - 1 ? 0.5 * s : s;
-        }
+  std::vector<float> sum(columns, 0.0f);
+  // Level by level along the field's layout, in float (a column's levels lie a layer apart: read
+  // column by column in double the pass took about 90 ms on a global 0.25-degree grid of 46 levels,
+  // level by level about 10 ms; float's rounding over the levels is a few parts in a million).
+  if (!ice.empty() && !mask.hide_ice && nz > 1 && ice.size() >= columns * static_cast<std::size_t>(nz)) {
+    for (int k = 0; k < nz; ++k) {
+      const float* level = ice.data() + static_cast<std::size_t>(k) * columns;
+      const float w = k == 0 || k == nz - 1 ? 0.5f : 1.0f;
+      const double alt = g.alt_m.at(k);
+      if (!mask.band) {
+        for (std::size_t c = 0; c < columns; ++c) sum[c] += w * std::max(0.0f, level[c]);
+        continue;
       }
-      layer[kColumnMapChannels * c] = nz > 1 ? static_cast<float>(sum * g.alt_m.step) : 0.0f;
+      for (std::size_t c = 0; c < columns; ++c) {
+        if (mask.shown(alt, maps[kColumnMapChannels * c + 1])) sum[c] += w * std::max(0.0f, level[c]);
+      }
     }
   }
+  float* layer = maps.data() + kColumnMapChannels * columns;
+  for (std::size_t c = 0; c < columns; ++c) layer[kColumnMapChannels * c] = static_cast<float>(double(sum[c]) * g.alt_m.step);
 }
 }  // namespace
 
