@@ -40,7 +40,7 @@ CV_FN real sky_through_cloud(real tau, real g) { return sky_share_of_depth((real
 // (1 - t for any conservative layer, as t is the same from either side), again and again:
 // t / (1 - a (1 - t)), the adding of a Lambertian surface. Under droplets (10 um) of optical depth 20
 // that is 2.2 times the black ground's t over snow (0.8), 1.05 times over the sea (0.07). Against
-// the solver's spherical albedo it is within +0.2..+4.3 %
+// the solver's spherical albedo it is within +0.2..+4.4 %
 // (`SlabCheckSky.TheSkysLightOnTheGroundUnderACloudIncludesWhatTheCloudReturns`).
 CV_FN real3 sky_to_ground_of_depth(real x, real3 a) {
   real t = sky_share_of_depth(x);

@@ -385,6 +385,28 @@ TEST_F(SlabCheck, EachColumnsGroundTakesTheGroundMapsAlbedo) {
   }
 }
 
+// The phases the renderer uses for ice (HG) and droplets (the Mie fit, its mean cosine as the march
+// takes it), and a slab's spherical albedo for one of them from the adding-doubling solver.
+struct SkyCase {
+  const char* name;
+  slabcheck::PhaseFunction phase;
+  double g;
+};
+std::vector<SkyCase> sky_cases() {
+  namespace p64 = cv::physics::f64;
+  return {{"HG 0.75", slabcheck::henyey_greenstein_phase(0.75), 0.75},
+          {"HG 0.85", slabcheck::henyey_greenstein_phase(0.85), 0.85},
+          {"Mie 10 um", slabcheck::approximate_mie_phase(10.0), p64::mie_mean_cosine(p64::mie_params(10.0))},
+          {"Mie 20 um", slabcheck::approximate_mie_phase(20.0), p64::mie_mean_cosine(p64::mie_params(20.0))}};
+}
+double sky_case_spherical_albedo(const SkyCase& c, double tau) {
+  slabcheck::SlabProblem p;
+  p.tau = tau;
+  p.phase = c.phase;
+  p.mu_extra = {1.0};
+  return solve_slab(p).spherical_albedo();
+}
+
 TEST(SlabCheckSky, TheSkysLightThroughACloudIsTheSlabsSphericalTransmittance) {
   // The two-stream march lights the ground under a cloud with the sky's irradiance times
   // sky_through_cloud(tau, g) (docs/physics.md, "The ground under the clouds"). For an isotropic
@@ -393,24 +415,9 @@ TEST(SlabCheckSky, TheSkysLightThroughACloudIsTheSlabsSphericalTransmittance) {
   // any of the renderer's code. The phases the renderer uses for ice (HG) and droplets (the Mie fit,
   // its mean cosine as the march takes it), optical depths from thin to opaque.
   namespace p64 = cv::physics::f64;
-  struct Case {
-    const char* name;
-    slabcheck::PhaseFunction phase;
-    double g;
-  };
-  const Case cases[] = {
-      {"HG 0.75", slabcheck::henyey_greenstein_phase(0.75), 0.75},
-      {"HG 0.85", slabcheck::henyey_greenstein_phase(0.85), 0.85},
-      {"Mie 10 um", slabcheck::approximate_mie_phase(10.0), p64::mie_mean_cosine(p64::mie_params(10.0))},
-      {"Mie 20 um", slabcheck::approximate_mie_phase(20.0), p64::mie_mean_cosine(p64::mie_params(20.0))},
-  };
-  for (const Case& c : cases) {
+  for (const SkyCase& c : sky_cases()) {
     for (double tau : {0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0}) {
-      slabcheck::SlabProblem p;
-      p.tau = tau;
-      p.phase = c.phase;
-      p.mu_extra = {1.0};
-      const double exact = 1.0 - solve_slab(p).spherical_albedo();
+      const double exact = 1.0 - sky_case_spherical_albedo(c, tau);
       const double got = p64::sky_through_cloud(tau, c.g);
       std::printf("%-9s (g %.4f) tau %5.1f: spherical transmittance %.4f, sky_through_cloud %.4f (%+.1f %%)\n", c.name, c.g, tau, exact, got,
                   100.0 * (got / exact - 1.0));
@@ -435,23 +442,10 @@ TEST(SlabCheckSky, TheSkysLightOnTheGroundUnderACloudIncludesWhatTheCloudReturns
   // to fresh snow. Leaving the returned light out (the black ground's t) gives snow (0.8) under
   // optical depth 20 less than half of it, and 0.95 under 100 an eighth.
   namespace p64 = cv::physics::f64;
-  struct Case {
-    const char* name;
-    slabcheck::PhaseFunction phase;
-    double g;
-  };
-  const Case cases[] = {
-      {"HG 0.85", slabcheck::henyey_greenstein_phase(0.85), 0.85},
-      {"Mie 10 um", slabcheck::approximate_mie_phase(10.0), p64::mie_mean_cosine(p64::mie_params(10.0))},
-  };
   double most_missed = 1.0;
-  for (const Case& c : cases) {
+  for (const SkyCase& c : sky_cases()) {
     for (double tau : {1.0, 5.0, 20.0, 100.0}) {
-      slabcheck::SlabProblem p;
-      p.tau = tau;
-      p.phase = c.phase;
-      p.mu_extra = {1.0};
-      const double s = solve_slab(p).spherical_albedo();
+      const double s = sky_case_spherical_albedo(c, tau);
       for (double a : {0.07, 0.3, 0.8, 0.95}) {
         const double exact = (1.0 - s) / (1.0 - a * s);
         const glm::dvec3 got = p64::sky_through_cloud_to_ground(tau, c.g, glm::dvec3(a));
