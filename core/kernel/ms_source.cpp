@@ -151,11 +151,9 @@ double column_ground_albedo(const AlbedoMap& map, double lat_deg, double lon_deg
     return glm::dvec4(map.rgba[i], map.rgba[i + 1], map.rgba[i + 2], map.rgba[i + 3]);
   };
   const glm::dvec4 t = glm::mix(glm::mix(texel(x0, y0), texel(x1, y0), c.z), glm::mix(texel(x0, y1), texel(x1, y1), c.z), c.w);
-  const double land = (t.x + t.y + t.z) / 3.0;
-  const glm::dvec3 body = p::CV_WATER_BODY;
-  const double water = p::CV_WATER_DIFFUSE_FRESNEL + (body.x + body.y + body.z) / 3.0;
-  const double w = std::clamp(t.w, 0.0, 1.0);
-  const double a = (1.0 - w) * land + w * water;
+  // The march's diffuse albedo of the ground (land, or water by the water fraction), grey.
+  const glm::dvec3 rgb = p::ground_diffuse_albedo(glm::dvec3(t), t.w);
+  const double a = (rgb.x + rgb.y + rgb.z) / 3.0;
   return std::isfinite(a) ? std::clamp(a, 0.0, 0.99) : 0.0;
 }
 
