@@ -465,8 +465,8 @@ const char* render_usage() {
         "         [--sun-mode valid_time|local_noon]  sun.mode: the physical sun at the instant, or for teaching the\n"
         "                           sun at local noon over the camera (the instant's declination), so no frame is dark\n"
         "         [--quality reference [--spp N] [--target-error E]]  the GPU path tracer (full multiple scattering,\n"
-        "                           clouds and the ground lit by the sun through the air and by the sky; no haze between\n"
-        "                           them): N samples per pixel at most (1024),\n"
+        "                           clouds and the ground lit by the sun through the air and by the sky, seen through\n"
+        "                           the haze in front of them): N samples per pixel at most (1024),\n"
         "                           fewer once the image's mean relative standard error is E\n"
         "         [--exposure E|auto] [--region W,E,S,N] [--levels MIN_HPA:MAX_HPA] [--stride N]\n"
         "         [--diagnose-cloud [--rh-critical RH]]  data.diagnose_cloud: a file with temperature and humidity but\n"
@@ -824,8 +824,8 @@ int cmd_render(const std::vector<std::string>& args) {
   if (ra.reference) {  // the path tracer marches nothing: the output size
     frame.march_camera = frame.camera;
     if (frame.march.features.atmosphere) {
-      std::printf("the path tracer's air: sunlight reddened through it and the sky's light where paths leave; no haze "
-                  "between the camera and the clouds\n");
+      std::printf("the path tracer's air: sunlight reddened through it, the sky's light where paths leave and the haze "
+                  "between the camera and what it sees; not between later vertices\n");
     }
   }
   const core::RenderSettings& rs = scene.render;

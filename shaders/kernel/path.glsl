@@ -11,7 +11,9 @@
 // the air on (kAtmosphere) the sunlight reaching a vertex is reddened by the air's transmittance,
 // and a path that leaves into the sky takes the sky's single-scattered radiance in its direction:
 // the sky as an environment light (docs/physics.md, "The path tracer's sky and ground"). The air
-// between vertices neither dims nor adds light.
+// between the camera and the first vertex adds its light and dims what lies behind it, as the
+// march's sky in front of its cloud and ground does; between later vertices it neither dims nor
+// adds light.
 // Needs march.glsl and tracking.glsl, and from the including side: track_bits(rng) (32 random
 // bits, for the Mie sampler's own stream), u_path_max_bounces, u_path_roulette_after and
 // u_path_peak_mis.
@@ -158,6 +160,34 @@ CV_FN real3 path_sky(real3 p, real3 d, CV_INOUT(TrackCounts) c) {
 // camera, none without air.
 CV_FN real3 path_miss(real3 d, CV_INOUT(TrackCounts) c) { return u_irradiance * path_sky(u_cam_ecef, d, c); }
 
+// The air between the camera and the point p on its view ray d: its single-scattered light per
+// unit sun irradiance (atmo_inscatter, the integral of the march's sky in front of its cloud and
+// ground) and, in tr, its transmittance; none without air. A camera above the atmosphere starts
+// where its ray enters it, on the exact sphere, as the march's sky_and_ground does.
+CV_FN real3 path_air_front(real3 d, real3 p, CV_OUT(real3) tr, CV_INOUT(TrackCounts) c) {
+  tr = real3(1.0);
+  if (!kAtmosphere) return real3(0.0);
+  real top = CV_ATMO_TOP_M;
+  real3 o = u_cam_ecef;
+  real h = u_cam_alt;
+  real3 up = u_cam_up;
+  real mu = dot(d, up);
+  real nu = length(cross(d, up));
+  real a0;
+  real a1;
+  if (!ray_sphere_rel_nu(u_r0, h, mu, nu, top, a0, a1) || !(a1 > real(0.0))) return real3(0.0);
+  if (h > top && a0 > real(0.0)) {
+    o = normalize(o + a0 * d) * (u_r0 + top);
+    h = top;
+    up = normalize(o);
+    mu = dot(d, up);
+    nu = length(cross(d, up));
+  }
+  real t = max(dot(p - o, d), real(0.0));
+  c.iterations += uint(u_sky_steps) * (uint(u_atmo_sun_steps) + 3u) + 2u;  // atmo_inscatter's loops
+  return atmo_inscatter(u_r0, h, mu, dot(u_to_sun, up), dot(d, u_to_sun), real(0.0), t, u_sky_steps, u_atmo_sun_steps, tr);
+}
+
 // Transmittance of the cloud from p along d by ratio tracking; 0 when the ray meets the Earth.
 CV_FN real path_transmittance(real3 p, real3 d, CV_INOUT(TrackRng) rng, CV_INOUT(TrackCounts) c) {
   c.iterations += 4u;  // path_shell_parts' loop
@@ -221,6 +251,17 @@ CV_FN PathState path_begin(real3 p, real3 d) {
   return s;
 }
 
+// The path's first vertex, at s.p on the pixel's view ray: the air in front of it adds its light,
+// and dims what the path gathers from there on (the march composites its cloud and ground behind
+// the same air).
+CV_FN void path_front_air(CV_INOUT(PathState) s, CV_INOUT(TrackCounts) c) {
+  if (!kAtmosphere) return;
+  real3 tr;
+  real3 l = path_air_front(s.d, s.p, tr, c);
+  s.radiance += s.beta * u_irradiance * l;
+  s.beta *= tr;
+}
+
 // How much more a path heading along d is worth keeping than its weight says: with splitting, a
 // path heading into the droplets' peak around the sun is about to meet a next-event estimate of up
 // to q per sr, so its survival is raised by q and a survivor's weight is never raised above 1 / q
@@ -276,10 +317,14 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
   while (!s.done && c.iterations < max_iterations) {
     // This loop's test, and the Mie sampler's rejection loop (a few tries: it accepts at least 1/3).
     c.iterations += 8u;
+    // The pixel's view ray itself (no vertex yet; a branch starts at one): the air between the
+    // camera and the first vertex counts (path_front_air).
+    bool front = s.scatterings == 0;
     real t_ground;
     real t = path_free_path(s.p, s.d, rng, c, t_ground);
     if (t < CV_PATH_FAR) {
       s.p += t * s.d;
+      if (front) path_front_air(s, c);
       real sl;
       real si;
       medium_at_point(s.p, sl, si);
@@ -378,6 +423,7 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
       // fraction with the glint and the water body (water_radiance), lit by the sun through the
       // air and the clouds; the sky's light reaches it by the paths that leave it.
       s.p = normalize(s.p + t_ground * s.d) * u_r0;
+      if (front) path_front_air(s, c);
       real3 n = s.p / u_r0;
       s.scatterings += 1;
       pc.vertices += 1u;
@@ -418,8 +464,11 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
       s.d = o;
     } else {
       s.end = t_ground < CV_PATH_FAR ? CV_PATH_GROUND : CV_PATH_SPACE;
-      // Into the sky: its light from that direction (none without air).
-      if (s.end == CV_PATH_SPACE) s.radiance += s.beta * u_irradiance * path_sky(s.p, s.d, c);
+      // Into the sky: its light from that direction (none without air). The view ray's from the
+      // camera, as a pixel that misses the grid sees it (path_miss), the air in front of a black
+      // ground included (the march draws that air too).
+      if (front) s.radiance += s.beta * u_irradiance * path_sky(u_cam_ecef, s.d, c);
+      else if (s.end == CV_PATH_SPACE) s.radiance += s.beta * u_irradiance * path_sky(s.p, s.d, c);
       s.done = true;
     }
   }

@@ -470,4 +470,44 @@ TEST(MonteCarlo, PeakImportanceSamplingLowersTheDeckNoise) {
   EXPECT_LT(a.mean_relative_standard_error(), b.mean_relative_standard_error());
 }
 
+
+// The air between the camera and what it sees (path.glsl path_front_air): a path's view ray takes
+// the air's light in front of its first vertex, as the march's sky in front of its cloud and
+// ground does. With no cloud and a black ground (the globe off) every sample of a pixel is that
+// integral alone, so the Monte Carlo and the march must give the same value: before, the paths
+// saw the sky where their ray left into space but nothing where it met the ground.
+TEST(MonteCarlo, TheViewRaySeesTheAirInFrontOfTheGroundAsTheMarchDoes) {
+  const bench::StandardScene sc = bench::standard_scene("clear_sky", 24, 14);
+  MarchSettings m = sc.march;
+  m.features.atmosphere = true;
+  m.features.globe = false;
+  m.quality.anti_alias = false;  // both through each pixel's centre
+  const GridMeanExtinction ext = grid_mean_extinction(sc.grid, sc.data);
+  const ReferenceImage march = render_reference(sc.grid, ext, sc.camera, sc.sun, m);
+  MonteCarloSettings mc;
+  mc.seed = 3;
+  const MonteCarloImage paths = render_monte_carlo(sc.grid, ext, sc.camera, sc.sun, m, mc, 2);
+  const std::vector<glm::dvec3> l = paths.radiance();
+  ASSERT_EQ(l.size(), march.radiance.size());
+  // Which pixels see the ground: the march's transmittance is 0 there with the globe drawn.
+  MarchSettings with_globe = m;
+  with_globe.features.globe = true;
+  const ReferenceImage globe = render_reference(sc.grid, ext, sc.camera, sc.sun, with_globe);
+  int ground = 0;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < l.size(); ++i) {
+    const glm::dvec3 a = march.radiance[i];
+    if (globe.transmittance[i] == 0.0) ++ground;
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_GT(a[k], 0.0) << "pixel " << i << ": the air shows everywhere";
+      worst = std::max(worst, std::abs(l[i][k] - a[k]) / a[k]);
+    }
+
+  }
+  std::printf("clear sky with air over a black ground: %d of %zu pixels see the ground; worst relative difference %.2g\n", ground,
+              l.size(), worst);
+  EXPECT_GT(ground, static_cast<int>(l.size() / 4)) << "the test needs pixels that see the ground";
+  EXPECT_LT(worst, 1e-9);
+}
+
 }  // namespace cv::core
