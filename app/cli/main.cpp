@@ -90,7 +90,7 @@ std::vector<std::pair<std::string, std::string>> command_usages() {
        "                           with that path or point, drawn as the section and series commands draw them\n"
        "                           --quality reference: the progressive path tracer (the Quality panel's switch):\n"
        "                           one sample per pixel per frame up to N (256), restarted by any change; clouds,\n"
-       "                           ground, sunlight through the air and the sky's light, no overlays\n"
+       "                           ground, sunlight through the air and the sky's light, the haze and the overlays\n"
        "                           --reproject: temporal reprojection (the Quality panel's switch): 1/16 of the\n"
        "                           pixels marched per frame, the rest carried from the last image along the\n"
        "                           camera's motion (and the wind's while a forecast plays) and clamped to the\n"

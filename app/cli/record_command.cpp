@@ -426,6 +426,7 @@ int cmd_record(const std::vector<std::string>& args) {
   auto render_frame = [&](int k, std::vector<glm::vec4>* marched, core::FrameSpec& frame) {
     core::Scene at;
     frame = render::resolve_path_frame(scene, path, vol, k, r.fps, &at);
+    if (r.reference) frame.march_camera = frame.camera;  // the path tracer and its overlays at the output size
     const core::Instant& instant = frame.instant;
     core::TimeInterpolationReport rep;
     renderer.use_volume(volumes.get(scene.data.path, vol, instant, at.time.interpolation, &rep, at.render.march.medium.modelled));
@@ -453,7 +454,6 @@ int cmd_record(const std::vector<std::string>& args) {
     // The path tracer at the output size (sunlight through the air, the sky as an environment
     // light), in batches of 8 samples until spp or the target error; the same frame number gives
     // the same samples.
-    frame.march_camera = frame.camera;
     core::MonteCarloImage img;
     render::PathTraceSettings pt;
     pt.samples_per_readback = 8;

@@ -512,7 +512,7 @@ const char* render_usage() {
 // until ra.spp samples per pixel or the mean relative standard error of the image (over pixels at
 // least 5 % of the brightest) falls to ra.target_error. rgb = radiance; a = 0 (no transmittance is
 // estimated: no background shows through).
-std::vector<glm::vec4> path_trace(render::GpuRaymarcher& gpu, const core::FrameSpec& frame, const RenderArgs& ra, double& gpu_s) {
+std::vector<glm::vec4> path_trace(render::FrameRenderer& renderer, const core::FrameSpec& frame, const RenderArgs& ra, double& gpu_s) {
   const auto t0 = clock::now();
   core::MonteCarloImage img;
   render::PathTraceStats extra;
@@ -521,7 +521,7 @@ std::vector<glm::vec4> path_trace(render::GpuRaymarcher& gpu, const core::FrameS
   double error = 0.0;
   while (img.spp < static_cast<std::uint64_t>(ra.spp)) {
     const int batch = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(ra.spp) - img.spp, 8));
-    gpu.trace_paths(img, frame.camera, frame.sun, frame.march, batch, pt, &extra);
+    renderer.trace_paths(img, frame, batch, pt, &extra);  // the overlays drawn for the camera
     error = img.spp >= 2 ? img.mean_relative_standard_error() : 1.0;
     progress_line("path traced %llu/%d samples per pixel, mean relative standard error %.4f, %.1f s",
                   static_cast<unsigned long long>(img.spp), ra.spp, error, seconds_since(t0));
@@ -847,9 +847,7 @@ int cmd_render(const std::vector<std::string>& args) {
 
   // The overlays' geometry (VTK), built only when the scene has overlays; drawn before the march.
   std::vector<overlays::BuiltOverlay> built;
-  if (!scene.overlays.empty() && ra.reference) {
-    std::printf("the path tracer composites no overlays: they are left out with --quality reference\n");
-  } else if (!scene.overlays.empty()) {
+  if (!scene.overlays.empty()) {
     overlays::OverlayBuilder builder;
     try {
       built = builder.build(scene.overlays, vol, static_cast<std::size_t>(scene.time_step), frame.march_camera);
@@ -875,7 +873,7 @@ int cmd_render(const std::vector<std::string>& args) {
   std::vector<glm::vec4> marched;  // at the march size, for the automatic exposure
   std::vector<glm::vec4> pixels;
   if (ra.reference) {
-    pixels = path_trace(gpu, frame, ra, gpu_s);
+    pixels = path_trace(renderer, frame, ra, gpu_s);
     marched = pixels;
   } else {
     pixels = renderer.render(

@@ -64,7 +64,7 @@ std::vector<std::vector<glm::dvec2>> read_gshhg_lines(GshhgFeature feature, char
       g_messages = nullptr;
     }
   } session;
-  session.api = GMT_Create_Session("cloudviewer", 2, GMT_SESSION_NOEXIT | GMT_SESSION_EXTERNAL | GMT_SESSION_COLMAJOR, collect);
+  session.api = GMT_Create_Session("cloudviewer", 2, GMT_SESSION_NOEXIT | GMT_SESSION_EXTERNAL | GMT_SESSION_COLMAJOR | GMT_SESSION_NOHISTORY, collect);
   auto fail = [&](const std::string& step) {
     std::string m = messages;
     while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.pop_back();

@@ -90,7 +90,11 @@ void FrameRenderer::march_into(GLuint out, const core::FrameSpec& f, int index, 
 void FrameRenderer::trace_paths(core::MonteCarloImage& img, const core::FrameSpec& f, int spp, const PathTraceSettings& pt,
                                 PathTraceStats* extra) {
   ensure_noise(f.march);
-  gpu_.trace_paths(img, f.march_camera, f.sun, f.march, spp, pt, extra);
+  // The overlays, drawn once per mean (its camera does not move while it accumulates): none, and
+  // no pass, without overlays.
+  OpaqueInput opaque;
+  if (!overlays_.empty()) opaque = img.spp == 0 || !overlay_pass_ ? draw_overlays(f.march_camera) : overlay_pass_->output();
+  gpu_.trace_paths(img, f.march_camera, f.sun, f.march, spp, pt, extra, {}, opaque);
 }
 
 std::vector<glm::vec4> FrameRenderer::render(const core::FrameSpec& f, const DispatchOptions& dispatch,

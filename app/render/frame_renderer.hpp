@@ -66,8 +66,9 @@ class FrameRenderer {
 
   // Adds `spp` path-traced samples per pixel of the spec's march camera into img (the GPU path
   // tracer, GpuRaymarcher::trace_paths; img empty or made for that camera), generating the erosion
-  // noise the first time it is needed. The viewer's progressive path tracer and `record` trace
-  // through it; the path tracer composites no overlays.
+  // noise the first time it is needed, with the overlays drawn for the march camera (the paths end
+  // on their geometry and pass through their translucent surfaces). `render --quality reference`,
+  // the viewer's progressive path tracer and `record` trace through it.
   void trace_paths(core::MonteCarloImage& img, const core::FrameSpec& frame, int spp, const PathTraceSettings& pt = {},
                    PathTraceStats* extra = nullptr);
 

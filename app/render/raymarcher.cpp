@@ -424,7 +424,7 @@ void GpuRaymarcher::read_stats() {
 
 void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& cam, const core::Sun& sun,
                                 const core::MarchSettings& s, int spp, const PathTraceSettings& pt, PathTraceStats* extra,
-                                const std::function<void(int, int)>& on_samples) {
+                                const std::function<void(int, int)>& on_samples, const OpaqueInput& opaque) {
   if (!volume_) throw GlError("trace_paths needs upload() first");
   if (pt.max_bounces < 1) throw GlError("the path tracer needs max_bounces >= 1");
   if (s.medium.modelled && !detail_table_) throw GlError("cloud_model modelled needs upload_noise() first");
@@ -451,7 +451,10 @@ void GpuRaymarcher::trace_paths(core::MonteCarloImage& img, const core::Camera& 
   const GLuint p = path_program_for(variant).id();
   core::MarchSettings paths = s;  // the paths scatter for themselves: no two-stream source is built for them
   paths.medium.ms_two_stream = false;
-  bind_inputs(cam, sun, paths, OpaqueInput{});
+  // The overlays' geometry only with its radiance: the paths have no alpha to hand a caller.
+  OpaqueInput shown = opaque;
+  if (shown.color == 0) shown.depth = 0;
+  bind_inputs(cam, sun, paths, shown);
   if (!path_sums_ || path_pixels_ != n) {
     if (path_sums_) glDeleteBuffers(1, &path_sums_);
     if (path_state_) glDeleteBuffers(1, &path_state_);

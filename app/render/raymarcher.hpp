@@ -149,10 +149,14 @@ class GpuRaymarcher {
   // start() for this camera, or empty of the camera's size), continuing its sample indices. The
   // path is the CPU Monte Carlo's (shaders/kernel/path.glsl): clouds and the globe's ground (the
   // ground texture's land albedo and water, else the constant albedo); with the air on, sunlight
-  // reddened by it and the sky as an environment light. on_samples(done, spp) after each readback.
+  // reddened by it, the sky as an environment light and the haze in front of the first vertex.
+  // on_samples(done, spp) after each readback. `opaque` (the overlays, drawn for this camera) ends
+  // each view ray at its geometry with the geometry's radiance, and its translucent fragments
+  // composite in front of the ray's first vertex, as the march composites them.
   void trace_paths(core::MonteCarloImage& img, const core::Camera& cam, const core::Sun& sun,
                    const core::MarchSettings& settings, int spp, const PathTraceSettings& pt = {},
-                   PathTraceStats* extra = nullptr, const std::function<void(int, int)>& on_samples = {});
+                   PathTraceStats* extra = nullptr, const std::function<void(int, int)>& on_samples = {},
+                   const OpaqueInput& opaque = {});
 
   // The last frame's cloud depth, for later passes: an R32F texture of its size holding the distance
   // (m) from the camera at which the view transmittance fell to 0.5 (3e38 where it never did).

@@ -204,7 +204,7 @@ void features_panel(ViewerState& s) {
 void quality_panel(ViewerState& s, const PanelContext& ctx) {
   if (!ImGui::CollapsingHeader("Quality")) return;
   // The GPU path tracer as a progressive mode: full multiple scattering, the sky and the ground,
-  // one sample per pixel per frame (no overlays; the haze in front of the clouds as the march has it).
+  // one sample per pixel per frame, with the overlays and the haze in front of the clouds as the march has them.
   ImGui::Checkbox("path tracer (progressive reference)", &s.path_trace);
   if (s.path_trace) ImGui::SliderInt("path samples per pixel", &s.path_spp, 1, 65536, "%d", ImGuiSliderFlags_AlwaysClamp | ImGuiSliderFlags_Logarithmic);
   // Temporal reprojection: 1/16 of the pixels marched per frame, the rest carried from the last image.

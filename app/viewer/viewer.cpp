@@ -977,7 +977,7 @@ int run_viewer(const ViewerOptions& o) {
       any_march = any_march || v.marching;
       const int w = v.spec.march_camera.width, h = v.spec.march_camera.height;
       if (v.presenter.width() != w || v.presenter.height() != h) v.presenter.resize(w, h);
-      if (!v.marching || v.accumulated != 0 || v.path_mode) continue;  // the path tracer composites no overlays
+      if (!v.marching || v.accumulated != 0) continue;  // a new mean, marched or path-traced: both composite the overlays
       try {  // a new mean: the overlays for this view (VTK only when a scene has some)
         const auto built = v.overlay_builder.build(sc.overlays, volume_of(static_cast<int>(i)), static_cast<std::size_t>(sc.time_step),
                                                    v.spec.march_camera);

@@ -907,9 +907,10 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, real behind_t, 
   real g1;
   bool hits_ground = ray_sphere_rel_nu(u_r0, h, mu, nu, real(0.0), g0, g1) && g1 > real(0.0);
   real t_end = hits_ground ? max(g0, real(0.0)) : a1;
-  // Opaque geometry nearer than the ground or the top of the air ends the ray there.
-  bool opaque = t_opaque - t_air0 < t_end;
-  if (opaque) t_end = max(t_opaque - t_air0, real(0.0));
+  // Opaque geometry nearer than the ground ends the ray there; beyond the top of the air it shows
+  // behind all the air the ray crosses (as where the ray misses the air, above).
+  bool opaque = t_opaque < real(3.0e38) && t_opaque - t_air0 < (hits_ground ? t_end : real(3.0e38));
+  if (opaque) t_end = clamp(t_opaque - t_air0, real(0.0), t_end);
   real t_cloud = has_cloud ? clamp(dot(p_cloud - o, d), real(0.0), t_end) : t_end;
   real3 sky_front = real3(0.0);
   real3 sky_back = real3(0.0);

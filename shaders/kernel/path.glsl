@@ -156,15 +156,12 @@ CV_FN real3 path_sky(real3 p, real3 d, CV_INOUT(TrackCounts) c) {
   return atmo_inscatter(u_r0, alt, mu, dot(u_to_sun, up), dot(d, u_to_sun), max(a0, real(0.0)), t_end, u_sky_steps, u_atmo_sun_steps, tr);
 }
 
-// What a pixel sees whose view ray misses the grid's shell (path_camera_origin): the sky from the
-// camera, none without air.
-CV_FN real3 path_miss(real3 d, CV_INOUT(TrackCounts) c) { return u_irradiance * path_sky(u_cam_ecef, d, c); }
-
-// The air between the camera and the point p on its view ray d: its single-scattered light per
-// unit sun irradiance (atmo_inscatter, the integral of the march's sky in front of its cloud and
-// ground) and, in tr, its transmittance; none without air. A camera above the atmosphere starts
-// where its ray enters it, on the exact sphere, as the march's sky_and_ground does.
-CV_FN real3 path_air_front(real3 d, real3 p, CV_OUT(real3) tr, CV_INOUT(TrackCounts) c) {
+// The air along the view ray d from the camera to t_cam metres from it (CV_PATH_FAR, or anything
+// past the ground or the atmosphere's top: to where the ray meets the one or leaves the other): its
+// single-scattered light per unit sun irradiance (atmo_inscatter, the integral of the march's sky in
+// front of its cloud and ground) and, in tr, its transmittance; none without air. A camera above
+// the atmosphere starts where its ray enters it, on the exact sphere, as the march's sky_and_ground.
+CV_FN real3 path_air_front(real3 d, real t_cam, CV_OUT(real3) tr, CV_INOUT(TrackCounts) c) {
   tr = real3(1.0);
   if (!kAtmosphere) return real3(0.0);
   real top = CV_ATMO_TOP_M;
@@ -176,16 +173,29 @@ CV_FN real3 path_air_front(real3 d, real3 p, CV_OUT(real3) tr, CV_INOUT(TrackCou
   real a0;
   real a1;
   if (!ray_sphere_rel_nu(u_r0, h, mu, nu, top, a0, a1) || !(a1 > real(0.0))) return real3(0.0);
+  real t_in = real(0.0);  // from the camera to o
   if (h > top && a0 > real(0.0)) {
+    t_in = a0;
     o = normalize(o + a0 * d) * (u_r0 + top);
     h = top;
     up = normalize(o);
     mu = dot(d, up);
     nu = length(cross(d, up));
+    ray_sphere_rel_nu(u_r0, h, mu, nu, top, a0, a1);
   }
-  real t = max(dot(p - o, d), real(0.0));
+  real g0;
+  real g1;
+  real t_end = ray_sphere_rel_nu(u_r0, h, mu, nu, real(0.0), g0, g1) && g1 > real(0.0) ? max(g0, real(0.0)) : a1;
+  real t = clamp(t_cam - t_in, real(0.0), t_end);
   c.iterations += uint(u_sky_steps) * (uint(u_atmo_sun_steps) + 3u) + 2u;  // atmo_inscatter's loops
   return atmo_inscatter(u_r0, h, mu, dot(u_to_sun, up), dot(d, u_to_sun), real(0.0), t, u_sky_steps, u_atmo_sun_steps, tr);
+}
+
+// What a pixel sees whose view ray misses the grid's shell (path_camera_origin): the air from the
+// camera (the sky), none without air.
+CV_FN real3 path_miss(real3 d, CV_INOUT(TrackCounts) c) {
+  real3 tr;
+  return u_irradiance * path_air_front(d, CV_PATH_FAR, tr, c);
 }
 
 // Transmittance of the cloud from p along d by ratio tracking; 0 when the ray meets the Earth.
@@ -223,6 +233,7 @@ struct PathState {
   real prev_sl;
   real prev_si;
   real3 prev_d;
+  ivec2 px;  // the pixel whose view ray the path starts on: its opaque and translucent inputs (overlays)
 };
 
 #if defined(CV_PATH_SPLIT) && defined(CV_GLSL)
@@ -248,18 +259,45 @@ CV_FN PathState path_begin(real3 p, real3 d) {
   s.prev_sl = real(0.0);
   s.prev_si = real(0.0);
   s.prev_d = real3(0.0);
+  s.px = ivec2(0, 0);
   return s;
 }
 
-// The path's first vertex, at s.p on the pixel's view ray: the air in front of it adds its light,
-// and dims what the path gathers from there on (the march composites its cloud and ground behind
-// the same air).
-CV_FN void path_front_air(CV_INOUT(PathState) s, CV_INOUT(TrackCounts) c) {
-  if (!kAtmosphere) return;
-  real3 tr;
-  real3 l = path_air_front(s.d, s.p, tr, c);
-  s.radiance += s.beta * u_irradiance * l;
-  s.beta *= tr;
+// What the pixel's view ray meets in front of its first vertex, t_cam metres from the camera: the
+// air, whose light the path adds and whose transmittance dims what it gathers from there on, and the
+// translucent fragments (the overlays' surfaces, nearest first) before it, each adding its radiance
+// times its alpha and passing 1 - alpha. The march composites the same: its sky in front of the
+// cloud and the fragments, which stand among the cloud (sky_and_ground, tl_composite).
+CV_FN void path_front(CV_INOUT(PathState) s, real t_cam, CV_INOUT(TrackCounts) c) {
+  if (kAtmosphere) {
+    real3 tr;
+    real3 l = path_air_front(s.d, t_cam, tr, c);
+    s.radiance += s.beta * u_irradiance * l;
+    s.beta *= tr;
+  }
+  for (int k = 0; k < u_tl_count; ++k) {
+    c.iterations += 1u;
+    if (!(tl_distance(s.px, k) < t_cam)) break;
+    real4 f = real4(texelFetch(u_tl_color, ivec2(s.px.x + k * u_size.x, s.px.y), 0));
+    s.radiance += s.beta * (f.w * real3(f.x, f.y, f.z));
+    s.beta *= real(1.0) - f.w;
+  }
+}
+
+// The radiance of the opaque geometry the pixel's view ray ends on (the overlays' colour input);
+// none where only its depth is given.
+CV_FN real3 path_opaque_radiance(ivec2 px) { return u_has_opaque_color ? real3(texelFetch(u_opaque, px, 0)) : real3(0.0); }
+
+// A view ray that misses the grid's shell (path_camera_origin): the air, the fragments and the
+// opaque geometry on it, if any, else the sky.
+CV_FN void path_view_misses(CV_INOUT(PathState) s, CV_INOUT(TrackCounts) c) {
+  real t_stop = opaque_distance(s.px);
+  path_front(s, t_stop, c);
+  if (t_stop < CV_PATH_FAR) {
+    s.radiance += s.beta * path_opaque_radiance(s.px);
+    s.end = CV_PATH_GROUND;
+  }
+  s.done = true;
 }
 
 // How much more a path heading along d is worth keeping than its weight says: with splitting, a
@@ -317,14 +355,26 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
   while (!s.done && c.iterations < max_iterations) {
     // This loop's test, and the Mie sampler's rejection loop (a few tries: it accepts at least 1/3).
     c.iterations += 8u;
-    // The pixel's view ray itself (no vertex yet; a branch starts at one): the air between the
-    // camera and the first vertex counts (path_front_air).
+    // The pixel's view ray itself (no vertex yet; a branch starts at one): what lies between the
+    // camera and the first vertex counts (path_front), and opaque geometry nearer than that vertex
+    // (the overlays' depth input) ends the ray with its own radiance. Distances from the camera:
+    // t_skip to where the path starts (the grid's top for a camera above it).
     bool front = s.scatterings == 0;
     real t_ground;
     real t = path_free_path(s.p, s.d, rng, c, t_ground);
+    real t_skip = front ? max(dot(s.p - u_cam_ecef, s.d), real(0.0)) : real(0.0);
+    real t_stop = front ? opaque_distance(s.px) : CV_PATH_FAR;
+    if (t_stop < CV_PATH_FAR && t_stop - t_skip < min(t, t_ground)) {
+      path_front(s, t_stop, c);
+      s.radiance += s.beta * path_opaque_radiance(s.px);
+      s.p += (t_stop - t_skip) * s.d;
+      s.end = CV_PATH_GROUND;
+      s.done = true;
+      break;
+    }
     if (t < CV_PATH_FAR) {
       s.p += t * s.d;
-      if (front) path_front_air(s, c);
+      if (front) path_front(s, t_skip + t, c);
       real sl;
       real si;
       medium_at_point(s.p, sl, si);
@@ -423,7 +473,9 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
       // fraction with the glint and the water body (water_radiance), lit by the sun through the
       // air and the clouds; the sky's light reaches it by the paths that leave it.
       s.p = normalize(s.p + t_ground * s.d) * u_r0;
-      if (front) path_front_air(s, c);
+      // The fragments on the ground itself count (the overlay pass keeps those within max(1 m, 1e-6
+      // of the distance) behind the sphere, overlay.frag).
+      if (front) path_front(s, t_skip + t_ground + max(real(1.0), real(1.0e-6) * (t_skip + t_ground)), c);
       real3 n = s.p / u_r0;
       s.scatterings += 1;
       pc.vertices += 1u;
@@ -466,8 +518,8 @@ CV_FN void path_advance(CV_INOUT(PathState) s, CV_INOUT(TrackRng) rng, CV_INOUT(
       s.end = t_ground < CV_PATH_FAR ? CV_PATH_GROUND : CV_PATH_SPACE;
       // Into the sky: its light from that direction (none without air). The view ray's from the
       // camera, as a pixel that misses the grid sees it (path_miss), the air in front of a black
-      // ground included (the march draws that air too).
-      if (front) s.radiance += s.beta * u_irradiance * path_sky(u_cam_ecef, s.d, c);
+      // ground included (the march draws that air too), and the fragments on it.
+      if (front) path_front(s, CV_PATH_FAR, c);
       else if (s.end == CV_PATH_SPACE) s.radiance += s.beta * u_irradiance * path_sky(s.p, s.d, c);
       s.done = true;
     }

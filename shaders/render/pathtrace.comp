@@ -129,6 +129,7 @@ PathState load_state(uint idx, out uint rng) {
   s.prev_si = e.w;
   s.absorbed = vec3(0.0);  // not kept on the GPU
   s.prev_d = f.xyz;
+  s.px = ivec2(0);  // a path in flight has met its first vertex: its pixel's inputs are behind it
   rng = floatBitsToUint(f.w);
   return s;
 }
@@ -154,10 +155,10 @@ void main() {
     bool misses;
     vec3 o = path_camera_origin(d, misses);
     s = path_begin(o, d);
-    s.done = misses;
+    s.px = px;  // the overlays' depth, colour and translucent fragments of this pixel
     if (misses) {
       TrackCounts c0 = track_counts();
-      s.radiance = path_miss(d, c0);
+      path_view_misses(s, c0);
     }
   } else {
     s = load_state(idx, rng);

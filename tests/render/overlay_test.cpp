@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -21,6 +22,7 @@
 #include "kernel/prepared_volume.hpp"
 #include "overlays/overlays.hpp"
 #include "physics/physics.hpp"
+#include "reference/monte_carlo.hpp"
 #include "reference/raymarcher.hpp"
 #include "render/context.hpp"
 #include "render/frame_renderer.hpp"
@@ -53,13 +55,13 @@ struct UniformCloud {
   }
 };
 
-// A square plane `height_m` above the camera, normal up, two triangles of one colour.
-std::shared_ptr<core::OverlayMesh> plane_above(const core::Camera& cam, double r0, double height_m, glm::vec4 color) {
+// A square plane `height_m` above the camera, normal up, 2 half_m wide, two triangles of one colour.
+std::shared_ptr<core::OverlayMesh> plane_above(const core::Camera& cam, double r0, double height_m, glm::vec4 color, double half_m = 3000.0) {
   auto m = std::make_shared<core::OverlayMesh>();
   const glm::dvec3 up = glm::normalize(core::camera_ecef(cam, r0));
   const geo::EnuFrame f = geo::sphere_enu(cam.lat_deg, cam.lon_deg);
   const glm::dvec3 c = core::camera_ecef(cam, r0) + height_m * up;
-  const double s = 3000.0;
+  const double s = half_m;
   m->positions = {c - s * f.east - s * f.north, c + s * f.east - s * f.north, c + s * f.east + s * f.north, c - s * f.east + s * f.north};
   m->colors.assign(4, color);
   m->triangles = {0, 1, 2, 0, 2, 3};
@@ -275,6 +277,105 @@ TEST(OverlayComposite, TranslucentPlanesInsideACloudInDepthOrder) {
   }
 }
 
+// The GPU path tracer with the overlays (path.glsl path_front): each view ray ends on the opaque
+// geometry with its radiance, and the translucent fragments in front of its first vertex
+// composite nearest first. Without sunlight the cloud adds no light, so a pixel's expectation is
+// the closed form the march gives: exp(-sigma d) C behind an opaque plane d away, and
+// exp(-sigma d1) a1 C1 + exp(-sigma d2) (1 - a1) a2 C2 through two translucent ones (a collision
+// before a plane hides it). Each pixel's mean is held within 5 of its standard errors.
+TEST(OverlayComposite, ThePathTracerSeesThePlanesInsideACloudAsTheClosedForms) {
+  auto ctx = render::make_headless_context();
+  UniformCloud u;
+  u.frame.sun.irradiance = glm::dvec3(0.0);
+  u.frame.march.features.atmosphere = false;
+  const double r0 = u.grid.earth_radius_m;
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  const auto volume = std::make_shared<const core::PreparedVolume>(core::prepare_volume(u.grid, u.data));
+  const glm::vec4 wall(0.5f, 0.25f, 0.125f, 1.0f), near_c(0.8f, 0.1f, 0.05f, 0.5f), far_c(0.05f, 0.6f, 0.3f, 0.25f);
+  const int spp = 256;
+  struct Case {
+    const char* name;
+    std::vector<std::shared_ptr<core::OverlayMesh>> planes;
+  };
+  const std::vector<Case> cases = {{"opaque", {plane_above(u.frame.camera, r0, 600.0, wall)}},
+                                   {"translucent", {plane_above(u.frame.camera, r0, 800.0, far_c), plane_above(u.frame.camera, r0, 400.0, near_c)}}};
+  for (const Case& k : cases) {
+    render::FrameRenderer renderer(loader);
+    renderer.use_volume(volume);
+    std::vector<render::OverlayDraw> draws;
+    for (const auto& p : k.planes) draws.push_back({"plane", p, nullptr, 1.0f});
+    renderer.set_overlays(draws);
+    core::MonteCarloImage img;
+    renderer.trace_paths(img, u.frame, spp);
+    const core::OpaqueLayer drawn = renderer.read_overlays();
+    ASSERT_EQ(img.spp, static_cast<std::uint64_t>(spp));
+    double worst_z = 0.0;
+    for (int i = 0; i < kSize * kSize; ++i) {
+      const std::size_t x = static_cast<std::size_t>(i % kSize), y = static_cast<std::size_t>(i / kSize);
+      auto at = [&](int layer) { return (y * core::kTranslucentLayers + static_cast<std::size_t>(layer)) * kSize + x; };
+      for (int c = 0; c < 3; ++c) {
+        double expected = 0.0;
+        if (k.planes.size() == 1) {
+          ASSERT_GT(drawn.distance_m[i], 0.0f) << i;
+          expected = std::exp(-kSigma * drawn.distance_m[i]) * drawn.radiance_rgba[4 * i + c];
+        } else {
+          const float* c1 = &drawn.layer_rgba[4 * at(0)];
+          const float* c2 = &drawn.layer_rgba[4 * at(1)];
+          ASSERT_NEAR(c1[3], near_c[3], 1e-6) << i;
+          expected = std::exp(-kSigma * drawn.layer_distance_m[at(0)]) * c1[3] * c1[c] +
+                     std::exp(-kSigma * drawn.layer_distance_m[at(1)]) * (1.0 - c1[3]) * c2[3] * c2[c];
+        }
+        const double mean = img.sum[static_cast<std::size_t>(i)][c] / spp;
+        const double var = std::max(img.sum_sq[static_cast<std::size_t>(i)][c] / spp - mean * mean, 0.0);
+        const double se = std::sqrt(var / (spp - 1));
+        ASSERT_GT(expected, 0.0) << i;
+        ASSERT_GT(se, 0.0) << "pixel " << i << ": the samples must differ (some paths collide before the planes)";
+        const double z = (mean - expected) / se;
+        worst_z = std::max(worst_z, std::abs(z));
+        EXPECT_LT(std::abs(z), 5.0) << k.name << " pixel " << i << " channel " << c << ": " << mean << " against " << expected;
+      }
+    }
+    std::printf("path tracer, %s planes inside the cloud, %d spp: largest |z| %.2f over %d pixels\n", k.name, spp, worst_z, kSize * kSize);
+  }
+}
+
+// With the air and the sun on and no cloud, a path's view ray meets nothing before the opaque
+// plane: its light is the air's in front of the plane plus the plane's radiance through the air,
+// in every sample alike, which is the march's composite: the two images agree to float rounding.
+// A plane 3 km above the camera (above the grid's top), and one 70 km above it, beyond the top of
+// the air, which the march once dropped (it took the air's end for the geometry's).
+TEST(OverlayComposite, ThePathTracerSeesAPlaneThroughTheAirAsTheMarchDoes) {
+  auto ctx = render::make_headless_context();
+  UniformCloud u;
+  u.data[core::Field::ExtinctionLiquid].assign(u.grid.points(), 0.0f);
+  u.frame.march.features.atmosphere = true;
+  u.frame.march.quality.anti_alias = false;  // both through each pixel's centre
+  u.frame.sun.subsolar_lat_deg = 30.0;
+  const double r0 = u.grid.earth_radius_m;
+  render::ShaderLoader loader({render::ShaderLoader::default_shader_dir()});
+  const auto volume = std::make_shared<const core::PreparedVolume>(core::prepare_volume(u.grid, u.data));
+  for (const double height : {3000.0, 70000.0}) {
+    render::FrameRenderer renderer(loader);
+    renderer.use_volume(volume);
+    renderer.set_overlays({{"plane", plane_above(u.frame.camera, r0, height, {0.5f, 0.25f, 0.125f, 1.0f}, height < 1e4 ? 3000.0 : 40000.0),
+                            nullptr, 1.0f}});
+    const std::vector<glm::vec4> march = renderer.render(u.frame);
+    core::MonteCarloImage img;
+    renderer.trace_paths(img, u.frame, 2);
+    const core::OpaqueLayer drawn = renderer.read_overlays();
+    int on_plane = 0;
+    for (int i = 0; i < kSize * kSize; ++i) {
+      on_plane += drawn.distance_m[i] > 0.0f ? 1 : 0;
+      const glm::dvec3 l = img.mean(static_cast<std::size_t>(i));
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_GT(march[i][c], 0.0f) << i;
+        EXPECT_NEAR(l[c], march[i][c], 1e-5 * march[i][c]) << "plane " << height << " m up, pixel " << i << " channel " << c;
+      }
+    }
+    EXPECT_GT(on_plane, height < 1e4 ? kSize * kSize / 2 : kSize * kSize - 1) << "the test needs pixels that see the plane";
+  }
+}
+
 // A plane of alpha 0 is translucent geometry that shows nothing: in a sunlit cloud the march
 // divides the steps it crosses and the image must not change (the two parts of a step sum to the
 // whole), to rounding.
@@ -365,6 +466,27 @@ TEST(Coastlines, MissingDataNamesThePackage) {
               "overlays: coastlines: no GSHHG files (binned_GSHHS_c.nc) under /nonexistent/gshhg, expected the files of the Debian "
               "package gmt-gshhg-low (apt-get install gmt-gshhg-low gmt-common)");
   }
+}
+
+// The GMT library keeps a gmt.history file in the working folder unless told not to: reading the
+// shorelines (every `render --overlay coastlines`) must leave the user's folder as it was.
+TEST(Coastlines, ReadingThemLeavesNoFileInTheWorkingFolder) {
+  const std::filesystem::path folder = std::filesystem::path(test_support::scratch_dir()) / "gmt_cwd";
+  std::filesystem::create_directories(folder);
+  const std::filesystem::path before = std::filesystem::current_path();
+  std::filesystem::current_path(folder);
+  std::size_t lines = 0;
+  try {
+    lines = overlays::read_gshhg_lines(overlays::GshhgFeature::Shore, 'c', "", {}).size();
+  } catch (...) {
+    std::filesystem::current_path(before);
+    throw;
+  }
+  std::filesystem::current_path(before);
+  EXPECT_GT(lines, 0u);
+  std::vector<std::string> left;
+  for (const auto& e : std::filesystem::directory_iterator(folder)) left.push_back(e.path().filename().string());
+  EXPECT_TRUE(left.empty()) << "left in the working folder: " << left.front();
 }
 
 // The crude GSHHG shoreline's vertex nearest 64.1 N, 21.9 W (Iceland), and its distance in degrees.
