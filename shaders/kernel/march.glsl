@@ -880,33 +880,65 @@ CV_FN real4 over_opaque(real3 l, real t, bool opaque, real3 opaque_l) {
 // model the delta-scaled one (the light the droplets' forward peak passes on counts as passed).
 // Alpha: 0 where the globe shows, else the cloud's times the air's (green) transmittance, for the
 // background behind.
-CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, real behind_t, bool has_cloud, real3 p_cloud, real t_opaque,
-                           real3 opaque_l) {
+// The camera's view ray d in the air's own frame: a camera above the atmosphere starts from where
+// its ray enters it, on the exact sphere (as march_ray): o, its altitude h, the up there and the
+// ray's cosine and sine to it, t_in the distance from the camera to o; from o, t_end where the ray
+// meets the ground (hits_ground) or leaves the air. in_air false: the ray misses the air. The
+// march's sky (sky_and_ground) and the path tracer's air in front (path.glsl) both start here.
+struct AirRay {
+  bool in_air;
+  real3 o;
+  real h;
+  real3 up;
+  real mu;
+  real nu;
+  real t_in;
+  real t_end;
+  bool hits_ground;
+};
+
+CV_FN AirRay camera_air_ray(real3 d) {
+  AirRay r;
   real top = CV_ATMO_TOP_M;
-  // The air's own frame: a camera above the atmosphere starts from where its ray enters it, on the
-  // exact sphere (as march_ray).
-  real3 o = u_cam_ecef;
-  real h = u_cam_alt;
-  real3 up = u_cam_up;
-  real mu = dot(d, up);
-  real nu = length(cross(d, up));
+  r.o = u_cam_ecef;
+  r.h = u_cam_alt;
+  r.up = u_cam_up;
+  r.mu = dot(d, r.up);
+  r.nu = length(cross(d, r.up));
+  r.t_in = real(0.0);
+  r.t_end = real(0.0);
+  r.hits_ground = false;
   real a0;
   real a1;
-  if (!ray_sphere_rel_nu(u_r0, h, mu, nu, top, a0, a1) || a1 < real(0.0)) return over_opaque(cloud_l, cloud_t, t_opaque < real(3.0e38), opaque_l);
-  real t_air0 = real(0.0);  // the distance from the camera to o
-  if (h > top && a0 > real(0.0)) {
-    t_air0 = a0;
-    o = normalize(o + a0 * d) * (u_r0 + top);
-    h = top;
-    up = normalize(o);
-    mu = dot(d, up);
-    nu = length(cross(d, up));
-    ray_sphere_rel_nu(u_r0, h, mu, nu, top, a0, a1);
+  r.in_air = ray_sphere_rel_nu(u_r0, r.h, r.mu, r.nu, top, a0, a1) && !(a1 < real(0.0));
+  if (!r.in_air) return r;
+  if (r.h > top && a0 > real(0.0)) {
+    r.t_in = a0;
+    r.o = normalize(r.o + a0 * d) * (u_r0 + top);
+    r.h = top;
+    r.up = normalize(r.o);
+    r.mu = dot(d, r.up);
+    r.nu = length(cross(d, r.up));
+    ray_sphere_rel_nu(u_r0, r.h, r.mu, r.nu, top, a0, a1);
   }
   real g0;
   real g1;
-  bool hits_ground = ray_sphere_rel_nu(u_r0, h, mu, nu, real(0.0), g0, g1) && g1 > real(0.0);
-  real t_end = hits_ground ? max(g0, real(0.0)) : a1;
+  r.hits_ground = ray_sphere_rel_nu(u_r0, r.h, r.mu, r.nu, real(0.0), g0, g1) && g1 > real(0.0);
+  r.t_end = r.hits_ground ? max(g0, real(0.0)) : a1;
+  return r;
+}
+
+CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, real behind_t, bool has_cloud, real3 p_cloud, real t_opaque,
+                           real3 opaque_l) {
+  AirRay air = camera_air_ray(d);
+  if (!air.in_air) return over_opaque(cloud_l, cloud_t, t_opaque < real(3.0e38), opaque_l);
+  real3 o = air.o;
+  real h = air.h;
+  real3 up = air.up;
+  real mu = air.mu;
+  real t_air0 = air.t_in;  // the distance from the camera to o
+  bool hits_ground = air.hits_ground;
+  real t_end = air.t_end;
   // Opaque geometry nearer than the ground ends the ray there; beyond the top of the air it shows
   // behind all the air the ray crosses (as where the ray misses the air, above).
   bool opaque = t_opaque < real(3.0e38) && t_opaque - t_air0 < (hits_ground ? t_end : real(3.0e38));

@@ -159,36 +159,16 @@ CV_FN real3 path_sky(real3 p, real3 d, CV_INOUT(TrackCounts) c) {
 // The air along the view ray d from the camera to t_cam metres from it (CV_PATH_FAR, or anything
 // past the ground or the atmosphere's top: to where the ray meets the one or leaves the other): its
 // single-scattered light per unit sun irradiance (atmo_inscatter, the integral of the march's sky in
-// front of its cloud and ground) and, in tr, its transmittance; none without air. A camera above
-// the atmosphere starts where its ray enters it, on the exact sphere, as the march's sky_and_ground.
+// front of its cloud and ground) and, in tr, its transmittance; none without air. The ray in the
+// air's frame as the march's sky_and_ground takes it (camera_air_ray).
 CV_FN real3 path_air_front(real3 d, real t_cam, CV_OUT(real3) tr, CV_INOUT(TrackCounts) c) {
   tr = real3(1.0);
   if (!kAtmosphere) return real3(0.0);
-  real top = CV_ATMO_TOP_M;
-  real3 o = u_cam_ecef;
-  real h = u_cam_alt;
-  real3 up = u_cam_up;
-  real mu = dot(d, up);
-  real nu = length(cross(d, up));
-  real a0;
-  real a1;
-  if (!ray_sphere_rel_nu(u_r0, h, mu, nu, top, a0, a1) || !(a1 > real(0.0))) return real3(0.0);
-  real t_in = real(0.0);  // from the camera to o
-  if (h > top && a0 > real(0.0)) {
-    t_in = a0;
-    o = normalize(o + a0 * d) * (u_r0 + top);
-    h = top;
-    up = normalize(o);
-    mu = dot(d, up);
-    nu = length(cross(d, up));
-    ray_sphere_rel_nu(u_r0, h, mu, nu, top, a0, a1);
-  }
-  real g0;
-  real g1;
-  real t_end = ray_sphere_rel_nu(u_r0, h, mu, nu, real(0.0), g0, g1) && g1 > real(0.0) ? max(g0, real(0.0)) : a1;
-  real t = clamp(t_cam - t_in, real(0.0), t_end);
+  AirRay air = camera_air_ray(d);
+  if (!air.in_air) return real3(0.0);
+  real t = clamp(t_cam - air.t_in, real(0.0), air.t_end);
   c.iterations += uint(u_sky_steps) * (uint(u_atmo_sun_steps) + 3u) + 2u;  // atmo_inscatter's loops
-  return atmo_inscatter(u_r0, h, mu, dot(u_to_sun, up), dot(d, u_to_sun), real(0.0), t, u_sky_steps, u_atmo_sun_steps, tr);
+  return atmo_inscatter(u_r0, air.h, air.mu, dot(u_to_sun, air.up), dot(d, u_to_sun), real(0.0), t, u_sky_steps, u_atmo_sun_steps, tr);
 }
 
 // What a pixel sees whose view ray misses the grid's shell (path_camera_origin): the air from the
