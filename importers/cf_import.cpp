@@ -307,6 +307,8 @@ struct Era5Source {
   int lon_lo = 0, lon_hi = 0, lat_lo = 0, lat_hi = 0, lev_lo = 0, lev_hi = 0;
   // Per-step input slabs, kept between steps so their memory is reused (loads are sequential).
   mutable std::vector<Slab> scratch = std::vector<Slab>(kRoleCount);
+  // The next band's slabs, read while the workers convert the band in `scratch`.
+  mutable std::vector<Slab> scratch_next = std::vector<Slab>(kRoleCount);
 };
 
 namespace {
@@ -401,7 +403,9 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   const CfLayout& L = S.layout;
   const std::string& path = S.file->path();
   const int t = S.steps[step];
-  std::vector<Slab>& slab = S.scratch;
+  // The band the workers convert, and the one the reading thread fills meanwhile.
+  std::vector<Slab>* slab_now = &S.scratch;
+  std::vector<Slab>* slab_next = &S.scratch_next;
   bool have[kRoleCount] = {};
   const bool diagnose = S.diagnose;
   // The variables read: every role present, relative humidity only for a diagnosed cloud (humidity
@@ -420,18 +424,18 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   // are counted in the report's "before" ranges (each row is counted by one band only). The
   // slabs hold a band, not the step: a global step's slabs were 900 MB of fresh memory.
   bool first_band = true;
-  auto read_band = [&](int j_lo, int j_hi, int j_own) {
+  auto read_band = [&](std::vector<Slab>& slab, int j_lo, int j_hi, int j_own) {
     for (int r : roles_read) {
       UnpackInfo info;
       const bool heights = static_cast<Role>(r) == Role::Geopotential || static_cast<Role>(r) == Role::GeopotentialHeight;
       Slab& sl = slab[static_cast<std::size_t>(r)];
       read_slab_into(sl, S, *L.roles[r], t, &info, heights, j_lo, j_hi);
       auto& use = report.use(role_name(static_cast<Role>(r)));
-      // The owned rows, level by level (a row's longitudes are contiguous in the usual layout),
-      // the levels split over the cores (this pass ran on one core while the other waited).
+      // The owned rows, level by level (a row's longitudes are contiguous in the usual layout).
+      // On the reading thread alone: the cores are converting the band before this one.
       const int nlon = S.lon_hi - S.lon_lo + 1, nk = sl.s_lev ? S.lev_hi - S.lev_lo + 1 : 1;
       std::vector<core::ValueStats> part(core::worker_count());
-      const unsigned parts = core::parallel_ranges(static_cast<std::size_t>(nk), 4, [&](std::size_t k0, std::size_t k1, unsigned p) {
+      const unsigned parts = core::parallel_ranges(static_cast<std::size_t>(nk), nk + 1, [&](std::size_t k0, std::size_t k1, unsigned p) {
         core::ValueStats& st = part[p];
         for (std::size_t k = k0; k < k1; ++k) {
           for (int j = j_lo; j <= j_own; ++j) {
@@ -543,7 +547,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     for (int l = 0; l < nlev; ++l) {
       const int k = S.levels[static_cast<std::size_t>(l)];
       for (int r : roles_read) {
-        RoleRow(slab[static_cast<std::size_t>(r)], j0, j1, w, k).fill(S.lon.src.data(), row_len, W.role_values[static_cast<std::size_t>(r)].data());
+        RoleRow((*slab_now)[static_cast<std::size_t>(r)], j0, j1, w, k).fill(S.lon.src.data(), row_len, W.role_values[static_cast<std::size_t>(r)].data());
       }
       const double* role_value[kRoleCount];
       for (int r = 0; r < kRoleCount; ++r) role_value[r] = W.role_values[static_cast<std::size_t>(r)].data();
@@ -710,7 +714,27 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   for (int b = 0; b < bands; ++b) {
     const std::size_t bb = static_cast<std::size_t>(b);
     const int j_lo = S.lat_lo + b * kBandRows, j_own = std::min(S.lat_hi, j_lo + kBandRows - 1);
-    read_band(j_lo, band_hi[bb], j_own);
+    // The next band is read on its own thread while the workers convert this one (netCDF is
+    // called from that thread alone): the reads no longer leave a core idle.
+    if (b == 0) read_band(*slab_now, j_lo, band_hi[bb], j_own);
+    std::thread reader;
+    std::exception_ptr read_error;
+    struct JoinAtExit {  // so that an error below never leaves the reading thread running
+      std::thread& t;
+      ~JoinAtExit() {
+        if (t.joinable()) t.join();
+      }
+    } join_reader{reader};
+    if (b + 1 < bands) {
+      const int n_lo = S.lat_lo + (b + 1) * kBandRows, n_own = std::min(S.lat_hi, n_lo + kBandRows - 1), n_hi = band_hi[bb + 1];
+      reader = std::thread([&, n_lo, n_own, n_hi] {
+        try {
+          read_band(*slab_next, n_lo, n_hi, n_own);
+        } catch (...) {
+          read_error = std::current_exception();
+        }
+      });
+    }
     const std::vector<int>& rows = band_rows[bb];
     auto run = [&](int wid) {
       RowWork& W = work[static_cast<std::size_t>(wid)];
@@ -726,9 +750,12 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     for (int wid = 1; wid < workers && static_cast<std::size_t>(wid) < rows.size(); ++wid) threads.emplace_back(run, wid);
     run(0);
     for (auto& th : threads) th.join();
+    if (reader.joinable()) reader.join();
     for (auto& W : work) {
       if (W.error) std::rethrow_exception(W.error);
     }
+    if (read_error) std::rethrow_exception(read_error);
+    std::swap(slab_now, slab_next);
   }
   std::size_t negative_water = 0, clamped_cf = 0;
   double worst_negative = 0.0;
