@@ -270,11 +270,6 @@ struct RoleRow {
 
 }  // namespace
 
-double ice_effective_radius_um(double temperature_k) {
-  const double t_c = temperature_k - 273.15;
-  return std::clamp(50.0 + 0.5 * t_c, 20.0, 50.0);
-}
-
 double isa_altitude_m(double p_pa) {
   constexpr double p0 = 101325.0, t0 = 288.15, lapse = 0.0065, p11 = 22632.06, t11 = 216.65;
   if (p_pa >= p11) return t0 / lapse * (1.0 - std::pow(p_pa / p0, kRd * lapse / kG0));

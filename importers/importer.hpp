@@ -57,8 +57,12 @@ std::string describe_file(const std::string& path, const ImportOptions& options 
 core::CloudVolume import_file(const std::string& path, const ImportOptions& options = {});
 
 // Effective radius of ice crystals (um) used when none is set: grows from 20 um at -60 C to 50 um
-// at 0 C, clamped to 20..50 um outside.
-double ice_effective_radius_um(double temperature_k);
+// at 0 C, clamped to 20..50 um outside. Inline, so the conversion's loops over a row vectorize.
+inline double ice_effective_radius_um(double temperature_k) {
+  const double r = 50.0 + 0.5 * (temperature_k - 273.15);
+  const double above = r < 20.0 ? 20.0 : r;  // std::clamp's result, NaN included, as two selects
+  return 50.0 < above ? 50.0 : above;
+}
 
 // International Standard Atmosphere altitude (m) of a pressure (Pa), troposphere and lower stratosphere.
 double isa_altitude_m(double pressure_pa);

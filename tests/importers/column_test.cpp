@@ -139,3 +139,74 @@ TEST(PlaceRow, EveryNodeIsTheFormulasOnRunsOfEveryLength) {
 }
 
 }  // namespace
+
+// Ice extinction takes the effective radius of its box's temperature (20 um at -60 C and below, 50
+// um at 0 C and above, linear between) or the radius the options fix, on a row whose length leaves
+// a remainder after the vector path's blocks of four; boxes with water but no fraction keep none.
+TEST(PlaceRow, IceExtinctionTakesTheRadiusOfItsBoxesTemperature) {
+  constexpr int kCols = 45, kLev = 3;
+  RowLevels r;
+  r.resize(kCols, kLev);
+  for (int l = 0; l < kLev; ++l) {
+    for (int x = 0; x < kCols; ++x) {
+      const std::size_t i = r.at(l, x);
+      r.z_m[i] = 1000.0 * l;
+      r.p_pa[i] = 90000.0 - 20000.0 * l;
+      r.t_k[i] = 190.0 + 2.5 * x + 3.0 * l;  // 190 to 306 K: both ends of the clamp and the ramp
+      r.qv[i] = 0.0005;
+      const double f[] = {0.6, 1.0, kNaN, 5e-5, 0.25};
+      r.cf[i] = f[(x + l) % 5];
+      const double q[] = {3e-5, kNaN, 1e-4, 0.0, 7e-6, 2e-4};
+      r.q_ice[i] = q[(2 * x + l) % 6];
+      r.q_liquid[i] = kNaN, r.u[i] = kNaN, r.v[i] = kNaN, r.w[i] = kNaN;
+    }
+  }
+  core::VolumeGrid grid;
+  grid.lon_deg = {0.0, 1.0, kCols};
+  grid.lat_deg = {10.0, 1.0, 1};
+  grid.alt_m = {0.0, 1000.0, kLev};  // a node on every level
+  for (const double fixed_um : {0.0, 30.0}) {
+    core::TimeStepData out;
+    for (core::Field f : {core::Field::ExtinctionIce, core::Field::CloudFraction}) out[f].assign(grid.points(), -1.0f);
+    importers::ColumnCounts counts;
+    importers::ConversionOptions options;
+    options.r_eff_ice_um = fixed_um;
+    importers::place_row(r, grid, 0, 0, options, out, counts);
+    std::size_t checked = 0, dropped = 0, clamped_low = 0, clamped_high = 0, in_cloud = 0;
+    auto box = [&](int l, int x) {  // the box extinction of the mean ice, by the formula
+      const std::size_t i = r.at(l, x);
+      const double q = r.q_ice[i], cf = r.cf[i], t = r.t_k[i];
+      if (std::isnan(q)) return kNaN;
+      if (!std::isnan(cf) && q > 0.0 && cf < importers::kZeroCloudFraction) return 0.0;
+      const double radius_um = fixed_um > 0 ? fixed_um : std::min(50.0, std::max(20.0, 50.0 + 0.5 * (t - 273.15)));
+      const double rho = r.p_pa[i] / (287.05 * t * (1.0 + 0.608 * r.qv[i]));
+      return 3.0 * rho * q / (2.0 * 917.0 * radius_um * 1e-6);
+    };
+    for (int l = 0; l < kLev; ++l) {
+      for (int x = 0; x < kCols; ++x) {
+        const std::size_t i = r.at(l, x);
+        const double t = r.t_k[i];
+        clamped_low += t < 213.15 ? 1 : 0;
+        clamped_high += t > 273.15 ? 1 : 0;
+        if (!std::isnan(r.cf[i]) && r.q_ice[i] > 0.0 && r.cf[i] < importers::kZeroCloudFraction) ++dropped;
+        // The node on level l lies at the bottom of the pair (0, 1), or at the top of (l - 1, l).
+        const int l0 = l == 0 ? 0 : l - 1, l1 = l == 0 ? 1 : l;
+        const double a = l == 0 ? 0.0 : 1.0;
+        const double e0 = box(l0, x), e = e0 + a * (box(l1, x) - e0);
+        const double c0 = r.cf[r.at(l0, x)], cf = c0 + a * (r.cf[r.at(l1, x)] - c0);
+        double want = e;
+        if (!std::isnan(cf)) want = e > 0.0 && cf > 0.0 ? e / cf : (std::isnan(e) ? e : 0.0);
+        in_cloud += want > 0.0 ? 1 : 0;
+        const float got = out[core::Field::ExtinctionIce][grid.index(x, 0, l)];
+        EXPECT_TRUE(same(got, want, 1e-6)) << "r_eff " << fixed_um << " x " << x << " level " << l << ": " << got << " against " << want;
+        ++checked;
+      }
+    }
+    EXPECT_GT(in_cloud, 40u);
+    EXPECT_EQ(checked, static_cast<std::size_t>(kCols * kLev));
+    EXPECT_GT(dropped, 0u);
+    EXPECT_EQ(counts.water_without_cf, dropped);
+    EXPECT_GT(clamped_low, 5u);
+    EXPECT_GT(clamped_high, 5u);
+  }
+}
