@@ -379,6 +379,7 @@ Slab read_slab(const Era5Source& S, const NcVar& v, int time_index, UnpackInfo* 
 // integration up each column, its consistency counts, and the error that stopped it, if any.
 struct RowWork {
   RowLevels levels;  // the row's level samples, level-major
+  PlaceRowScratch place;  // place_row's working arrays: the workers' threads are new for every band
   StoredStats stored;  // ranges of the values the row's conversion stored
   std::vector<double> z_prev, p_prev, tv_prev;
   // Per column of the row: the surface geopotential height and geometric altitude, and the surface
@@ -677,7 +678,7 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
         out.ground_m[grid.column(x, y)] = static_cast<float>(zg);
       }
     }
-    place_row(W.levels, grid, 0, y, conv, out, W.counts, &W.stored);
+    place_row(W.levels, grid, 0, y, conv, out, W.counts, &W.stored, W.place);
     };
   const unsigned hw = core::worker_count();  // the machine's cores, or CLOUDVIEWER_THREADS
   const int workers = static_cast<int>(std::min<unsigned>(std::min(hw, 8u), static_cast<unsigned>(std::max(1, ny / 4))));
@@ -742,6 +743,14 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
       }
     };
     std::vector<std::thread> threads;
+    struct JoinAllAtExit {  // a thread that cannot be started must not leave the others running
+      std::vector<std::thread>& ts;
+      ~JoinAllAtExit() {
+        for (auto& th : ts) {
+          if (th.joinable()) th.join();
+        }
+      }
+    } join_workers{threads};
     for (int wid = 1; wid < workers && static_cast<std::size_t>(wid) < rows.size(); ++wid) threads.emplace_back(run, wid);
     run(0);
     for (auto& th : threads) th.join();

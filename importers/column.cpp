@@ -51,13 +51,6 @@ void RowLevels::resize(int columns, int levels) {
 }
 
 namespace {
-// A run of a layer's nodes that lie between the same pair of levels (lev: the upper level, -1
-// where the nodes have none: NaN). Neighbouring columns' levels differ little in height, so a
-// layer holds few runs, and within one the two levels' values are contiguous in the row's arrays.
-struct LevelRun {
-  int begin, end, lev;
-};
-
 // One node's value, linear between its level pair (q0, q1 at weight a), as the field needs: the
 // in-cloud value (the grid-box mean over the interpolated fraction, from c0, c1) or the value itself.
 template <bool kInCloud>
@@ -215,6 +208,12 @@ void interpolate_nodes(const LevelRun* run, const LevelRun* runs_end, const doub
 
 void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, const ConversionOptions& options,
                core::TimeStepData& out, ColumnCounts& counts, StoredStats* stored) {
+  thread_local PlaceRowScratch scratch;
+  place_row(r, grid, x0, y, options, out, counts, stored, scratch);
+}
+
+void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, const ConversionOptions& options,
+               core::TimeStepData& out, ColumnCounts& counts, StoredStats* stored, PlaceRowScratch& scratch) {
   const int n = r.nlev, nx = r.nx, nz = grid.alt_m.count;
   const std::size_t plane = static_cast<std::size_t>(n) * static_cast<std::size_t>(nx);
   // Per level and column, level-major like `r`: the quantities the conversion makes (the two
@@ -223,7 +222,7 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
   // they are.
   constexpr int kLiq = static_cast<int>(core::Field::ExtinctionLiquid), kIce = static_cast<int>(core::Field::ExtinctionIce),
                 kCf = static_cast<int>(core::Field::CloudFraction), kP = static_cast<int>(core::Field::Pressure);
-  thread_local std::vector<double> buffer;
+  std::vector<double>& buffer = scratch.buffer;
   buffer.resize(3 * plane);
   std::array<const double*, core::kFieldCount> source{};
   source[kLiq] = buffer.data(), source[kIce] = buffer.data() + plane, source[kP] = buffer.data() + 2 * plane;
@@ -274,8 +273,8 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
   // micrometre of the top level (the axis was fitted to end there) takes the top level's value.
   // First each node's level pair and weight (node-major, like the output's layers), then field by
   // field, node by node, along the row.
-  thread_local std::vector<int> node_level;
-  thread_local std::vector<double> node_weight;
+  std::vector<int>& node_level = scratch.node_level;
+  std::vector<double>& node_weight = scratch.node_weight;
   const std::size_t nodes = static_cast<std::size_t>(nz) * static_cast<std::size_t>(nx);
   node_level.assign(nodes, -1);
   node_weight.resize(nodes);
@@ -297,8 +296,8 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
   }
   const std::size_t nxs = static_cast<std::size_t>(nx);
   // Each layer's runs of nodes between the same level pair, shared by every field.
-  thread_local std::vector<LevelRun> runs;
-  thread_local std::vector<std::size_t> layer_runs;
+  std::vector<LevelRun>& runs = scratch.runs;
+  std::vector<std::size_t>& layer_runs = scratch.layer_runs;
   runs.clear();
   layer_runs.assign(static_cast<std::size_t>(nz) + 1, 0);
   for (int z = 0; z < nz; ++z) {
@@ -314,7 +313,7 @@ void place_row(const RowLevels& r, const core::VolumeGrid& grid, int x0, int y, 
   const double* qcf = source[kCf];
   // A field held as half floats (TimeStepData::halves): each layer row is made in floats here, in
   // cache, and stored converted, as write_cvvol would convert the float field.
-  thread_local std::vector<float> layer;
+  std::vector<float>& layer = scratch.layer;
   layer.resize(nxs);
   for (int f = 0; f < core::kFieldCount; ++f) {
     auto& dst = out.fields[static_cast<std::size_t>(f)];

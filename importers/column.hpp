@@ -68,10 +68,31 @@ struct RowLevels {
 // the volume.
 using StoredStats = std::array<core::ValueStats, core::kFieldCount>;
 
+// A run of a layer's nodes that lie between the same pair of levels (lev: the upper level, -1
+// where the nodes have none: NaN). Neighbouring columns' levels differ little in height, so a
+// layer holds few runs, and within one the two levels' values are contiguous in the row's arrays.
+struct LevelRun {
+  int begin, end, lev;
+};
+
+// place_row's working arrays (a row's extinctions, its nodes' level pairs and weights, the runs, a
+// layer row), kept by a caller that converts rows on threads of its own so that their pages are
+// faulted in once, not once per thread.
+struct PlaceRowScratch {
+  std::vector<double> buffer, node_weight;
+  std::vector<int> node_level;
+  std::vector<LevelRun> runs;
+  std::vector<std::size_t> layer_runs;
+  std::vector<float> layer;
+};
+
 // Converts a row's levels and interpolates them linearly in altitude into columns x0 .. x0 + nx - 1
-// of row y of `out` (below). Adds to `stored` when given.
+// of row y of `out` (below). Adds to `stored` when given. The first form keeps its working arrays
+// per thread.
 void place_row(const RowLevels& levels, const core::VolumeGrid& grid, int x0, int y, const ConversionOptions& options,
                core::TimeStepData& out, ColumnCounts& counts, StoredStats* stored = nullptr);
+void place_row(const RowLevels& levels, const core::VolumeGrid& grid, int x0, int y, const ConversionOptions& options,
+               core::TimeStepData& out, ColumnCounts& counts, StoredStats* stored, PlaceRowScratch& scratch);
 
 // Converts the levels and interpolates them linearly in altitude into column (x, y) of `out`, whose
 // fields were allocated by the caller (absent fields stay empty). Outside the column's levels,

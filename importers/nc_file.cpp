@@ -871,7 +871,7 @@ bool NcFile::any_at_least(const NcVar& v, std::vector<std::size_t> start, std::v
   whole_if_empty(v, start, count);
   const UnpackRules rules = unpack_rules(v);
   if (isolated_ || v.type != NC_SHORT || !rules.approx.empty() || rules.exact.size() > 2) {
-    thread_local std::vector<float> values;
+    std::vector<float>& values = floats_;
     read_float_into(values, v, std::move(start), std::move(count));
     for (float x : values) {
       if (x >= threshold) return true;
@@ -896,7 +896,7 @@ bool NcFile::any_at_least(const NcVar& v, std::vector<std::size_t> start, std::v
     return false;
   }
   const std::size_t m = checked_read_count(v, start, count);
-  thread_local std::vector<std::int16_t> raw;
+  std::vector<std::int16_t>& raw = shorts_;
   core::reserve_exact(raw, m);
   raw.resize(m);
   if (m) {
@@ -919,15 +919,15 @@ void NcFile::read_float_into(std::vector<float>& out, const NcVar& v, std::vecto
   // double, the unpacking pass in double, and a netCDF call per level were most of a read.
   const UnpackRules rules = unpack_rules(v);
   const bool short_path = !isolated_ && v.type == NC_SHORT && rules.approx.empty() && rules.exact.size() <= 2;
-  thread_local std::vector<std::int16_t> raw;
+  std::vector<std::int16_t>& raw = shorts_;
   // Else split along the first axis with more than one index; each chunk goes through read_into().
   std::size_t axis = 0;
   while (axis + 1 < nd && count[axis] == 1) ++axis;
   UnpackInfo total;
   const std::size_t chunks = short_path || !nd ? 1 : count[axis];
-  // One chunk's doubles, reused from chunk to chunk (and call to call on this thread), written into
+  // One chunk's doubles, reused from chunk to chunk (and call to call), written into
   // `out` in place: `out` keeps its memory when the caller reuses it.
-  thread_local std::vector<double> d;
+  std::vector<double>& d = doubles_;
   std::size_t filled = 0;
   for (std::size_t c = 0; c < chunks; ++c) {
     std::vector<std::size_t> s = start, n = count;

@@ -128,6 +128,12 @@ class NcFile {
   bool isolated_ = false;        // read through the reader process
   mutable int sock_ = -1;        // the reader's socket; -1 once it is gone
   mutable int reader_pid_ = -1;
+  // The reads' buffers, reused from call to call (their pages faulted in once): members rather
+  // than thread_local, since a file is read from one thread at a time but not always the same one
+  // (the CF import reads each band on a thread of its own).
+  mutable std::vector<std::int16_t> shorts_;
+  mutable std::vector<double> doubles_;
+  mutable std::vector<float> floats_;
   std::vector<NcDim> dims_;
   std::vector<NcVar> vars_;
   std::vector<NcAtt> global_atts_;
