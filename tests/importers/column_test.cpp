@@ -141,8 +141,10 @@ TEST(PlaceRow, EveryNodeIsTheFormulasOnRunsOfEveryLength) {
 }  // namespace
 
 // Ice extinction takes the effective radius of its box's temperature (20 um at -60 C and below, 50
-// um at 0 C and above, linear between) or the radius the options fix, on a row whose length leaves
-// a remainder after the vector path's blocks of four; boxes with water but no fraction keep none.
+// um at 0 C and above, linear between) or the radius the options fix, and liquid the droplets'
+// radius, on a row whose 135 level samples leave three after the vector path's blocks of four
+// (those three set apart: missing ice, a box with water but no fraction, a missing fraction with
+// a temperature on the radius's ramp); boxes with water but no fraction keep none.
 TEST(PlaceRow, IceExtinctionTakesTheRadiusOfItsBoxesTemperature) {
   constexpr int kCols = 45, kLev = 3;
   RowLevels r;
@@ -158,29 +160,46 @@ TEST(PlaceRow, IceExtinctionTakesTheRadiusOfItsBoxesTemperature) {
       r.cf[i] = f[(x + l) % 5];
       const double q[] = {3e-5, kNaN, 1e-4, 0.0, 7e-6, 2e-4};
       r.q_ice[i] = q[(2 * x + l) % 6];
-      r.q_liquid[i] = kNaN, r.u[i] = kNaN, r.v[i] = kNaN, r.w[i] = kNaN;
+      const double ql[] = {1e-4, 0.0, 4e-5, kNaN, 2e-5, 3e-4, 6e-6};
+      r.q_liquid[i] = ql[(x + 2 * l) % 7];
+      r.u[i] = kNaN, r.v[i] = kNaN, r.w[i] = kNaN;
     }
   }
+  // The scalar remainder: the last three samples (top level, columns 42-44), and below them
+  // water and a fraction, so the nodes on the top level take these samples' values.
+  for (int x = 42; x < kCols; ++x) {
+    const std::size_t below = r.at(1, x), top = r.at(2, x);
+    r.q_ice[below] = 5e-5, r.q_liquid[below] = 5e-5, r.cf[below] = 0.8;
+    r.q_liquid[top] = 1e-4;
+  }
+  r.q_ice[r.at(2, 42)] = kNaN, r.cf[r.at(2, 42)] = 0.5, r.t_k[r.at(2, 42)] = 200.0;  // missing ice (liquid kept)
+  r.q_ice[r.at(2, 43)] = 3e-5, r.cf[r.at(2, 43)] = 5e-5, r.t_k[r.at(2, 43)] = 300.0;  // water, no fraction: none kept
+  r.q_ice[r.at(2, 44)] = 3e-5, r.cf[r.at(2, 44)] = kNaN, r.t_k[r.at(2, 44)] = 250.0;  // no fraction value; on the ramp
   core::VolumeGrid grid;
   grid.lon_deg = {0.0, 1.0, kCols};
   grid.lat_deg = {10.0, 1.0, 1};
   grid.alt_m = {0.0, 1000.0, kLev};  // a node on every level
   for (const double fixed_um : {0.0, 30.0}) {
     core::TimeStepData out;
-    for (core::Field f : {core::Field::ExtinctionIce, core::Field::CloudFraction}) out[f].assign(grid.points(), -1.0f);
+    for (core::Field f : {core::Field::ExtinctionIce, core::Field::ExtinctionLiquid, core::Field::CloudFraction}) {
+      out[f].assign(grid.points(), -1.0f);
+    }
     importers::ColumnCounts counts;
     importers::ConversionOptions options;
     options.r_eff_ice_um = fixed_um;
     importers::place_row(r, grid, 0, 0, options, out, counts);
     std::size_t checked = 0, dropped = 0, clamped_low = 0, clamped_high = 0, in_cloud = 0;
-    auto box = [&](int l, int x) {  // the box extinction of the mean ice, by the formula
+    // The box extinction of the mean ice (or liquid), by the formula; none where the box's water
+    // (ice and liquid together) has no fraction to hold it.
+    auto box = [&](int l, int x, bool ice) {
       const std::size_t i = r.at(l, x);
-      const double q = r.q_ice[i], cf = r.cf[i], t = r.t_k[i];
+      const double q = ice ? r.q_ice[i] : r.q_liquid[i], cf = r.cf[i], t = r.t_k[i];
       if (std::isnan(q)) return kNaN;
-      if (!std::isnan(cf) && q > 0.0 && cf < importers::kZeroCloudFraction) return 0.0;
-      const double radius_um = fixed_um > 0 ? fixed_um : std::min(50.0, std::max(20.0, 50.0 + 0.5 * (t - 273.15)));
+      const double total = (std::isnan(r.q_ice[i]) ? 0.0 : r.q_ice[i]) + (std::isnan(r.q_liquid[i]) ? 0.0 : r.q_liquid[i]);
+      if (!std::isnan(cf) && total > 0.0 && cf < importers::kZeroCloudFraction) return 0.0;
+      const double radius_um = !ice ? 10.0 : fixed_um > 0 ? fixed_um : std::min(50.0, std::max(20.0, 50.0 + 0.5 * (t - 273.15)));
       const double rho = r.p_pa[i] / (287.05 * t * (1.0 + 0.608 * r.qv[i]));
-      return 3.0 * rho * q / (2.0 * 917.0 * radius_um * 1e-6);
+      return 3.0 * rho * q / (2.0 * (ice ? 917.0 : 1000.0) * radius_um * 1e-6);
     };
     for (int l = 0; l < kLev; ++l) {
       for (int x = 0; x < kCols; ++x) {
@@ -188,22 +207,31 @@ TEST(PlaceRow, IceExtinctionTakesTheRadiusOfItsBoxesTemperature) {
         const double t = r.t_k[i];
         clamped_low += t < 213.15 ? 1 : 0;
         clamped_high += t > 273.15 ? 1 : 0;
-        if (!std::isnan(r.cf[i]) && r.q_ice[i] > 0.0 && r.cf[i] < importers::kZeroCloudFraction) ++dropped;
+        const double total = (std::isnan(r.q_ice[i]) ? 0.0 : r.q_ice[i]) + (std::isnan(r.q_liquid[i]) ? 0.0 : r.q_liquid[i]);
+        if (!std::isnan(r.cf[i]) && total > 0.0 && r.cf[i] < importers::kZeroCloudFraction) ++dropped;
         // The node on level l lies at the bottom of the pair (0, 1), or at the top of (l - 1, l).
         const int l0 = l == 0 ? 0 : l - 1, l1 = l == 0 ? 1 : l;
         const double a = l == 0 ? 0.0 : 1.0;
-        const double e0 = box(l0, x), e = e0 + a * (box(l1, x) - e0);
         const double c0 = r.cf[r.at(l0, x)], cf = c0 + a * (r.cf[r.at(l1, x)] - c0);
-        double want = e;
-        if (!std::isnan(cf)) want = e > 0.0 && cf > 0.0 ? e / cf : (std::isnan(e) ? e : 0.0);
-        in_cloud += want > 0.0 ? 1 : 0;
-        const float got = out[core::Field::ExtinctionIce][grid.index(x, 0, l)];
-        EXPECT_TRUE(same(got, want, 1e-6)) << "r_eff " << fixed_um << " x " << x << " level " << l << ": " << got << " against " << want;
-        ++checked;
+        for (const bool ice : {true, false}) {
+          const double e0 = box(l0, x, ice), e = e0 + a * (box(l1, x, ice) - e0);
+          double want = e;
+          if (!std::isnan(cf)) want = e > 0.0 && cf > 0.0 ? e / cf : (std::isnan(e) ? e : 0.0);
+          in_cloud += want > 0.0 ? 1 : 0;
+          const float got = out[ice ? core::Field::ExtinctionIce : core::Field::ExtinctionLiquid][grid.index(x, 0, l)];
+          EXPECT_TRUE(same(got, want, 1e-6)) << (ice ? "ice" : "liquid") << ", r_eff " << fixed_um << " x " << x << " level " << l
+                                             << ": " << got << " against " << want;
+          ++checked;
+        }
       }
     }
-    EXPECT_GT(in_cloud, 40u);
-    EXPECT_EQ(checked, static_cast<std::size_t>(kCols * kLev));
+    EXPECT_GT(in_cloud, 80u);
+    // The three samples of the scalar remainder reached the nodes on the top level as set.
+    EXPECT_TRUE(std::isnan(out[core::Field::ExtinctionIce][grid.index(42, 0, 2)]));
+    EXPECT_GT(out[core::Field::ExtinctionLiquid][grid.index(42, 0, 2)], 0.0f);
+    EXPECT_EQ(out[core::Field::ExtinctionIce][grid.index(43, 0, 2)], 0.0f);
+    EXPECT_GT(out[core::Field::ExtinctionIce][grid.index(44, 0, 2)], 0.0f);
+    EXPECT_EQ(checked, static_cast<std::size_t>(2 * kCols * kLev));
     EXPECT_GT(dropped, 0u);
     EXPECT_EQ(counts.water_without_cf, dropped);
     EXPECT_GT(clamped_low, 5u);
