@@ -429,26 +429,23 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
       auto& use = report.use(role_name(static_cast<Role>(r)));
       // The owned rows, level by level (a row's longitudes are contiguous in the usual layout).
       // On the reading thread alone: the cores are converting the band before this one.
-      const int nlon = S.lon_hi - S.lon_lo + 1, nk = sl.s_lev ? S.lev_hi - S.lev_lo + 1 : 1;
-      std::vector<core::ValueStats> part(core::worker_count());
-      const unsigned parts = core::parallel_ranges(static_cast<std::size_t>(nk), nk + 1, [&](std::size_t k0, std::size_t k1, unsigned p) {
-        core::ValueStats& st = part[p];
-        for (std::size_t k = k0; k < k1; ++k) {
-          for (int j = j_lo; j <= j_own; ++j) {
-            const std::size_t base = static_cast<std::size_t>(j - sl.j_off) * sl.s_lat + k * sl.s_lev;
-            if (sl.s_lon == 1) {
-              if (!sl.f.empty()) st.add_all(sl.f.data() + base, static_cast<std::size_t>(nlon));
-              if (!sl.d.empty()) st.add_all(sl.d.data() + base, static_cast<std::size_t>(nlon));
-            } else {
-              for (int i = 0; i < nlon; ++i) {
-                const std::size_t at = base + static_cast<std::size_t>(i) * sl.s_lon;
-                st.add(sl.f.empty() ? sl.d[at] : static_cast<double>(sl.f[at]));
-              }
+      const std::size_t nlon = static_cast<std::size_t>(S.lon_hi - S.lon_lo + 1), nk = sl.s_lev ? static_cast<std::size_t>(S.lev_hi - S.lev_lo + 1) : 1;
+      core::ValueStats st;
+      for (std::size_t k = 0; k < nk; ++k) {
+        for (int j = j_lo; j <= j_own; ++j) {
+          const std::size_t base = static_cast<std::size_t>(j - sl.j_off) * sl.s_lat + k * sl.s_lev;
+          if (sl.s_lon == 1) {
+            if (!sl.f.empty()) st.add_all(sl.f.data() + base, nlon);
+            if (!sl.d.empty()) st.add_all(sl.d.data() + base, nlon);
+          } else {
+            for (std::size_t i = 0; i < nlon; ++i) {
+              const std::size_t at = base + i * sl.s_lon;
+              st.add(sl.f.empty() ? sl.d[at] : static_cast<double>(sl.f[at]));
             }
           }
         }
-      });
-      for (unsigned p = 0; p < parts; ++p) use.before.merge(part[p]);
+      }
+      use.before.merge(st);
       if (first_band && info.packed && use.conversion.empty()) {
         use.conversion = "unpacked x * " + fmt(info.scale) + " + " + fmt(info.offset) + "; ";
       }
