@@ -2,6 +2,7 @@
 // and uneven latitudes, subsetting), heights from geopotential, the physics of the conversion, and
 // the consistency checks of the import report.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
@@ -10,6 +11,9 @@
 #include <numeric>
 #include <optional>
 #include <thread>
+
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include "checks.hpp"
 #include "cf_layout.hpp"
@@ -304,9 +308,98 @@ struct Era5Source {
   mutable std::vector<Slab> scratch = std::vector<Slab>(kRoleCount);
   // The next band's slabs, read while the workers convert the band in `scratch`.
   mutable std::vector<Slab> scratch_next = std::vector<Slab>(kRoleCount);
+  // The first step's half-float arrays with part of their pages already touched (FirstStepPages),
+  // taken by the first load; empty after it, or when there are none.
+  mutable std::array<core::HalfBuffer, core::kFieldCount> first_halves;
 };
 
 namespace {
+
+// The first step's half-float arrays, their pages first touched on a core that is otherwise idle
+// while the file is opened (the level scan and the altitude probe read the file from one thread).
+//
+// Why: on the team's VM (one that hands freed memory back to its host) the first write to each
+// fresh page is slow, 1.5 ms per MB or more whether or not the kernel populated it first, so a
+// global step's 670 MB of half floats cost its first load about a second more than the later
+// loads, which reuse them (docs/BENCHMARKS.md). Touching them here takes part of that off the
+// import's path, on the core the open leaves free; on other machines the same holds for the
+// ordinary page faults, a few tenths of a second for a global step.
+//
+// The grid's level count is known only at the end of the open, so the arrays are reserved for
+// an upper bound and their planes (one level of one field) touched bottom up until finish() says
+// how many there are; pages touched beyond them are given back.
+class FirstStepPages {
+ public:
+  // `fields`: the fields the step will hold as half floats; `plane`: values per level; at most
+  // `max_planes` levels are reserved and touched.
+  FirstStepPages(const std::vector<int>& fields, std::size_t plane, std::size_t max_planes)
+      : fields_(fields), plane_(plane), max_planes_(max_planes) {
+    if (fields_.empty() || plane_ == 0 || max_planes_ == 0) return;
+    for (int f : fields_) buffers_[static_cast<std::size_t>(f)].resize(plane_ * max_planes_);  // reserved, not written
+    thread_ = std::thread([this] { touch(); });
+  }
+  ~FirstStepPages() { stop(); }
+  FirstStepPages(const FirstStepPages&) = delete;
+  FirstStepPages& operator=(const FirstStepPages&) = delete;
+
+  // Stops the touching and, when the step's `planes` levels fit, moves the arrays into `into`
+  // (sized for them); otherwise they are dropped and the step makes its own.
+  void finish(std::size_t planes, std::array<core::HalfBuffer, core::kFieldCount>& into) {
+    stop();
+    if (planes > max_planes_) return;
+    const long page_size = ::sysconf(_SC_PAGESIZE);
+    for (int f : fields_) {
+      core::HalfBuffer& b = buffers_[static_cast<std::size_t>(f)];
+      if (b.empty()) continue;
+      // The whole pages past the step's values that were touched: handed back to the system.
+      const std::uintptr_t used = reinterpret_cast<std::uintptr_t>(b.data() + plane_ * planes);
+      const std::uintptr_t reached = reinterpret_cast<std::uintptr_t>(b.data() + plane_ * std::max(planes, touched_));
+      if (page_size > 0) {
+        const std::uintptr_t page = static_cast<std::uintptr_t>(page_size);
+        const std::uintptr_t lo = (used + page - 1) / page * page, hi = reached / page * page;
+        if (hi > lo) (void)::madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_DONTNEED);
+      }
+      // The planes not reached are faulted in as a fresh step's are (the first write then costs what
+      // it would have).
+      if (planes > touched_) core::populate_pages(b.data() + plane_ * touched_, plane_ * (planes - touched_) * sizeof(std::uint16_t));
+      b.resize(plane_ * planes);  // smaller: the capacity (and the touched pages) stay
+      into[static_cast<std::size_t>(f)] = std::move(b);
+    }
+  }
+
+ private:
+  void stop() {
+    stop_.store(true);
+    if (thread_.joinable()) thread_.join();
+  }
+  void touch() {
+    const std::size_t page = 4096;  // at most the page size: every page is written at least once
+    for (std::size_t z = 0; z < max_planes_; ++z) {
+      for (int f : fields_) {
+        if (stop_.load(std::memory_order_relaxed)) return;
+        std::uint16_t* p = buffers_[static_cast<std::size_t>(f)].data() + plane_ * z;
+        volatile unsigned char* c = reinterpret_cast<unsigned char*>(p);
+        const std::size_t bytes = plane_ * sizeof(std::uint16_t);
+        // Faulted in as one range first (one fault per page costs far more on this VM), then written.
+        const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(p) + page - 1) / page * page;
+        const std::uintptr_t hi = (reinterpret_cast<std::uintptr_t>(p) + bytes) / page * page;
+#ifdef MADV_POPULATE_WRITE
+        if (hi > lo) (void)::madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_POPULATE_WRITE);
+#endif
+        for (std::size_t at = 0; at < bytes; at += page) c[at] = 0;
+        c[bytes - 1] = 0;
+      }
+      touched_ = z + 1;  // read after the join
+    }
+  }
+
+  std::vector<int> fields_;
+  std::size_t plane_, max_planes_;
+  std::array<core::HalfBuffer, core::kFieldCount> buffers_;
+  std::size_t touched_ = 0;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
 
 // Reads into `s`, reusing its memory: the region's rows, or rows j_lo .. j_hi of the file when
 // given (j_lo >= 0).
@@ -480,6 +573,10 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
     if (on && S.options.half_fields) {
       out[f].clear();
       out[f].shrink_to_fit();
+      // The first step takes the arrays whose pages were touched while the file was opened.
+      auto& first = S.first_halves[static_cast<std::size_t>(f)];
+      if (halves.capacity() < grid.points() && first.capacity() >= grid.points()) halves.swap(first);
+      core::HalfBuffer().swap(first);
       const bool fresh = halves.capacity() < grid.points();
       core::reserve_exact(halves, grid.points());
       if (fresh) core::populate_pages(halves.data(), grid.points() * sizeof(std::uint16_t));
@@ -965,6 +1062,31 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
                       (nt ? ", from " + L.times.front().iso_utc + " to " + L.times.back().iso_utc : std::string()));
   }
   for (int t : S->steps) vol.times.push_back(L.times[static_cast<std::size_t>(t)]);
+  // The fields a step holds (load_era5_step's allocations follow the same roles).
+  vol.has_field[static_cast<int>(core::Field::ExtinctionLiquid)] = L.roles[static_cast<int>(Role::Liquid)] != nullptr || S->diagnose;
+  vol.has_field[static_cast<int>(core::Field::ExtinctionIce)] =
+      L.roles[static_cast<int>(Role::Ice)] != nullptr || L.roles[static_cast<int>(Role::Snow)] != nullptr || S->diagnose;
+  vol.has_field[static_cast<int>(core::Field::CloudFraction)] = L.roles[static_cast<int>(Role::CloudFraction)] != nullptr || S->diagnose;
+  vol.has_field[static_cast<int>(core::Field::WindU)] = L.roles[static_cast<int>(Role::U)] != nullptr;
+  vol.has_field[static_cast<int>(core::Field::WindV)] = L.roles[static_cast<int>(Role::V)] != nullptr;
+  vol.has_field[static_cast<int>(core::Field::WindW)] =
+      L.roles[static_cast<int>(Role::Omega)] != nullptr || L.roles[static_cast<int>(Role::UpwardVelocity)] != nullptr;
+  vol.has_field[static_cast<int>(core::Field::Temperature)] = true;
+  vol.has_field[static_cast<int>(core::Field::Pressure)] = L.vertical_kind != Vertical::Height;
+  // The first step's half floats get their pages touched on the second core while the rest of the
+  // open reads the file on this one: for up to two grid levels per source level (the automatic
+  // spacing is half the median level thickness), never more than a volume the import accepts.
+  std::optional<FirstStepPages> first_pages;
+  if (options.half_fields && core::worker_count() >= 2) {
+    std::vector<int> fields;
+    for (int i = 0; i < core::kFieldCount; ++i) {
+      if (vol.has_field[static_cast<std::size_t>(i)]) fields.push_back(i);
+    }
+    const std::size_t plane = vol.grid.columns();
+    const double accepted = options.max_volume_bytes / (static_cast<double>(plane) * core::kFieldCount * sizeof(float));
+    const std::size_t planes = static_cast<std::size_t>(std::min(2.0 * static_cast<double>(S->levels.size()) + 2.0, std::floor(accepted)));
+    first_pages.emplace(fields, plane, planes);
+  }
   if (L.times_uneven) vol.report.warn("time steps are unevenly spaced");
   if (!has_geo && L.vertical_kind == Vertical::Pressure) {
     vol.report.warn("no geopotential: level heights come from the standard atmosphere (errors of a few hundred metres)");
@@ -1155,22 +1277,13 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
     throw ImportError(path + ": the volume would take " + fmt(bytes / 1e9) + " GB per time step (limit " +
                       fmt(options.max_volume_bytes / 1e9) + " GB); subset the region, levels or stride, or raise --dz");
   }
-  vol.has_field[static_cast<int>(core::Field::ExtinctionLiquid)] = L.roles[static_cast<int>(Role::Liquid)] != nullptr || S->diagnose;
-  vol.has_field[static_cast<int>(core::Field::ExtinctionIce)] =
-      L.roles[static_cast<int>(Role::Ice)] != nullptr || L.roles[static_cast<int>(Role::Snow)] != nullptr || S->diagnose;
-  vol.has_field[static_cast<int>(core::Field::CloudFraction)] = L.roles[static_cast<int>(Role::CloudFraction)] != nullptr || S->diagnose;
   vol.has_ground = L.surface_geopotential != nullptr;
   vol.report.notes.push_back(vol.has_ground ? "low/mid/high cover by height above the ground ('" + L.surface_geopotential->name + "')"
                                             : "low/mid/high cover by height above sea level (the file gives no terrain)");
-  vol.has_field[static_cast<int>(core::Field::WindU)] = L.roles[static_cast<int>(Role::U)] != nullptr;
-  vol.has_field[static_cast<int>(core::Field::WindV)] = L.roles[static_cast<int>(Role::V)] != nullptr;
-  vol.has_field[static_cast<int>(core::Field::WindW)] =
-      L.roles[static_cast<int>(Role::Omega)] != nullptr || L.roles[static_cast<int>(Role::UpwardVelocity)] != nullptr;
-  vol.has_field[static_cast<int>(core::Field::Temperature)] = true;
-  vol.has_field[static_cast<int>(core::Field::Pressure)] = L.vertical_kind != Vertical::Height;
   if (!L.roles[static_cast<int>(Role::CloudFraction)] && !S->diagnose) {
     vol.report.notes.push_back("no cloud fraction: water is taken as covering whole grid boxes");
   }
+  if (first_pages) first_pages->finish(static_cast<std::size_t>(vol.grid.alt_m.count), S->first_halves);
   const core::VolumeGrid grid = vol.grid;
   vol.set_loader([S, grid](std::size_t step, core::ImportReport& report, core::TimeStepData& out) {
     load_era5_step(*S, grid, step, report, out);

@@ -566,55 +566,66 @@ TEST_F(CfImport, HalfFieldsAreTheFloatFieldsAsTheVolumeStoresThem) {
   SynthOptions o;
   o.lats = {40, 42, 44, 46, 48, 50, 52, 54, 56};
   const std::string path = write(o);
-  importers::ImportOptions as_half;
-  as_half.half_fields = true;
-  auto f = import(path);
-  auto h = import(path, as_half);
-  ASSERT_EQ(f.times.size(), h.times.size());
-  const std::size_t n = f.grid.points();
-  int compared = 0;
-  for (std::size_t t = 0; t < f.times.size(); ++t) {
-    core::TimeStepData widened;
-    {
-      const core::TimeStepData& df = f.step(t);
-      const core::TimeStepData& dh = h.step(t);
-      for (int k = 0; k < core::kFieldCount; ++k) {
-        const auto field = static_cast<core::Field>(k);
-        const std::size_t kk = static_cast<std::size_t>(k);
-        ASSERT_EQ(f.has_field[kk], h.has_field[kk]) << core::field_name(field);
-        ASSERT_TRUE(dh.fields[kk].empty()) << core::field_name(field);
-        if (!f.has_field[kk]) {
-          EXPECT_TRUE(dh.halves[kk].empty()) << core::field_name(field);
-          continue;
+  // With the fixture's spacing, and with one fine enough that the grid has more levels than the
+  // arrays reserved for the first step while the file is opened (two per file level) can hold.
+  for (const double dz : {0.0, 50.0}) {
+    SCOPED_TRACE("dz " + std::to_string(dz));
+    importers::ImportOptions as_float, as_half;
+    as_float.dz_m = as_half.dz_m = dz;
+    as_float.keep_cloudless_levels = as_half.keep_cloudless_levels = dz > 0.0;  // the grid spans every level
+    as_half.half_fields = true;
+    auto run = [&](const importers::ImportOptions& opt) { return dz > 0.0 ? importers::import_file(path, opt) : import(path, opt); };
+    auto f = run(as_float);
+    auto h = run(as_half);
+    if (dz > 0.0) {
+      ASSERT_GT(static_cast<std::size_t>(h.grid.alt_m.count), 2 * o.levels_hpa.size() + 2);
+    }
+    ASSERT_EQ(f.times.size(), h.times.size());
+    const std::size_t n = f.grid.points();
+    int compared = 0;
+    for (std::size_t t = 0; t < f.times.size(); ++t) {
+      core::TimeStepData widened;
+      {
+        const core::TimeStepData& df = f.step(t);
+        const core::TimeStepData& dh = h.step(t);
+        for (int k = 0; k < core::kFieldCount; ++k) {
+          const auto field = static_cast<core::Field>(k);
+          const std::size_t kk = static_cast<std::size_t>(k);
+          ASSERT_EQ(f.has_field[kk], h.has_field[kk]) << core::field_name(field);
+          ASSERT_TRUE(dh.fields[kk].empty()) << core::field_name(field);
+          if (!f.has_field[kk]) {
+            EXPECT_TRUE(dh.halves[kk].empty()) << core::field_name(field);
+            continue;
+          }
+          ASSERT_EQ(df.fields[kk].size(), n);
+          ASSERT_EQ(dh.halves[kk].size(), n);
+          const float scale = core::half_field_scale(field);
+          core::HalfBuffer want(n);
+          core::floats_to_halves(df.fields[kk].data(), scale, want.data(), n);
+          EXPECT_TRUE(want == dh.halves[kk]) << core::field_name(field) << " at step " << t;
+          widened.fields[kk].resize(n);
+          core::halves_to_floats(dh.halves[kk].data(), 1.0f / scale, widened.fields[kk].data(), n);
+          ++compared;
         }
-        ASSERT_EQ(df.fields[kk].size(), n);
-        ASSERT_EQ(dh.halves[kk].size(), n);
-        const float scale = core::half_field_scale(field);
-        core::HalfBuffer want(n);
-        core::floats_to_halves(df.fields[kk].data(), scale, want.data(), n);
-        EXPECT_TRUE(want == dh.halves[kk]) << core::field_name(field) << " at step " << t;
-        widened.fields[kk].resize(n);
-        core::halves_to_floats(dh.halves[kk].data(), 1.0f / scale, widened.fields[kk].data(), n);
-        ++compared;
-      }
-      widened.ground_m = dh.ground_m;
-      core::derive_maps(h.grid, widened);
-      for (std::size_t c = 0; c < h.grid.columns(); ++c) {
-        const float a = widened.maps.optical_depth[c], b = dh.maps.optical_depth[c];
-        EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << "column " << c;
-        EXPECT_TRUE(widened.maps.cloud_cover[c] == dh.maps.cloud_cover[c] ||
-                    (std::isnan(widened.maps.cloud_cover[c]) && std::isnan(dh.maps.cloud_cover[c])));
+        widened.ground_m = dh.ground_m;
+        core::derive_maps(h.grid, widened);
+        for (std::size_t c = 0; c < h.grid.columns(); ++c) {
+          const float a = widened.maps.optical_depth[c], b = dh.maps.optical_depth[c];
+          EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << "column " << c;
+          EXPECT_TRUE(widened.maps.cloud_cover[c] == dh.maps.cloud_cover[c] ||
+                      (std::isnan(widened.maps.cloud_cover[c]) && std::isnan(dh.maps.cloud_cover[c])));
+        }
       }
     }
-  }
-  EXPECT_GE(compared, 10);
-  ASSERT_EQ(f.report.variables.size(), h.report.variables.size());
-  for (std::size_t i = 0; i < f.report.variables.size(); ++i) {
-    const auto &a = f.report.variables[i], &b = h.report.variables[i];
-    EXPECT_EQ(a.variable, b.variable);
-    EXPECT_EQ(a.after.count, b.after.count) << a.variable;
-    EXPECT_EQ(a.after.min, b.after.min) << a.variable;
-    EXPECT_EQ(a.after.max, b.after.max) << a.variable;
+    EXPECT_GE(compared, 10);
+    ASSERT_EQ(f.report.variables.size(), h.report.variables.size());
+    for (std::size_t i = 0; i < f.report.variables.size(); ++i) {
+      const auto &a = f.report.variables[i], &b = h.report.variables[i];
+      EXPECT_EQ(a.variable, b.variable);
+      EXPECT_EQ(a.after.count, b.after.count) << a.variable;
+      EXPECT_EQ(a.after.min, b.after.min) << a.variable;
+      EXPECT_EQ(a.after.max, b.after.max) << a.variable;
+    }
   }
 }
 
