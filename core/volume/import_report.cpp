@@ -7,10 +7,16 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <type_traits>
 #include <vector>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+
+#include "io/cpu.hpp"
 #endif
 
 namespace cv::core {
@@ -72,6 +78,39 @@ void add_simd(const float* v, std::size_t n, float& lo, float& hi, std::size_t& 
   add_scalar(v + i, n - i, lo, hi, finite);
 }
 
+#if defined(__x86_64__) && defined(__GNUC__)
+// The float loop with AVX where the processor has it: sixteen values a step in two independent
+// accumulators (the SSE2 loop waits on one minimum and one maximum chain, and the import adds every
+// stored row of a global step, a few per cent of its time). The same minimum, maximum and count.
+__attribute__((target("avx,popcnt"))) void add_avx(const float* v, std::size_t n, float& lo, float& hi, std::size_t& finite) {
+  const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
+  const __m256 ninf = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
+  const __m256 big = _mm256_set1_ps(std::numeric_limits<float>::max());
+  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  __m256 lo0 = inf, lo1 = inf, hi0 = ninf, hi1 = ninf;
+  std::size_t i = 0, count = 0;
+  for (; n - i >= 16; i += 16) {
+    const __m256 x0 = _mm256_loadu_ps(v + i), x1 = _mm256_loadu_ps(v + i + 8);
+    const __m256 ok0 = _mm256_cmp_ps(_mm256_and_ps(x0, abs_mask), big, _CMP_LE_OQ);  // false for NaN and infinity
+    const __m256 ok1 = _mm256_cmp_ps(_mm256_and_ps(x1, abs_mask), big, _CMP_LE_OQ);
+    // Masks rather than blends (GCC 12 takes the blend's mask apart lane by lane here).
+    const __m256 in0 = _mm256_and_ps(ok0, x0), in1 = _mm256_and_ps(ok1, x1);
+    lo0 = _mm256_min_ps(lo0, _mm256_or_ps(in0, _mm256_andnot_ps(ok0, inf)));
+    hi0 = _mm256_max_ps(hi0, _mm256_or_ps(in0, _mm256_andnot_ps(ok0, ninf)));
+    lo1 = _mm256_min_ps(lo1, _mm256_or_ps(in1, _mm256_andnot_ps(ok1, inf)));
+    hi1 = _mm256_max_ps(hi1, _mm256_or_ps(in1, _mm256_andnot_ps(ok1, ninf)));
+    count += static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(_mm256_movemask_ps(ok0))) +
+                                      __builtin_popcount(static_cast<unsigned>(_mm256_movemask_ps(ok1))));
+  }
+  alignas(32) float l[8], h[8];
+  _mm256_store_ps(l, _mm256_min_ps(lo0, lo1));
+  _mm256_store_ps(h, _mm256_max_ps(hi0, hi1));
+  for (int k = 0; k < 8; ++k) lo = std::min(lo, l[k]), hi = std::max(hi, h[k]);
+  finite += count;
+  add_scalar(v + i, n - i, lo, hi, finite);
+}
+#endif
+
 void add_simd(const double* v, std::size_t n, double& lo, double& hi, std::size_t& finite) {
   const __m128d inf = _mm_set1_pd(std::numeric_limits<double>::infinity()), ninf = _mm_set1_pd(-std::numeric_limits<double>::infinity());
   const __m128d big = _mm_set1_pd(std::numeric_limits<double>::max());
@@ -101,7 +140,14 @@ template <typename T>
 void add_range(ValueStats& s, const T* v, std::size_t n) {
   T lo = std::numeric_limits<T>::infinity(), hi = -std::numeric_limits<T>::infinity();
   std::size_t finite = 0;
-#if defined(__SSE2__)
+#if defined(__x86_64__) && defined(__GNUC__)
+  if constexpr (std::is_same_v<T, float>) {
+    if (cpu_has_avx()) add_avx(v, n, lo, hi, finite);
+    else add_simd(v, n, lo, hi, finite);
+  } else {
+    add_simd(v, n, lo, hi, finite);
+  }
+#elif defined(__SSE2__)
   add_simd(v, n, lo, hi, finite);
 #else
   add_scalar(v, n, lo, hi, finite);
