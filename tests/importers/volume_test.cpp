@@ -71,6 +71,93 @@ TEST(ValueStats, AddAllEqualsAddingEachValue) {
   EXPECT_TRUE(none.empty());
 }
 
+// The maps of a row are worked out four columns at a time where the processor has AVX, the rest
+// column by column: every map equals walking each column alone from the top by the maps'
+// definition, to the bit, for rows of every width around the vector's, with missing values,
+// absent fields, fractions at and past the thresholds and 0 and 1, and columns whose ground puts a
+// level in each band.
+TEST(Maps, EveryColumnAsIfWalkedAlone) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const MapOptions o;
+  for (const int nx : {1, 3, 4, 5, 8, 11}) {
+    for (const int absent : {-1, 0, 1, 2}) {  // which of cf, liquid, ice is left out (-1: none)
+      SCOPED_TRACE("nx " + std::to_string(nx) + ", absent " + std::to_string(absent));
+      VolumeGrid g;
+      g.lon_deg = {0.0, 1.0, nx};
+      g.lat_deg = {0.0, 1.0, 3};
+      g.alt_m = {0.0, 500.0, 20};  // to 9.5 km: every band
+      TimeStepData d;
+      const float nan = std::numeric_limits<float>::quiet_NaN();
+      auto value = [&](double scale) -> float {
+        const double r = u(rng);
+        if (r < 0.08) return nan;
+        if (r < 0.35) return 0.0f;
+        if (r < 0.40) return static_cast<float>(scale);
+        return static_cast<float>(scale * u(rng) * u(rng));
+      };
+      const Field fields[3] = {Field::CloudFraction, Field::ExtinctionLiquid, Field::ExtinctionIce};
+      const double scales[3] = {1.0, 4e-3, 2e-4};
+      for (int f = 0; f < 3; ++f) {
+        if (f == absent) continue;
+        auto& v = d[fields[f]];
+        v.resize(g.points());
+        for (auto& x : v) x = value(scales[f]);
+        if (f == 0) {  // at the thresholds, past them, and just short
+          for (std::size_t p = 0; p < v.size(); p += 13) v[p] = o.min_cloud_fraction;
+          for (std::size_t p = 5; p < v.size(); p += 17) v[p] = std::nextafter(o.min_cloud_fraction, 0.0f);
+          for (std::size_t p = 7; p < v.size(); p += 19) v[p] = 1.0f;
+        } else {
+          for (std::size_t p = 3; p < v.size(); p += 11) v[p] = o.min_extinction_per_m;
+        }
+      }
+      d.ground_m.resize(g.columns());
+      for (auto& x : d.ground_m) x = u(rng) < 0.2 ? nan : static_cast<float>(4500.0 * u(rng));
+      derive_maps(g, d, o);
+      for (int j = 0; j < g.lat_deg.count; ++j) {
+        for (int i = 0; i < nx; ++i) {
+          const std::size_t col = g.column(i, j);
+          MaxRandomOverlap all, low, mid, high;
+          double tau = 0.0, base = NAN, top = NAN;
+          bool any = false;
+          const double ground = std::isfinite(d.ground_m[col]) ? d.ground_m[col] : 0.0;
+          for (int k = g.alt_m.count - 1; k >= 0; --k) {
+            const std::size_t p = g.index(i, j, k);
+            auto at = [&](Field f) { return d[f].empty() ? static_cast<double>(nan) : static_cast<double>(d[f][p]); };
+            const double cf = at(Field::CloudFraction), el = at(Field::ExtinctionLiquid), ei = at(Field::ExtinctionIce);
+            if (std::isnan(cf) && std::isnan(el) && std::isnan(ei)) continue;
+            any = true;
+            const double ext = (std::isnan(el) ? 0.0 : el) + (std::isnan(ei) ? 0.0 : ei);
+            const double frac = std::isnan(cf) ? (ext > 0.0 ? 1.0 : 0.0) : cf;
+            const double above = g.alt_m.at(k) - ground;
+            MaxRandomOverlap& band = above < o.low_top_m ? low : above < o.mid_top_m ? mid : high;
+            if (frac >= o.min_cloud_fraction && ext >= o.min_extinction_per_m) {
+              all.add(frac);
+              band.add(frac);
+              tau += frac * ext * g.alt_m.step;
+              if (std::isnan(top)) top = g.alt_m.at(k);
+              base = g.alt_m.at(k);
+            } else {
+              all.gap();
+              band.gap();
+            }
+          }
+          const auto& m = d.maps;
+          auto same = [](float a, double b) { return std::isnan(b) ? std::isnan(a) : a == static_cast<float>(b); };
+          const double none = NAN;
+          EXPECT_TRUE(same(m.cloud_cover[col], any ? all.cover() : none)) << i << "," << j;
+          EXPECT_TRUE(same(m.low_cover[col], any ? low.cover() : none)) << i << "," << j;
+          EXPECT_TRUE(same(m.mid_cover[col], any ? mid.cover() : none)) << i << "," << j;
+          EXPECT_TRUE(same(m.high_cover[col], any ? high.cover() : none)) << i << "," << j;
+          EXPECT_TRUE(same(m.optical_depth[col], any ? tau : none)) << i << "," << j;
+          EXPECT_TRUE(same(m.cloud_base_m[col], any ? base : none)) << i << "," << j;
+          EXPECT_TRUE(same(m.cloud_top_m[col], any ? top : none)) << i << "," << j;
+        }
+      }
+    }
+  }
+}
+
 TEST(Maps, MaximumRandomOverlap) {
   const VolumeGrid g = column_grid(6);
   // Two adjacent layers of 0.5 overlap fully: cover 0.5.
