@@ -615,7 +615,7 @@ namespace {
 using cv::test::NcBuilder;
 
 // int16 variables of classic files are read straight to float (NcFile::read_float_into's short
-// path, one pass with SSE2); every value, fill and range rule must come out as the general path
+// path, one pass with AVX or SSE2); every value, fill and range rule must come out as the general path
 // (netCDF's doubles, unpacked in double) rounded to float, and the missing count the same.
 TEST(NcShortReads, UnpackToTheSameFloatsAsTheDoublePath) {
   // The process's scratch folder: removed when the process ends, a failed assertion included.
