@@ -352,17 +352,23 @@ namespace {
 // ordinary page faults, a few tenths of a second for a global step.
 //
 // The grid's level count is known only at the end of the open, so the arrays are reserved for
-// an upper bound and their planes (one level of one field) touched bottom up until finish() says
-// how many there are; pages touched beyond them are given back.
+// more levels than the step is expected to have (virtual memory only) and their planes (one level
+// of one field) touched bottom up, to the expected count at most, until finish() says how many
+// there are; pages touched beyond them are given back, and planes not reached are faulted in then.
 class FirstStepPages {
  public:
-  // `fields`: the fields the step will hold as half floats; `plane`: values per level; at most
-  // `max_planes` levels are reserved and touched.
-  FirstStepPages(const std::vector<int>& fields, std::size_t plane, std::size_t max_planes)
-      : fields_(fields), plane_(plane), max_planes_(max_planes) {
-    if (fields_.empty() || plane_ == 0 || max_planes_ == 0) return;
-    for (int f : fields_) buffers_[static_cast<std::size_t>(f)].resize(plane_ * max_planes_);  // reserved, not written
-    thread_ = std::thread([this] { touch(); });
+  // `fields`: the fields the step will hold as half floats; `plane`: values per level; room for
+  // `reserve_planes` levels, of which at most `touch_planes` are touched. Nothing happens (the
+  // step makes its own arrays) where the room cannot be had or the thread cannot start.
+  FirstStepPages(const std::vector<int>& fields, std::size_t plane, std::size_t reserve_planes, std::size_t touch_planes)
+      : fields_(fields), plane_(plane), reserve_planes_(reserve_planes), touch_planes_(std::min(touch_planes, reserve_planes)) {
+    if (fields_.empty() || plane_ == 0 || touch_planes_ == 0) return;
+    try {
+      for (int f : fields_) buffers_[static_cast<std::size_t>(f)].resize(plane_ * reserve_planes_);  // reserved, not written
+      thread_ = std::thread([this] { touch(); });
+    } catch (const std::exception&) {  // no memory or no thread: only the head start is lost
+      for (auto& b : buffers_) core::HalfBuffer().swap(b);
+    }
   }
   ~FirstStepPages() { stop(); }
   FirstStepPages(const FirstStepPages&) = delete;
@@ -372,14 +378,16 @@ class FirstStepPages {
   // (sized for them); otherwise they are dropped and the step makes its own.
   void finish(std::size_t planes, std::array<core::HalfBuffer, core::kFieldCount>& into) {
     stop();
-    if (planes > max_planes_) return;
+    if (planes > reserve_planes_) return;
     const long page_size = ::sysconf(_SC_PAGESIZE);
     for (int f : fields_) {
       core::HalfBuffer& b = buffers_[static_cast<std::size_t>(f)];
       if (b.empty()) continue;
       // The whole pages past the step's values that were touched: handed back to the system.
       const std::uintptr_t used = reinterpret_cast<std::uintptr_t>(b.data() + plane_ * planes);
-      const std::uintptr_t reached = reinterpret_cast<std::uintptr_t>(b.data() + plane_ * std::max(planes, touched_));
+      // (The plane being touched when the thread stopped counts: some fields' were.)
+      const std::size_t reached_planes = std::min(std::max(planes, touched_ + 1), reserve_planes_);
+      const std::uintptr_t reached = reinterpret_cast<std::uintptr_t>(b.data() + plane_ * reached_planes);
       if (page_size > 0) {
         const std::uintptr_t page = static_cast<std::uintptr_t>(page_size);
         const std::uintptr_t lo = (used + page - 1) / page * page, hi = reached / page * page;
@@ -400,7 +408,7 @@ class FirstStepPages {
   }
   void touch() {
     const std::size_t page = 4096;  // at most the page size: every page is written at least once
-    for (std::size_t z = 0; z < max_planes_; ++z) {
+    for (std::size_t z = 0; z < touch_planes_; ++z) {
       for (int f : fields_) {
         if (stop_.load(std::memory_order_relaxed)) return;
         std::uint16_t* p = buffers_[static_cast<std::size_t>(f)].data() + plane_ * z;
@@ -420,7 +428,7 @@ class FirstStepPages {
   }
 
   std::vector<int> fields_;
-  std::size_t plane_, max_planes_;
+  std::size_t plane_, reserve_planes_, touch_planes_;
   std::array<core::HalfBuffer, core::kFieldCount> buffers_;
   std::size_t touched_ = 0;
   std::atomic<bool> stop_{false};
@@ -1101,18 +1109,23 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
   vol.has_field[static_cast<int>(core::Field::Temperature)] = true;
   vol.has_field[static_cast<int>(core::Field::Pressure)] = L.vertical_kind != Vertical::Height;
   // The first step's half floats get their pages touched on the second core while the rest of the
-  // open reads the file on this one: for up to two grid levels per source level (the automatic
-  // spacing is half the median level thickness), never more than a volume the import accepts.
+  // open reads the file on this one: up to two grid levels per source level (the automatic spacing
+  // is half the median level thickness), with room for four times that (never more than a volume
+  // the import accepts). Not with a spacing asked for (--dz), whose level count nothing here can
+  // foresee.
   std::optional<FirstStepPages> first_pages;
-  if (options.half_fields && core::worker_count() >= 2) {
+  if (options.half_fields && options.dz_m <= 0.0 && core::worker_count() >= 2) {
     std::vector<int> fields;
     for (int i = 0; i < core::kFieldCount; ++i) {
       if (vol.has_field[static_cast<std::size_t>(i)]) fields.push_back(i);
     }
     const std::size_t plane = vol.grid.columns();
-    const double accepted = options.max_volume_bytes / (static_cast<double>(plane) * core::kFieldCount * sizeof(float));
-    const std::size_t planes = static_cast<std::size_t>(std::min(2.0 * static_cast<double>(S->levels.size()) + 2.0, std::floor(accepted)));
-    first_pages.emplace(fields, plane, planes);
+    const double accepted = std::floor(options.max_volume_bytes / (static_cast<double>(plane) * core::kFieldCount * sizeof(float)));
+    const double expected = 2.0 * static_cast<double>(S->levels.size()) + 2.0;
+    if (accepted >= 1.0) {  // false for NaN too
+      const double room = std::min(accepted, 4.0 * expected + 16.0);
+      first_pages.emplace(fields, plane, static_cast<std::size_t>(room), static_cast<std::size_t>(std::min(room, expected)));
+    }
   }
   if (L.times_uneven) vol.report.warn("time steps are unevenly spaced");
   if (!has_geo && L.vertical_kind == Vertical::Pressure) {

@@ -764,9 +764,9 @@ namespace {
 // markers, and x * scale + offset rounded to float, the same operations as the SSE2 and scalar
 // loops. Unpacks the first n / 8 * 8 values into o, adds the missing ones to `missed`, and
 // returns how many it unpacked.
-__attribute__((target("avx,popcnt"))) std::size_t unpack_shorts_avx(const std::int16_t* r, std::size_t n, double lo, double hi,
-                                                                    double m0, double m1, double scale, double offset, float* o,
-                                                                    std::size_t& missed) {
+__attribute__((target("avx"))) std::size_t unpack_shorts_avx(const std::int16_t* r, std::size_t n, double lo, double hi,
+                                                             double m0, double m1, double scale, double offset, float* o,
+                                                             std::size_t& missed) {
   const __m256d vlo = _mm256_set1_pd(lo), vhi = _mm256_set1_pd(hi), vm0 = _mm256_set1_pd(m0), vm1 = _mm256_set1_pd(m1);
   const __m256d vscale = _mm256_set1_pd(scale), voffset = _mm256_set1_pd(offset);
   const __m128 vnan = _mm_set1_ps(std::numeric_limits<float>::quiet_NaN());
@@ -784,7 +784,7 @@ __attribute__((target("avx,popcnt"))) std::size_t unpack_shorts_avx(const std::i
       const __m128 m = _mm256_cvtpd_ps(miss);  // NaN where missed, 0 elsewhere
       const __m128 missf = _mm_cmpunord_ps(m, m);
       _mm_storeu_ps(o + i + 4 * static_cast<std::size_t>(half), _mm_or_ps(_mm_and_ps(missf, vnan), _mm_andnot_ps(missf, y)));
-      count += static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(bits)));
+      count += core::mask_lanes(static_cast<unsigned>(bits));
     }
   }
   missed += count;

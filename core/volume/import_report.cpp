@@ -82,7 +82,7 @@ void add_simd(const float* v, std::size_t n, float& lo, float& hi, std::size_t& 
 // The float loop with AVX where the processor has it: sixteen values a step in two independent
 // accumulators (the SSE2 loop waits on one minimum and one maximum chain, and the import adds every
 // stored row of a global step, a few per cent of its time). The same minimum, maximum and count.
-__attribute__((target("avx,popcnt"))) void add_avx(const float* v, std::size_t n, float& lo, float& hi, std::size_t& finite) {
+__attribute__((target("avx"))) void add_avx(const float* v, std::size_t n, float& lo, float& hi, std::size_t& finite) {
   const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
   const __m256 ninf = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
   const __m256 big = _mm256_set1_ps(std::numeric_limits<float>::max());
@@ -99,8 +99,7 @@ __attribute__((target("avx,popcnt"))) void add_avx(const float* v, std::size_t n
     hi0 = _mm256_max_ps(hi0, _mm256_or_ps(in0, _mm256_andnot_ps(ok0, ninf)));
     lo1 = _mm256_min_ps(lo1, _mm256_or_ps(in1, _mm256_andnot_ps(ok1, inf)));
     hi1 = _mm256_max_ps(hi1, _mm256_or_ps(in1, _mm256_andnot_ps(ok1, ninf)));
-    count += static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(_mm256_movemask_ps(ok0))) +
-                                      __builtin_popcount(static_cast<unsigned>(_mm256_movemask_ps(ok1))));
+    count += mask_lanes(static_cast<unsigned>(_mm256_movemask_ps(ok0))) + mask_lanes(static_cast<unsigned>(_mm256_movemask_ps(ok1)));
   }
   alignas(32) float l[8], h[8];
   _mm256_store_ps(l, _mm256_min_ps(lo0, lo1));

@@ -74,8 +74,8 @@ TEST(ValueStats, AddAllEqualsAddingEachValue) {
 // The maps of a row are worked out four columns at a time where the processor has AVX, the rest
 // column by column: every map equals walking each column alone from the top by the maps'
 // definition, to the bit, for rows of every width around the vector's, with missing values,
-// absent fields, fractions at and past the thresholds and 0 and 1, and columns whose ground puts a
-// level in each band.
+// absent fields, fractions at and past the thresholds, 0 and 1, outside 0..1 and infinite values,
+// and columns whose ground puts a level in each band.
 TEST(Maps, EveryColumnAsIfWalkedAlone) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -103,6 +103,10 @@ TEST(Maps, EveryColumnAsIfWalkedAlone) {
         auto& v = d[fields[f]];
         v.resize(g.points());
         for (auto& x : v) x = value(scales[f]);
+        // Past the fields' ranges (fractions outside 0..1 are clamped as they are added) and infinite.
+        for (std::size_t p = 9; p < v.size(); p += 23) v[p] = static_cast<float>(1.5 * scales[f]);
+        for (std::size_t p = 10; p < v.size(); p += 29) v[p] = static_cast<float>(-0.5 * scales[f]);
+        for (std::size_t p = 2; p < v.size(); p += 31) v[p] = std::numeric_limits<float>::infinity();
         if (f == 0) {  // at the thresholds, past them, and just short
           for (std::size_t p = 0; p < v.size(); p += 13) v[p] = o.min_cloud_fraction;
           for (std::size_t p = 5; p < v.size(); p += 17) v[p] = std::nextafter(o.min_cloud_fraction, 0.0f);
