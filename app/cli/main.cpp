@@ -192,6 +192,7 @@ int cmd_info(const std::vector<std::string>& args) {
       }
     }
     std::printf("\n");
+    for (const auto& note : v.report.notes) std::printf("%s\n", note.c_str());
     return 0;
   }
   std::printf("%s", cv::importers::describe_file(path, options).c_str());

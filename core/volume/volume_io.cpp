@@ -7,7 +7,6 @@
 #include <cstdlib>
 #include <limits>
 #include <cstring>
-#include <limits>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
@@ -147,6 +146,51 @@ float half_to_float(std::uint16_t h) {
 }
 
 namespace {
+// Version 2's plane table: one byte per (field, level) plane of a step, 1 where the plane is stored
+// and 0 where every value in it is zero (of either sign; read back as +0), padded with zeros to a
+// multiple of 8 bytes so the fields after it stay aligned.
+std::size_t cvvol_plane_table_bytes(std::size_t fields, std::size_t levels) { return (fields * levels + 7) / 8 * 8; }
+// Blocks of 4096 values, OR-ed without a branch (vectorised), so a plane with data stops early.
+constexpr std::size_t kZeroScanBlock = 4096;
+bool halves_all_zero(const std::uint16_t* h, std::size_t n) {
+  for (std::size_t at = 0; at < n; at += kZeroScanBlock) {
+    const std::size_t e = std::min(n, at + kZeroScanBlock);
+    unsigned acc = 0;
+    for (std::size_t i = at; i < e; ++i) acc |= h[i];
+    if (acc & 0x7fffu) return false;
+  }
+  return true;
+}
+bool floats_all_zero(const float* a, std::size_t n) {
+  for (std::size_t at = 0; at < n; at += kZeroScanBlock) {
+    const std::size_t e = std::min(n, at + kZeroScanBlock);
+    std::uint32_t acc = 0;
+    for (std::size_t i = at; i < e; ++i) {
+      std::uint32_t b;
+      std::memcpy(&b, a + i, sizeof b);
+      acc |= b;
+    }
+    if (acc & 0x7fffffffu) return false;
+  }
+  return true;
+}
+// Whether float_to_half(a[i] * k) is zero (of either sign) for every i: the product's magnitude is
+// at most 2^-25 (0x33000000), which rounds to zero, to even at the tie; NaN is not.
+bool floats_round_to_zero_halves(const float* a, float k, std::size_t n) {
+  for (std::size_t at = 0; at < n; at += kZeroScanBlock) {
+    const std::size_t e = std::min(n, at + kZeroScanBlock);
+    std::uint32_t most = 0;
+    for (std::size_t i = at; i < e; ++i) {
+      const float x = a[i] * k;
+      std::uint32_t b;
+      std::memcpy(&b, &x, sizeof b);
+      most = std::max(most, b & 0x7fffffffu);
+    }
+    if (most > 0x33000000u) return false;
+  }
+  return true;
+}
+
 void write_cvvol_to(const std::function<void(const std::string&, const std::function<void(std::FILE*)>&)>& writer,
                     const std::string& path, CloudVolume& v, const std::function<void(std::size_t, std::size_t)>& progress,
                     CvvolEncoding encoding) {
@@ -166,7 +210,7 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
     times += std::string(t ? ", " : "") + "{\"iso_utc\": " + json_quote(v.times[t].iso_utc) +
              ", \"unix_s\": " + std::to_string(v.times[t].unix_s) + "}";
   }
-  std::string header = "{\"format\": \"cvvol\", \"version\": 1,\n \"grid\": {\"lon_deg\": " + axis_json(v.grid.lon_deg) +
+  std::string header = "{\"format\": \"cvvol\", \"version\": 2, \"zero_planes\": \"left out\",\n \"grid\": {\"lon_deg\": " + axis_json(v.grid.lon_deg) +
                              ", \"lat_deg\": " + axis_json(v.grid.lat_deg) + ", \"alt_m\": " + axis_json(v.grid.alt_m) +
                              ", \"earth_radius_m\": " + std::to_string(v.grid.earth_radius_m) + "},\n \"liquid_r_eff_um\": " +
                              std::to_string(v.liquid_r_eff_um) + ",\n" +
@@ -175,8 +219,9 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
                              " \"times\": " + times +
                              "],\n \"fields\": " + fields + "],\n \"maps\": " + maps +
                              "],\n \"layout\": \"" + (half ? "fields float16, maps float32" : "float32") +
-                             " little-endian; per time step, each field (lon fastest, then lat, "
-                             "then alt) then each map (lon fastest, then lat); NaN = no data\"}\n";
+                             " little-endian; per time step, a plane table (a byte per field and level, 1 = "
+                             "stored, 0 = all zero and left out; padded to 8 bytes), each field's stored levels (lon "
+                             "fastest, then lat), then each map (lon fastest, then lat); NaN = no data\"}\n";
   // Padded so the data starts 8-byte aligned (magic 8 + length 8 + header): the half floats are
   // then converted in place in the write queue.
   header.pop_back();  // the closing newline, put back after the spaces
@@ -197,55 +242,90 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
     const std::uint64_t len = header.size();
     out.write(&len, sizeof len);
     out.write(header.data(), header.size());
+    const std::size_t cols = v.grid.columns(), levels = static_cast<std::size_t>(v.grid.alt_m.count);
+    std::vector<int> order;
+    for (int i = 0; i < kFieldCount; ++i) {
+      if (v.has_field[static_cast<std::size_t>(i)]) order.push_back(i);
+    }
+    const std::size_t table_bytes = cvvol_plane_table_bytes(order.size(), levels);
+    std::vector<std::uint8_t> table(table_bytes);
     for (std::size_t t = 0; t < v.times.size(); ++t) {
       if (progress) progress(t, v.times.size());
       const TimeStepData& d = v.step(t);
-      for (int i = 0; i < kFieldCount; ++i) {
-        if (!v.has_field[static_cast<std::size_t>(i)]) continue;
+      // The step's plane table: which (field, level) planes hold a value other than zero.
+      std::fill(table.begin(), table.end(), std::uint8_t{0});
+      for (std::size_t fi = 0; fi < order.size(); ++fi) {
+        const int i = order[fi];
         const auto& a = d.fields[static_cast<std::size_t>(i)];
         const auto& h = d.halves[static_cast<std::size_t>(i)];
         if (a.size() != v.grid.points() && h.size() != v.grid.points()) {
           throw std::runtime_error(std::string("field ") + field_name(static_cast<Field>(i)) + " has the wrong size");
         }
-        if (a.size() != v.grid.points()) {
-          // Held as half floats already (TimeStepData::halves): written as they are, or widened.
-          if (half) {
-            out.write(h.data(), h.size() * sizeof(std::uint16_t));
+        for (std::size_t z = 0; z < levels; ++z) {
+          bool zero;
+          if (a.size() != v.grid.points()) zero = halves_all_zero(h.data() + z * cols, cols);
+          else if (half) zero = floats_round_to_zero_halves(a.data() + z * cols, half_scale(i), cols);
+          else zero = floats_all_zero(a.data() + z * cols, cols);
+          table[fi * levels + z] = zero ? 0 : 1;
+        }
+      }
+      out.write(table.data(), table.size());
+      for (std::size_t fi = 0; fi < order.size(); ++fi) {
+        const int i = order[fi];
+        const auto& a_all = d.fields[static_cast<std::size_t>(i)];
+        const auto& h_all = d.halves[static_cast<std::size_t>(i)];
+        // Each run of consecutive stored planes, as one span of the field.
+        for (std::size_t z0 = 0; z0 < levels;) {
+          if (!table[fi * levels + z0]) {
+            ++z0;
+            continue;
+          }
+          std::size_t z1 = z0 + 1;
+          while (z1 < levels && table[fi * levels + z1]) ++z1;
+          const std::size_t first = z0 * cols, count = (z1 - z0) * cols;
+          z0 = z1;
+          if (a_all.size() != v.grid.points()) {
+            // Held as half floats already (TimeStepData::halves): written as they are, or widened.
+            const std::uint16_t* h = h_all.data() + first;
+            if (half) {
+              out.write(h, count * sizeof(std::uint16_t));
+            } else {
+              const float k = 1.0f / half_scale(i);
+              std::vector<float> buf(std::min<std::size_t>(count, std::size_t(1) << 18));
+              for (std::size_t at = 0; at < count; at += buf.size()) {
+                const std::size_t n = std::min(buf.size(), count - at);
+                halves_to_floats(h + at, k, buf.data(), n);
+                out.write(buf.data(), n * sizeof(float));
+              }
+            }
+          } else if (half) {
+            // Converted straight into the write queue's chunks, so no second copy of the volume exists.
+            const float k = half_scale(i);
+            const float* a = a_all.data() + first;
+            for (std::size_t at = 0; at < count;) {
+              const std::span<std::byte> r = out.room();
+              const std::size_t n = std::min(count - at, r.size() / sizeof(std::uint16_t));
+              if (n == 0 || reinterpret_cast<std::uintptr_t>(r.data()) % alignof(std::uint16_t)) {
+                // Not at a half's alignment (cannot happen with the padded header and table; kept
+                // for safety): through a small buffer instead.
+                std::uint16_t hb[256];
+                const std::size_t m = std::min<std::size_t>(count - at, 256);
+                floats_to_halves(a + at, k, hb, m);
+                out.write(hb, m * sizeof(std::uint16_t));
+                at += m;
+                continue;
+              }
+              std::uint16_t* dst = reinterpret_cast<std::uint16_t*>(r.data());
+              const float* src = a + at;
+              parallel_ranges(n, std::size_t(1) << 20, [&](std::size_t b, std::size_t e, unsigned) {
+                floats_to_halves(src + b, k, dst + b, e - b);
+              });
+              out.commit(n * sizeof(std::uint16_t));
+              at += n;
+            }
           } else {
-            const float k = 1.0f / half_scale(i);
-            std::vector<float> buf(std::min<std::size_t>(h.size(), std::size_t(1) << 18));
-            for (std::size_t at = 0; at < h.size(); at += buf.size()) {
-              const std::size_t n = std::min(buf.size(), h.size() - at);
-              halves_to_floats(h.data() + at, k, buf.data(), n);
-              out.write(buf.data(), n * sizeof(float));
-            }
+            out.write(a_all.data() + first, count * sizeof(float));
           }
-        } else if (half) {
-          // Converted straight into the write queue's chunks, so no second copy of the volume exists.
-          const float k = half_scale(i);
-          for (std::size_t at = 0; at < a.size();) {
-            const std::span<std::byte> r = out.room();
-            const std::size_t n = std::min(a.size() - at, r.size() / sizeof(std::uint16_t));
-            if (n == 0 || reinterpret_cast<std::uintptr_t>(r.data()) % alignof(std::uint16_t)) {
-              // Not at a half's alignment (cannot happen with the padded header; kept for safety):
-              // through a small buffer instead.
-              std::uint16_t h[256];
-              const std::size_t m = std::min<std::size_t>(a.size() - at, 256);
-              floats_to_halves(a.data() + at, k, h, m);
-              out.write(h, m * sizeof(std::uint16_t));
-              at += m;
-              continue;
-            }
-            std::uint16_t* dst = reinterpret_cast<std::uint16_t*>(r.data());
-            const float* src = a.data() + at;
-            parallel_ranges(n, std::size_t(1) << 20, [&](std::size_t b, std::size_t e, unsigned) {
-              floats_to_halves(src + b, k, dst + b, e - b);
-            });
-            out.commit(n * sizeof(std::uint16_t));
-            at += n;
-          }
-        } else {
-          out.write(a.data(), a.size() * sizeof(float));
         }
       }
       for (const auto& [name, arr] : map_arrays(d.maps)) out.write(arr->data(), arr->size() * sizeof(float));
@@ -445,39 +525,108 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   const auto field_bytes = field_values ? checked_product({*field_values, value_bytes}) : std::nullopt;
   const auto map_bytes = map_values ? checked_product({*map_values, sizeof(float)}) : std::nullopt;
   if (!field_bytes || !map_bytes) throw VolumeFileError(path + ": one time step's size overflows 64 bits");
-  const std::uint64_t step_bytes = *field_bytes + *map_bytes;
+  // Version 1 stores every plane; version 2 ("zero_planes": "left out") starts each step with a
+  // plane table and leaves out the planes whose values are all zero, so its steps' sizes differ:
+  // each step's table is read here to find where the step starts, and the sizes must add up to
+  // the file's.
+  double version = 1;
+  if (header.find("\"version\":") != std::string::npos) version = json_number(header, "version", 0, path);
+  if (version != 1 && version != 2) {
+    char found[32];
+    std::snprintf(found, sizeof found, "%.17g", version);
+    throw VolumeFileError(path + ": header key 'version': found " + found + ", expected 1 or 2 (written by a newer cloudviewer?)");
+  }
+  const bool sparse = version == 2;
+  const std::size_t levels = static_cast<std::size_t>(v.grid.alt_m.count);
+  const std::size_t table_bytes = sparse ? cvvol_plane_table_bytes(order.size(), levels) : 0;
+  const std::uint64_t plane_bytes = static_cast<std::uint64_t>(cols) * value_bytes;
   const std::uint64_t data0 = 16 + len;
-  const auto payload = checked_product({step_bytes, v.times.size()});
   std::fseek(f, 0, SEEK_END);
-  const long long size = std::ftell(f);
-  if (!payload || *payload > std::numeric_limits<std::uint64_t>::max() - data0 || static_cast<std::uint64_t>(size) != data0 + *payload) {
-    throw VolumeFileError(path + ": holds " + std::to_string(size) + " bytes, expected " +
-                          (payload ? std::to_string(data0 + *payload) : std::string("more than 2^64")) +
-                          " for its header's " + std::to_string(v.times.size()) + " time step(s) (truncated?)");
+  const long long size_signed = std::ftell(f);
+  const std::uint64_t size = size_signed < 0 ? 0 : static_cast<std::uint64_t>(size_signed);
+  const auto refuse_size = [&](const std::string& expected) {
+    throw VolumeFileError(path + ": holds " + std::to_string(size) + " bytes, expected " + expected + " for its header's " +
+                          std::to_string(v.times.size()) + " time step(s) (truncated?)");
+  };
+  // The table at `at`, checked: every byte 0 or 1, the padding 0. Returns the planes stored.
+  const auto read_table = [path, table_bytes, n = order.size() * levels](std::FILE* file, std::uint64_t at, std::size_t t,
+                                                                       std::vector<std::uint8_t>& table) {
+    table.resize(table_bytes);
+    if (std::fseek(file, static_cast<long>(at), SEEK_SET) != 0 || std::fread(table.data(), 1, table_bytes, file) != table_bytes) {
+      throw VolumeFileError(path + ": truncated in the plane table of time step " + std::to_string(t));
+    }
+    std::uint64_t stored = 0;
+    for (std::size_t k = 0; k < table_bytes; ++k) {
+      if (table[k] > (k < n ? 1 : 0)) {
+        throw VolumeFileError(path + ": plane table of time step " + std::to_string(t) + ", byte " + std::to_string(k) +
+                              ": found " + std::to_string(table[k]) + ", expected " + (k < n ? "0 or 1" : "0 (padding)"));
+      }
+      stored += table[k];
+    }
+    return stored;
+  };
+  std::vector<std::uint64_t> starts;
+  const std::uint64_t all_planes = static_cast<std::uint64_t>(order.size()) * levels * v.times.size();
+  std::uint64_t stored_planes = sparse ? 0 : all_planes;
+  if (!sparse) {
+    const std::uint64_t step_bytes = *field_bytes + *map_bytes;
+    const auto payload = checked_product({step_bytes, v.times.size()});
+    if (!payload || *payload > std::numeric_limits<std::uint64_t>::max() - data0 || size != data0 + *payload) {
+      refuse_size(payload ? std::to_string(data0 + *payload) : std::string("more than 2^64"));
+    }
+    for (std::size_t t = 0; t < v.times.size(); ++t) starts.push_back(data0 + step_bytes * t);
+  } else {
+    std::vector<std::uint8_t> table;
+    std::uint64_t at = data0;
+    for (std::size_t t = 0; t < v.times.size(); ++t) {
+      if (at > size || size - at < table_bytes) refuse_size("more");
+      starts.push_back(at);
+      const std::uint64_t stored = read_table(f, at, t, table);
+      stored_planes += stored;
+      // stored <= fields x levels, whose bytes were checked above; so is the sum below 2^64.
+      const std::uint64_t step = table_bytes + stored * plane_bytes + *map_bytes;
+      if (size - at < step) refuse_size("more");
+      at += step;
+    }
+    if (at != size) refuse_size(std::to_string(at));
   }
   v.report.file = path;
   v.report.format = "cloud volume (.cvvol)";
+  // What `cloudviewer info` says of the storage.
+  v.report.notes.push_back(std::string("storage: ") + (half ? "float16" : "float32") + " fields, " +
+                           std::to_string(stored_planes) + " of " + std::to_string(all_planes) + " field planes stored" +
+                           (sparse ? " (" + std::to_string(all_planes - stored_planes) + " holding only zeros left out)"
+                                   : " (version 1: every plane stored)"));
   v.set_loader(
-      [file, order, data0, step_bytes, points, cols, half, ground = v.has_ground, path](std::size_t t, ImportReport&, TimeStepData& out) {
-        if (std::fseek(file.get(), static_cast<long>(data0 + step_bytes * t), SEEK_SET) != 0) {
+      [file, order, starts, read_table, levels, points, cols, half, sparse, ground = v.has_ground, path](
+          std::size_t t, ImportReport&, TimeStepData& out) {
+        std::vector<std::uint8_t> table;
+        if (sparse) {
+          read_table(file.get(), starts[t], t, table);  // and leaves the file after it
+        } else if (std::fseek(file.get(), static_cast<long>(starts[t]), SEEK_SET) != 0) {
           throw VolumeFileError(path + ": cannot seek to time step " + std::to_string(t));
         }
         for (auto& fld : out.fields) fld.clear();
-        for (int i : order) {
+        const auto truncated = [&] { return VolumeFileError(path + ": truncated at time step " + std::to_string(t)); };
+        std::vector<std::uint16_t> buf(half ? std::min<std::size_t>(cols, std::size_t(1) << 20) : 0);
+        for (std::size_t fi = 0; fi < order.size(); ++fi) {
+          const int i = order[fi];
           auto& a = out.fields[static_cast<std::size_t>(i)];
           a.resize(points);
-          if (half) {
-            const float k = 1.0f / half_scale(i);
-            std::vector<std::uint16_t> buf(std::min<std::size_t>(points, std::size_t(1) << 20));
-            for (std::size_t at = 0; at < points; at += buf.size()) {
-              const std::size_t n = std::min(buf.size(), points - at);
-              if (std::fread(buf.data(), sizeof(std::uint16_t), n, file.get()) != n) {
-                throw VolumeFileError(path + ": truncated at time step " + std::to_string(t));
+          for (std::size_t z = 0; z < levels; ++z) {
+            float* plane = a.data() + z * cols;
+            if (sparse && !table[fi * levels + z]) {
+              std::fill(plane, plane + cols, 0.0f);
+            } else if (half) {
+              const float k = 1.0f / half_scale(i);
+              for (std::size_t at = 0; at < cols; at += buf.size()) {
+                const std::size_t n = std::min(buf.size(), cols - at);
+                if (std::fread(buf.data(), sizeof(std::uint16_t), n, file.get()) != n) throw truncated();
+                halves_to_floats(buf.data(), k, plane + at, n);
               }
-              halves_to_floats(buf.data(), k, a.data() + at, n);
+            } else if (std::fread(plane, sizeof(float), cols, file.get()) != cols) {
+              throw truncated();
             }
-          } else if (std::fread(a.data(), sizeof(float), points, file.get()) != points) {
-            throw VolumeFileError(path + ": truncated at time step " + std::to_string(t));
           }
         }
         // The maps that follow are derived again from the fields (and the ground) by CloudVolume::step.
@@ -487,9 +636,7 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
             throw VolumeFileError(path + ": cannot seek to the ground of time step " + std::to_string(t));
           }
           out.ground_m.resize(cols);
-          if (std::fread(out.ground_m.data(), sizeof(float), cols, file.get()) != cols) {
-            throw VolumeFileError(path + ": truncated at time step " + std::to_string(t));
-          }
+          if (std::fread(out.ground_m.data(), sizeof(float), cols, file.get()) != cols) throw truncated();
         }
       },
       cache_steps);

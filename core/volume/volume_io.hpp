@@ -1,4 +1,4 @@
-// Writing a CloudVolume: the documented .cvvol format (docs/formats.md) and VTK XML image data
+// Writing a CloudVolume: the documented .cvvol format (docs/importers.md) and VTK XML image data
 // (.vti, one file per time step) that ParaView opens. Every file is written atomically.
 #pragma once
 

@@ -1,6 +1,8 @@
 // CloudVolume: derived maps (maximum-random overlap), the lazy cache, and the writers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -235,13 +237,30 @@ TEST(VolumeIo, CvvolHeaderAndPayloadAndVti) {
   in.read(header.data(), static_cast<std::streamsize>(len));
   EXPECT_NE(header.find("\"cloud_fraction\""), std::string::npos) << header;
   EXPECT_NE(header.find("1970-01-01T01:00:00Z"), std::string::npos);
-  float first[3];
+  EXPECT_NE(header.find("\"version\": 2, \"zero_planes\": \"left out\""), std::string::npos) << header;
+  EXPECT_EQ((16 + len) % 8, 0u) << "the data starts 8-byte aligned";
+  // Step 0: the plane table (one field, 3 levels, padded to 8 bytes); the first level (0.1 x 0)
+  // is zero and left out.
+  std::uint8_t table[8];
+  in.read(reinterpret_cast<char*>(table), sizeof table);
+  const std::uint8_t expected_table[8] = {0, 1, 1, 0, 0, 0, 0, 0};
+  EXPECT_EQ(std::memcmp(table, expected_table, 8), 0);
+  float first[2];
   in.read(reinterpret_cast<char*>(first), sizeof first);
-  EXPECT_EQ(first[1], 0.5f);
-  EXPECT_TRUE(std::isnan(first[2]));
-  // Per step: 3 field values and 7 one-column maps.
+  EXPECT_EQ(first[0], 0.5f);
+  EXPECT_TRUE(std::isnan(first[1]));
+  // Per step: the table, the stored values (2, then 3) and 7 one-column maps.
   in.seekg(0, std::ios::end);
-  EXPECT_EQ(static_cast<std::uint64_t>(in.tellg()), 16 + len + 2 * (3 + 7) * sizeof(float));
+  EXPECT_EQ(static_cast<std::uint64_t>(in.tellg()), 16 + len + 8 * 2 + (2 + 7 + 3 + 7) * sizeof(float));
+  {
+    CloudVolume r = read_cvvol(path);
+    const std::vector<float>& back = r.step(0)[Field::CloudFraction];
+    ASSERT_EQ(back.size(), 3u);
+    EXPECT_EQ(back[0], 0.0f);
+    EXPECT_FALSE(std::signbit(back[0]));
+    EXPECT_EQ(back[1], 0.5f);
+    EXPECT_TRUE(std::isnan(back[2]));
+  }
   // No temporary file left behind.
   int files = 0;
   for (const auto& e : std::filesystem::directory_iterator(dir)) files += e.is_regular_file();
@@ -296,6 +315,182 @@ TEST(VolumeIo, CvvolRoundTrip) {
     FAIL();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("not a cloud volume"), std::string::npos);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// Version 2 leaves out each (field, level) plane whose values are all zero: of either sign, or, in
+// float16, small enough to round to a zero half float. The file is smaller by exactly those
+// planes, reads back the values it would have held (a left-out plane as +0), and a step held as
+// half floats (the import's way) is written with the same bytes as its float fields. A corrupt
+// plane table is refused with its byte named.
+TEST(VolumeIo, CvvolLeavesOutPlanesOfZeros) {
+  const auto dir = cv::test::temp_dir("volume_zero_planes");
+  const std::size_t cols = 6, levels = 6;
+  const Field cf = Field::CloudFraction, liquid = Field::ExtinctionLiquid, temp = Field::Temperature;
+  // The values, level by level.
+  std::array<std::vector<float>, kFieldCount> values;
+  for (Field f : {cf, liquid, temp}) values[static_cast<std::size_t>(f)].assign(cols * levels, 0.0f);
+  const auto at = [&](Field f, std::size_t z, std::size_t c) -> float& { return values[static_cast<std::size_t>(f)][z * cols + c]; };
+  const float tie = std::ldexp(1.0f, -25);  // half way to the least half float: rounds to zero (even)
+  for (std::size_t c = 0; c < cols; ++c) {
+    at(cf, 0, c) = 0.5f;
+    at(cf, 2, c) = c % 2 ? -0.0f : 0.0f;  // zeros of both signs
+    at(cf, 3, c) = 1e-9f;                 // zero as a half float only
+    at(temp, 0, c) = at(temp, 1, c) = at(temp, 2, c) = at(temp, 3, c) = at(temp, 4, c) = at(temp, 5, c) = 250.0f;
+  }
+  at(cf, 4, 1) = tie;
+  at(cf, 4, 4) = -tie;
+  at(cf, 5, 2) = 3.0e-8f;  // just past the tie: the least half float
+  at(liquid, 3, 5) = NAN;  // one NaN keeps its plane
+  at(liquid, 5, 0) = 1e-12f;  // 1e-9 /km: zero as a half float
+  const std::vector<std::vector<std::uint8_t>> stored_f32 = {{1, 0, 0, 1, 1, 1}, {0, 0, 0, 1, 0, 1}, {1, 1, 1, 1, 1, 1}};
+  const std::vector<std::vector<std::uint8_t>> stored_f16 = {{1, 0, 0, 0, 0, 1}, {0, 0, 0, 1, 0, 0}, {1, 1, 1, 1, 1, 1}};
+  const auto volume = [&](bool as_halves) {
+    CloudVolume v;
+    v.grid.lon_deg = {0.0, 1.0, 3};
+    v.grid.lat_deg = {0.0, 1.0, 2};
+    v.grid.alt_m = {0.0, 1000.0, static_cast<int>(levels)};
+    v.times = {{0, "1970-01-01T00:00:00Z"}};
+    for (Field f : {cf, liquid, temp}) v.has_field[static_cast<std::size_t>(f)] = true;
+    v.set_loader([&values, as_halves](std::size_t, ImportReport&, TimeStepData& d) {
+      for (Field f : {Field::CloudFraction, Field::ExtinctionLiquid, Field::Temperature}) {
+        const auto& x = values[static_cast<std::size_t>(f)];
+        if (!as_halves) {
+          d[f] = x;
+          continue;
+        }
+        auto& h = d.halves[static_cast<std::size_t>(f)];
+        h.resize(x.size());
+        floats_to_halves(x.data(), half_field_scale(f), h.data(), x.size());
+      }
+    });
+    return v;
+  };
+  const auto file_bytes = [](const std::string& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  for (const bool f16 : {false, true}) {
+    SCOPED_TRACE(f16 ? "float16" : "float32");
+    const std::string path = (dir / (f16 ? "h.cvvol" : "f.cvvol")).string();
+    CloudVolume v = volume(false);
+    write_cvvol(path, v, {}, f16 ? CvvolEncoding::Float16 : CvvolEncoding::Float32);
+    const std::string bytes = file_bytes(path);
+    std::uint64_t len = 0;
+    std::memcpy(&len, bytes.data() + 8, 8);
+    const auto& expected = f16 ? stored_f16 : stored_f32;
+    // The table's fields come in the header's order, the fields' own (Field) order.
+    std::vector<std::pair<Field, std::size_t>> order = {{cf, 0}, {liquid, 1}, {temp, 2}};
+    std::sort(order.begin(), order.end());
+    std::size_t planes = 0;
+    for (std::size_t fi = 0; fi < 3; ++fi) {
+      for (std::size_t z = 0; z < levels; ++z) {
+        const int want = expected[order[fi].second][z];
+        EXPECT_EQ(static_cast<int>(bytes[16 + len + fi * levels + z]), want) << field_name(order[fi].first) << " level " << z;
+        planes += static_cast<std::size_t>(want);
+      }
+    }
+    EXPECT_EQ(bytes.size(), 16 + len + 24 + planes * cols * (f16 ? 2 : 4) + 7 * cols * 4);
+    CloudVolume r = read_cvvol(path);
+    // What `info` prints of the storage.
+    ASSERT_EQ(r.report.notes.size(), 1u);
+    EXPECT_EQ(r.report.notes[0], std::string("storage: ") + (f16 ? "float16" : "float32") + " fields, " +
+                                     std::to_string(planes) + " of 18 field planes stored (" + std::to_string(18 - planes) +
+                                     " holding only zeros left out)");
+    for (Field f : {cf, liquid, temp}) {
+      const auto& back = r.step(0)[f];
+      const auto& x = values[static_cast<std::size_t>(f)];
+      ASSERT_EQ(back.size(), x.size());
+      for (std::size_t i = 0; i < x.size(); ++i) {
+        const float k = half_field_scale(f);
+        const float want = f16 ? half_to_float(float_to_half(x[i] * k)) * (1.0f / k) : x[i];
+        if (std::isnan(want)) {
+          EXPECT_TRUE(std::isnan(back[i])) << field_name(f) << " " << i;
+        } else {
+          EXPECT_EQ(back[i], want) << field_name(f) << " " << i;
+        }
+      }
+    }
+    EXPECT_FALSE(std::signbit(r.step(0)[cf][2 * cols + 1])) << "a left-out plane reads as +0";
+    if (!f16) {
+      // Version 1 (every plane stored, no table) is still read: the same file made dense by hand.
+      std::string v1 = bytes.substr(0, 16 + len);
+      const std::string key = "\"version\": 2, \"zero_planes\": \"left out\",";
+      const std::size_t k = v1.find(key);
+      ASSERT_NE(k, std::string::npos);
+      const std::string key1 = "\"version\": 1,";
+      v1.replace(k, key.size(), key1 + std::string(key.size() - key1.size(), ' '));
+      std::size_t from = 16 + len + 24;
+      for (std::size_t fi = 0; fi < 3; ++fi) {
+        for (std::size_t z = 0; z < levels; ++z) {
+          if (bytes[16 + len + fi * levels + z]) {
+            v1 += bytes.substr(from, cols * 4);
+            from += cols * 4;
+          } else {
+            v1 += std::string(cols * 4, '\0');
+          }
+        }
+      }
+      v1 += bytes.substr(from);
+      const std::string path1 = (dir / "v1.cvvol").string();
+      std::ofstream(path1, std::ios::binary | std::ios::trunc) << v1;
+      CloudVolume r1 = read_cvvol(path1);
+      ASSERT_EQ(r1.report.notes.size(), 1u);
+      EXPECT_EQ(r1.report.notes[0], "storage: float32 fields, 18 of 18 field planes stored (version 1: every plane stored)");
+      for (Field f : {cf, liquid, temp}) {
+        const auto& a = r.step(0)[f];
+        const auto& b = r1.step(0)[f];
+        ASSERT_EQ(a.size(), b.size());
+        EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << field_name(f);
+      }
+      // A version this reader does not know is refused, not misread.
+      std::string v3 = bytes;
+      v3.replace(v3.find(key), 12, "\"version\": 3");
+      std::ofstream(path1, std::ios::binary | std::ios::trunc) << v3;
+      try {
+        read_cvvol(path1);
+        ADD_FAILURE() << "version 3 accepted";
+      } catch (const VolumeFileError& e) {
+        EXPECT_EQ(std::string(e.what()), path1 + ": header key 'version': found 3, expected 1 or 2 (written by a newer cloudviewer?)");
+      }
+    }
+    if (f16) {
+      // The import's way: the same step held as half floats gives the same file.
+      const std::string path2 = (dir / "held.cvvol").string();
+      CloudVolume held = volume(true);
+      write_cvvol(path2, held, {}, CvvolEncoding::Float16);
+      EXPECT_TRUE(file_bytes(path2) == bytes);
+      // Corrupt plane tables: a byte other than 0 or 1, padding that is not zero, a table that
+      // claims a plane the file does not hold.
+      const std::pair<std::size_t, std::string> cases[] = {
+          {0, ": plane table of time step 0, byte 0: found 2, expected 0 or 1"},
+          {20, ": plane table of time step 0, byte 20: found 2, expected 0 (padding)"},
+      };
+      for (const auto& [byte, message] : cases) {
+        std::string bad = bytes;
+        bad[16 + len + byte] = 2;
+        std::ofstream(path2, std::ios::binary | std::ios::trunc) << bad;
+        try {
+          read_cvvol(path2);
+          ADD_FAILURE() << "byte " << byte << " accepted";
+        } catch (const VolumeFileError& e) {
+          EXPECT_EQ(std::string(e.what()), path2 + message);
+        }
+      }
+      std::string more = bytes;
+      more[16 + len + 1] = 1;
+      std::ofstream(path2, std::ios::binary | std::ios::trunc) << more;
+      try {
+        read_cvvol(path2);
+        ADD_FAILURE() << "a table claiming an absent plane accepted";
+      } catch (const VolumeFileError& e) {
+        EXPECT_NE(std::string(e.what()).find("holds " + std::to_string(bytes.size()) + " bytes, expected more"), std::string::npos)
+            << e.what();
+      }
+    }
   }
   std::filesystem::remove_all(dir);
 }
