@@ -146,49 +146,67 @@ float half_to_float(std::uint16_t h) {
 }
 
 namespace {
-// Version 2's plane table: one byte per (field, level) plane of a step, 1 where the plane is stored
-// and 0 where every value in it is zero (of either sign; read back as +0), padded with zeros to a
-// multiple of 8 bytes so the fields after it stay aligned.
+// Version 2's plane table: one byte per (field, level) plane of a step, padded with zeros to a
+// multiple of 8 bytes so the fields after it stay aligned:
+//   0  every value is zero (of either sign): left out, read back as +0;
+//   1  the plane is stored;
+//   2  every value is zero or NaN (no data), with at least one NaN: stored as a mask of the NaNs,
+//      bit i % 8 of byte i / 8 for the plane's value i, padded with zeros to 8 bytes (a WRF domain
+//      resampled to latitude and longitude has no data outside it, on every level).
+enum PlaneCode : std::uint8_t { kPlaneZero = 0, kPlaneStored = 1, kPlaneNanMask = 2 };
 std::size_t cvvol_plane_table_bytes(std::size_t fields, std::size_t levels) { return (fields * levels + 7) / 8 * 8; }
-// Blocks of 4096 values, OR-ed without a branch (vectorised), so a plane with data stops early.
+std::size_t cvvol_mask_bytes(std::size_t cols) { return (cols + 63) / 64 * 8; }
+// Blocks of 4096 values, each scanned without a branch (vectorised), so a plane with data stops
+// early. Per value: `zero`, `nan`, or neither (the plane is stored).
 constexpr std::size_t kZeroScanBlock = 4096;
-bool halves_all_zero(const std::uint16_t* h, std::size_t n) {
+template <class T, class Classify>
+PlaneCode plane_code(const T* p, std::size_t n, Classify classify) {
+  bool any_nan = false;
   for (std::size_t at = 0; at < n; at += kZeroScanBlock) {
     const std::size_t e = std::min(n, at + kZeroScanBlock);
-    unsigned acc = 0;
-    for (std::size_t i = at; i < e; ++i) acc |= h[i];
-    if (acc & 0x7fffu) return false;
-  }
-  return true;
-}
-bool floats_all_zero(const float* a, std::size_t n) {
-  for (std::size_t at = 0; at < n; at += kZeroScanBlock) {
-    const std::size_t e = std::min(n, at + kZeroScanBlock);
-    std::uint32_t acc = 0;
+    unsigned other = 0, nan = 0;
     for (std::size_t i = at; i < e; ++i) {
-      std::uint32_t b;
-      std::memcpy(&b, a + i, sizeof b);
-      acc |= b;
+      const auto [is_zero, is_nan] = classify(p[i]);
+      other |= static_cast<unsigned>(!is_zero & !is_nan);
+      nan |= static_cast<unsigned>(is_nan);
     }
-    if (acc & 0x7fffffffu) return false;
+    if (other) return kPlaneStored;
+    any_nan = any_nan || nan;
   }
-  return true;
+  return any_nan ? kPlaneNanMask : kPlaneZero;
 }
-// Whether float_to_half(a[i] * k) is zero (of either sign) for every i: the product's magnitude is
-// at most 2^-25 (0x33000000), which rounds to zero, to even at the tie; NaN is not.
-bool floats_round_to_zero_halves(const float* a, float k, std::size_t n) {
-  for (std::size_t at = 0; at < n; at += kZeroScanBlock) {
-    const std::size_t e = std::min(n, at + kZeroScanBlock);
-    std::uint32_t most = 0;
-    for (std::size_t i = at; i < e; ++i) {
-      const float x = a[i] * k;
-      std::uint32_t b;
-      std::memcpy(&b, &x, sizeof b);
-      most = std::max(most, b & 0x7fffffffu);
-    }
-    if (most > 0x33000000u) return false;
+struct ZeroNan {
+  bool zero, nan;
+};
+// Held half floats: zero is +-0, NaN is an exponent of all ones with a mantissa.
+ZeroNan half_zero_nan(std::uint16_t h) {
+  const unsigned m = h & 0x7fffu;
+  return {m == 0, m > 0x7c00u};
+}
+// float32 as stored.
+ZeroNan float_zero_nan(float x) {
+  std::uint32_t b;
+  std::memcpy(&b, &x, sizeof b);
+  b &= 0x7fffffffu;
+  return {b == 0, b > 0x7f800000u};
+}
+// float32 to be stored as float_to_half(x * k): zero where the product's magnitude is at most 2^-25
+// (0x33000000), which rounds to zero, to even at the tie.
+struct FloatHalfZeroNan {
+  float k;
+  ZeroNan operator()(float x) const {
+    const float y = x * k;
+    std::uint32_t b;
+    std::memcpy(&b, &y, sizeof b);
+    b &= 0x7fffffffu;
+    return {b <= 0x33000000u, b > 0x7f800000u};
   }
-  return true;
+};
+// The mask of a kPlaneNanMask plane, into `mask` (cvvol_mask_bytes(n) bytes).
+template <class IsNan>
+void nan_mask(std::size_t n, IsNan is_nan, std::vector<std::uint8_t>& mask) {
+  mask.assign(cvvol_mask_bytes(n), 0);
+  for (std::size_t i = 0; i < n; ++i) mask[i / 8] |= static_cast<std::uint8_t>(is_nan(i) << (i % 8));
 }
 
 void write_cvvol_to(const std::function<void(const std::string&, const std::function<void(std::FILE*)>&)>& writer,
@@ -220,8 +238,10 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
                              "],\n \"fields\": " + fields + "],\n \"maps\": " + maps +
                              "],\n \"layout\": \"" + (half ? "fields float16, maps float32" : "float32") +
                              " little-endian; per time step, a plane table (a byte per field and level, 1 = "
-                             "stored, 0 = all zero and left out; padded to 8 bytes), each field's stored levels (lon "
-                             "fastest, then lat), then each map (lon fastest, then lat); NaN = no data\"}\n";
+                             "stored, 0 = all zero and left out, 2 = zeros and NaNs only, stored as a bit mask of the "
+                             "NaNs, bit i % 8 of byte i / 8, padded to 8 bytes; the table padded to 8 bytes), each "
+                             "field's stored levels (lon fastest, then lat), then each map (lon fastest, then lat); "
+                             "NaN = no data\"}\n";
   // Padded so the data starts 8-byte aligned (magic 8 + length 8 + header): the half floats are
   // then converted in place in the write queue.
   header.pop_back();  // the closing newline, put back after the spaces
@@ -248,11 +268,11 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
       if (v.has_field[static_cast<std::size_t>(i)]) order.push_back(i);
     }
     const std::size_t table_bytes = cvvol_plane_table_bytes(order.size(), levels);
-    std::vector<std::uint8_t> table(table_bytes);
+    std::vector<std::uint8_t> table(table_bytes), mask;
     for (std::size_t t = 0; t < v.times.size(); ++t) {
       if (progress) progress(t, v.times.size());
       const TimeStepData& d = v.step(t);
-      // The step's plane table: which (field, level) planes hold a value other than zero.
+      // The step's plane table: which (field, level) planes hold a value other than zero or NaN.
       std::fill(table.begin(), table.end(), std::uint8_t{0});
       for (std::size_t fi = 0; fi < order.size(); ++fi) {
         const int i = order[fi];
@@ -261,12 +281,13 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
         if (a.size() != v.grid.points() && h.size() != v.grid.points()) {
           throw std::runtime_error(std::string("field ") + field_name(static_cast<Field>(i)) + " has the wrong size");
         }
+        const float k = half_scale(i);
         for (std::size_t z = 0; z < levels; ++z) {
-          bool zero;
-          if (a.size() != v.grid.points()) zero = halves_all_zero(h.data() + z * cols, cols);
-          else if (half) zero = floats_round_to_zero_halves(a.data() + z * cols, half_scale(i), cols);
-          else zero = floats_all_zero(a.data() + z * cols, cols);
-          table[fi * levels + z] = zero ? 0 : 1;
+          PlaneCode code;
+          if (a.size() != v.grid.points()) code = plane_code(h.data() + z * cols, cols, half_zero_nan);
+          else if (half) code = plane_code(a.data() + z * cols, cols, FloatHalfZeroNan{k});
+          else code = plane_code(a.data() + z * cols, cols, float_zero_nan);
+          table[fi * levels + z] = code;
         }
       }
       out.write(table.data(), table.size());
@@ -274,14 +295,26 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
         const int i = order[fi];
         const auto& a_all = d.fields[static_cast<std::size_t>(i)];
         const auto& h_all = d.halves[static_cast<std::size_t>(i)];
-        // Each run of consecutive stored planes, as one span of the field.
+        // Each run of consecutive stored planes, as one span of the field; a NaN mask in its place.
         for (std::size_t z0 = 0; z0 < levels;) {
-          if (!table[fi * levels + z0]) {
+          if (table[fi * levels + z0] == kPlaneZero) {
+            ++z0;
+            continue;
+          }
+          if (table[fi * levels + z0] == kPlaneNanMask) {
+            if (a_all.size() != v.grid.points()) {
+              const std::uint16_t* p = h_all.data() + z0 * cols;
+              nan_mask(cols, [p](std::size_t j) { return half_zero_nan(p[j]).nan; }, mask);
+            } else {
+              const float* p = a_all.data() + z0 * cols;
+              nan_mask(cols, [p](std::size_t j) { return std::isnan(p[j]); }, mask);
+            }
+            out.write(mask.data(), mask.size());
             ++z0;
             continue;
           }
           std::size_t z1 = z0 + 1;
-          while (z1 < levels && table[fi * levels + z1]) ++z1;
+          while (z1 < levels && table[fi * levels + z1] == kPlaneStored) ++z1;
           const std::size_t first = z0 * cols, count = (z1 - z0) * cols;
           z0 = z1;
           if (a_all.size() != v.grid.points()) {
@@ -548,26 +581,32 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
     throw VolumeFileError(path + ": holds " + std::to_string(size) + " bytes, expected " + expected + " for its header's " +
                           std::to_string(v.times.size()) + " time step(s) (truncated?)");
   };
-  // The table at `at`, checked: every byte 0 or 1, the padding 0. Returns the planes stored.
+  // The table at `at`, checked: every byte 0, 1 or 2, the padding 0. Counts the planes stored and
+  // the NaN masks.
+  struct TableCount {
+    std::uint64_t planes = 0, masks = 0;
+  };
   const auto read_table = [path, table_bytes, n = order.size() * levels](std::FILE* file, std::uint64_t at, std::size_t t,
                                                                        std::vector<std::uint8_t>& table) {
     table.resize(table_bytes);
     if (std::fseek(file, static_cast<long>(at), SEEK_SET) != 0 || std::fread(table.data(), 1, table_bytes, file) != table_bytes) {
       throw VolumeFileError(path + ": truncated in the plane table of time step " + std::to_string(t));
     }
-    std::uint64_t stored = 0;
+    TableCount c;
     for (std::size_t k = 0; k < table_bytes; ++k) {
-      if (table[k] > (k < n ? 1 : 0)) {
+      if (table[k] > (k < n ? kPlaneNanMask : 0)) {
         throw VolumeFileError(path + ": plane table of time step " + std::to_string(t) + ", byte " + std::to_string(k) +
-                              ": found " + std::to_string(table[k]) + ", expected " + (k < n ? "0 or 1" : "0 (padding)"));
+                              ": found " + std::to_string(table[k]) + ", expected " + (k < n ? "0, 1 or 2" : "0 (padding)"));
       }
-      stored += table[k];
+      c.planes += table[k] == kPlaneStored;
+      c.masks += table[k] == kPlaneNanMask;
     }
-    return stored;
+    return c;
   };
   std::vector<std::uint64_t> starts;
   const std::uint64_t all_planes = static_cast<std::uint64_t>(order.size()) * levels * v.times.size();
-  std::uint64_t stored_planes = sparse ? 0 : all_planes;
+  std::uint64_t stored_planes = sparse ? 0 : all_planes, mask_planes = 0;
+  const std::uint64_t mask_bytes = cvvol_mask_bytes(cols);
   if (!sparse) {
     const std::uint64_t step_bytes = *field_bytes + *map_bytes;
     const auto payload = checked_product({step_bytes, v.times.size()});
@@ -581,10 +620,12 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
     for (std::size_t t = 0; t < v.times.size(); ++t) {
       if (at > size || size - at < table_bytes) refuse_size("more");
       starts.push_back(at);
-      const std::uint64_t stored = read_table(f, at, t, table);
-      stored_planes += stored;
-      // stored <= fields x levels, whose bytes were checked above; so is the sum below 2^64.
-      const std::uint64_t step = table_bytes + stored * plane_bytes + *map_bytes;
+      const TableCount c = read_table(f, at, t, table);
+      stored_planes += c.planes;
+      mask_planes += c.masks;
+      // planes + masks <= fields x levels, whose bytes were checked above (a mask is smaller than
+      // a plane); so is the sum below 2^64.
+      const std::uint64_t step = table_bytes + c.planes * plane_bytes + c.masks * mask_bytes + *map_bytes;
       if (size - at < step) refuse_size("more");
       at += step;
     }
@@ -595,12 +636,13 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   // What `cloudviewer info` says of the storage.
   v.report.notes.push_back(std::string("storage: ") + (half ? "float16" : "float32") + " fields, " +
                            std::to_string(stored_planes) + " of " + std::to_string(all_planes) + " field planes stored" +
-                           (sparse ? " (" + std::to_string(all_planes - stored_planes) + " holding only zeros left out)"
+                           (sparse ? " (" + std::to_string(mask_planes) + " of zeros and no data as masks, " +
+                                         std::to_string(all_planes - stored_planes - mask_planes) + " holding only zeros left out)"
                                    : " (version 1: every plane stored)"));
   v.set_loader(
       [file, order, starts, read_table, levels, points, cols, half, sparse, ground = v.has_ground, path](
           std::size_t t, ImportReport&, TimeStepData& out) {
-        std::vector<std::uint8_t> table;
+        std::vector<std::uint8_t> table, mask(sparse ? cvvol_mask_bytes(cols) : 0);
         if (sparse) {
           read_table(file.get(), starts[t], t, table);  // and leaves the file after it
         } else if (std::fseek(file.get(), static_cast<long>(starts[t]), SEEK_SET) != 0) {
@@ -615,8 +657,21 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
           a.resize(points);
           for (std::size_t z = 0; z < levels; ++z) {
             float* plane = a.data() + z * cols;
-            if (sparse && !table[fi * levels + z]) {
+            if (sparse && table[fi * levels + z] == kPlaneZero) {
               std::fill(plane, plane + cols, 0.0f);
+            } else if (sparse && table[fi * levels + z] == kPlaneNanMask) {
+              if (std::fread(mask.data(), 1, mask.size(), file.get()) != mask.size()) throw truncated();
+              // Its bits past the plane's values are zero, as written.
+              for (std::size_t j = cols; j < mask.size() * 8; ++j) {
+                if ((mask[j / 8] >> (j % 8)) & 1u) {
+                  throw VolumeFileError(path + ": NaN mask of time step " + std::to_string(t) + ", field " +
+                                        field_name(static_cast<Field>(i)) + ", level " + std::to_string(z) + ": bit " +
+                                        std::to_string(j) + " past its " + std::to_string(cols) + " values is set, expected 0");
+                }
+              }
+              for (std::size_t j = 0; j < cols; ++j) {
+                plane[j] = (mask[j / 8] >> (j % 8)) & 1u ? std::numeric_limits<float>::quiet_NaN() : 0.0f;
+              }
             } else if (half) {
               const float k = 1.0f / half_scale(i);
               for (std::size_t at = 0; at < cols; at += buf.size()) {

@@ -240,18 +240,21 @@ TEST(VolumeIo, CvvolHeaderAndPayloadAndVti) {
   EXPECT_NE(header.find("\"version\": 2, \"zero_planes\": \"left out\""), std::string::npos) << header;
   EXPECT_EQ((16 + len) % 8, 0u) << "the data starts 8-byte aligned";
   // Step 0: the plane table (one field, 3 levels, padded to 8 bytes); the first level (0.1 x 0)
-  // is zero and left out.
+  // is zero and left out, the third (NaN only) is a mask of its one column.
   std::uint8_t table[8];
   in.read(reinterpret_cast<char*>(table), sizeof table);
-  const std::uint8_t expected_table[8] = {0, 1, 1, 0, 0, 0, 0, 0};
+  const std::uint8_t expected_table[8] = {0, 1, 2, 0, 0, 0, 0, 0};
   EXPECT_EQ(std::memcmp(table, expected_table, 8), 0);
-  float first[2];
-  in.read(reinterpret_cast<char*>(first), sizeof first);
-  EXPECT_EQ(first[0], 0.5f);
-  EXPECT_TRUE(std::isnan(first[1]));
-  // Per step: the table, the stored values (2, then 3) and 7 one-column maps.
+  float first;
+  in.read(reinterpret_cast<char*>(&first), sizeof first);
+  EXPECT_EQ(first, 0.5f);
+  std::uint8_t mask[8];
+  in.read(reinterpret_cast<char*>(mask), sizeof mask);
+  const std::uint8_t expected_mask[8] = {1, 0, 0, 0, 0, 0, 0, 0};
+  EXPECT_EQ(std::memcmp(mask, expected_mask, 8), 0);
+  // Per step: the table, the stored values (1, then 2), the mask and 7 one-column maps.
   in.seekg(0, std::ios::end);
-  EXPECT_EQ(static_cast<std::uint64_t>(in.tellg()), 16 + len + 8 * 2 + (2 + 7 + 3 + 7) * sizeof(float));
+  EXPECT_EQ(static_cast<std::uint64_t>(in.tellg()), 16 + len + 8 * 2 + (1 + 7 + 2 + 7) * sizeof(float) + 8 * 2);
   {
     CloudVolume r = read_cvvol(path);
     const std::vector<float>& back = r.step(0)[Field::CloudFraction];
@@ -342,10 +345,17 @@ TEST(VolumeIo, CvvolLeavesOutPlanesOfZeros) {
   at(cf, 4, 1) = tie;
   at(cf, 4, 4) = -tie;
   at(cf, 5, 2) = 3.0e-8f;  // just past the tie: the least half float
-  at(liquid, 3, 5) = NAN;  // one NaN keeps its plane
-  at(liquid, 5, 0) = 1e-12f;  // 1e-9 /km: zero as a half float
-  const std::vector<std::vector<std::uint8_t>> stored_f32 = {{1, 0, 0, 1, 1, 1}, {0, 0, 0, 1, 0, 1}, {1, 1, 1, 1, 1, 1}};
-  const std::vector<std::vector<std::uint8_t>> stored_f16 = {{1, 0, 0, 0, 0, 1}, {0, 0, 0, 1, 0, 0}, {1, 1, 1, 1, 1, 1}};
+  for (std::size_t c = 0; c < cols; ++c) at(cf, 1, c) = NAN;  // no data at all: a mask of NaNs
+  at(liquid, 1, 0) = NAN;       // NaN with infinity: stored
+  at(liquid, 1, 1) = INFINITY;
+  at(liquid, 2, 2) = NAN;       // NaN with zeros and a value that is zero only as a half float
+  at(liquid, 2, 3) = -0.0f;
+  at(liquid, 2, 4) = 1e-12f;
+  at(liquid, 3, 5) = NAN;       // NaN with zeros: a mask
+  at(liquid, 5, 0) = 1e-12f;    // 1e-9 /km: zero as a half float
+  // 0: left out (zeros), 1: stored, 2: a mask of the NaNs among zeros.
+  const std::vector<std::vector<std::uint8_t>> stored_f32 = {{1, 2, 0, 1, 1, 1}, {0, 1, 1, 2, 0, 1}, {1, 1, 1, 1, 1, 1}};
+  const std::vector<std::vector<std::uint8_t>> stored_f16 = {{1, 2, 0, 0, 0, 1}, {0, 1, 2, 2, 0, 0}, {1, 1, 1, 1, 1, 1}};
   const auto volume = [&](bool as_halves) {
     CloudVolume v;
     v.grid.lon_deg = {0.0, 1.0, 3};
@@ -385,20 +395,23 @@ TEST(VolumeIo, CvvolLeavesOutPlanesOfZeros) {
     // The table's fields come in the header's order, the fields' own (Field) order.
     std::vector<std::pair<Field, std::size_t>> order = {{cf, 0}, {liquid, 1}, {temp, 2}};
     std::sort(order.begin(), order.end());
-    std::size_t planes = 0;
+    std::size_t planes = 0, masks = 0;
     for (std::size_t fi = 0; fi < 3; ++fi) {
       for (std::size_t z = 0; z < levels; ++z) {
         const int want = expected[order[fi].second][z];
         EXPECT_EQ(static_cast<int>(bytes[16 + len + fi * levels + z]), want) << field_name(order[fi].first) << " level " << z;
-        planes += static_cast<std::size_t>(want);
+        planes += want == 1;
+        masks += want == 2;
       }
     }
-    EXPECT_EQ(bytes.size(), 16 + len + 24 + planes * cols * (f16 ? 2 : 4) + 7 * cols * 4);
+    // A mask of 6 values takes 8 bytes (a byte, padded to 8).
+    EXPECT_EQ(bytes.size(), 16 + len + 24 + planes * cols * (f16 ? 2 : 4) + masks * 8 + 7 * cols * 4);
     CloudVolume r = read_cvvol(path);
     // What `info` prints of the storage.
     ASSERT_EQ(r.report.notes.size(), 1u);
     EXPECT_EQ(r.report.notes[0], std::string("storage: ") + (f16 ? "float16" : "float32") + " fields, " +
-                                     std::to_string(planes) + " of 18 field planes stored (" + std::to_string(18 - planes) +
+                                     std::to_string(planes) + " of 18 field planes stored (" + std::to_string(masks) +
+                                     " of zeros and no data as masks, " + std::to_string(18 - planes - masks) +
                                      " holding only zeros left out)");
     for (Field f : {cf, liquid, temp}) {
       const auto& back = r.step(0)[f];
@@ -426,9 +439,16 @@ TEST(VolumeIo, CvvolLeavesOutPlanesOfZeros) {
       std::size_t from = 16 + len + 24;
       for (std::size_t fi = 0; fi < 3; ++fi) {
         for (std::size_t z = 0; z < levels; ++z) {
-          if (bytes[16 + len + fi * levels + z]) {
+          if (bytes[16 + len + fi * levels + z] == 1) {
             v1 += bytes.substr(from, cols * 4);
             from += cols * 4;
+          } else if (bytes[16 + len + fi * levels + z] == 2) {
+            // The mask's bits, LSB first, to NaN or +0.
+            for (std::size_t c = 0; c < cols; ++c) {
+              const float x = (static_cast<unsigned char>(bytes[from + c / 8]) >> (c % 8)) & 1u ? std::numeric_limits<float>::quiet_NaN() : 0.0f;
+              v1.append(reinterpret_cast<const char*>(&x), sizeof x);
+            }
+            from += 8;
           } else {
             v1 += std::string(cols * 4, '\0');
           }
@@ -466,12 +486,12 @@ TEST(VolumeIo, CvvolLeavesOutPlanesOfZeros) {
       // Corrupt plane tables: a byte other than 0 or 1, padding that is not zero, a table that
       // claims a plane the file does not hold.
       const std::pair<std::size_t, std::string> cases[] = {
-          {0, ": plane table of time step 0, byte 0: found 2, expected 0 or 1"},
-          {20, ": plane table of time step 0, byte 20: found 2, expected 0 (padding)"},
+          {0, ": plane table of time step 0, byte 0: found 3, expected 0, 1 or 2"},
+          {20, ": plane table of time step 0, byte 20: found 3, expected 0 (padding)"},
       };
       for (const auto& [byte, message] : cases) {
         std::string bad = bytes;
-        bad[16 + len + byte] = 2;
+        bad[16 + len + byte] = 3;
         std::ofstream(path2, std::ios::binary | std::ios::trunc) << bad;
         try {
           read_cvvol(path2);
@@ -480,8 +500,35 @@ TEST(VolumeIo, CvvolLeavesOutPlanesOfZeros) {
           EXPECT_EQ(std::string(e.what()), path2 + message);
         }
       }
+      // A mask with a bit set past the plane's values, found when the step is read.
+      std::size_t offset = 16 + len + 24, mask_field = 0, mask_level = 0;
+      bool found = false;
+      for (std::size_t fi = 0; fi < 3 && !found; ++fi) {
+        for (std::size_t z = 0; z < levels && !found; ++z) {
+          const int code = bytes[16 + len + fi * levels + z];
+          if (code == 2) {
+            found = true;
+            mask_field = fi;
+            mask_level = z;
+          } else {
+            offset += code == 1 ? cols * 2 : 0;
+          }
+        }
+      }
+      ASSERT_TRUE(found);
+      std::string stray = bytes;
+      stray[offset] = static_cast<char>(stray[offset] | 0x80);
+      std::ofstream(path2, std::ios::binary | std::ios::trunc) << stray;
+      CloudVolume sv = read_cvvol(path2);
+      try {
+        sv.step(0);
+        ADD_FAILURE() << "a stray mask bit accepted";
+      } catch (const VolumeFileError& e) {
+        EXPECT_EQ(std::string(e.what()), path2 + ": NaN mask of time step 0, field " + field_name(order[mask_field].first) +
+                                             ", level " + std::to_string(mask_level) + ": bit 7 past its 6 values is set, expected 0");
+      }
       std::string more = bytes;
-      more[16 + len + 1] = 1;
+      more[16 + len + 2] = 1;  // cloud fraction's level 2, left out
       std::ofstream(path2, std::ios::binary | std::ios::trunc) << more;
       try {
         read_cvvol(path2);
