@@ -558,10 +558,10 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   const auto field_bytes = field_values ? checked_product({*field_values, value_bytes}) : std::nullopt;
   const auto map_bytes = map_values ? checked_product({*map_values, sizeof(float)}) : std::nullopt;
   if (!field_bytes || !map_bytes) throw VolumeFileError(path + ": one time step's size overflows 64 bits");
-  // Version 1 stores every plane; version 2 ("zero_planes": "left out") starts each step with a
-  // plane table and leaves out the planes whose values are all zero, so its steps' sizes differ:
-  // each step's table is read here to find where the step starts, and the sizes must add up to
-  // the file's.
+  // Version 1 stores every plane; version 2 starts each step with a plane table, leaves out the
+  // planes whose values are all zero and stores planes of zeros and NaN as masks, so its steps'
+  // sizes differ: each step's table is read here to find where the step starts, and the sizes
+  // must add up to the file's.
   double version = 1;
   if (header.find("\"version\":") != std::string::npos) version = json_number(header, "version", 0, path);
   if (version != 1 && version != 2) {
