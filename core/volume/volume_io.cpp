@@ -258,7 +258,9 @@ void write_cvvol_to(const std::function<void(const std::string&, const std::func
     wo.direct = bytes >= kDirectWriteBytes;
     if (!wo.direct) wo.chunk_bytes = std::size_t(1) << 20;  // a small file: a small queue (4 MB)
     BackgroundWriter out(f, wo);
-    out.write("CVVOL01\n", 8);
+    // Version 2's own magic: a reader of version 1 (which ignores the header's version) refuses
+    // the file instead of misreading it.
+    out.write("CVVOL02\n", 8);
     const std::uint64_t len = header.size();
     out.write(&len, sizeof len);
     out.write(header.data(), header.size());
@@ -489,9 +491,10 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
   std::shared_ptr<std::FILE> file(f, [](std::FILE* p) { std::fclose(p); });
   char magic[8];
   std::uint64_t len = 0;
-  if (std::fread(magic, 1, 8, f) != 8 || std::memcmp(magic, "CVVOL01\n", 8) != 0) {
-    throw VolumeFileError(path + ": not a cloud volume (expected the CVVOL01 header of a .cvvol file)");
+  if (std::fread(magic, 1, 8, f) != 8 || (std::memcmp(magic, "CVVOL01\n", 8) != 0 && std::memcmp(magic, "CVVOL02\n", 8) != 0)) {
+    throw VolumeFileError(path + ": not a cloud volume (expected the CVVOL01 or CVVOL02 header of a .cvvol file)");
   }
+  const int magic_version = magic[6] - '0';
   if (std::fread(&len, sizeof len, 1, f) != 1 || len > (1u << 26)) throw VolumeFileError(path + ": truncated or corrupt header");
   std::string header(len, '\0');
   if (std::fread(header.data(), 1, len, f) != len) throw VolumeFileError(path + ": truncated header");
@@ -569,6 +572,10 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
     std::snprintf(found, sizeof found, "%.17g", version);
     throw VolumeFileError(path + ": header key 'version': found " + found + ", expected 1 or 2 (written by a newer cloudviewer?)");
   }
+  if (version != magic_version) {
+    throw VolumeFileError(path + ": header key 'version': found " + std::to_string(static_cast<int>(version)) + ", expected " +
+                          std::to_string(magic_version) + " in a file that starts CVVOL0" + std::to_string(magic_version));
+  }
   const bool sparse = version == 2;
   const std::size_t levels = static_cast<std::size_t>(v.grid.alt_m.count);
   const std::size_t table_bytes = sparse ? cvvol_plane_table_bytes(order.size(), levels) : 0;
@@ -623,8 +630,8 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
       const TableCount c = read_table(f, at, t, table);
       stored_planes += c.planes;
       mask_planes += c.masks;
-      // planes + masks <= fields x levels, whose bytes were checked above (a mask is smaller than
-      // a plane); so is the sum below 2^64.
+      // planes + masks <= fields x levels, and a mask's bytes <= 8 + a float16 plane's: bounded by
+      // the step's memory checked above, so the sum stays far below 2^64.
       const std::uint64_t step = table_bytes + c.planes * plane_bytes + c.masks * mask_bytes + *map_bytes;
       if (size - at < step) refuse_size("more");
       at += step;
@@ -661,7 +668,13 @@ CloudVolume read_cvvol(const std::string& path, std::size_t cache_steps) {
               std::fill(plane, plane + cols, 0.0f);
             } else if (sparse && table[fi * levels + z] == kPlaneNanMask) {
               if (std::fread(mask.data(), 1, mask.size(), file.get()) != mask.size()) throw truncated();
-              // Its bits past the plane's values are zero, as written.
+              // At least one NaN (a plane of zeros is left out), and its bits past the plane's
+              // values zero, as written.
+              if (std::all_of(mask.begin(), mask.end(), [](std::uint8_t b) { return b == 0; })) {
+                throw VolumeFileError(path + ": NaN mask of time step " + std::to_string(t) + ", field " +
+                                      field_name(static_cast<Field>(i)) + ", level " + std::to_string(z) +
+                                      ": no bit set, expected at least one (a plane of zeros is left out)");
+              }
               for (std::size_t j = cols; j < mask.size() * 8; ++j) {
                 if ((mask[j / 8] >> (j % 8)) & 1u) {
                   throw VolumeFileError(path + ": NaN mask of time step " + std::to_string(t) + ", field " +

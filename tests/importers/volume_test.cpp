@@ -230,7 +230,7 @@ TEST(VolumeIo, CvvolHeaderAndPayloadAndVti) {
   std::ifstream in(path, std::ios::binary);
   std::string magic(8, '\0');
   in.read(magic.data(), 8);
-  EXPECT_EQ(magic, "CVVOL01\n");
+  EXPECT_EQ(magic, "CVVOL02\n");
   std::uint64_t len = 0;
   in.read(reinterpret_cast<char*>(&len), 8);
   std::string header(len, '\0');
@@ -263,6 +263,12 @@ TEST(VolumeIo, CvvolHeaderAndPayloadAndVti) {
     EXPECT_FALSE(std::signbit(back[0]));
     EXPECT_EQ(back[1], 0.5f);
     EXPECT_TRUE(std::isnan(back[2]));
+    // The second step, found after the first's smaller one.
+    const std::vector<float>& second = r.step(1)[Field::CloudFraction];
+    ASSERT_EQ(second.size(), 3u);
+    EXPECT_EQ(second[0], 0.1f);
+    EXPECT_EQ(second[1], 0.5f);
+    EXPECT_TRUE(std::isnan(second[2]));
   }
   // No temporary file left behind.
   int files = 0;
@@ -431,6 +437,7 @@ TEST(VolumeIo, CvvolLeavesOutPlanesOfZeros) {
     if (!f16) {
       // Version 1 (every plane stored, no table) is still read: the same file made dense by hand.
       std::string v1 = bytes.substr(0, 16 + len);
+      v1.replace(0, 8, "CVVOL01\n");
       const std::string key = "\"version\": 2, \"zero_planes\": \"left out\",";
       const std::size_t k = v1.find(key);
       ASSERT_NE(k, std::string::npos);
@@ -476,6 +483,16 @@ TEST(VolumeIo, CvvolLeavesOutPlanesOfZeros) {
       } catch (const VolumeFileError& e) {
         EXPECT_EQ(std::string(e.what()), path1 + ": header key 'version': found 3, expected 1 or 2 (written by a newer cloudviewer?)");
       }
+      // A version 1 header in a version 2 file (or the other way) is refused.
+      std::string mixed = bytes;
+      mixed.replace(mixed.find(key), 12, "\"version\": 1");
+      std::ofstream(path1, std::ios::binary | std::ios::trunc) << mixed;
+      try {
+        read_cvvol(path1);
+        ADD_FAILURE() << "version 1 in a CVVOL02 file accepted";
+      } catch (const VolumeFileError& e) {
+        EXPECT_EQ(std::string(e.what()), path1 + ": header key 'version': found 1, expected 2 in a file that starts CVVOL02");
+      }
     }
     if (f16) {
       // The import's way: the same step held as half floats gives the same file.
@@ -483,7 +500,22 @@ TEST(VolumeIo, CvvolLeavesOutPlanesOfZeros) {
       CloudVolume held = volume(true);
       write_cvvol(path2, held, {}, CvvolEncoding::Float16);
       EXPECT_TRUE(file_bytes(path2) == bytes);
-      // Corrupt plane tables: a byte other than 0 or 1, padding that is not zero, a table that
+      // Held half floats written as float32: the planes as the halves have them.
+      {
+        const std::string path3 = (dir / "held32.cvvol").string();
+        CloudVolume held32 = volume(true);
+        write_cvvol(path3, held32, {}, CvvolEncoding::Float32);
+        const std::string b32 = file_bytes(path3);
+        std::uint64_t len32 = 0;
+        std::memcpy(&len32, b32.data() + 8, 8);
+        for (std::size_t fi = 0; fi < 3; ++fi) {
+          for (std::size_t z = 0; z < levels; ++z) {
+            EXPECT_EQ(static_cast<int>(b32[16 + len32 + fi * levels + z]), stored_f16[order[fi].second][z])
+                << "float32 from halves, " << field_name(order[fi].first) << " level " << z;
+          }
+        }
+      }
+      // Corrupt plane tables: a byte other than 0, 1 or 2, padding that is not zero, a table that
       // claims a plane the file does not hold.
       const std::pair<std::size_t, std::string> cases[] = {
           {0, ": plane table of time step 0, byte 0: found 3, expected 0, 1 or 2"},
@@ -527,6 +559,19 @@ TEST(VolumeIo, CvvolLeavesOutPlanesOfZeros) {
         EXPECT_EQ(std::string(e.what()), path2 + ": NaN mask of time step 0, field " + field_name(order[mask_field].first) +
                                              ", level " + std::to_string(mask_level) + ": bit 7 past its 6 values is set, expected 0");
       }
+      // A mask with no bit set (such a plane is left out instead).
+      std::string empty_mask = bytes;
+      empty_mask[offset] = 0;
+      std::ofstream(path2, std::ios::binary | std::ios::trunc) << empty_mask;
+      CloudVolume ev = read_cvvol(path2);
+      try {
+        ev.step(0);
+        ADD_FAILURE() << "an empty mask accepted";
+      } catch (const VolumeFileError& e) {
+        EXPECT_EQ(std::string(e.what()), path2 + ": NaN mask of time step 0, field " + field_name(order[mask_field].first) +
+                                             ", level " + std::to_string(mask_level) +
+                                             ": no bit set, expected at least one (a plane of zeros is left out)");
+      }
       std::string more = bytes;
       more[16 + len + 2] = 1;  // cloud fraction's level 2, left out
       std::ofstream(path2, std::ios::binary | std::ios::trunc) << more;
@@ -538,6 +583,50 @@ TEST(VolumeIo, CvvolLeavesOutPlanesOfZeros) {
             << e.what();
       }
     }
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(VolumeIo, CvvolMasksLongerThanAByte) {
+  // 70 columns: a mask of 9 bytes of bits, padded to 16; NaN at columns 0, 9, 64 and 69.
+  const auto dir = cv::test::temp_dir("volume_masks");
+  const std::size_t cols = 70;
+  std::vector<float> cf(cols * 2, 0.0f);
+  for (std::size_t c : {0, 9, 64, 69}) cf[c] = NAN;
+  for (std::size_t c = 0; c < cols; ++c) cf[cols + c] = 0.5f;
+  CloudVolume v;
+  v.grid.lon_deg = {0.0, 1.0, static_cast<int>(cols)};
+  v.grid.lat_deg = {0.0, 1.0, 1};
+  v.grid.alt_m = {0.0, 1000.0, 2};
+  v.times = {{0, "1970-01-01T00:00:00Z"}};
+  v.has_field[static_cast<std::size_t>(Field::CloudFraction)] = true;
+  v.set_loader([&cf](std::size_t, ImportReport&, TimeStepData& d) { d[Field::CloudFraction] = cf; });
+  const std::string path = (dir / "m.cvvol").string();
+  write_cvvol(path, v, {}, CvvolEncoding::Float16);
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string bytes = ss.str();
+  std::uint64_t len = 0;
+  std::memcpy(&len, bytes.data() + 8, 8);
+  EXPECT_EQ(bytes[16 + len], 2);
+  EXPECT_EQ(bytes[16 + len + 1], 1);
+  std::array<std::uint8_t, 16> want{};
+  want[0] = 0x01;  // column 0
+  want[1] = 0x02;  // column 9
+  want[8] = 0x21;  // columns 64 and 69
+  EXPECT_EQ(std::memcmp(bytes.data() + 16 + len + 8, want.data(), want.size()), 0);
+  EXPECT_EQ(bytes.size(), 16 + len + 8 + 16 + cols * 2 + 7 * cols * 4);
+  CloudVolume r = read_cvvol(path);
+  const auto& back = r.step(0)[Field::CloudFraction];
+  ASSERT_EQ(back.size(), cols * 2);
+  for (std::size_t i = 0; i < cols; ++i) {
+    const bool nan = i == 0 || i == 9 || i == 64 || i == 69;
+    EXPECT_EQ(std::isnan(back[i]), nan) << i;
+    if (!nan) {
+      EXPECT_EQ(back[i], 0.0f) << i;
+    }
+    EXPECT_NEAR(back[cols + i], 0.5f, 1e-3f) << i;
   }
   std::filesystem::remove_all(dir);
 }
