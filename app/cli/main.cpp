@@ -107,7 +107,9 @@ void print_usage() {
   std::printf("  help COMMAND             that command's usage (as COMMAND --help)\n");
   std::printf("  --version                print the version\n");
   std::printf("environment: CLOUDVIEWER_MEMORY_LIMIT  the most memory one input may ask for (bytes, or 512M, 4G, ...;\n"
-              "                           default half the machine's memory); larger declared sizes are refused\n");
+              "                           default half the machine's memory); larger declared sizes are refused\n"
+              "             CLOUDVIEWER_THREADS       worker threads per parallel pass (default one per core)\n"
+              "             CLOUDVIEWER_CPU=baseline  no AVX paths (the same output, more slowly; for checks)\n");
 }
 
 // `cloudviewer COMMAND --help`: that command's usage, exit 0. False for an unknown command.

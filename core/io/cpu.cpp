@@ -1,6 +1,10 @@
 // CPUID and XCR0, read once.
 #include "io/cpu.hpp"
 
+#include <atomic>
+#include <cstdlib>
+#include <cstring>
+
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <cpuid.h>
 #endif
@@ -24,16 +28,30 @@ bool cpu_has(unsigned want) {
 #endif
 }
 constexpr unsigned kOsxsave = 1u << 27, kAvx = 1u << 28, kF16c = 1u << 29;
+
+std::atomic<bool> forced_baseline{false};
+
+bool environment_asks_baseline() {
+  static const bool asked = [] {
+    const char* v = std::getenv("CLOUDVIEWER_CPU");
+    return v && std::strcmp(v, "baseline") == 0;
+  }();
+  return asked;
+}
 }  // namespace
+
+void set_baseline_cpu(bool on) { forced_baseline.store(on, std::memory_order_relaxed); }
+
+bool baseline_cpu() { return environment_asks_baseline() || forced_baseline.load(std::memory_order_relaxed); }
 
 bool cpu_has_avx() {
   static const bool has = cpu_has(kOsxsave | kAvx);
-  return has;
+  return has && !baseline_cpu();
 }
 
 bool cpu_has_avx_f16c() {
   static const bool has = cpu_has(kOsxsave | kAvx | kF16c);
-  return has;
+  return has && !baseline_cpu();
 }
 
 }  // namespace cv::core
