@@ -29,6 +29,7 @@
 #include "reference/earth_shadow.hpp"
 #include "render/context.hpp"
 #include "render/frame_renderer.hpp"
+#include "render/exr_output.hpp"
 #include "render/image_output.hpp"
 #include "render/shader_loader.hpp"
 #include "scene/camera_path.hpp"
@@ -59,6 +60,7 @@ struct RecordArgs {
   bool spp_given = false;
   int crf = 18;
   bool vdb = false;  // --vdb: each frame's medium as OpenVDB grids beside its PNG
+  bool exr = false;  // --exr: each frame's linear radiance (and coverage) as OpenEXR beside its PNG
 };
 
 int parse_whole(const std::string& option, const std::string& text, int lo, int hi, const std::string& expected) {
@@ -74,6 +76,8 @@ RecordArgs parse_record_args(const std::vector<std::string>& args, core::Scene& 
     const std::string& a = args[i];
     if (a == "--vdb") {
       r.vdb = true;
+    } else if (a == "--exr") {
+      r.exr = true;
     } else if (a == "--assemble") {
       r.assemble = true;
     } else if (a == "--count") {
@@ -334,7 +338,11 @@ const char* record_usage() {
          "         [--vdb]                   also each frame's medium at its weather instant (interpolated between\n"
          "                           forecast steps as the frame shows it) as OUT_frames/frame_00000.vdb, ...: OpenVDB\n"
          "                           grid-mean liquid and ice extinction (and cloud fraction at a forecast step) in\n"
-         "                           metres in a tangent frame at the region's centre, as import --vdb writes them\n";
+         "                           metres in a tangent frame at the region's centre, as import --vdb writes them\n"
+         "         [--exr]                   also each frame as OpenEXR for compositing, OUT_frames/frame_00000.exr, ...:\n"
+         "                           R, G, B the linear radiance (no background, no exposure) and A = 1 - transmittance\n"
+         "                           (premultiplied: over a plate, RGB + (1 - A) x plate); R, G, B alone with\n"
+         "                           --quality reference; a frame is whole when its PNG and its EXR both are\n";
 }
 
 int cmd_record(const std::vector<std::string>& args) {
@@ -504,11 +512,14 @@ int cmd_record(const std::vector<std::string>& args) {
   double verify_s = 0.0, render_s = 0.0;
   const auto t_loop = clock::now();
   double vdb_s = 0.0;
-  int vdb_written = 0;
+  int vdb_written = 0, exr_written = 0;
   for (int k = first; k <= last; ++k) {
     const fs::path file = frame_file(folder, k);
     const auto t_verify = clock::now();
-    const bool whole = render::png_decodes_at_size(file.string(), scene.width, scene.height);
+    fs::path exr_file = file;
+    exr_file.replace_extension(".exr");
+    const bool whole = render::png_decodes_at_size(file.string(), scene.width, scene.height) &&
+                       (!r.exr || render::exr_decodes_at_size(exr_file.string(), scene.width, scene.height, !r.reference));
     verify_s += seconds_since(t_verify);
     if (r.vdb) {
       // The medium the frame shows, at its instant, written atomically (a rerun writes the missing).
@@ -547,6 +558,12 @@ int cmd_record(const std::vector<std::string>& args) {
     tone.exposure = *exposure;
     if (frame.march.features.atmosphere || frame.march.features.globe) tone.background = glm::dvec3(0.0);
     const std::vector<unsigned char> rgb8 = render::tonemap_srgb8(pixels, tone);
+    // The EXR before the PNG: a whole PNG is what marks the frame done.
+    if (r.exr) {
+      core::write_file_atomically(exr_file.string(),
+                                  [&](std::FILE* f) { render::encode_exr(f, frame.camera.width, frame.camera.height, pixels, !r.reference); });
+      ++exr_written;
+    }
     core::write_file_atomically(file.string(), [&](std::FILE* f) { render::encode_png(f, frame.camera.width, frame.camera.height, rgb8); });
     render_s += seconds_since(t0);
     ++rendered;
@@ -561,6 +578,7 @@ int cmd_record(const std::vector<std::string>& args) {
   std::printf("rendered %d frame(s), skipped %d already whole, in %.1f s (%.1f frames/min; checking frames on disk %.3f s)\n", rendered,
               skipped, loop_s, rendered > 0 ? 60.0 * rendered / std::max(1e-9, render_s) : 0.0, verify_s);
   if (r.vdb) std::printf("wrote %d OpenVDB file(s) beside the frames in %.2f s\n", vdb_written, vdb_s);
+  if (r.exr) std::printf("wrote %d OpenEXR frame(s) beside the PNGs\n", exr_written);
   if (!encode) {
     std::printf("frames %d..%d of %d in %s; build the video with: cloudviewer record %s -o %s --assemble\n", first, last, count, folder.c_str(),
                 r.scene_path.c_str(), r.out.c_str());

@@ -26,6 +26,7 @@
 #include "quality_budget.hpp"
 #include "render/albedo_map.hpp"
 #include "render/context.hpp"
+#include "render/exr_output.hpp"
 #include "render/image_output.hpp"
 #include "render/machine_id.hpp"
 #include "render/raymarcher.hpp"
@@ -94,7 +95,7 @@ void end_progress() {
 
 // What the options ask for, applied on top of the scene file (or the defaults) in one place.
 struct RenderArgs {
-  std::string input, out, pfm, save_scene;
+  std::string input, out, pfm, exr, save_scene;
   std::string front;              // --front FILE: the measured quality front for --budget-ms
   bool march_overridden = false;  // --steps, --sun-steps, --octaves or --accumulate: quality becomes custom
   bool quality_given = false, adaptive_given = false, budget_given = false;
@@ -209,6 +210,10 @@ void check_outputs(const RenderArgs& r, const core::Scene& scene) {
     outputs.push_back({r.pfm, "--pfm"});
     outputs.push_back({render::transmittance_pfm_path(r.pfm), "--pfm (its transmittance beside it)"});
   }
+  if (!r.exr.empty()) {
+    core::check_output_extension(r.exr, "--exr", {".exr"});
+    outputs.push_back({r.exr, "--exr"});
+  }
   if (!r.save_scene.empty()) {
     core::check_output_extension(r.save_scene, "--save-scene", {".json"});
     outputs.push_back({r.save_scene, "--save-scene"});
@@ -257,6 +262,7 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
   for (const auto& [a, v] : options) {
     if (a == "-o") r.out = v;
     else if (a == "--pfm") r.pfm = v;
+    else if (a == "--exr") r.exr = v;
     else if (a == "--save-scene") r.save_scene = v;
     else if (a == "--size") {
       const auto size = parse_size(v, 1, 16384);
@@ -406,8 +412,8 @@ RenderArgs parse_render_args(const std::vector<std::string>& args, core::Scene& 
     if (r.times_from.empty() || r.every_s <= 0) {
       throw UsageError{"cloudviewer render: --times and --every: found one without the other, expected both (--times START..END --every 30m)"};
     }
-    if (!r.pfm.empty() || !r.save_scene.empty() || r.reference || scene.render.budget_ms > 0) {
-      throw UsageError{"cloudviewer render: --times: found it with --pfm, --save-scene, --quality reference or a budget, "
+    if (!r.pfm.empty() || !r.exr.empty() || !r.save_scene.empty() || r.reference || scene.render.budget_ms > 0) {
+      throw UsageError{"cloudviewer render: --times: found it with --pfm, --exr, --save-scene, --quality reference or a budget, "
                        "expected a sequence of PNGs alone"};
     }
     const std::int64_t count = (*core::parse_iso_utc(r.times_to) - *core::parse_iso_utc(r.times_from)) / r.every_s + 1;
@@ -500,6 +506,10 @@ const char* render_usage() {
     return t +
            "         [--pfm OUT.pfm]           linear radiance alone (no background, no exposure), and the\n"
            "                           transmittance beside it as OUT.transmittance.pfm (one channel)\n"
+           "         [--exr OUT.exr]           OpenEXR for compositing: R, G, B the linear radiance as --pfm, and\n"
+           "                           A = 1 - transmittance (premultiplied: over a plate, RGB + (1 - A) x plate);\n"
+           "                           with --quality reference R, G, B alone (the path tracer estimates no\n"
+           "                           transmittance)\n"
            "         [--save-scene OUT.json]  (the effective scene, camera and sun resolved, to reproduce the image)\n"
            "         [--budget-ms MS [--front quality_front.json]]  the most accurate settings of the measured front\n"
            "                           (from bench; else its cached copy, else the presets) that render within MS here\n"
@@ -930,6 +940,9 @@ int cmd_render(const std::vector<std::string>& args) {
     outputs.write(ra.pfm, [&](std::FILE* f) { render::encode_pfm(f, cam.width, cam.height, pixels); });
     outputs.write(transmittance_pfm, [&](std::FILE* f) { render::encode_pfm_transmittance(f, cam.width, cam.height, pixels); });
   }
+  if (!ra.exr.empty()) {  // radiance and coverage in one file; the path tracer's has no coverage
+    outputs.write(ra.exr, [&](std::FILE* f) { render::encode_exr(f, cam.width, cam.height, pixels, !ra.reference); });
+  }
   outputs.commit();
   if (!ra.save_scene.empty()) std::printf("wrote the scene %s\n", ra.save_scene.c_str());
   const double t_write = seconds_since(t0);
@@ -952,8 +965,9 @@ int cmd_render(const std::vector<std::string>& args) {
                 built[i].name.c_str(), built[i].build_ms * 1e-3, draw * 1e-3, v, inst);
   }
   std::printf("  composite/tonemap %.3f s\n  write       %.3f s\n", t_tone, t_write);
-  std::printf("wrote %s%s\n", ra.out.c_str(),
-              ra.pfm.empty() ? "" : (", " + ra.pfm + " (radiance) and " + transmittance_pfm + " (transmittance)").c_str());
+  std::printf("wrote %s%s%s\n", ra.out.c_str(),
+              ra.pfm.empty() ? "" : (", " + ra.pfm + " (radiance) and " + transmittance_pfm + " (transmittance)").c_str(),
+              ra.exr.empty() ? "" : (", " + ra.exr + (ra.reference ? " (radiance)" : " (radiance and coverage)")).c_str());
   return 0;
 }
 

@@ -9,11 +9,18 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImathBox.h>
 
 #include "support/nc_builder.hpp"
 
@@ -222,6 +229,81 @@ TEST_F(CliHostile, AFailedImportLeavesNoPartOfItsSet) {
   EXPECT_FALSE(fs::exists(path("v_t000.vti")));
   EXPECT_FALSE(fs::exists(path("v.report.json")));
   EXPECT_EQ(files(), 3u);  // in.nc, bad.nc, v.cvvol
+}
+
+// render --exr: the --pfm pair (radiance, transmittance) in one OpenEXR file, R, G, B and A = 1 - T,
+// read here through OpenEXR itself; the path tracer's has R, G, B alone; its arguments are checked
+// before the render like every output's.
+TEST_F(CliHostile, ExrIsThePfmPairInOneFileAndItsArgumentsAreChecked) {
+  const int w = 24, h = 14;
+  const std::string size = " --size " + std::to_string(w) + "x" + std::to_string(h);
+  Result r = cloudviewer("render " + sample_ + " --time 1" + size + " -o " + path("x.png") + " --pfm " + path("x.pfm") + " --exr " + path("x.exr"));
+  ASSERT_EQ(r.rc, 0) << r.out;
+  EXPECT_NE(r.out.find(path("x.exr") + " (radiance and coverage)"), std::string::npos) << r.out;
+  // The PFM pair, rows bottom to top.
+  auto pfm = [&](const std::string& name, int channels) {
+    const std::string bytes = read(name);
+    const std::string head = std::string(channels == 3 ? "PF" : "Pf") + "\n" + std::to_string(w) + " " + std::to_string(h) + "\n-1.0\n";
+    EXPECT_EQ(bytes.substr(0, head.size()), head);
+    std::vector<float> v(static_cast<std::size_t>(w) * h * channels);
+    EXPECT_EQ(bytes.size(), head.size() + v.size() * sizeof(float));
+    if (bytes.size() == head.size() + v.size() * sizeof(float)) std::memcpy(v.data(), bytes.data() + head.size(), v.size() * sizeof(float));
+    return v;
+  };
+  const std::vector<float> rgb = pfm("x.pfm", 3), t = pfm("x.transmittance.pfm", 1);
+  auto exr = [&](const std::string& name, int ew, int eh, std::vector<std::string>& channels) {
+    Imf::InputFile file(path(name).c_str());
+    const Imath::Box2i dw = file.header().dataWindow();
+    EXPECT_EQ(dw.min.x, 0);
+    EXPECT_EQ(dw.min.y, 0);
+    EXPECT_EQ(dw.max.x, ew - 1);
+    EXPECT_EQ(dw.max.y, eh - 1);
+    for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) {
+      channels.push_back(it.name());
+      EXPECT_EQ(it.channel().type, Imf::FLOAT) << it.name();
+    }
+    std::vector<std::vector<float>> v(channels.size(), std::vector<float>(static_cast<std::size_t>(ew) * eh));
+    Imf::FrameBuffer fb;
+    for (std::size_t c = 0; c < channels.size(); ++c) {
+      fb.insert(channels[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(v[c].data()), sizeof(float), sizeof(float) * ew));
+    }
+    file.setFrameBuffer(fb);
+    file.readPixels(0, eh - 1);
+    return v;
+  };
+  std::vector<std::string> names;
+  const auto e = exr("x.exr", w, h, names);  // A, B, G, R
+  ASSERT_EQ(names, (std::vector<std::string>{"A", "B", "G", "R"}));
+  std::size_t lit = 0, see_through = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x, j = static_cast<std::size_t>(h - 1 - y) * w + x;
+      EXPECT_EQ(e[3][i], rgb[j * 3 + 0]) << x << "," << y;
+      EXPECT_EQ(e[2][i], rgb[j * 3 + 1]) << x << "," << y;
+      EXPECT_EQ(e[1][i], rgb[j * 3 + 2]) << x << "," << y;
+      EXPECT_EQ(e[0][i], 1.0f - t[j]) << x << "," << y;
+      lit += e[3][i] > 0.0f ? 1 : 0;
+      see_through += e[0][i] < 1.0f ? 1 : 0;
+    }
+  }
+  EXPECT_GT(lit, 0u);          // not an empty image
+  EXPECT_GT(see_through, 0u);  // and not all opaque: the coverage is the transmittance's
+  // The path tracer: radiance alone.
+  r = cloudviewer("render " + sample_ + " --time 1 --size 8x5 --quality reference --spp 2 -o " + path("p.png") + " --exr " + path("p.exr"));
+  ASSERT_EQ(r.rc, 0) << r.out;
+  EXPECT_NE(r.out.find(path("p.exr") + " (radiance)"), std::string::npos) << r.out;
+  names.clear();
+  exr("p.exr", 8, 5, names);
+  EXPECT_EQ(names, (std::vector<std::string>{"B", "G", "R"}));
+  // Arguments.
+  expect_refused(cloudviewer("render " + sample_ + " -o " + path("y.png") + " --exr " + path("y.pfm")),
+                 "--exr: found '" + path("y.pfm") + "', expected a file name ending in .exr");
+  expect_refused(cloudviewer("render " + sample_ + " -o " + path("y.png") + " --exr " + sample_), "--exr");
+  expect_refused(cloudviewer("render " + sample_ + " -o " + path("frames") + " --times 2000-01-01T00:00Z..2000-01-01T01:00Z --every 30m --exr " +
+                             path("y.exr")),
+                 "--times: found it with --pfm, --exr");
+  EXPECT_FALSE(fs::exists(path("y.png")));
+  EXPECT_FALSE(fs::exists(path("y.exr")));
 }
 
 TEST_F(CliHostile, AFullDiskNamesTheOutput) {

@@ -122,6 +122,22 @@ cmp -s "$work/g/v_frames/frame_00000.vdb" "$work/g/v_frames/frame_00001.vdb" && 
 cmp -s "$work/a/v_frames/frame_00001.png" "$work/g/v_frames/frame_00001.png" || fail "--vdb changed a frame's pixels"
 out=$("$cv" record "$work/fly.json" -o "$work/g/v.mp4" --fps 10 --frames 0:2 --vdb 2>&1) || fail "--vdb rerun failed: $out"
 echo "$out" | grep -q "wrote 0 OpenVDB file(s)" || fail "the rerun wrote OpenVDB files again: $out"
+# OpenEXR per frame (--exr): beside each PNG, the PNG's pixels unchanged; a frame is whole only with
+# its EXR, so a frame whose EXR was removed is rendered again, and a rerun renders nothing.
+mkdir -p "$work/j"
+out=$("$cv" record "$work/fly.json" -o "$work/j/v.mp4" --fps 10 --frames 0:2 --exr 2>&1) || fail "--exr failed: $out"
+echo "$out" | grep -q "wrote 3 OpenEXR frame(s)" || fail "--exr did not write 3 frames: $out"
+for k in 0 1 2; do
+  f="$work/j/v_frames/frame_0000$k.exr"
+  [ "$(od -An -tx1 -N4 "$f" | tr -d ' ')" = "762f3101" ] || fail "frame $k's EXR lacks the OpenEXR magic number"
+  cmp -s "$work/a/v_frames/frame_0000$k.png" "$work/j/v_frames/frame_0000$k.png" || fail "--exr changed frame $k's pixels"
+done
+cmp -s "$work/j/v_frames/frame_00000.exr" "$work/j/v_frames/frame_00001.exr" && fail "frames 0 and 1 wrote the same EXR"
+rm "$work/j/v_frames/frame_00001.exr"
+out=$("$cv" record "$work/fly.json" -o "$work/j/v.mp4" --fps 10 --frames 0:2 --exr 2>&1) || fail "--exr rerun failed: $out"
+echo "$out" | grep -q "rendered 1 frame(s), skipped 2 already whole" || fail "the frame without its EXR was not rendered again: $out"
+[ -s "$work/j/v_frames/frame_00001.exr" ] || fail "the missing EXR was not written again"
+echo "OpenEXR frames beside the PNGs, resumed"
 # The automatic exposure: one for all frames from the same spread frames whatever the range, and
 # the probed frames' kept images are the loop's own: frames 0:10 and 11:20 rendered apart equal one run.
 scene "$work/auto.json" "$K0, $K1, $K2" ""

@@ -14,7 +14,9 @@
 
 #include <unistd.h>
 
+#include "io/output_file.hpp"
 #include "render/context.hpp"
+#include "render/exr_output.hpp"
 #include "render/image_output.hpp"
 #include "render/presenter.hpp"
 
@@ -272,6 +274,48 @@ TEST(ImageOutput, PfmHoldsRadianceAloneAndTheTransmittanceBeside) {
       EXPECT_EQ(t.data[row], p.w) << x << "," << y;
     }
   }
+  fs::remove_all(dir);
+}
+
+// OpenEXR output: R, G, B the radiance alone and A = 1 - transmittance, float for float (so a
+// compositor's RGB + (1 - A) x plate is the renderer's radiance + transmittance x background);
+// without alpha (the path tracer's) R, G, B alone. Written atomically through the FILE the output
+// gives; a stream that fails is a WriteError, not a truncated file taken for an image.
+TEST(ImageOutput, ExrHoldsRadianceAndOneMinusTransmittance) {
+  const fs::path dir = fs::temp_directory_path() / ("cv_exr_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const int w = 5, h = 3;  // not square, so swapped axes would show
+  std::vector<glm::vec4> px(static_cast<std::size_t>(w) * h);
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    const float k = static_cast<float>(i);
+    px[i] = {0.01f * k, 1e-6f * k, 3.0f + k, std::fmod(0.37f * k, 1.0f)};
+  }
+  px[3] = {0, 0, 0, 1};     // clear sky: nothing, all shows through
+  px[7] = {2, 2, 2, 0};     // opaque
+  for (const bool alpha : {true, false}) {
+    SCOPED_TRACE(alpha ? "with alpha" : "without");
+    const std::string path = (dir / (alpha ? "a.exr" : "b.exr")).string();
+    cv::core::write_file_atomically(path, [&](std::FILE* f) { encode_exr(f, w, h, px, alpha); });
+    const ExrImage img = read_exr(path, alpha ? std::vector<std::string>{"R", "G", "B", "A"} : std::vector<std::string>{"R", "G", "B"});
+    ASSERT_EQ(img.width, w);
+    ASSERT_EQ(img.height, h);
+    EXPECT_EQ(img.channels, alpha ? (std::vector<std::string>{"A", "B", "G", "R"}) : (std::vector<std::string>{"B", "G", "R"}));
+    for (std::size_t i = 0; i < px.size(); ++i) {
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(img.values[static_cast<std::size_t>(c)][i], px[i][c]) << "pixel " << i << " channel " << c;
+      if (alpha) {
+        EXPECT_EQ(img.values[3][i], 1.0f - px[i].a) << "pixel " << i;
+      }
+    }
+    if (alpha) {
+      EXPECT_THROW(read_exr(path, {"Z"}), std::runtime_error);  // a channel the file lacks
+    }
+  }
+  // A stream that cannot take the bytes.
+  if (std::FILE* full = std::fopen("/dev/full", "wb")) {
+    EXPECT_THROW(encode_exr(full, w, h, px, true), cv::core::WriteError);
+    std::fclose(full);
+  }
+  EXPECT_THROW(encode_exr(nullptr, w, h + 1, px, true), std::invalid_argument);  // pixels that do not fill the size
   fs::remove_all(dir);
 }
 
