@@ -109,7 +109,9 @@ void print_usage() {
   std::printf("environment: CLOUDVIEWER_MEMORY_LIMIT  the most memory one input may ask for (bytes, or 512M, 4G, ...;\n"
               "                           default half the machine's memory); larger declared sizes are refused\n"
               "             CLOUDVIEWER_THREADS       worker threads per parallel pass (default one per core)\n"
-              "             CLOUDVIEWER_CPU=baseline  no AVX paths (the same output, more slowly; for checks)\n");
+              "             CLOUDVIEWER_CPU=baseline  no AVX paths (the same output, more slowly; for checks)\n"
+              "             CLOUDVIEWER_OPEN_TIMEOUT_S, CLOUDVIEWER_READ_TIMEOUT_S  the longest wait for a NetCDF-4\n"
+              "                           file's header (30 s) and for its reads (300 s) before the file is named as hung\n");
 }
 
 // `cloudviewer COMMAND --help`: that command's usage, exit 0. False for an unknown command.
@@ -353,6 +355,18 @@ int main(int argc, char** argv) {
   if (const char* limit = std::getenv("CLOUDVIEWER_MEMORY_LIMIT"); limit && *limit && !cv::core::parse_byte_size(limit)) {
     std::fprintf(stderr, "cloudviewer: CLOUDVIEWER_MEMORY_LIMIT: found '%s', expected a size in bytes such as 512M or 4G\n", limit);
     return kExitBadInput;
+  }
+  if (const char* cpu = std::getenv("CLOUDVIEWER_CPU"); cpu && *cpu && std::string(cpu) != "baseline") {
+    std::fprintf(stderr, "cloudviewer: CLOUDVIEWER_CPU: found '%s', expected baseline (or unset)\n", cpu);
+    return kExitBadInput;
+  }
+  if (const char* threads = std::getenv("CLOUDVIEWER_THREADS"); threads && *threads) {
+    char* end = nullptr;
+    const long n = std::strtol(threads, &end, 10);
+    if (*end != '\0' || n < 1 || n > 4096) {
+      std::fprintf(stderr, "cloudviewer: CLOUDVIEWER_THREADS: found '%s', expected a whole number of threads 1..4096\n", threads);
+      return kExitBadInput;
+    }
   }
   if (args[0] == "help") {  // `cloudviewer help COMMAND`: as `cloudviewer COMMAND --help`
     if (args.size() == 1 || (args.size() == 2 && (args[1] == "--help" || args[1] == "-h"))) {  // help on help: the usage

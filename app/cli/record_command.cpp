@@ -341,8 +341,10 @@ const char* record_usage() {
          "                           metres in a tangent frame at the region's centre, as import --vdb writes them\n"
          "         [--exr]                   also each frame as OpenEXR for compositing, OUT_frames/frame_00000.exr, ...:\n"
          "                           R, G, B the linear radiance (no background, no exposure) and A = 1 - transmittance\n"
-         "                           (premultiplied: over a plate, RGB + (1 - A) x plate); R, G, B alone with\n"
-         "                           --quality reference; a frame is whole when its PNG and its EXR both are\n";
+         "                           (premultiplied: over a plate, RGB + (1 - A) x plate; A is 1 where the globe shows:\n"
+         "                           clouds alone with render.march.globe and .atmosphere false); R, G, B alone with\n"
+         "                           --quality reference; a frame is whole when its PNG and its EXR both are (--assemble\n"
+         "                           --exr names frames whose EXR is missing too)\n";
 }
 
 int cmd_record(const std::vector<std::string>& args) {
@@ -370,13 +372,20 @@ int cmd_record(const std::vector<std::string>& args) {
   if (r.assemble) {
     std::vector<int> missing;
     for (int k = 0; k < count; ++k) {
-      if (!render::png_decodes_at_size(frame_file(folder, k).string(), scene.width, scene.height)) missing.push_back(k);
+      const fs::path file = frame_file(folder, k);
+      fs::path exr_file = file;
+      exr_file.replace_extension(".exr");
+      // With --exr (as a cluster's assemble step passes the frames' options on) a frame needs its EXR too.
+      if (!render::png_decodes_at_size(file.string(), scene.width, scene.height) ||
+          (r.exr && !render::exr_decodes_at_size(exr_file.string(), scene.width, scene.height, !r.reference))) {
+        missing.push_back(k);
+      }
     }
     if (!missing.empty()) {
       throw UsageError{"cloudviewer record --assemble: " + folder.string() + ": frames " + ranges_text(missing) + " of 0.." +
                        std::to_string(count - 1) + " are missing or not whole " + std::to_string(scene.width) + "x" +
-                       std::to_string(scene.height) + " PNGs, expected all " + std::to_string(count) +
-                       " (render them with --frames A:B)"};
+                       std::to_string(scene.height) + (r.exr ? " PNGs with their EXRs" : " PNGs") + ", expected all " +
+                       std::to_string(count) + " (render them with --frames A:B)"};
     }
     const auto t0 = clock::now();
     assemble_mp4(ffmpeg, folder, r.out, r.fps, r.crf);

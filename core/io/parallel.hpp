@@ -10,7 +10,8 @@
 
 namespace cv::core {
 
-// The cores to use: the hardware's, capped by CLOUDVIEWER_THREADS when set to a positive number.
+// The threads to use: one per hardware core, or CLOUDVIEWER_THREADS when set to a positive number
+// (`cloudviewer` refuses any other value before it starts).
 inline unsigned worker_count() {
   unsigned hw = std::max(1u, std::thread::hardware_concurrency());
   if (const char* env = std::getenv("CLOUDVIEWER_THREADS"); env && std::atoi(env) > 0) hw = static_cast<unsigned>(std::atoi(env));

@@ -298,12 +298,23 @@ TEST_F(CliHostile, ExrIsThePfmPairInOneFileAndItsArgumentsAreChecked) {
   // Arguments.
   expect_refused(cloudviewer("render " + sample_ + " -o " + path("y.png") + " --exr " + path("y.pfm")),
                  "--exr: found '" + path("y.pfm") + "', expected a file name ending in .exr");
-  expect_refused(cloudviewer("render " + sample_ + " -o " + path("y.png") + " --exr " + sample_), "--exr");
+  expect_refused(cloudviewer("render " + sample_ + " -o " + path("y.png") + " --exr " + path("no/such/y.exr")),
+                 "--exr: found '" + path("no/such/y.exr") + "': its folder '" + path("no/such") + "' does not exist");
   expect_refused(cloudviewer("render " + sample_ + " -o " + path("frames") + " --times 2000-01-01T00:00Z..2000-01-01T01:00Z --every 30m --exr " +
                              path("y.exr")),
                  "--times: found it with --pfm, --exr");
   EXPECT_FALSE(fs::exists(path("y.png")));
   EXPECT_FALSE(fs::exists(path("y.exr")));
+}
+
+// The environment is input too: a value the program would not use is refused, not ignored.
+TEST_F(CliHostile, UnknownEnvironmentValuesAreRefused) {
+  expect_refused(cloudviewer("info " + sample_, "CLOUDVIEWER_CPU=Baseline "), "CLOUDVIEWER_CPU: found 'Baseline', expected baseline (or unset)");
+  expect_refused(cloudviewer("info " + sample_, "CLOUDVIEWER_THREADS=lots "),
+                 "CLOUDVIEWER_THREADS: found 'lots', expected a whole number of threads 1..4096");
+  expect_refused(cloudviewer("info " + sample_, "CLOUDVIEWER_THREADS=0 "), "CLOUDVIEWER_THREADS: found '0'");
+  const Result ok = cloudviewer("info " + sample_, "CLOUDVIEWER_CPU=baseline CLOUDVIEWER_THREADS=1 ");
+  EXPECT_EQ(ok.rc, 0) << ok.out;
 }
 
 TEST_F(CliHostile, AFullDiskNamesTheOutput) {

@@ -122,8 +122,10 @@ cmp -s "$work/g/v_frames/frame_00000.vdb" "$work/g/v_frames/frame_00001.vdb" && 
 cmp -s "$work/a/v_frames/frame_00001.png" "$work/g/v_frames/frame_00001.png" || fail "--vdb changed a frame's pixels"
 out=$("$cv" record "$work/fly.json" -o "$work/g/v.mp4" --fps 10 --frames 0:2 --vdb 2>&1) || fail "--vdb rerun failed: $out"
 echo "$out" | grep -q "wrote 0 OpenVDB file(s)" || fail "the rerun wrote OpenVDB files again: $out"
-# OpenEXR per frame (--exr): beside each PNG, the PNG's pixels unchanged; a frame is whole only with
-# its EXR, so a frame whose EXR was removed is rendered again, and a rerun renders nothing.
+# OpenEXR per frame (--exr): beside each PNG, the PNG's pixels unchanged (the EXR's values are held
+# to the PFM pair in CliHostile.ExrIsThePfmPairInOneFileAndItsArgumentsAreChecked); a frame is whole
+# only with a whole EXR, so a frame whose EXR was removed or damaged is rendered again (to the same
+# bytes), a rerun over whole frames renders nothing, and --assemble --exr names a missing EXR.
 mkdir -p "$work/j"
 out=$("$cv" record "$work/fly.json" -o "$work/j/v.mp4" --fps 10 --frames 0:2 --exr 2>&1) || fail "--exr failed: $out"
 echo "$out" | grep -q "wrote 3 OpenEXR frame(s)" || fail "--exr did not write 3 frames: $out"
@@ -133,10 +135,19 @@ for k in 0 1 2; do
   cmp -s "$work/a/v_frames/frame_0000$k.png" "$work/j/v_frames/frame_0000$k.png" || fail "--exr changed frame $k's pixels"
 done
 cmp -s "$work/j/v_frames/frame_00000.exr" "$work/j/v_frames/frame_00001.exr" && fail "frames 0 and 1 wrote the same EXR"
+cp "$work/j/v_frames/frame_00001.exr" "$work/j/first1.exr"
+cp "$work/j/v_frames/frame_00002.exr" "$work/j/first2.exr"
 rm "$work/j/v_frames/frame_00001.exr"
+head -c 300 "$work/j/first2.exr" > "$work/j/v_frames/frame_00002.exr"
 out=$("$cv" record "$work/fly.json" -o "$work/j/v.mp4" --fps 10 --frames 0:2 --exr 2>&1) || fail "--exr rerun failed: $out"
-echo "$out" | grep -q "rendered 1 frame(s), skipped 2 already whole" || fail "the frame without its EXR was not rendered again: $out"
-[ -s "$work/j/v_frames/frame_00001.exr" ] || fail "the missing EXR was not written again"
+echo "$out" | grep -q "rendered 2 frame(s), skipped 1 already whole" || fail "frames with a missing or damaged EXR were not rendered again: $out"
+cmp -s "$work/j/first1.exr" "$work/j/v_frames/frame_00001.exr" || fail "the re-rendered EXR of frame 1 differs"
+cmp -s "$work/j/first2.exr" "$work/j/v_frames/frame_00002.exr" || fail "the re-rendered EXR of frame 2 differs"
+out=$("$cv" record "$work/fly.json" -o "$work/j/v.mp4" --fps 10 --frames 0:2 --exr 2>&1) || fail "--exr second rerun failed: $out"
+echo "$out" | grep -q "rendered 0 frame(s), skipped 3 already whole" || fail "a rerun over whole frames rendered some: $out"
+rm "$work/j/v_frames/frame_00001.exr"
+expect2 assemble_exr "frames 1, 3-20 of 0..20 are missing or not whole 32x18 PNGs with their EXRs" \
+  "$cv" record "$work/fly.json" -o "$work/j/v.mp4" --fps 10 --assemble --exr
 echo "OpenEXR frames beside the PNGs, resumed"
 # The automatic exposure: one for all frames from the same spread frames whatever the range, and
 # the probed frames' kept images are the loop's own: frames 0:10 and 11:20 rendered apart equal one run.

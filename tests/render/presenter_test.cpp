@@ -310,9 +310,12 @@ TEST(ImageOutput, ExrHoldsRadianceAndOneMinusTransmittance) {
       EXPECT_THROW(read_exr(path, {"Z"}), std::runtime_error);  // a channel the file lacks
     }
   }
-  // A stream that cannot take the bytes.
+  // A stream that cannot take the bytes: an image larger than stdio's buffer, so the failing write
+  // itself is met, not only the final flush.
   if (std::FILE* full = std::fopen("/dev/full", "wb")) {
-    EXPECT_THROW(encode_exr(full, w, h, px, true), cv::core::WriteError);
+    std::vector<glm::vec4> big(256 * 256, glm::vec4(0.3f, 0.2f, 0.1f, 0.5f));
+    for (std::size_t i = 0; i < big.size(); ++i) big[i].x = static_cast<float>(i);  // not compressed away
+    EXPECT_THROW(encode_exr(full, 256, 256, big, true), cv::core::WriteError);
     std::fclose(full);
   }
   EXPECT_THROW(encode_exr(nullptr, w, h + 1, px, true), std::invalid_argument);  // pixels that do not fill the size
