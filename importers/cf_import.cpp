@@ -955,6 +955,12 @@ void load_era5_step(const Era5Source& S, const core::VolumeGrid& grid, std::size
   report_counts(counts, t, report);
 }
 
+namespace {
+std::atomic<std::size_t> exact_median_count{0};
+}  // namespace
+
+std::size_t exact_median_passes() { return exact_median_count.load(std::memory_order_relaxed); }
+
 core::CloudVolume import_file(const std::string& path, const ImportOptions& options) {
   auto S = std::make_shared<Era5Source>();
   S->file = std::make_unique<NcFile>(path);
@@ -1222,11 +1228,17 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
           });
         }
       };
-      // The median thickness exactly (the element a full sort would put in the middle) without
-      // storing 10^7 thicknesses: a first pass counts them in 1 m bins, a second keeps only the
-      // median's bin.
-      constexpr double kBinM = 1.0;
-      constexpr std::size_t kBins = 200000;  // thicknesses up to 200 km: the heights are checked to 100 km
+      // The median thickness without storing 10^7 thicknesses: a first pass counts them in bins
+      // (1 cm up to 5 km, 1 m beyond, to 200 km: the heights are checked to 100 km); the axis
+      // depends on the median only through its number of intervals, so a second pass that keeps
+      // only the median's bin, for the exact median (the element a full sort would put in the
+      // middle), is made only when the bin's ends would give different axes.
+      constexpr std::size_t kFineBins = 500000, kBins = kFineBins + 195000;
+      auto bin_of = [](double t) {
+        return t < 5000.0 ? std::min(kFineBins - 1, static_cast<std::size_t>(t * 100.0))
+                          : std::min(kBins - 1, kFineBins + static_cast<std::size_t>(t - 5000.0));
+      };
+      auto bin_start = [](std::size_t i) { return i < kFineBins ? static_cast<double>(i) / 100.0 : 5000.0 + static_cast<double>(i - kFineBins); };
       for (ProbePart& q : part) q.bins.assign(kBins, 0);
       heights([&](ProbePart& q, double raw, double zz, double t) {
         if (!(zz >= -1000.0 && zz <= 1.0e5)) {
@@ -1235,7 +1247,7 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
         }
         q.zmin = std::min(q.zmin, zz);
         q.zmax = std::max(q.zmax, zz);
-        if (!std::isnan(t)) ++q.bins[std::min(kBins - 1, static_cast<std::size_t>(t / kBinM))];
+        if (!std::isnan(t)) ++q.bins[bin_of(t)];
       });
       for (const ProbePart& q : part) {
         if (q.bad) {
@@ -1255,15 +1267,34 @@ core::CloudVolume import_file(const std::string& path, const ImportOptions& opti
         const std::size_t mid = n_thick / 2;  // the index of the median in sorted order
         std::size_t below = 0, bin = 0;
         while (below + bins[bin] <= mid) below += bins[bin++];
-        heights([&](ProbePart& q, double, double, double t) {
-          if (!std::isnan(t) && std::min(kBins - 1, static_cast<std::size_t>(t / kBinM)) == bin) q.in_bin.push_back(t);
-        });
-        std::vector<double> in_bin;
-        in_bin.reserve(bins[bin]);
-        for (const ProbePart& q : part) in_bin.insert(in_bin.end(), q.in_bin.begin(), q.in_bin.end());
-        const auto at = in_bin.begin() + static_cast<std::ptrdiff_t>(mid - below);
-        std::nth_element(in_bin.begin(), at, in_bin.end());
-        median_thickness = *at;
+        // The automatic axis a median gives (its node count), or -1 where the import refuses it
+        // (that message names the spacing, so the exact median is found for it).
+        auto axis_nodes = [&](double median) {
+          const double d = std::clamp(median / 2.0, 50.0, 500.0), lo = std::max(zmin, -500.0);
+          try {
+            checked_level_count(path, lo, zmax, d, "the levels' spacing");
+          } catch (const ImportError&) {
+            return -1;
+          }
+          return altitude_axis(lo, zmax, d, true).count;
+        };
+        // The bin's ends widened by a micrometre, against rounding in the bin's index.
+        const bool exact = options.dz_m <= 0.0 &&
+                           (bin + 1 >= kBins || axis_nodes(bin_start(bin) - 1e-6) != axis_nodes(bin_start(bin + 1) + 1e-6));
+        if (exact) {
+          exact_median_count.fetch_add(1, std::memory_order_relaxed);
+          heights([&](ProbePart& q, double, double, double t) {
+            if (!std::isnan(t) && bin_of(t) == bin) q.in_bin.push_back(t);
+          });
+          std::vector<double> in_bin;
+          in_bin.reserve(bins[bin]);
+          for (const ProbePart& q : part) in_bin.insert(in_bin.end(), q.in_bin.begin(), q.in_bin.end());
+          const auto at = in_bin.begin() + static_cast<std::ptrdiff_t>(mid - below);
+          std::nth_element(in_bin.begin(), at, in_bin.end());
+          median_thickness = *at;
+        } else {
+          median_thickness = 0.5 * (bin_start(bin) + bin_start(bin + 1));  // within the bin: the same axis
+        }
       }
     } else {
       // Height levels are their own heights; pressure and hybrid levels take the standard

@@ -2,6 +2,7 @@
 // only core types, ImportError, and these options.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <string>
 
@@ -55,6 +56,11 @@ std::string describe_file(const std::string& path, const ImportOptions& options 
 
 // Opens the file, checks it, fixes the grid, and returns a volume whose time steps load lazily.
 core::CloudVolume import_file(const std::string& path, const ImportOptions& options = {});
+
+// How many CF imports in this process read the levels' heights a second time for the exact median
+// level thickness (only where the median's 1 cm bin leaves the automatic altitude axis undecided):
+// for tests and benchmarks.
+std::size_t exact_median_passes();
 
 // Effective radius of ice crystals (um) used when none is set: grows from 20 um at -60 C to 50 um
 // at 0 C, clamped to 20..50 um outside. Inline, so the conversion's loops over a row vectorize.

@@ -3,6 +3,7 @@
 // hand, never from the importer.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "cf_layout.hpp"
+#include "column.hpp"
 #include "diagnosed_cloud.hpp"
 #include "importer.hpp"
 #include "support/cf_writer.hpp"
@@ -242,6 +244,72 @@ TEST_F(CfImportFixes, AltitudeAxisCoversTheHighestLevel) {
   auto w = importers::import_file(p, o);
   EXPECT_DOUBLE_EQ(w.grid.alt_m.step, 500.0);
   EXPECT_GE(w.grid.alt_m.last(), 3700.0);
+}
+
+// The automatic axis takes the median level thickness only through its number of intervals; the
+// heights are read a second time for the exact median only where the median's 1 cm bin leaves that
+// number undecided. Each way the axis is the one the exact median gives (computed here from the
+// heights written). Three files: levels evenly 700 m apart (the span is 8 half-medians exactly:
+// the bin straddles the boundary, a second pass); levels 700.004 m apart with one column's top
+// 4 mm higher (the bin's middle would give 8 intervals, the exact median 9: a second pass, and a
+// wrong axis without it); uneven levels (no second pass).
+TEST_F(CfImportFixes, AltitudeAxisFromTheMedianThicknessWithOrWithoutASecondPass) {
+  constexpr double kR = 6371000.0;
+  for (const int kind : {0, 1, 2}) {
+    const char* names[] = {"even", "near a boundary", "uneven"};
+    SCOPED_TRACE(names[kind]);
+    const std::string p = path("median" + std::to_string(kind) + ".nc");
+    const std::vector<std::string> d = {"time", "level", "latitude", "longitude"};
+    // Geometric heights per level and column, bottom up; geopotential written from them.
+    auto height = [kind](int k, int y, int x) {
+      if (kind == 0) return 120.0 + 700.0 * k;
+      if (kind == 1) return 120.0 + 700.004 * k + (k == 4 && x == 0 && y == 0 ? 0.004 : 0.0);
+      return 120.0 + 7.0 * x + 3.0 * y + 700.0 * k + 37.3 * ((k * 5 + x * 3 + y) % 7) + 0.11 * k * k;
+    };
+    cv::test::write_cf(p,
+                       {{"time", {0.0}, {{"units", "hours since 2024-01-15 00:00:00"}}},
+                        {"level", {1000, 900, 800, 700, 600}, {{"units", "hPa"}, {"positive", "down"}}},
+                        {"latitude", {0, 1}, {{"units", "degrees_north"}}},
+                        {"longitude", {0, 1, 2}, {{"units", "degrees_east"}}}},
+                       {{"t", d, {{"units", "K"}}, {}, [](const Idx&) { return 260.0; }},
+                        {"z", d, {{"units", "m**2 s**-2"}, {"standard_name", "geopotential"}}, {},
+                         [&](const Idx& i) {
+                           const double h = height(i[1], i[2], i[3]);
+                           return kG0 * h * kR / (kR + h);
+                         }},
+                        {"ciwc", d, {{"units", "kg kg**-1"}}, {}, [](const Idx& i) { return i[1] == 2 ? 1e-5 : 0.0; }}});
+    // The exact median from the heights as the importer converts them (z R / (g0 R - z)).
+    std::vector<double> thick;
+    double zmin = 1e30, zmax = -1e30;
+    for (int y = 0; y < 2; ++y) {
+      for (int x = 0; x < 3; ++x) {
+        double prev = NAN;
+        for (int k = 0; k < 5; ++k) {
+          const double h = height(k, y, x), phi = kG0 * h * kR / (kR + h);
+          const double zz = phi * kR / (kG0 * kR - phi);
+          zmin = std::min(zmin, zz), zmax = std::max(zmax, zz);
+          if (k) thick.push_back(zz - prev);
+          prev = zz;
+        }
+      }
+    }
+    std::nth_element(thick.begin(), thick.begin() + static_cast<std::ptrdiff_t>(thick.size() / 2), thick.end());
+    const double median = thick[thick.size() / 2];
+    const core::RegularAxis want = importers::altitude_axis(std::max(zmin, -500.0), zmax, std::clamp(median / 2.0, 50.0, 500.0), true);
+    if (kind == 1) {  // the case is what it claims: the bin's middle would give another axis
+      const core::RegularAxis middle = importers::altitude_axis(std::max(zmin, -500.0), zmax, 700.005 / 2.0, true);
+      ASSERT_EQ(want.count, 10);
+      ASSERT_EQ(middle.count, 9);
+    }
+    importers::ImportOptions o;
+    o.keep_cloudless_levels = true;  // every level in the probe, as counted above
+    const std::size_t passes = importers::exact_median_passes();
+    auto v = importers::import_file(p, o);
+    EXPECT_EQ(importers::exact_median_passes() - passes, kind == 2 ? 0u : 1u);
+    EXPECT_EQ(v.grid.alt_m.count, want.count);
+    EXPECT_NEAR(v.grid.alt_m.start, want.start, 1e-6);  // the heights' conversion may round otherwise
+    EXPECT_NEAR(v.grid.alt_m.step, want.step, 1e-9 * want.step);
+  }
 }
 
 // 6. Low/mid/high cover by height above the ground where the file gives terrain: cloud 300 m
