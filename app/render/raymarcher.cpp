@@ -86,7 +86,9 @@ GpuRaymarcher::~GpuRaymarcher() {
   if (ground_) glDeleteTextures(1, &ground_);
   if (jitter_mask_) glDeleteTextures(1, &jitter_mask_);
   if (column_tau_) glDeleteTextures(1, &column_tau_);
-  if (ms_[0]) glDeleteTextures(2, ms_);
+  for (GLuint t : ms_) {
+    if (t) glDeleteTextures(1, &t);
+  }
   if (noise_textures_[0]) glDeleteTextures(2, noise_textures_);
   if (fraction_) glDeleteTextures(1, &fraction_);
   if (detail_table_) glDeleteTextures(1, &detail_table_);
@@ -163,8 +165,11 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
   check_gl("uploading the column optical depths");
   column_mask_ = core::MediumMask{};
   // The two-stream source belongs to a time step: built again, at this size, when a march needs it.
-  if (ms_[0]) glDeleteTextures(2, ms_);
-  ms_[0] = ms_[1] = 0;
+  for (GLuint& t : ms_) {
+    if (t) glDeleteTextures(1, &t);
+    t = 0;
+  }
+  ms_lateral_ = false;
   ms_volume_ = nullptr;
   // The modelled cloud's cover: uploaded again when a march needs it, into a texture of this grid's size.
   if (fraction_) glDeleteTextures(1, &fraction_);
@@ -228,20 +233,26 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
       bool built = true;
       const std::shared_ptr<const core::MsSource> ms = core::ms_source_for(v, key, &built);  // built ahead by the viewer's prefetcher, or now
       const core::MsSource& src = *ms;
-      if (!ms_[0]) {
-        glCreateTextures(GL_TEXTURE_3D, 2, ms_);
-        const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
-        for (GLuint t : ms_) glTextureStorage3D(t, 1, GL_R32F, n.x, n.y, n.z);
+      // Two RG32F textures: (I0, I1 up) and, where the columns exchange light, (I1 east, I1 north).
+      const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
+      for (int t = 0; t < 2; ++t) {
+        if (ms_[t] || (t == 1 && src.i1e.empty())) continue;
+        glCreateTextures(GL_TEXTURE_3D, 1, &ms_[t]);
+        glTextureStorage3D(ms_[t], 1, GL_RG32F, n.x, n.y, n.z);
       }
       glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-      glTextureSubImage3D(ms_[0], 0, 0, 0, 0, grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count, GL_RED, GL_FLOAT,
-                          src.i0.data());
-      glTextureSubImage3D(ms_[1], 0, 0, 0, 0, grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count, GL_RED, GL_FLOAT,
-                          src.i1.data());
+      const std::vector<float> moments = core::ms_moments_texels(src);
+      glTextureSubImage3D(ms_[0], 0, 0, 0, 0, n.x, n.y, n.z, GL_RG, GL_FLOAT, moments.data());
+      ms_lateral_ = !src.i1e.empty();
+      if (ms_lateral_) {
+        const std::vector<float> horizontal = core::ms_horizontal_texels(src);
+        glTextureSubImage3D(ms_[1], 0, 0, 0, 0, n.x, n.y, n.z, GL_RG, GL_FLOAT, horizontal.data());
+      }
       check_gl("uploading the two-stream source");
       ms_volume_ = &v, ms_key_ = key, ms_build_ms_ = src.build_ms, ms_built_here_ = built;
       ++ms_count_[built ? 0 : 1];
     }
+    params.u_ms_lateral = ms_lateral_;
   }
   // The droplets' beam table (core::ms_peaks, remembered there per droplet size): always bound, since
   // llvmpipe may read it under a mask where the kernel does not use it.
@@ -325,8 +336,8 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
   glBindTextureUnit(CV_TEX_GROUND, ground_);
   glBindTextureUnit(CV_TEX_JITTER_MASK, jitter_mask_);
   glBindTextureUnit(CV_TEX_COLUMN_TAU, column_tau_);
-  glBindTextureUnit(CV_TEX_MS_I0, ms_[0]);
-  glBindTextureUnit(CV_TEX_MS_I1, ms_[1]);
+  glBindTextureUnit(CV_TEX_MS_MOMENTS, ms_[0]);
+  glBindTextureUnit(CV_TEX_MS_HORIZONTAL, ms_lateral_ ? ms_[1] : ms_[0]);  // unread without the light between columns
   glBindTextureUnit(CV_TEX_FRACTION, fraction_);
   glBindTextureUnit(CV_TEX_DETAIL_TABLE, detail_table_);
   glBindTextureUnit(CV_TEX_DETAIL_SHIFT, detail_shift_);

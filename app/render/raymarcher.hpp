@@ -194,7 +194,8 @@ class GpuRaymarcher {
   std::size_t path_pixels_ = 0;
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
-  GLuint ms_[2] = {0, 0};           // the two-stream source (R32F x2), built for ms_key_ on ms_volume_
+  GLuint ms_[2] = {0, 0};           // the two-stream source (RG32F x2), built for ms_key_ on ms_volume_
+  bool ms_lateral_ = false;         // ms_[1] holds the source's horizontal moment
   GLuint fraction_ = 0;             // the modelled cloud's cover (R32F 3-D), uploaded for fraction_volume_ when used
   const core::PreparedVolume* fraction_volume_ = nullptr;
   GLuint detail_shift_ = 0;         // the modelled cloud's displacement per level (RG32F, detail_shift_levels_ x 1)

@@ -104,7 +104,9 @@ double local_solar_time_h(double lon_deg, std::int64_t unix_s) {
 }
 
 std::size_t prepared_bytes(const core::PreparedVolume& v) {
-  const std::size_t source = v.ms_prebuilt ? v.ms_prebuilt->source.i0.size() + v.ms_prebuilt->source.i1.size() : 0;
+  const std::size_t source = v.ms_prebuilt ? v.ms_prebuilt->source.i0.size() + v.ms_prebuilt->source.i1.size() +
+                                                  v.ms_prebuilt->source.i1e.size() + v.ms_prebuilt->source.i1n.size()
+                                            : 0;
   return (v.extinction.liquid_per_m.size() + v.extinction.ice_per_m.size() + v.columns.tau.size() + source) * sizeof(float) +
          v.pyramid_packed.size() * sizeof(glm::vec2);
 }

@@ -15,10 +15,11 @@
 
 namespace cv::kernel {
 
-// A single-channel 3-D texture of floats, x fastest (an R32F texture on the GPU).
+// A 3-D texture of floats with 1 or 2 channels, x fastest (an R32F or RG32F texture on the GPU).
 struct sampler3D {
   const float* texels = nullptr;
   glm::ivec3 size{0};
+  int channels = 1;
 };
 // A 2-D texture of floats with 1 to 4 channels, x fastest, row 0 first (R32F, RG32F, RGB32F or RGBA32F).
 struct sampler2D {
@@ -29,6 +30,7 @@ struct sampler2D {
 // As GLSL: a missing channel reads 0, alpha 1. Indices are the kernel's to keep in range.
 inline glm::dvec4 texelFetch(const sampler3D& t, glm::ivec3 p, int) {
   const std::size_t i = (static_cast<std::size_t>(p.z) * t.size.y + p.y) * t.size.x + p.x;
+  if (t.channels == 2) return glm::dvec4(t.texels[2 * i], t.texels[2 * i + 1], 0.0, 1.0);
   return glm::dvec4(t.texels[i], 0.0, 0.0, 1.0);
 }
 inline glm::dvec4 texelFetch(const sampler2D& t, glm::ivec2 p, int) {
@@ -60,7 +62,7 @@ using namespace cv::physics::f64;
 #define CV_INOUT(T) T&
 
 struct MarchKernel : MarchParams {
-  sampler3D u_liquid, u_ice, u_noise_low, u_noise_high, u_ms_i0, u_ms_i1, u_fraction;
+  sampler3D u_liquid, u_ice, u_noise_low, u_noise_high, u_ms_moments, u_ms_horizontal, u_fraction;
   sampler2DArray u_column_tau;
   sampler2D u_jitter_mask, u_ground, u_depth, u_opaque, u_tl_distance, u_tl_color, u_detail_table, u_detail_shift;
   const glm::vec2* u_min_max = nullptr;

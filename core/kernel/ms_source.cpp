@@ -5,11 +5,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <utility>
 
 #include "geo/geodesy.hpp"
 #include "io/parallel.hpp"
 #include "kernel/ms_beam.glsl"
+#include "kernel/ms_lateral.hpp"
 #include "physics/physics.hpp"
 #include "volume/sampler.hpp"
 
@@ -400,6 +402,59 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
   // feeds its columns as light through the top does (docs/physics.md, "The columns lit by the
   // beam in three dimensions").
   sweep_sun_beam(grid, scaled, to_sun, top_level, beam);
+  // Each column's ground: the map's under its footprint where the march draws one, else the
+  // constant; made when a cloudy column first asks (each column belongs to one thread at a time).
+  std::vector<double> ground(layer, std::numeric_limits<double>::quiet_NaN());
+  auto ground_at = [&](int i, int j) {
+    double& g = ground[grid.column(i, j)];
+    if (std::isnan(g)) {
+      g = key.ground ? column_ground_albedo(*key.ground, grid.lat_deg.at(j), grid.lon_deg.at(i), grid.lat_deg.step, grid.lon_deg.step)
+                     : key.ground_albedo;
+    }
+    return g;
+  };
+  // Light between the columns (docs/physics.md, "Light between the columns"): the 3-D diffusion of
+  // the scaled problem against the columns' own, from the same beam, before the columns overwrite it.
+  LateralRatio lateral;
+  std::vector<unsigned char> cloudy;  // per column: any cloud shown
+  const bool use_lateral = key.lateral && grid.points() <= kLateralMaxNodes && layer > 1;
+  if (use_lateral) {
+    const auto tl = std::chrono::steady_clock::now();
+    LateralMedium lm;
+    const std::size_t np = grid.points();
+    lm.kappa.assign(np, 0.0f);
+    lm.scaled.assign(np, 0.0f);
+    lm.gcoef.assign(np, 0.0f);
+    lm.beam.assign(beam, beam + np);
+    lm.beam_dir.resize(layer);
+    lm.ground.assign(layer, 0.0);
+    cloudy.assign(layer, 0);
+    parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
+      for (std::size_t jj = jb; jj < je; ++jj) {
+        const int j = static_cast<int>(jj);
+        for (int i = 0; i < nx; ++i) {
+          const std::size_t c = grid.column(i, j);
+          const geo::EnuFrame enu = geo::sphere_enu(grid.lat_deg.at(j), grid.lon_deg.at(i));
+          lm.beam_dir[c] = glm::dvec3(-glm::dot(enu.east, to_sun), -glm::dot(enu.north, to_sun), -glm::dot(enu.up, to_sun));
+          for (int k = 0; k < nz; ++k) {
+            double sl, si;
+            shown_at(i, j, k, sl, si);
+            const double kap = sl * (1.0 - key.liquid_g) + si * (1.0 - key.ice_g);
+            if (!(kap > 0.0) || !std::isfinite(kap)) continue;
+            const std::size_t a = grid.index(i, j, k);
+            lm.kappa[a] = static_cast<float>(kap);
+            lm.scaled[a] = static_cast<float>(sl * (1.0 - key.liquid_g * key.liquid_g) + si * (1.0 - key.ice_g * key.ice_g));
+            lm.gcoef[a] = static_cast<float>((sl * (1.0 - key.liquid_g) * key.liquid_g + si * (1.0 - key.ice_g) * key.ice_g) / kap);
+            cloudy[c] = 1;
+          }
+          if (cloudy[c]) lm.ground[c] = ground_at(i, j);
+        }
+      }
+    });
+    lateral = lateral_ratio(grid, lm);
+    out.lateral_iterations = lateral.iterations;
+    out.lateral_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tl).count();
+  }
   parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
     std::vector<double> sigma(static_cast<std::size_t>(nz)), g(static_cast<std::size_t>(nz)), col_beam(static_cast<std::size_t>(nz));
     for (std::size_t jj = jb; jj < je; ++jj) {
@@ -428,11 +483,7 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
           clear();
           continue;
         }
-        // The column's ground: the map's under its footprint where the march draws one, else the constant.
-        const double ground_albedo = key.ground ? column_ground_albedo(*key.ground, grid.lat_deg.at(j), grid.lon_deg.at(i), grid.lat_deg.step,
-                                                                       grid.lon_deg.step)
-                                                : key.ground_albedo;
-        const TwoStreamColumn tc = two_stream_column(sigma.data(), g.data(), nz, grid.alt_m.step, mu0, ground_albedo,
+        const TwoStreamColumn tc = two_stream_column(sigma.data(), g.data(), nz, grid.alt_m.step, mu0, ground_at(i, j),
                                                      TwoStreamClosure::Quadrature, col_beam.data());
         for (int k = 0; k < nz; ++k) {
           out.i0[grid.index(i, j, k)] = static_cast<float>(tc.i0[static_cast<std::size_t>(k)]);
@@ -441,9 +492,71 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
       }
     }
   });
+  if (use_lateral) {
+    // The columns' light scaled by the ratio, its horizontal first moment from the 3-D flux.
+    out.i1e.assign(out.i0.size(), 0.0f);
+    out.i1n.assign(out.i0.size(), 0.0f);
+    parallel_ranges(out.i0.size(), 65536, [&](std::size_t b, std::size_t e, unsigned) {
+      for (std::size_t a = b; a < e; ++a) {
+        out.i0[a] *= lateral.ratio[a];
+        out.i1[a] *= lateral.ratio[a];
+        out.i1e[a] = out.i0[a] * lateral.east[a];
+        out.i1n[a] = out.i0[a] * lateral.north[a];
+      }
+    });
+    // A clear column beside cloudy ones: the march interpolates the source between its nodes and
+    // theirs through cells that hold the cloud's fringe, so it takes their mean at each level (the
+    // light at the cloud's edge) instead of 0.
+    const bool wrap = grid.wraps_lon();
+    std::vector<float>* fields[4] = {&out.i0, &out.i1, &out.i1e, &out.i1n};
+    parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
+      std::vector<std::size_t> near;
+      for (std::size_t jj = jb; jj < je; ++jj) {
+        const int j = static_cast<int>(jj);
+        for (int i = 0; i < nx; ++i) {
+          if (cloudy[grid.column(i, j)]) continue;
+          near.clear();
+          for (int dj = -1; dj <= 1; ++dj) {
+            for (int di = -1; di <= 1; ++di) {
+              int ii = i + di;
+              const int jn = j + dj;
+              if (wrap) ii = (ii + nx) % nx;
+              if (ii < 0 || ii >= nx || jn < 0 || jn >= ny || (ii == i && jn == j)) continue;
+              if (cloudy[grid.column(ii, jn)]) near.push_back(grid.column(ii, jn));
+            }
+          }
+          if (near.empty()) continue;
+          const double w = 1.0 / static_cast<double>(near.size());
+          for (int k = 0; k < nz; ++k) {
+            const std::size_t off = static_cast<std::size_t>(k) * layer;
+            for (std::vector<float>* f : fields) {
+              double sum = 0.0;
+              for (std::size_t c : near) sum += (*f)[c + off];
+              (*f)[grid.column(i, j) + off] = static_cast<float>(sum * w);
+            }
+          }
+        }
+      }
+    });
+  }
   out.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
+
+namespace {
+std::vector<float> interleave(const std::vector<float>& a, const std::vector<float>& b) {
+  std::vector<float> out;
+  if (a.empty() || a.size() != b.size()) return out;
+  out.resize(2 * a.size());
+  parallel_ranges(a.size(), 65536, [&](std::size_t lo, std::size_t hi, unsigned) {
+    for (std::size_t i = lo; i < hi; ++i) out[2 * i] = a[i], out[2 * i + 1] = b[i];
+  });
+  return out;
+}
+}  // namespace
+
+std::vector<float> ms_moments_texels(const MsSource& s) { return interleave(s.i0, s.i1); }
+std::vector<float> ms_horizontal_texels(const MsSource& s) { return interleave(s.i1e, s.i1n); }
 
 std::shared_ptr<const MsSource> ms_source_for(const PreparedVolume& v, const MsSourceKey& key, bool* built) {
   const bool ahead = v.ms_prebuilt && v.ms_prebuilt->key == key;

@@ -3,9 +3,10 @@
 // plane-parallel column lit by the sun, as the mean diffuse radiance I0 and its first moment I1
 // (I(mu) = I0 + I1 mu, mu the cosine to the local upward vertical) at every grid node, per unit
 // solar irradiance. Built once per time step and sun direction on the CPU, read by the march kernel
-// (u_ms_i0, u_ms_i1) on the GPU and in the CPU reference alike.
+// (u_ms_moments, u_ms_horizontal) on the GPU and in the CPU reference alike.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -58,8 +59,23 @@ std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<floa
 // The source over a prepared volume: i0 and i1 per grid node (the grid's layout), as R32F textures.
 struct MsSource {
   std::vector<float> i0, i1;
-  double build_ms = 0.0;  // wall time to build it
+  // The first moment's east and north parts, from the light between the columns (lateral_ratio);
+  // empty where the columns were left independent (MsSourceKey::lateral off, or a grid beyond
+  // kLateralMaxNodes).
+  std::vector<float> i1e, i1n;
+  double build_ms = 0.0;        // wall time to build it
+  int lateral_iterations = -1;  // the 3-D diffusion's conjugate-gradient iterations (-1: not solved)
+  double lateral_ms = 0.0;      // its share of build_ms
 };
+
+// The kernel's two textures of the source, two channels per node: (I0, I1 up) and (I1 east, I1
+// north); the second is empty where the source has no horizontal moment.
+std::vector<float> ms_moments_texels(const MsSource& s);
+std::vector<float> ms_horizontal_texels(const MsSource& s);
+
+// The largest grid whose columns exchange light (the 3-D diffusion holds about 80 bytes per node
+// while it solves): beyond it each column stays on its own.
+inline constexpr std::size_t kLateralMaxNodes = std::size_t(8) << 20;
 
 // The asymmetry parameters of the medium's two phases: liquid (the approximate Mie fit's mean cosine
 // at the droplet diameter, or HG's g) and ice; and the ground's albedo (0: no ground, the ray ends).
@@ -74,11 +90,14 @@ struct MsSourceKey {
   // (AlbedoMap::id), else its address; the map must outlive any build from this key.
   const AlbedoMap* ground = nullptr;
   std::uint64_t ground_id = 0;
+  // Light between the columns (the 3-D diffusion's ratio and horizontal flux); off, every column on
+  // its own as before the fortieth session (kept for comparison).
+  bool lateral = true;
   bool operator==(const MsSourceKey& o) const {
     const bool same_ground = (ground == nullptr) == (o.ground == nullptr) &&
                              (ground_id != 0 || o.ground_id != 0 ? ground_id == o.ground_id : ground == o.ground);
     return to_sun == o.to_sun && liquid_g == o.liquid_g && ice_g == o.ice_g && ground_albedo == o.ground_albedo && mask == o.mask &&
-           same_ground;
+           same_ground && lateral == o.lateral;
   }
 };
 

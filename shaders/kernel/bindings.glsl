@@ -10,8 +10,8 @@
 #define CV_TEX_COLUMN_TAU 7
 #define CV_TEX_DEPTH 8
 #define CV_TEX_OPAQUE 9
-#define CV_TEX_MS_I0 10
-#define CV_TEX_MS_I1 11
+#define CV_TEX_MS_MOMENTS 10
+#define CV_TEX_MS_HORIZONTAL 11
 #define CV_TEX_TL_DISTANCE 12
 #define CV_TEX_TL_COLOR 13
 #define CV_TEX_FRACTION 14

@@ -41,8 +41,8 @@ layout(binding = CV_TEX_OPAQUE) uniform sampler2D u_opaque;  // that geometry's 
 // and the radiance with its alpha (not premultiplied).
 layout(binding = CV_TEX_TL_DISTANCE) uniform sampler2D u_tl_distance;
 layout(binding = CV_TEX_TL_COLOR) uniform sampler2D u_tl_color;
-layout(binding = CV_TEX_MS_I0) uniform sampler3D u_ms_i0;  // two-stream diffuse radiance per unit irradiance
-layout(binding = CV_TEX_MS_I1) uniform sampler3D u_ms_i1;  // its first moment (upward)
+layout(binding = CV_TEX_MS_MOMENTS) uniform sampler3D u_ms_moments;        // two-stream diffuse radiance per unit irradiance, its first moment up (RG)
+layout(binding = CV_TEX_MS_HORIZONTAL) uniform sampler3D u_ms_horizontal;  // the first moment east and north (RG; read when u_ms_lateral)
 layout(binding = CV_TEX_FRACTION) uniform sampler3D u_fraction;  // cloud fraction per node (the modelled cloud's cover)
 layout(binding = CV_TEX_DETAIL_TABLE) uniform sampler2D u_detail_table;  // (threshold, ramp mean) by cover (x) and cloud type (y) (core/noise detail_table)
 layout(binding = CV_TEX_DETAIL_SHIFT) uniform sampler2D u_detail_shift;  // the detail's wind displacement per level, in tiles (core/kernel/detail_drift)

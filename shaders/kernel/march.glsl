@@ -5,7 +5,7 @@
 // a state, then composites sky and ground. The parameters are shaders/kernel/march_params.glsl.
 //
 // What the including side declares before this file: the parameters (u_*), the textures u_liquid,
-// u_ice (sampler3D, grid-mean extinction 1/m), u_ms_i0, u_ms_i1 (sampler3D, the two-stream source), u_column_tau, u_jitter_mask, u_ground, u_depth (the
+// u_ice (sampler3D, grid-mean extinction 1/m), u_ms_moments, u_ms_horizontal (sampler3D, the two-stream source: I0 and I1 up; I1 east and north), u_column_tau, u_jitter_mask, u_ground, u_depth (the
 // distance to opaque geometry per pixel, m), u_opaque (that geometry's radiance), u_tl_distance and
 // u_tl_color (translucent fragments, u_tl_count per pixel side by side, nearest first) (sampler2D),
 // u_noise_low, u_noise_high (sampler3D), the pyramid u_min_max (vec2 per brick, levels one after
@@ -32,17 +32,32 @@ CV_FN real node(sampler3D tex, int x, int y, int z) {
 // The trilinear value at f (x) with its cell's shape from the same 8 nodes: their mean (y, the
 // cell's mean of the trilinear field) and the differences between the cell's faces along the
 // longitude (z) and latitude (w) indices (face means, upper minus lower).
-CV_FN real4 fetch_cell(sampler3D tex, real3 f) {
+// The cell at f: its lower and upper node indices (longitude wrapping where the grid does) and the
+// trilinear weights.
+CV_FN void cell_at(real3 f, CV_OUT(ivec3) lo, CV_OUT(ivec3) hi, CV_OUT(real3) w) {
   ivec3 n = ivec3(u_grid_count);
   real wx;
   real wy;
   real wz;
-  int x0 = volume_fetch_index(f.x, n.x, wx);
-  int y0 = volume_fetch_index(f.y, n.y, wy);
-  int z0 = volume_fetch_index(f.z, n.z, wz);
-  int x1 = u_wraps ? (x0 + 1) % n.x : x0 + 1;
-  int y1 = y0 + 1;
-  int z1 = min(z0 + 1, n.z - 1);
+  lo = ivec3(volume_fetch_index(f.x, n.x, wx), volume_fetch_index(f.y, n.y, wy), volume_fetch_index(f.z, n.z, wz));
+  hi = ivec3(u_wraps ? (lo.x + 1) % n.x : lo.x + 1, lo.y + 1, min(lo.z + 1, n.z - 1));
+  w = real3(wx, wy, wz);
+}
+
+CV_FN real4 fetch_cell(sampler3D tex, real3 f) {
+  ivec3 lo;
+  ivec3 hi;
+  real3 w;
+  cell_at(f, lo, hi, w);
+  int x0 = lo.x;
+  int y0 = lo.y;
+  int z0 = lo.z;
+  int x1 = hi.x;
+  int y1 = hi.y;
+  int z1 = hi.z;
+  real wx = w.x;
+  real wy = w.y;
+  real wz = w.z;
   real n000 = node(tex, x0, y0, z0);
   real n100 = node(tex, x1, y0, z0);
   real n010 = node(tex, x0, y1, z0);
@@ -60,6 +75,23 @@ CV_FN real4 fetch_cell(sampler3D tex, real3 f) {
 
 // The trilinear value at f (the shape's sums are left to the compiler to drop).
 CV_FN real fetch(sampler3D tex, real3 f) { return fetch_cell(tex, f).x; }
+
+// The trilinear value of a two-channel texture (red, green) at f, as fetch.
+CV_FN real2 node2(sampler3D tex, int x, int y, int z) {
+  ivec3 n = ivec3(u_grid_count);
+  if (x < 0 || x >= n.x || y < 0 || y >= n.y) return real2(0.0);
+  real4 t = real4(texelFetch(tex, ivec3(x, y, z), 0));
+  return real2(t.x, t.y);
+}
+CV_FN real2 fetch2(sampler3D tex, real3 f) {
+  ivec3 a;
+  ivec3 b;
+  real3 w;
+  cell_at(f, a, b, w);
+  real2 lo = mix(mix(node2(tex, a.x, a.y, a.z), node2(tex, b.x, a.y, a.z), w.x), mix(node2(tex, a.x, b.y, a.z), node2(tex, b.x, b.y, a.z), w.x), w.y);
+  real2 hi = mix(mix(node2(tex, a.x, a.y, b.z), node2(tex, b.x, a.y, b.z), w.x), mix(node2(tex, a.x, b.y, b.z), node2(tex, b.x, b.y, b.z), w.x), w.y);
+  return mix(lo, hi, w.z);
+}
 
 // Trilinear with wrap-around over a periodic noise tile (x, then y, then z).
 CV_FN real fetch_noise(sampler3D tex, real3 t) {
@@ -294,14 +326,25 @@ CV_FN void medium_in(real3 p, real3 g, real alt_m, CV_OUT(real) sl, CV_OUT(real)
 }
 
 // The two-stream source's moments (per unit irradiance) at p, altitude alt_m (core/kernel/ms_source).
-CV_FN void ms_source_at(real3 p, real alt_m, CV_OUT(real) i0, CV_OUT(real) i1) {
+CV_FN void ms_source_at(real3 p, real alt_m, CV_OUT(real) i0, CV_OUT(real3) i1) {
   i0 = real(0.0);
-  i1 = real(0.0);
+  i1 = real3(0.0);
   real3 g = ecef_to_sphere(p, u_r0);
   real3 f;
   if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
-  i0 = fetch(u_ms_i0, f);
-  i1 = fetch(u_ms_i1, f);
+  real2 m = fetch2(u_ms_moments, f);
+  real3 up = normalize(p);
+  i0 = m.x;
+  i1 = m.y * up;
+  if (u_ms_lateral) {
+    // The light between the columns: the first moment's east and north parts (the local frame
+    // from p; at the axis, longitude 0's).
+    real rho = length(real2(p.x, p.y));
+    real3 east = rho > real(0.0) ? real3(-p.y / rho, p.x / rho, real(0.0)) : real3(0.0, 1.0, 0.0);
+    real3 north = cross(up, east);
+    real2 h = fetch2(u_ms_horizontal, f);
+    i1 += h.x * east + h.y * north;
+  }
 }
 
 // The medium at p whose altitude alt_m a marcher knows better than |p| - r0 (ray_altitude).
@@ -573,9 +616,9 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
     sigma_ms = sl * (real(1.0) - g_liquid * g_liquid) + si * (real(1.0) - g_ice * g_ice);
     real first = sl * g_liquid * (real(1.0) - g_liquid) + si * g_ice * (real(1.0) - g_ice);
     real i0;
-    real i1;
+    real3 i1;
     ms_source_at(p, alt_p, i0, i1);
-    scaled_source += sun_air * max(sigma_ms * i0 - first * i1 * dot(d, up_p), real(0.0));
+    scaled_source += sun_air * max(sigma_ms * i0 - first * dot(i1, d), real(0.0));
   } else if (lit) {
     // The octave gate (octaves.glsl): w from the column's optical depth; off, the classic sum.
     bool gate = u_octave_gate && u_octaves > 1;
@@ -988,9 +1031,9 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, real behind_t, 
       shadow = transmittance(cloud_sun_depth_weighted(pg, real(0.0), mu_sg, nu_sg, real(1.0) - g_liquid * g_liquid,
                                                       real(1.0) - u_ice_g * u_ice_g));
       real i0;
-      real i1;
+      real3 i1;
       ms_source_at(pg, u_grid_start.z, i0, i1);
-      real down = max(CV_PI * i0 - real(2.0) * CV_PI / real(3.0) * i1, real(0.0));
+      real down = max(CV_PI * i0 - real(2.0) * CV_PI / real(3.0) * dot(i1, n), real(0.0));
       real x_sky = column_diffusion_depth(pg, g_liquid, u_ice_g);
       e_sky = e_sky * sky_to_ground_of_depth(x_sky, ground_diffuse_albedo(real3(g), g.w)) + sun_air * down;
     }

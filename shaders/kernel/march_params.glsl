@@ -57,6 +57,7 @@ CV_PARAM(bool, u_global_lat)
 CV_PARAM(bool, u_cloudless)          // no cloud anywhere: nothing to march
 CV_PARAM(bool, u_sun_down)           // the whole cloud layer is in the Earth's shadow (layer_in_earth_shadow)
 CV_PARAM(bool, u_octave_gate)        // weight octave i >= 1 by w^i from the column's optical depth
+CV_PARAM(bool, u_ms_lateral)         // the two-stream source has a horizontal first moment (u_ms_horizontal)
 CV_PARAM(bool, u_liquid_phase_hg)    // Henyey-Greenstein with the Mie fit's mean cosine instead of the fit
 CV_PARAM(bool, u_blue_noise)         // the jitter from the blue-noise mask, else the hash
 CV_PARAM(bool, u_anti_alias)         // accumulation frames >= 1 spread their rays over the pixel (pixel_jitter)
