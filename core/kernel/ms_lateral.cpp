@@ -21,47 +21,36 @@ struct Layout {
   }
 };
 
-// One column's tridiagonal system (diagonal `diag`, -wz[k] between nodes k and k + 1), solved by
-// Thomas's algorithm (the matrix is diagonally dominant: no pivoting).
-void solve_column(const Layout& L, std::size_t col, const std::vector<float>& diag,
+// One column's tridiagonal system over levels k0..k1 (diagonal `diag`, -wz[k] between nodes k and
+// k + 1; no coupling leaves the range), solved by Thomas's algorithm (the matrix is diagonally
+// dominant: no pivoting).
+void solve_column(const Layout& L, std::size_t col, int k0, int k1, const std::vector<float>& diag,
                   const std::vector<float>& wz, const double* rhs, double* x, std::vector<double>& scratch) {
   scratch.resize(static_cast<std::size_t>(L.nz));
   double prev_c = 0.0, prev_x = 0.0;
-  for (int k = 0; k < L.nz; ++k) {
+  for (int k = k0; k <= k1; ++k) {
     const std::size_t a = static_cast<std::size_t>(k) * L.layer + col;
-    const double lower = k > 0 ? double(wz[a - L.layer]) : 0.0;
+    const double lower = k > k0 ? double(wz[a - L.layer]) : 0.0;
     const double den = double(diag[a]) - lower * prev_c;
-    const double c = den > 0.0 ? double(wz[a]) / den : 0.0;
+    const double c = den > 0.0 && k < k1 ? double(wz[a]) / den : 0.0;
     const double xv = den > 0.0 ? (rhs[a] + lower * prev_x) / den : 0.0;
     scratch[static_cast<std::size_t>(k)] = c;
     x[a] = xv;
     prev_c = c;
     prev_x = xv;
   }
-  for (int k = L.nz - 2; k >= 0; --k) {
+  for (int k = k1 - 1; k >= k0; --k) {
     const std::size_t a = static_cast<std::size_t>(k) * L.layer + col;
     x[a] += scratch[static_cast<std::size_t>(k)] * x[a + L.layer];
   }
 }
 
-// A sum over [0, n) in blocks of a fixed size, added in order: the same bits whatever the number of
-// threads.
-template <typename F>
-double ordered_sum(std::size_t n, F&& term) {
-  constexpr std::size_t kBlock = 16384;
-  const std::size_t blocks = (n + kBlock - 1) / kBlock;
-  std::vector<double> parts(blocks, 0.0);
-  parallel_ranges(blocks, 1, [&](std::size_t bb, std::size_t be, unsigned) {
-    for (std::size_t b = bb; b < be; ++b) {
-      double s = 0.0;
-      for (std::size_t a = b * kBlock, e = std::min(n, a + kBlock); a < e; ++a) s += term(a);
-      parts[b] = s;
-    }
-  });
-  double s = 0.0;
-  for (double v : parts) s += v;
-  return s;
-}
+// A column holding cloud and its levels from the lowest cloudy node to the highest: the solve
+// works on these alone (every other node is clear, and stays 0).
+struct Span {
+  std::size_t col;
+  int k0, k1;
+};
 }  // namespace
 
 LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, double tolerance,
@@ -104,16 +93,49 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
   // deep, single scattering's reach, and not the 1 / (3 kappa) of diffusion that grows without
   // bound as the cloud thins) and its lowest cloudy node (the ground lies under it).
   std::vector<double> depth(L.layer, 0.0);
-  std::vector<int> lowest(L.layer, -1);
+  std::vector<int> lowest(L.layer, -1), highest(L.layer, -1);
   parallel_ranges(L.layer, 1024, [&](std::size_t cb, std::size_t ce, unsigned) {
     for (std::size_t c = cb; c < ce; ++c) {
       for (int k = L.nz - 1; k >= 0; --k) {
         if (!cloud(static_cast<std::size_t>(k) * L.layer + c)) continue;
         depth[c] += hz > 0.0 ? hz : 1.0;
         lowest[c] = k;
+        if (highest[c] < 0) highest[c] = k;
       }
     }
   });
+  std::vector<Span> spans;
+  for (std::size_t c = 0; c < L.layer; ++c) {
+    if (lowest[c] >= 0) spans.push_back({c, lowest[c], highest[c]});
+  }
+  // fn(col, k, a) for every node of the spans, in blocks of spans on the machine's cores; sum adds
+  // term(a) over them block by block in a fixed order (the same bits whatever the thread count).
+  constexpr std::size_t kSpanBlock = 256;
+  const std::size_t span_blocks = (spans.size() + kSpanBlock - 1) / kSpanBlock;
+  auto each_block = [&](std::size_t b, auto&& fn) {
+    for (std::size_t sp = b * kSpanBlock, se = std::min(spans.size(), sp + kSpanBlock); sp < se; ++sp) {
+      const Span& span = spans[sp];
+      for (int k = span.k0; k <= span.k1; ++k) fn(span.col, k, static_cast<std::size_t>(k) * L.layer + span.col);
+    }
+  };
+  auto each_active = [&](auto&& fn) {
+    parallel_ranges(span_blocks, 1, [&](std::size_t bb, std::size_t be, unsigned) {
+      for (std::size_t b = bb; b < be; ++b) each_block(b, fn);
+    });
+  };
+  auto sum = [&](auto&& term) {
+    std::vector<double> parts(span_blocks, 0.0);
+    parallel_ranges(span_blocks, 1, [&](std::size_t bb, std::size_t be, unsigned) {
+      for (std::size_t b = bb; b < be; ++b) {
+        double part = 0.0;
+        each_block(b, [&](std::size_t, int, std::size_t a) { part += term(a); });
+        parts[b] = part;
+      }
+    });
+    double total = 0.0;
+    for (double v : parts) total += v;
+    return total;
+  };
   auto diffusion = [&](std::size_t a) { return 1.0 / (3.0 * double(m.kappa[a]) + 1.0 / depth[a % L.layer]); };
   auto beam_dir = [&](std::size_t col) {
     const glm::dvec3 d = m.beam_dir[col];
@@ -244,9 +266,11 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
     rhs1[a] = r1;
   });
   auto by_columns = [&](const std::vector<float>& diag, const double* rhs, double* x) {
-    parallel_ranges(L.layer, 256, [&](std::size_t cb, std::size_t ce, unsigned) {
+    parallel_ranges(spans.size(), 256, [&](std::size_t sb, std::size_t se, unsigned) {
       std::vector<double> scratch;
-      for (std::size_t c = cb; c < ce; ++c) solve_column(L, c, diag, wz, rhs, x, scratch);
+      for (std::size_t sp = sb; sp < se; ++sp) {
+        solve_column(L, spans[sp].col, spans[sp].k0, spans[sp].k1, diag, wz, rhs, x, scratch);
+      }
     });
   };
   // The independent columns.
@@ -255,62 +279,54 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
   std::vector<float>().swap(diag1);
   std::vector<double>().swap(rhs1);
 
-  // y = A x for the 3-D matrix.
+  // y = A x for the 3-D matrix (on the spans; elsewhere both are 0).
   auto apply = [&](const std::vector<double>& x, std::vector<double>& y) {
-    parallel_ranges(static_cast<std::size_t>(L.ny), 4, [&](std::size_t jb, std::size_t je, unsigned) {
-      for (int k = 0; k < L.nz; ++k) {
-        for (std::size_t jj = jb; jj < je; ++jj) {
-          const int j = static_cast<int>(jj);
-          for (int i = 0; i < L.nx; ++i) {
-            const std::size_t a = L.at(i, j, k);
-            double v = double(diag3[a]) * x[a];
-            if (k + 1 < L.nz) v -= double(wz[a]) * x[a + L.layer];
-            if (k > 0) v -= double(wz[a - L.layer]) * x[a - L.layer];
-            if (has_x) {
-              const std::size_t e = i + 1 < L.nx ? a + 1 : a + 1 - static_cast<std::size_t>(L.nx);
-              const std::size_t w = i > 0 ? a - 1 : a + static_cast<std::size_t>(L.nx) - 1;
-              v -= double(wx[a]) * x[e] + double(wx[w]) * x[w];
-            }
-            if (has_y) {
-              const std::size_t row = static_cast<std::size_t>(L.nx);
-              if (j + 1 < L.ny) v -= double(wy[a]) * x[a + row];
-              if (j > 0) v -= double(wy[a - row]) * x[a - row];
-            }
-            y[a] = v;
-          }
-        }
+    each_active([&](std::size_t col, int k, std::size_t a) {
+      double v = double(diag3[a]) * x[a];
+      if (k + 1 < L.nz) v -= double(wz[a]) * x[a + L.layer];
+      if (k > 0) v -= double(wz[a - L.layer]) * x[a - L.layer];
+      const std::size_t row = static_cast<std::size_t>(L.nx);
+      const std::size_t i = col % row, j = col / row;
+      if (has_x) {
+        const std::size_t e = i + 1 < row ? a + 1 : a + 1 - row;
+        const std::size_t w = i > 0 ? a - 1 : a + row - 1;
+        v -= double(wx[a]) * x[e] + double(wx[w]) * x[w];
       }
+      if (has_y) {
+        if (j + 1 < static_cast<std::size_t>(L.ny)) v -= double(wy[a]) * x[a + row];
+        if (j > 0) v -= double(wy[a - row]) * x[a - row];
+      }
+      y[a] = v;
     });
   };
   // Conjugate gradients from the columns' solution, preconditioned by each column's part of the
   // 3-D matrix (block Jacobi: the vertical coupling is the strong one).
-  std::vector<double> phi3 = phi1, r(n), z(n, 0.0), p, q(n);
+  std::vector<double> phi3 = phi1, r(n, 0.0), z(n, 0.0), p, q(n, 0.0);
   apply(phi3, q);
-  for (std::size_t a = 0; a < n; ++a) r[a] = rhs3[a] - q[a];
-  const double bnorm = std::sqrt(ordered_sum(n, [&](std::size_t a) { return rhs3[a] * rhs3[a]; }));
+  each_active([&](std::size_t, int, std::size_t a) { r[a] = rhs3[a] - q[a]; });
+  const double bnorm = std::sqrt(sum([&](std::size_t a) { return rhs3[a] * rhs3[a]; }));
   std::vector<double>().swap(rhs3);
   by_columns(diag3, r.data(), z.data());
   p = z;
-  double rz = ordered_sum(n, [&](std::size_t a) { return r[a] * z[a]; });
-  double res =
-      bnorm > 0.0 ? std::sqrt(ordered_sum(n, [&](std::size_t a) { return r[a] * r[a]; })) / bnorm : 0.0;
+  double rz = sum([&](std::size_t a) { return r[a] * z[a]; });
+  double res = bnorm > 0.0 ? std::sqrt(sum([&](std::size_t a) { return r[a] * r[a]; })) / bnorm : 0.0;
   int it = 0;
   while (res > tolerance && it < max_iterations && rz > 0.0 && std::isfinite(rz)) {
     apply(p, q);
-    const double pq = ordered_sum(n, [&](std::size_t a) { return p[a] * q[a]; });
+    const double pq = sum([&](std::size_t a) { return p[a] * q[a]; });
     if (!(pq > 0.0) || !std::isfinite(pq)) break;
     const double alpha = rz / pq;
-    for (std::size_t a = 0; a < n; ++a) {
+    each_active([&](std::size_t, int, std::size_t a) {
       phi3[a] += alpha * p[a];
       r[a] -= alpha * q[a];
-    }
+    });
     ++it;
-    res = std::sqrt(ordered_sum(n, [&](std::size_t a) { return r[a] * r[a]; })) / bnorm;
+    res = std::sqrt(sum([&](std::size_t a) { return r[a] * r[a]; })) / bnorm;
     by_columns(diag3, r.data(), z.data());
-    const double rz_new = ordered_sum(n, [&](std::size_t a) { return r[a] * z[a]; });
+    const double rz_new = sum([&](std::size_t a) { return r[a] * z[a]; });
     const double beta = rz_new / rz;
     rz = rz_new;
-    for (std::size_t a = 0; a < n; ++a) p[a] = z[a] + beta * p[a];
+    each_active([&](std::size_t, int, std::size_t a) { p[a] = z[a] + beta * p[a]; });
   }
   out.iterations = it;
   out.residual = res;
