@@ -896,8 +896,15 @@ int cmd_render(const std::vector<std::string>& args) {
     end_progress();
   }
   const double t_march = seconds_since(t0);
-  if (march.medium.ms_two_stream && !ra.reference)
-    std::printf("two-stream source built in %.1f ms (once per time step and sun direction)\n", gpu.ms_source_build_ms());
+  if (march.medium.ms_two_stream && !ra.reference) {
+    const int lateral = gpu.ms_source_lateral_iterations();
+    const std::string between =
+        lateral >= 0 ? "light between columns in " + std::to_string(lateral) + " iteration(s)"
+                     : "columns on their own: light between columns is solved on grids up to " +
+                           std::to_string(core::kLateralMaxNodes) + " nodes";
+    std::printf("two-stream source built in %.1f ms (once per time step and sun direction; %s)\n", gpu.ms_source_build_ms(),
+                between.c_str());
+  }
   const core::MarchStats& ms = ra.reference ? core::MarchStats{} : gpu.last_stats();
   if (!ra.reference) std::printf("march%s: %llu view samples, %llu skipped in %llu empty-brick jumps (view and sun), %llu sun samples, "
               "%llu skipped or cut off, %llu of %d rays missed the cloud shell%s\n",

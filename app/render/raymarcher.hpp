@@ -170,6 +170,9 @@ class GpuRaymarcher {
   // Wall time of the last build of the two-stream source (ms; 0 before any), rebuilt only when the
   // time step, the sun or the medium's phases change.
   double ms_source_build_ms() const { return ms_build_ms_; }
+  // The last source's light between columns: its 3-D solve's iterations, -1 where the columns were
+  // left on their own (a grid beyond core::kLateralMaxNodes).
+  int ms_source_lateral_iterations() const { return ms_lateral_iterations_; }
   // Whether the source in use was built on this thread (false: the volume's prebuilt one), and how
   // many sources were built here and taken prebuilt so far.
   bool ms_source_built_here() const { return ms_built_here_; }
@@ -208,6 +211,7 @@ class GpuRaymarcher {
   core::MsSourceKey ms_key_;
   const core::PreparedVolume* ms_volume_ = nullptr;
   double ms_build_ms_ = 0.0;
+  int ms_lateral_iterations_ = -1;
   bool ms_built_here_ = true;
   std::size_t ms_count_[2] = {0, 0};  // sources built here, taken prebuilt
   GLuint ms_beam_buffer_ = 0;         // the droplets' beam table (CV_SSBO_MS_BEAM)

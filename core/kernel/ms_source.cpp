@@ -394,7 +394,8 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
     }
   });
   const int top_level = row_top.empty() ? -1 : *std::max_element(row_top.begin(), row_top.end());
-  if (top_level < 0) {
+  if (top_level < 0) {  // no cloud: nothing to exchange either
+    if (key.lateral && grid.points() <= kLateralMaxNodes && layer > 1) out.lateral_iterations = 0;
     out.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return out;
   }

@@ -64,7 +64,7 @@ struct MsSource {
   // kLateralMaxNodes).
   std::vector<float> i1e, i1n;
   double build_ms = 0.0;        // wall time to build it
-  int lateral_iterations = -1;  // the 3-D diffusion's conjugate-gradient iterations (-1: not solved)
+  int lateral_iterations = -1;  // the 3-D diffusion's conjugate-gradient iterations (-1: the columns left on their own)
   double lateral_ms = 0.0;      // its share of build_ms
 };
 
