@@ -142,6 +142,13 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
     return std::isfinite(d.x + d.y + d.z) ? d : glm::dvec3(0.0);
   };
 
+  // The light a clear column's sunlit ground sends into a cloud's side facing it: half the side's
+  // view is of that ground, so the partial current coming in is A mu0 E / 2 (s_g = 2 J_in).
+  auto side_light = [&](std::size_t col) {
+    if (m.ground_light.size() != L.layer) return 0.0;
+    const double v = m.ground_light[col];
+    return std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : 0.0;
+  };
   // Visits the six faces of cloudy node (i, j, k): face(axis, sign, b, area, h, beta, s_g, q) with b
   // the cloudy neighbour across it, or kNone (clear air, the grid's edge, the ground: a Marshak
   // condition with beta and s_g), the face's area, the distance between the nodes, and q the
@@ -181,7 +188,7 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
         if (b != kNone && cloud(b)) {
           face(0, sign, b, ax, hxc, 0.5, 0.0, 0.5 * sign * (ge * om.x + ge_of(b) * beam_dir(b % L.layer).x));
         } else {
-          face(0, sign, kNone, ax, hxc, 0.5, 0.0, sign * ge * om.x);
+          face(0, sign, kNone, ax, hxc, 0.5, b != kNone ? side_light(b % L.layer) : 0.0, sign * ge * om.x);
         }
       }
     }
@@ -194,7 +201,7 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
         if (b != kNone && cloud(b)) {
           face(1, sign, b, ay, hy, 0.5, 0.0, 0.5 * sign * (ge * om.y + ge_of(b) * beam_dir(b % L.layer).y));
         } else {
-          face(1, sign, kNone, ay, hy, 0.5, 0.0, sign * ge * om.y);
+          face(1, sign, kNone, ay, hy, 0.5, b != kNone ? side_light(b % L.layer) : 0.0, sign * ge * om.y);
         }
       }
     }

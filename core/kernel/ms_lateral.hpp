@@ -25,6 +25,7 @@ struct LateralMedium {
   std::vector<float> beam;           // the sun's delta-scaled beam E, 0..1
   std::vector<glm::dvec3> beam_dir;  // per column: the beam's direction of travel in (east, north, up)
   std::vector<double> ground;        // per column: the ground's albedo under the column's lowest cloud
+  std::vector<double> ground_light;  // per column: its ground's reflected sunlight A mu0 E (empty: none)
 };
 
 struct LateralRatio {

@@ -8,6 +8,8 @@
 #include <limits>
 #include <utility>
 
+#include <glm/vec2.hpp>
+
 #include "geo/geodesy.hpp"
 #include "io/parallel.hpp"
 #include "kernel/ms_beam.glsl"
@@ -452,6 +454,28 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
         }
       }
     });
+    // The sunlit ground of a clear column beside cloud (its sunlight A mu0 E at the lowest level)
+    // lights the cloud's sides that face it (docs/physics.md, "Light between the columns").
+    lm.ground_light.assign(layer, 0.0);
+    const bool wrap = grid.wraps_lon();
+    if (key.ground || key.ground_albedo > 0.0) {
+      parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
+        for (std::size_t jj = jb; jj < je; ++jj) {
+          const int j = static_cast<int>(jj);
+          for (int i = 0; i < nx; ++i) {
+            const std::size_t c = grid.column(i, j);
+            bool near = false;
+            for (int dj = -1; dj <= 1 && !near && !cloudy[c]; ++dj) {
+              for (int di = -1; di <= 1 && !near; ++di) {
+                const int ii = wrap ? (i + di + nx) % nx : i + di, jn = j + dj;
+                near = ii >= 0 && ii < nx && jn >= 0 && jn < ny && cloudy[grid.column(ii, jn)];
+              }
+            }
+            if (near) lm.ground_light[c] = ground_at(i, j) * std::max(-lm.beam_dir[c].z, 0.0) * std::clamp(double(beam[c]), 0.0, 1.0);
+          }
+        }
+      });
+    }
     lateral = lateral_ratio(grid, lm);
     out.lateral_iterations = lateral.iterations;
     out.lateral_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tl).count();
@@ -506,12 +530,14 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
       }
     });
     // A clear column beside cloudy ones: the march interpolates the source between its nodes and
-    // theirs through cells that hold the cloud's fringe, so it takes their mean at each level (the
-    // light at the cloud's edge) instead of 0.
+    // theirs through cells that hold the cloud's fringe, so at a level where a neighbour (of its 8)
+    // holds cloud within one level, it takes those neighbours' mean there (the light at the cloud's
+    // edge) instead of 0. Other levels keep 0: the ground beside a cloud takes no diffuse light from
+    // under it.
     const bool wrap = grid.wraps_lon();
     std::vector<float>* fields[4] = {&out.i0, &out.i1, &out.i1e, &out.i1n};
     parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
-      std::vector<std::size_t> near;
+      std::vector<glm::ivec2> near;
       for (std::size_t jj = jb; jj < je; ++jj) {
         const int j = static_cast<int>(jj);
         for (int i = 0; i < nx; ++i) {
@@ -523,18 +549,26 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
               const int jn = j + dj;
               if (wrap) ii = (ii + nx) % nx;
               if (ii < 0 || ii >= nx || jn < 0 || jn >= ny || (ii == i && jn == j)) continue;
-              if (cloudy[grid.column(ii, jn)]) near.push_back(grid.column(ii, jn));
+              if (cloudy[grid.column(ii, jn)]) near.emplace_back(ii, jn);
             }
           }
-          if (near.empty()) continue;
-          const double w = 1.0 / static_cast<double>(near.size());
-          for (int k = 0; k < nz; ++k) {
+          for (int k = 0; k < nz && !near.empty(); ++k) {
             const std::size_t off = static_cast<std::size_t>(k) * layer;
-            for (std::vector<float>* f : fields) {
-              double sum = 0.0;
-              for (std::size_t c : near) sum += (*f)[c + off];
-              (*f)[grid.column(i, j) + off] = static_cast<float>(sum * w);
+            double sum[4] = {0.0, 0.0, 0.0, 0.0};
+            int count = 0;
+            for (const glm::ivec2 c : near) {
+              bool fringe = false;
+              for (int kk = std::max(k - 1, 0); kk <= std::min(k + 1, nz - 1) && !fringe; ++kk) {
+                double sl, si;
+                shown_at(c.x, c.y, kk, sl, si);
+                fringe = sl + si > 0.0;
+              }
+              if (!fringe) continue;
+              ++count;
+              for (int f = 0; f < 4; ++f) sum[f] += (*fields[f])[grid.column(c.x, c.y) + off];
             }
+            if (count == 0) continue;
+            for (int f = 0; f < 4; ++f) (*fields[f])[grid.column(i, j) + off] = static_cast<float>(sum[f] / count);
           }
         }
       }

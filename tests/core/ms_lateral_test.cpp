@@ -112,6 +112,16 @@ TEST(Lateral, ANarrowTowerLosesLightThroughItsSidesAndItsFluxPointsOutOfThem) {
     EXPECT_NEAR(s, -n, 1e-3 * n) << k;
     EXPECT_NEAR(r.east[grid.index(10, 10, k)], 0.0, 1e-3 * e) << "the axis, level " << k;
   }
+  // The sunlit ground around the tower (albedo 0.3 under an overhead sun) lights its sides: more
+  // light in the side columns, and less flowing out of them.
+  LateralMedium lit = medium_of(grid, tower, {0.0, 0.0, -1.0}, 0.3);
+  const LateralRatio r_dark = lateral_ratio(grid, lit);
+  lit.ground_light.assign(grid.columns(), 0.3);
+  const LateralRatio r_lit = lateral_ratio(grid, lit);
+  for (int k = 10; k <= 30; k += 5) {
+    EXPECT_GT(r_lit.ratio[grid.index(11, 10, k)], r_dark.ratio[grid.index(11, 10, k)] * 1.02) << k;
+    EXPECT_LT(r_lit.east[grid.index(11, 10, k)], r_dark.east[grid.index(11, 10, k)]) << k;
+  }
 }
 
 // The 3-D solution's balance: all the light the beam puts into the diffuse field (and the ground
@@ -124,7 +134,9 @@ TEST(Lateral, TheLightPutInLeavesThroughTheBoundaries) {
     return r2 < 1.0 ? 0.006 * (1.0 - r2) : 0.0;
   };
   for (const double ground : {0.0, 0.3, 1.0}) {
-    const LateralRatio r = lateral_ratio(grid, medium_of(grid, blob, {0.3, -0.4, -0.866}, ground));
+    LateralMedium m = medium_of(grid, blob, {0.3, -0.4, -0.866}, ground);
+    m.ground_light.assign(grid.columns(), 0.866 * ground);  // the sunlit ground beside it lights its sides
+    const LateralRatio r = lateral_ratio(grid, m);
     EXPECT_LT(r.residual, 1e-6);
     ASSERT_GT(r.put_in, 0.0);
     EXPECT_NEAR(r.let_out / r.put_in, 1.0, 1e-5) << "ground " << ground;
@@ -243,6 +255,8 @@ TEST(Lateral, TheSourceTakesTheLightBetweenItsColumns) {
       << "the clear column beside the cloud takes the light at its edge";
   EXPECT_GT(lateral.i1e[g.index(edge - 1, 20, k)], 0.0f) << "the east side's light flows east";
   EXPECT_EQ(lateral.i0[g.index(edge + 2, 20, k)], 0.0f) << "further out, no light of the cloud's";
+  EXPECT_EQ(lateral.i0[g.index(edge, 20, 0)], 0.0f) << "the ground beside the cloud takes no light from under it";
+  EXPECT_GT(lateral.i0[g.index(20, 20, 0)], 0.0f) << "the ground under it does";
   const std::vector<float> moments = ms_moments_texels(lateral), horizontal = ms_horizontal_texels(lateral);
   ASSERT_EQ(moments.size(), 2 * lateral.i0.size());
   EXPECT_EQ(moments[2 * g.index(20, 20, k)], lateral.i0[g.index(20, 20, k)]);
