@@ -24,14 +24,14 @@ struct Layout {
 // One column's tridiagonal system over levels k0..k1 (diagonal `diag`, -wz[k] between nodes k and
 // k + 1; no coupling leaves the range), solved by Thomas's algorithm (the matrix is diagonally
 // dominant: no pivoting).
-void solve_column(const Layout& L, std::size_t col, int k0, int k1, const std::vector<float>& diag,
+void solve_column(const Layout& L, std::size_t col, int k0, int k1, const std::vector<double>& diag,
                   const std::vector<float>& wz, const double* rhs, double* x, std::vector<double>& scratch) {
   scratch.resize(static_cast<std::size_t>(L.nz));
   double prev_c = 0.0, prev_x = 0.0;
   for (int k = k0; k <= k1; ++k) {
     const std::size_t a = static_cast<std::size_t>(k) * L.layer + col;
     const double lower = k > k0 ? double(wz[a - L.layer]) : 0.0;
-    const double den = double(diag[a]) - lower * prev_c;
+    const double den = diag[a] - lower * prev_c;
     const double c = den > 0.0 && k < k1 ? double(wz[a]) / den : 0.0;
     const double xv = den > 0.0 ? (rhs[a] + lower * prev_x) / den : 0.0;
     scratch[static_cast<std::size_t>(k)] = c;
@@ -75,7 +75,7 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
                dlat = std::abs(grid.lat_deg.step) * kPi / 180.0;
   const double hy = R * dlat, hz = std::abs(grid.alt_m.step);
   const bool has_x = L.nx > 1 && dlon > 0.0, has_y = L.ny > 1 && dlat > 0.0, has_z = L.nz > 1 && hz > 0.0;
-  if (!(hz > 0.0) && L.nz > 1) return out;
+  if (!has_z) return out;  // one level (or none apart): no column to compare with
   auto hx_at = [&](double lat_deg) { return R * std::max(std::cos(lat_deg * kPi / 180.0), 1e-3) * dlon; };
   auto cloud = [&](std::size_t a) { return m.kappa[a] > 0.0f && std::isfinite(m.kappa[a]); };
   auto beam_at = [&](std::size_t a) {
@@ -115,7 +115,8 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
   auto each_block = [&](std::size_t b, auto&& fn) {
     for (std::size_t sp = b * kSpanBlock, se = std::min(spans.size(), sp + kSpanBlock); sp < se; ++sp) {
       const Span& span = spans[sp];
-      for (int k = span.k0; k <= span.k1; ++k) fn(span.col, k, static_cast<std::size_t>(k) * L.layer + span.col);
+      for (int k = span.k0; k <= span.k1; ++k)
+        fn(span.col, k, static_cast<std::size_t>(k) * L.layer + span.col);
     }
   };
   auto each_active = [&](auto&& fn) {
@@ -212,17 +213,19 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
     const double da = diffusion(a), db = diffusion(b);
     return area * 2.0 * da * db / (da + db) / h;
   };
-  // A face toward clear air, the grid's edge or the ground: the outward net flux
-  // Jn = c (phi_a - phi_b) + q (c = 2 D / h, phi_b at the face) meets Jn = beta phi_b - s_g
-  // (Marshak's condition: beta = 1/2 and s_g = 0 for vacuum; for a Lambertian ground of albedo A,
-  // beta = (1 - A) / (2 (1 + A)) and s_g = 2 A mu0 E / (1 + A)), so
-  // Jn = (beta phi_a - s_g + beta q / c) / (1 + beta / c), per unit area.
+  // A face toward clear air, the grid's edge or the ground: the diffused part of the outward flux,
+  // c (phi_a - phi_b) (c = 2 D / h, phi_b at the face), meets Marshak's condition beta phi_b - s_g
+  // (beta = 1/2 and s_g = 0 for vacuum; for a Lambertian ground of albedo A, beta = (1 - A) /
+  // (2 (1 + A)) and s_g = 2 A mu0 E / (1 + A)), and the beam's forward flux q leaves as it is:
+  // Jn = (beta phi_a - s_g) / (1 + beta / c) + q, per unit area. (Marshak's condition on the whole
+  // flux, P1's own, made phi negative in thin cloud, where the forward flux outweighs phi / 2:
+  // the light scattered forward there leaves the cloud without diffusing.)
   auto boundary_terms = [&](std::size_t a, double h, double beta, double sg, double q, double& per_phi,
                             double& fixed) {
     const double c = 2.0 * diffusion(a) / h;
     const double t = 1.0 + beta / c;
     per_phi = beta / t;
-    fixed = (-sg + beta * q / c) / t;
+    fixed = -sg / t + q;
   };
 
   // fn(i, j, k, a, volume) for every node, rows on the machine's cores.
@@ -241,12 +244,12 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
   // Both systems, multiplied through by each node's volume: diagonal, couplings east, north and up
   // (the matrix: symmetric, diagonally dominant, positive definite), right-hand sides. Clear nodes
   // hold 1 on the diagonal and 0 on the right. Each node writes only its own row.
-  std::vector<float> diag3(n, 0.0f), diag1(n, 0.0f), wx(has_x ? n : 0, 0.0f), wy(has_y ? n : 0, 0.0f),
-      wz(n, 0.0f);
+  std::vector<double> diag3(n, 0.0), diag1(n, 0.0);
+  std::vector<float> wx(has_x ? n : 0, 0.0f), wy(has_y ? n : 0, 0.0f), wz(n, 0.0f);
   std::vector<double> rhs3(n, 0.0), rhs1(n, 0.0);
   each_node([&](int i, int j, int k, std::size_t a, double vol) {
     if (!cloud(a)) {
-      diag3[a] = diag1[a] = 1.0f;
+      diag3[a] = diag1[a] = 1.0;
       return;
     }
     double d3 = 0.0, d1 = 0.0, r3 = vol * scaled_at(a) * beam_at(a), r1 = r3;
@@ -255,9 +258,11 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
             const bool vertical = axis == 2;
             double dd, rr;
             if (b != kNone) {
-              dd = coupling(a, b, area, h);
+              const float w =
+                  static_cast<float>(coupling(a, b, area, h));  // the diagonal sums the stored couplings
+              dd = double(w);
               rr = -area * q;
-              if (sign > 0) (axis == 0 ? wx : axis == 1 ? wy : wz)[a] = static_cast<float>(dd);
+              if (sign > 0) (axis == 0 ? wx : axis == 1 ? wy : wz)[a] = w;
             } else {
               double per_phi, fixed;
               boundary_terms(a, h, beta, sg, q, per_phi, fixed);
@@ -267,12 +272,12 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
             d3 += dd, r3 += rr;
             if (vertical) d1 += dd, r1 += rr;
           });
-    diag3[a] = static_cast<float>(d3);
-    diag1[a] = static_cast<float>(d1);
+    diag3[a] = d3;
+    diag1[a] = d1;
     rhs3[a] = r3;
     rhs1[a] = r1;
   });
-  auto by_columns = [&](const std::vector<float>& diag, const double* rhs, double* x) {
+  auto by_columns = [&](const std::vector<double>& diag, const double* rhs, double* x) {
     parallel_ranges(spans.size(), 256, [&](std::size_t sb, std::size_t se, unsigned) {
       std::vector<double> scratch;
       for (std::size_t sp = sb; sp < se; ++sp) {
@@ -283,13 +288,13 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
   // The independent columns.
   std::vector<double> phi1(n, 0.0);
   by_columns(diag1, rhs1.data(), phi1.data());
-  std::vector<float>().swap(diag1);
+  std::vector<double>().swap(diag1);
   std::vector<double>().swap(rhs1);
 
   // y = A x for the 3-D matrix (on the spans; elsewhere both are 0).
   auto apply = [&](const std::vector<double>& x, std::vector<double>& y) {
     each_active([&](std::size_t col, int k, std::size_t a) {
-      double v = double(diag3[a]) * x[a];
+      double v = diag3[a] * x[a];
       if (k + 1 < L.nz) v -= double(wz[a]) * x[a + L.layer];
       if (k > 0) v -= double(wz[a - L.layer]) * x[a - L.layer];
       const std::size_t row = static_cast<std::size_t>(L.nx);
@@ -354,6 +359,7 @@ LateralRatio lateral_ratio(const VolumeGrid& grid, const LateralMedium& m, doubl
       out_row[jj] += area * (per_phi * phi3[a] + fixed);
     });
     const double v3 = phi3[a], v1 = phi1[a];
+    // No column light (v1 <= 0): nothing to scale, the ratio stays 1; no 3-D light: 0.
     if (v1 > 0.0 && std::isfinite(v3 / v1))
       out.ratio[a] = static_cast<float>(std::clamp(v3 / v1, 0.0, kLateralRatioMax));
     if (!(v3 > 0.0) || !std::isfinite(v3)) return;

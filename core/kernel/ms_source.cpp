@@ -549,7 +549,9 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
               const int jn = j + dj;
               if (wrap) ii = (ii + nx) % nx;
               if (ii < 0 || ii >= nx || jn < 0 || jn >= ny || (ii == i && jn == j)) continue;
-              if (cloudy[grid.column(ii, jn)]) near.emplace_back(ii, jn);
+              if (cloudy[grid.column(ii, jn)] && std::find(near.begin(), near.end(), glm::ivec2(ii, jn)) == near.end()) {
+                near.emplace_back(ii, jn);
+              }
             }
           }
           for (int k = 0; k < nz && !near.empty(); ++k) {

@@ -127,19 +127,50 @@ TEST(Lateral, ANarrowTowerLosesLightThroughItsSidesAndItsFluxPointsOutOfThem) {
 // The 3-D solution's balance: all the light the beam puts into the diffuse field (and the ground
 // returns) leaves through the cloud's boundaries; the inner faces' flows cancel in pairs.
 TEST(Lateral, TheLightPutInLeavesThroughTheBoundaries) {
+  for (const double lat : {0.0, 70.0}) {  // the sphere's metric: east-west spacing by cos(latitude)
+    VolumeGrid grid = box(0.005, 21, 31);
+    grid.lat_deg.start += lat;
+    const auto blob = [](int i, int j, int k) {
+      const double r2 =
+          ((i - 9.0) * (i - 9.0) + (j - 11.0) * (j - 11.0)) / 16.0 + (k - 14.0) * (k - 14.0) / 64.0;
+      return r2 < 1.0 ? 0.006 * (1.0 - r2) : 0.0;
+    };
+    for (const double ground : {0.0, 0.3, 1.0}) {
+      LateralMedium m = medium_of(grid, blob, {0.3, -0.4, -0.866}, ground);
+      m.ground_light.assign(grid.columns(), 0.866 * ground);  // the sunlit ground beside it lights its sides
+      const LateralRatio r = lateral_ratio(grid, m);
+      EXPECT_LT(r.residual, 1e-6);
+      ASSERT_GT(r.put_in, 0.0);
+      EXPECT_NEAR(r.let_out / r.put_in, 1.0, 1e-5) << "ground " << ground << ", latitude " << lat;
+    }
+  }
+}
+
+// A thin forward-scattering cloud (optical depth about 3 through its middle, the droplets' g) under
+// an overhead and an oblique sun: both solutions stay positive, so no node's ratio falls to 0,
+// reaches the clamp or is left at 1 for want of column light.
+TEST(Lateral, AThinCloudKeepsPositiveLight) {
   const VolumeGrid grid = box(0.005, 21, 31);
   const auto blob = [](int i, int j, int k) {
     const double r2 =
         ((i - 9.0) * (i - 9.0) + (j - 11.0) * (j - 11.0)) / 16.0 + (k - 14.0) * (k - 14.0) / 64.0;
-    return r2 < 1.0 ? 0.006 * (1.0 - r2) : 0.0;
+    return r2 < 1.0 ? 0.0006 * (1.0 - r2) : 0.0;
   };
-  for (const double ground : {0.0, 0.3, 1.0}) {
-    LateralMedium m = medium_of(grid, blob, {0.3, -0.4, -0.866}, ground);
-    m.ground_light.assign(grid.columns(), 0.866 * ground);  // the sunlit ground beside it lights its sides
-    const LateralRatio r = lateral_ratio(grid, m);
-    EXPECT_LT(r.residual, 1e-6);
-    ASSERT_GT(r.put_in, 0.0);
-    EXPECT_NEAR(r.let_out / r.put_in, 1.0, 1e-5) << "ground " << ground;
+  for (const glm::dvec3 dir : {glm::dvec3(0.0, 0.0, -1.0), glm::dvec3(0.85, 0.0, -0.5)}) {
+    const LateralRatio r = lateral_ratio(grid, medium_of(grid, blob, dir));
+    int cloudy = 0;
+    for (int k = 0; k < grid.alt_m.count; ++k)
+      for (int j = 0; j < grid.lat_deg.count; ++j)
+        for (int i = 0; i < grid.lon_deg.count; ++i) {
+          if (!(blob(i, j, k) > 0.0)) continue;
+          ++cloudy;
+          const std::size_t a = grid.index(i, j, k);
+          ASSERT_GT(r.ratio[a], 0.0f) << i << " " << j << " " << k << " sun " << dir.x;
+          ASSERT_LT(r.ratio[a], float(kLateralRatioMax)) << i << " " << j << " " << k << " sun " << dir.x;
+          ASSERT_NE(r.ratio[a], 1.0f)
+              << "no column light at " << i << " " << j << " " << k << " sun " << dir.x;
+        }
+    EXPECT_GT(cloudy, 300);
   }
 }
 
@@ -169,12 +200,13 @@ TEST(Lateral, TheLongitudesWrapOnAGlobalGrid) {
   }
 }
 
-// The sums are taken in a fixed order: one thread and two give the same bits.
+// The sums are taken in a fixed order: one thread and three give the same bits (about 2 300
+// cloudy columns: the sums run over several blocks).
 TEST(Lateral, TheAnswerDoesNotDependOnTheNumberOfThreads) {
-  const VolumeGrid grid = box(0.005, 31, 31);
+  const VolumeGrid grid = box(0.005, 61, 31);
   const auto blob = [](int i, int j, int k) {
     const double r2 =
-        ((i - 15.0) * (i - 15.0) + (j - 14.0) * (j - 14.0)) / 36.0 + (k - 15.0) * (k - 15.0) / 81.0;
+        ((i - 30.0) * (i - 30.0) + (j - 29.0) * (j - 29.0)) / 729.0 + (k - 15.0) * (k - 15.0) / 81.0;
     return r2 < 1.0 ? 0.005 * (1.0 - r2) : 0.0;
   };
   const LateralMedium m = medium_of(grid, blob, {0.5, 0.0, -0.866});
@@ -204,8 +236,13 @@ TEST(Lateral, ExtremeInputsGiveFiniteLight) {
     for (const double value : {1e-9, 1e-3, 1e7, nan, inf}) {
       LateralMedium m = medium_of(
           grid, [&](int i, int, int k) { return (i + k) % 3 == 0 ? value : 0.004; }, {0.2, 0.1, -0.3}, 0.9);
-      if (std::isnan(value)) m.beam[0] = static_cast<float>(nan), m.beam_dir[0] = glm::dvec3(nan);
-      if (std::isinf(value)) m.gcoef[0] = static_cast<float>(inf), m.ground[0] = inf;
+      // Bad beams, directions, forward shares and grounds on a cloudy node (i = 1, k = 1) and its column.
+      const std::size_t a =
+          grid.index(std::min(1, grid.lon_deg.count - 1), 0, std::min(1, grid.alt_m.count - 1));
+      if (std::isnan(value))
+        m.beam[a] = static_cast<float>(nan), m.beam_dir[a % grid.columns()] = glm::dvec3(nan);
+      if (std::isinf(value)) m.gcoef[a] = static_cast<float>(inf), m.ground[a % grid.columns()] = inf;
+      m.ground_light.assign(grid.columns(), value);
       const LateralRatio r = lateral_ratio(grid, m);
       for (std::size_t a = 0; a < grid.points(); ++a) {
         ASSERT_TRUE(r.ratio[a] >= 0.0f && r.ratio[a] <= float(kLateralRatioMax))
@@ -255,7 +292,8 @@ TEST(Lateral, TheSourceTakesTheLightBetweenItsColumns) {
       << "the clear column beside the cloud takes the light at its edge";
   EXPECT_GT(lateral.i1e[g.index(edge - 1, 20, k)], 0.0f) << "the east side's light flows east";
   EXPECT_EQ(lateral.i0[g.index(edge + 2, 20, k)], 0.0f) << "further out, no light of the cloud's";
-  EXPECT_EQ(lateral.i0[g.index(edge, 20, 0)], 0.0f) << "the ground beside the cloud takes no light from under it";
+  EXPECT_EQ(lateral.i0[g.index(edge, 20, 0)], 0.0f)
+      << "the ground beside the cloud takes no light from under it";
   EXPECT_GT(lateral.i0[g.index(20, 20, 0)], 0.0f) << "the ground under it does";
   const std::vector<float> moments = ms_moments_texels(lateral), horizontal = ms_horizontal_texels(lateral);
   ASSERT_EQ(moments.size(), 2 * lateral.i0.size());
