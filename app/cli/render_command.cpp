@@ -900,8 +900,7 @@ int cmd_render(const std::vector<std::string>& args) {
     const int lateral = gpu.ms_source_lateral_iterations();
     const std::string between =
         lateral >= 0 ? "light between columns in " + std::to_string(lateral) + " iteration(s)"
-                     : "columns on their own: light between columns is solved on grids up to " +
-                           std::to_string(core::kLateralMaxNodes) + " nodes";
+                     : "columns on their own: " + gpu.ms_source_columns_alone();
     std::printf("two-stream source built in %.1f ms (once per time step and sun direction; %s)\n", gpu.ms_source_build_ms(),
                 between.c_str());
   }

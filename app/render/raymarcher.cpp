@@ -251,6 +251,7 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
       check_gl("uploading the two-stream source");
       ms_volume_ = &v, ms_key_ = key, ms_build_ms_ = src.build_ms, ms_built_here_ = built;
       ms_lateral_iterations_ = src.lateral_iterations;
+      ms_columns_alone_ = src.columns_alone;
       ++ms_count_[built ? 0 : 1];
     }
     params.u_ms_lateral = ms_lateral_;

@@ -171,8 +171,10 @@ class GpuRaymarcher {
   // time step, the sun or the medium's phases change.
   double ms_source_build_ms() const { return ms_build_ms_; }
   // The last source's light between columns: its 3-D solve's iterations, -1 where the columns were
-  // left on their own (a grid beyond core::kLateralMaxNodes).
+  // left on their own.
   int ms_source_lateral_iterations() const { return ms_lateral_iterations_; }
+  // With -1 above: why (core::ms_columns_alone_why).
+  const std::string& ms_source_columns_alone() const { return ms_columns_alone_; }
   // Whether the source in use was built on this thread (false: the volume's prebuilt one), and how
   // many sources were built here and taken prebuilt so far.
   bool ms_source_built_here() const { return ms_built_here_; }
@@ -212,6 +214,7 @@ class GpuRaymarcher {
   const core::PreparedVolume* ms_volume_ = nullptr;
   double ms_build_ms_ = 0.0;
   int ms_lateral_iterations_ = -1;
+  std::string ms_columns_alone_;
   bool ms_built_here_ = true;
   std::size_t ms_count_[2] = {0, 0};  // sources built here, taken prebuilt
   GLuint ms_beam_buffer_ = 0;         // the droplets' beam table (CV_SSBO_MS_BEAM)

@@ -126,6 +126,18 @@ TwoStreamColumn two_stream_column(const double* sigma, const double* g, int n, d
   return c;
 }
 
+std::string ms_columns_alone_why(const VolumeGrid& grid, const MsSourceKey& key) {
+  if (!key.lateral) return "the exchange was turned off (MsSourceKey::lateral)";
+  if (grid.points() > kLateralMaxNodes) {
+    return "the grid's " + std::to_string(grid.points()) + " nodes are beyond the " + std::to_string(kLateralMaxNodes) +
+           " the exchange is solved on";
+  }
+  if (static_cast<std::size_t>(std::max(grid.lon_deg.count, 0)) * static_cast<std::size_t>(std::max(grid.lat_deg.count, 0)) <= 1) {
+    return "the grid has one column";
+  }
+  return "";
+}
+
 MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun, const AlbedoMap* ground) {
   MsSourceKey k;
   k.to_sun = to_sun;
@@ -396,8 +408,9 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
     }
   });
   const int top_level = row_top.empty() ? -1 : *std::max_element(row_top.begin(), row_top.end());
+  out.columns_alone = ms_columns_alone_why(grid, key);
   if (top_level < 0) {  // no cloud: nothing to exchange either
-    if (key.lateral && grid.points() <= kLateralMaxNodes && layer > 1) out.lateral_iterations = 0;
+    if (out.columns_alone.empty()) out.lateral_iterations = 0;
     out.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return out;
   }
@@ -420,7 +433,7 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
   // the scaled problem against the columns' own, from the same beam, before the columns overwrite it.
   LateralRatio lateral;
   std::vector<unsigned char> cloudy;  // per column: any cloud shown
-  const bool use_lateral = key.lateral && grid.points() <= kLateralMaxNodes && layer > 1;
+  const bool use_lateral = out.columns_alone.empty();
   if (use_lateral) {
     const auto tl = std::chrono::steady_clock::now();
     LateralMedium lm;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -65,6 +66,7 @@ struct MsSource {
   std::vector<float> i1e, i1n;
   double build_ms = 0.0;        // wall time to build it
   int lateral_iterations = -1;  // the 3-D diffusion's conjugate-gradient iterations (-1: the columns left on their own)
+  std::string columns_alone;    // with -1: why the columns were left on their own (ms_columns_alone_why)
   double lateral_ms = 0.0;      // its share of build_ms
 };
 
@@ -100,6 +102,10 @@ struct MsSourceKey {
            same_ground && lateral == o.lateral;
   }
 };
+
+// Why a build with this key on this grid leaves every column on its own (the light between the
+// columns not solved), or empty where it solves it.
+std::string ms_columns_alone_why(const VolumeGrid& grid, const MsSourceKey& key);
 
 // The key of the source a march with these settings and this sun needs (ground albedo: the mean of
 // the constant ground_albedo where the globe is drawn, else 0; the ground map where the globe is

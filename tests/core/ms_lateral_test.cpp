@@ -276,8 +276,10 @@ TEST(Lateral, TheSourceTakesTheLightBetweenItsColumns) {
   const MsSource columns = build_ms_source(v, off), lateral = build_ms_source(v, on);
   EXPECT_TRUE(columns.i1e.empty() && columns.i1n.empty());
   EXPECT_EQ(columns.lateral_iterations, -1);
+  EXPECT_NE(columns.columns_alone.find("turned off"), std::string::npos) << columns.columns_alone;
   ASSERT_EQ(lateral.i1e.size(), lateral.i0.size());
   EXPECT_GT(lateral.lateral_iterations, 0);
+  EXPECT_TRUE(lateral.columns_alone.empty()) << lateral.columns_alone;
   const VolumeGrid& g = bubble.grid;
   const int k = 10;  // 3 km, the bubble's middle
   EXPECT_LT(lateral.i0[g.index(20, 20, k)], columns.i0[g.index(20, 20, k)])
@@ -301,6 +303,22 @@ TEST(Lateral, TheSourceTakesTheLightBetweenItsColumns) {
   EXPECT_EQ(moments[2 * g.index(20, 20, k) + 1], lateral.i1[g.index(20, 20, k)]);
   EXPECT_EQ(horizontal[2 * g.index(edge - 1, 20, k)], lateral.i1e[g.index(edge - 1, 20, k)]);
   EXPECT_TRUE(ms_horizontal_texels(columns).empty());
+}
+
+// What `render` says when the columns stay on their own: the reason, not a budget the grid is within.
+TEST(Lateral, SaysWhyTheColumnsStayOnTheirOwn) {
+  MsSourceKey key;
+  VolumeGrid g = box(0.005, 21, 31);
+  EXPECT_EQ(ms_columns_alone_why(g, key), "");
+  key.lateral = false;
+  EXPECT_NE(ms_columns_alone_why(g, key).find("turned off"), std::string::npos);
+  key.lateral = true;
+  g.lon_deg.count = g.lat_deg.count = 1;  // one column: no neighbours
+  EXPECT_EQ(ms_columns_alone_why(g, key), "the grid has one column");
+  g.lon_deg.count = 2048, g.lat_deg.count = 1024, g.alt_m.count = 8;  // 16 Mi nodes: counts only, nothing allocated
+  const std::string big = ms_columns_alone_why(g, key);
+  EXPECT_NE(big.find("16777216 nodes"), std::string::npos) << big;
+  EXPECT_NE(big.find(std::to_string(kLateralMaxNodes)), std::string::npos) << big;
 }
 
 }  // namespace
