@@ -211,34 +211,70 @@ void sweep_sun_beam(const VolumeGrid& grid, const float* scaled, const glm::dvec
   top_level = std::clamp(top_level, 0, nz - 1);
   const std::size_t layer = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
   std::fill(beam + static_cast<std::size_t>(top_level + 1) * layer, beam + grid.points(), 1.0f);
-  // Per column: the upstream point's shift per level in index units, the path per level (m) and its
-  // sub-samples, or mu0 <= 0 (the sun down: no beam).
+  // Per column: the sun's cosine mu0 to the local vertical and its horizontal direction (index
+  // units per metre of arc on the reference sphere), and the pieces of path per level. The ray to
+  // the sun is straight over a curved Earth: from a node at radius r it reaches the radius of m
+  // levels up after s = -r mu0 + sqrt(r^2 mu0^2 + (2 r + m dz) m dz) (for mu0 well above 0 about
+  // m dz / mu0, the flat column; for a sun at or a little below the local horizon tens of
+  // kilometres, where the flat column's dz / mu0 grew without bound), first dipping below the node
+  // where the sun is below its horizon. A node whose ray meets the Earth (the sun below the
+  // horizon by more than the dip at its height) is in the Earth's shadow: no beam.
   struct Shift {
-    double di = 0.0, dj = 0.0, path = 0.0;
-    int sub = 1;
-    bool lit = false;
+    double mu0 = 1.0, sin0 = 0.0;  // the sun's cosine and sine to the local vertical
+    bool flat = true;              // a sun high enough that the Earth's curve changes a hop's path by under 0.5 %
+    double ie = 0.0, jn = 0.0;     // index units per metre of arc along the sun's horizontal direction
+    int sub = 1;                   // pieces of path per level
   };
+  const double R = grid.earth_radius_m;
+  const double r_top = R + grid.alt_m.at(top_level);
   std::vector<Shift> shift(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+  // Along the ray from a node at radius r: the distance to m levels up, and at distance t the
+  // height above the node and the arc (m) on the reference sphere.
+  auto reach = [&](const Shift& s, double r, int m) {
+    const double rise = m * dz;
+    if (s.flat) return rise / s.mu0;
+    return -r * s.mu0 + std::sqrt(std::max(r * r * s.mu0 * s.mu0 + (2.0 * r + rise) * rise, 0.0));
+  };
+  // (The height as (2 r mu0 t + t^2) / (rho + r), without the cancellation of rho - r; the arc's
+  // arctangent by its series where the angle is small, as it is but for long grazing paths.)
+  auto lift = [&](const Shift& s, double r, double t) {
+    if (s.flat) return t * s.mu0;
+    const double num = (2.0 * r * s.mu0 + t) * t;
+    return num / (std::sqrt(std::max(r * r + num, 0.0)) + r);
+  };
+  auto arc = [&](const Shift& s, double r, double t) {
+    if (s.flat) return t * s.sin0;
+    const double y = t * s.sin0, x = r + t * s.mu0;
+    if (x > 0.0 && y < 1e-2 * x) {
+      const double u = y / x, u2 = u * u;
+      return R * u * (1.0 - u2 * (1.0 / 3.0 - u2 * (0.2 - u2 / 7.0)));
+    }
+    return R * std::atan2(y, x);
+  };
+  auto shadowed = [&](const Shift& s, double r) { return s.mu0 < 0.0 && r * s.sin0 <= R; };
   for (int j = 0; j < ny; ++j) {
     const double lat = grid.lat_deg.at(j);
     const double dx = grid.earth_radius_m * std::cos(lat * d2r) * grid.lon_deg.step * d2r;
     const double dy = grid.earth_radius_m * grid.lat_deg.step * d2r;
     for (int i = 0; i < nx; ++i) {
       const geo::EnuFrame f = geo::sphere_enu(lat, grid.lon_deg.at(i));
-      const double mu0 = glm::dot(f.up, to_sun);
       Shift& s = shift[static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i)];
-      if (!(mu0 > 1e-4)) continue;
-      s.lit = true;
-      const double run = dz / mu0;  // metres along the ray per level
-      s.di = std::abs(dx) > 1e-9 ? run * glm::dot(f.east, to_sun) / dx : 0.0;
-      s.dj = std::abs(dy) > 1e-9 ? run * glm::dot(f.north, to_sun) / dy : 0.0;
-      s.path = run;
-      s.sub = static_cast<int>(std::clamp(std::ceil(2.0 * std::max(std::abs(s.di), std::abs(s.dj))), 1.0, 64.0));
+      s.mu0 = std::clamp(glm::dot(f.up, to_sun), -1.0, 1.0);
+      s.sin0 = std::sqrt(std::max(1.0 - s.mu0 * s.mu0, 0.0));
+      s.flat = s.mu0 >= 0.3;
+      const double he = glm::dot(f.east, to_sun), hn = glm::dot(f.north, to_sun);
+      if (s.sin0 > 1e-12) {
+        s.ie = std::abs(dx) > 1e-9 ? he / s.sin0 / dx : 0.0;
+        s.jn = std::abs(dy) > 1e-9 ? hn / s.sin0 / dy : 0.0;
+      }
+      const double a1 = arc(s, r_top, reach(s, r_top, 1));
+      s.sub = static_cast<int>(std::clamp(std::ceil(2.0 * a1 * std::max(std::abs(s.ie), std::abs(s.jn))), 1.0, 64.0));
     }
   }
   // Index-space lookups: outside a regional grid is clear air; longitude wraps on global grids and
   // latitude clamps at the edge rows.
   auto column_of = [&](double fi, double fj, int& i0, int& i1, int& j0, int& j1, double& wi, double& wj) {
+    if (!(std::isfinite(fi) && std::isfinite(fj))) return false;
     if (wraps) {
       if (fi < 0.0 || fi >= nx) {  // fmod only off the grid: most points are on it
         fi = std::fmod(fi, double(nx));
@@ -278,26 +314,56 @@ void sweep_sun_beam(const VolumeGrid& grid, const float* scaled, const glm::dvec
     t.in = true;
     return t;
   };
-  auto level_value = [&](const float* lv, double fi, double fj) { return tap_at(fi, fj).on(lv); };
+  // The scaled extinction at distance t along the ray from node (i, j) on level k (radius r): read
+  // at the point's height (linear between the two levels around it; clear air below the lowest).
+  auto extinction = [&](const Shift& sh, double r, int i, int j, int k, double t) {
+    const double a = arc(sh, r, t);
+    const double lv = std::min(k + lift(sh, r, t) / dz, double(nz - 1));  // the point's level, fractional
+    if (!(lv >= 0.0)) return 0.0;
+    const int lo = std::min(static_cast<int>(lv), nz - 1);
+    const double w = lv - lo;
+    const Tap tp = tap_at(i + a * sh.ie, double(j) + a * sh.jn);
+    const float* s0 = scaled + static_cast<std::size_t>(lo) * layer;
+    double v = tp.on(s0);
+    if (w > 1e-9 && lo + 1 < nz) v = (1.0 - w) * v + w * tp.on(s0 + layer);
+    return v;
+  };
+  // How far along the ray from node (i, j) it stays over a regional grid (infinite where the grid
+  // wraps or reaches the poles on the axis it leaves by): beyond is clear air.
+  auto inside = [&](const Shift& sh, double r, int i, int j) {
+    constexpr double kFar = 1e30;
+    double a_out = kFar;  // the arc (m) at which the point's index leaves [0, n - 1]
+    if (!wraps && sh.ie != 0.0) a_out = std::min(a_out, ((sh.ie > 0.0 ? nx - 1 - i : -i)) / sh.ie);
+    if (!global_lat && sh.jn != 0.0) a_out = std::min(a_out, ((sh.jn > 0.0 ? ny - 1 - j : -j)) / sh.jn);
+    if (!(a_out < kFar)) return kFar;
+    if (sh.flat) return a_out / sh.sin0;  // ie or jn is not 0, so neither is sin0
+    // The ray's arc grows as R atan(t sin0 / (r + t mu0)): invert it (beyond its reach, far).
+    const double th = a_out / R;
+    if (!(th < 0.5 * kPi)) return kFar;
+    const double tn = std::tan(th), den = sh.sin0 - sh.mu0 * tn;
+    return den > 0.0 ? std::max(r * tn / den, 0.0) : kFar;
+  };
   // beam holds tau' on the levels swept while the sweep runs (each is written before a level below
   // reads it), then exp(-tau'); above top_level it stays 1.
   constexpr int stride = 8;
   // Per column, the number of levels m (1..stride) after which the upstream point lies nearest to
   // grid nodes: the bilinear reading of the optical depth there smears least per level (the smear
-  // of one reading is frac (1 - frac) cells squared in each direction).
+  // of one reading is frac (1 - frac) cells squared in each direction). At most 64 pieces of path
+  // per node: a low sun's long steps take one level at a time. The fewest levels whose smear is
+  // within 1.5 times the least (plus 0.002 cells^2 per level): where the sun is high the upstream
+  // point moves a small part of a cell per level, the smear is about that part whatever m is, and
+  // one level at a time costs least.
   std::vector<std::uint8_t> hop(shift.size(), 1);
   for (std::size_t c = 0; c < shift.size(); ++c) {
-    // At most 64 pieces of path per node: a low sun's long steps take one level at a time. The
-    // fewest levels whose smear is within 1.5 times the least (plus 0.002 cells^2 per level): where
-    // the sun is high the upstream point moves a small part of a cell per level, the smear is about
-    // that part whatever m is, and one level at a time costs least.
-    const int most = std::clamp(64 / std::max(shift[c].sub, 1), 1, stride);
+    const Shift& sh = shift[c];
+    const int most = std::clamp(64 / std::max(sh.sub, 1), 1, stride);
     auto smear = [&](int m) {
       auto f = [](double x) {
         const double r = x - std::floor(x);
         return r * (1.0 - r);
       };
-      return (f(m * shift[c].di) + f(m * shift[c].dj)) / m;
+      const double a = arc(sh, r_top, reach(sh, r_top, m));
+      return (f(a * sh.ie) + f(a * sh.jn)) / m;
     };
     double best = 1e30;
     for (int m = 1; m <= most; ++m) best = std::min(best, smear(m));
@@ -309,6 +375,7 @@ void sweep_sun_beam(const VolumeGrid& grid, const float* scaled, const glm::dvec
     }
   }
   for (int k = top_level; k >= 0; --k) {
+    const double r = R + grid.alt_m.at(k);
     parallel_ranges(static_cast<std::size_t>(ny), 16, [&](std::size_t jb, std::size_t je, unsigned) {
       for (std::size_t j = jb; j < je; ++j) {
         for (int i = 0; i < nx; ++i) {
@@ -316,35 +383,42 @@ void sweep_sun_beam(const VolumeGrid& grid, const float* scaled, const glm::dvec
           const Shift& sh = shift[c];
           const int m = std::min(int(hop[c]), nz - 1 - k);
           double tau = 0.0;
-          if (!sh.lit) {
+          if (shadowed(sh, r)) {
             tau = 1e30;
           } else if (m > 0) {
-            // The path up m levels by the trapezoid on sub pieces per level (points on a level read
-            // that level alone, the node itself exactly; points between levels linear between
-            // them), then the optical depth already reached at the upstream point on level k + m.
+            // The path up m levels by the trapezoid on sub pieces per level (each point read at its
+            // height: a level alone where it lies on one, else linear between the two levels around
+            // it, clear air below the grid's lowest level), then the optical depth already reached
+            // at the upstream point on level k + m. Where the path leaves a regional grid before
+            // that level, the pieces cover the part inside it (the rest is clear air): a long
+            // grazing path keeps its pieces where the cloud is.
             const int pieces = sh.sub * m;
+            const double s_m = reach(sh, r, m);
+            const double t_end = std::min(s_m, inside(sh, r, i, static_cast<int>(j)));
             double sum = 0.5 * double(scaled[static_cast<std::size_t>(k) * layer + c]);
-            for (int q = 1; q < pieces; ++q) {
-              const int lo = std::min(q / sh.sub, m - 1), rem = q - lo * sh.sub;  // level below the point, and sub-steps past it
-              const double t = double(q) / sh.sub;
-              const double fi = i + t * sh.di, fj = double(j) + t * sh.dj;
-              const float* s0 = scaled + static_cast<std::size_t>(k + lo) * layer;
-              double v;
-              if (rem == 0) {
-                v = level_value(s0, fi, fj);
-              } else if (rem == sh.sub) {
-                v = level_value(s0 + layer, fi, fj);
-              } else {
-                const double w = double(rem) / sh.sub;
-                v = (1.0 - w) * level_value(s0, fi, fj) + w * level_value(s0 + layer, fi, fj);
-              }
-              sum += v;
+            for (int q = 1; q < pieces; ++q) sum += extinction(sh, r, i, static_cast<int>(j), k, t_end * q / pieces);
+            if (t_end < s_m) {
+              sum += 0.5 * extinction(sh, r, i, static_cast<int>(j), k, t_end);
+              tau = sum * t_end / pieces;
+            } else {
+              // The last point, on level k + m: its extinction ends the path, its optical depth adds.
+              const double a = arc(sh, r, s_m);
+              const Tap last = tap_at(i + a * sh.ie, double(j) + a * sh.jn);
+              const std::size_t up = static_cast<std::size_t>(k + m) * layer;
+              sum += 0.5 * last.on(scaled + up);
+              tau = sum * s_m / pieces + (k + m <= top_level ? last.on(beam + up) : 0.0);
             }
-            // The last point, on level k + m: its extinction ends the path, its optical depth adds.
-            const Tap last = tap_at(i + m * sh.di, double(j) + m * sh.dj);
-            const std::size_t up = static_cast<std::size_t>(k + m) * layer;
-            sum += 0.5 * last.on(scaled + up);
-            tau = sum / sh.sub * sh.path + (k + m <= top_level ? last.on(beam + up) : 0.0);
+          } else if (sh.mu0 < 0.0) {
+            // The grid's top level under a sun below its horizon: the ray dips through the cloud
+            // below and is back at this height after -2 r mu0, clear air above.
+            const int pieces = std::max(sh.sub, 8);
+            const double t_end = std::min(-2.0 * r * sh.mu0, inside(sh, r, i, static_cast<int>(j)));
+            double sum = 0.5 * double(scaled[static_cast<std::size_t>(k) * layer + c]);
+            for (int q = 1; q <= pieces; ++q) {
+              const double v = extinction(sh, r, i, static_cast<int>(j), k, t_end * q / pieces);
+              sum += q == pieces ? 0.5 * v : v;
+            }
+            tau = sum * t_end / pieces;
           }
           beam[static_cast<std::size_t>(k) * layer + c] = static_cast<float>(std::min(tau, 1e30));
         }
@@ -503,11 +577,7 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
           for (int k = 0; k < nz; ++k) out.i0[c + static_cast<std::size_t>(k) * layer] = 0.0f, out.i1[c + static_cast<std::size_t>(k) * layer] = 0.0f;
         };
         const double mu0 = glm::dot(geo::sphere_enu(grid.lat_deg.at(j), grid.lon_deg.at(i)).up, to_sun);
-        if (!(mu0 > 0.0)) {  // night: no source
-          clear();
-          continue;
-        }
-        bool any = false;
+        bool any = false, lit = false;
         for (int k = 0; k < nz; ++k) {
           const std::size_t K = static_cast<std::size_t>(k);
           double sl, si;
@@ -516,16 +586,30 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
           g[K] = sl + si > 0.0 ? (sl * key.liquid_g + si * key.ice_g) / (sl + si) : 0.0;
           col_beam[K] = beam[grid.index(i, j, k)];
           any = any || sl + si > 0.0;
+          lit = lit || col_beam[K] > 0.0f;
         }
-        if (!any) {  // a clear column holds no diffuse light from cloud (the sky is the air's)
+        // A clear column holds no diffuse light from cloud (the sky is the air's); a column the
+        // beam reaches nowhere (the Earth's shadow) holds none either.
+        if (!any || !lit || !std::isfinite(mu0)) {
           clear();
           continue;
         }
-        const TwoStreamColumn tc = two_stream_column(sigma.data(), g.data(), nz, grid.alt_m.step, mu0, ground_at(i, j),
-                                                     TwoStreamClosure::Quadrature, col_beam.data());
+        // The sun below the column's horizon, its cloud lit through the air beside it (a sun up to
+        // the dip at the cloud's height, a degree or three): the beam climbs, so the column is
+        // solved upside down (its top the ground's side) with |mu0>, the ground dark (the sun is
+        // below its horizon too; the light it would send back up is left out), and turned back.
+        const bool below = !(mu0 > 0.0);
+        if (below) {
+          std::reverse(sigma.begin(), sigma.end());
+          std::reverse(g.begin(), g.end());
+          std::reverse(col_beam.begin(), col_beam.end());
+        }
+        const TwoStreamColumn tc = two_stream_column(sigma.data(), g.data(), nz, grid.alt_m.step, below ? std::max(-mu0, 1e-6) : mu0,
+                                                     below ? 0.0 : ground_at(i, j), TwoStreamClosure::Quadrature, col_beam.data());
         for (int k = 0; k < nz; ++k) {
-          out.i0[grid.index(i, j, k)] = static_cast<float>(tc.i0[static_cast<std::size_t>(k)]);
-          out.i1[grid.index(i, j, k)] = static_cast<float>(tc.i1[static_cast<std::size_t>(k)]);
+          const std::size_t K = static_cast<std::size_t>(below ? nz - 1 - k : k);
+          out.i0[grid.index(i, j, k)] = static_cast<float>(tc.i0[K]);
+          out.i1[grid.index(i, j, k)] = static_cast<float>(below ? -tc.i1[K] : tc.i1[K]);
         }
       }
     }

@@ -50,11 +50,13 @@ TwoStreamColumn two_stream_column(const double* sigma_per_m, const double* g, in
 // The sun's delta-scaled beam exp(-tau') at every node (0..1), tau' the optical depth of the scaled
 // extinction `scaled` (1/m, the grid's layout) toward the sun: swept down from level top_level
 // (above it the beam is 1), each node's tau' the upstream point's on a level 1 to 8 above (bilinear,
-// the sun's direction taken in the column's local frame; per column the hop whose upstream point
-// falls nearest to nodes, so the readings smear a shadow's edge least, with at most 64 pieces of
-// path per node) plus the path between (the trapezoid, points between levels linear between the
-// two levels' values). Outside a regional grid is clear air; latitude clamps at the edge rows of a
-// grid whose rows reach both poles; the sun below the horizon gives 0.
+// where the straight ray to the sun climbs to that level over the curved Earth; per column the hop
+// whose upstream point falls nearest to nodes, so the readings smear a shadow's edge least, with at
+// most 64 pieces of path per node) plus the path between (the trapezoid, each point read at its own
+// height, linear between the two levels around it). A sun a little below a node's horizon still
+// lights it (the ray dips first, then climbs) unless the ray meets the Earth: in the Earth's shadow
+// the beam is 0. Outside a regional grid is clear air; latitude clamps at the edge rows of a grid
+// whose rows reach both poles.
 std::vector<float> sun_beam_field(const VolumeGrid& grid, const std::vector<float>& scaled, const glm::dvec3& to_sun, int top_level);
 
 // The source over a prepared volume: i0 and i1 per grid node (the grid's layout), as R32F textures.

@@ -618,7 +618,9 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
     real i0;
     real3 i1;
     ms_source_at(p, alt_p, i0, i1);
-    scaled_source += sun_air * max(sigma_ms * i0 - first * dot(i1, d), real(0.0));
+    // In the Earth's shadow (a column lit by a sun below its horizon, its lower part in shadow) the
+    // sun's light through the air is not known here: that diffuse light is left out.
+    if (lit) scaled_source += sun_air * max(sigma_ms * i0 - first * dot(i1, d), real(0.0));
   } else if (lit) {
     // The octave gate (octaves.glsl): w from the column's optical depth; off, the classic sum.
     bool gate = u_octave_gate && u_octaves > 1;

@@ -328,7 +328,10 @@ TEST(TwoStream, TheBeamsSweepFollowsTheRayToTheSun) {
         }
       }
     }
-    for (double zenith : {30.0, 60.0}) {
+    // Regional: also a sun just above and just below the horizon, whose ray climbs out over the
+    // curved Earth (below the horizon it first dips under the node).
+    const std::vector<double> zeniths = global ? std::vector<double>{30.0, 60.0} : std::vector<double>{30.0, 60.0, 89.5, 90.5};
+    for (double zenith : zeniths) {
       for (double azimuth : {0.0, 90.0, 180.0, 270.0}) {
         // The sun's direction in the blob's local frame, then in Earth-centred coordinates.
         const geo::EnuFrame f = geo::sphere_enu(0.0, c_lon);
@@ -354,6 +357,50 @@ TEST(TwoStream, TheBeamsSweepFollowsTheRayToTheSun) {
       }
     }
   }
+}
+
+// A sun on or a little below the local horizon still lights cloud whose ray to it clears the Earth
+// (below the horizon by less than the dip at its height): its columns take diffuse light, the same
+// just below the horizon as just above it (no edge where the sun sets locally); a sun below the
+// horizon by more than the dip leaves the cloud in the Earth's shadow, without any.
+TEST(TwoStream, ASunJustBelowTheHorizonStillLightsTheCloud) {
+  const cv::test::BubbleScene bubble(false);
+  const PreparedVolume v = prepare_volume(bubble.grid, bubble.data);
+  MarchSettings s;
+  const geo::EnuFrame f = geo::sphere_enu(0.0, 0.0);
+  auto sun = [&](double zenith_deg) {
+    const double z = zenith_deg * 3.14159265358979 / 180.0;
+    return std::cos(z) * f.up + std::sin(z) * f.east;
+  };
+  auto total = [](const MsSource& src) {
+    double sum = 0.0;
+    for (float x : src.i0) {
+      EXPECT_TRUE(std::isfinite(x) && x >= 0.0f);
+      sum += x;
+    }
+    return sum;
+  };
+  const MsSource above = build_ms_source(v, ms_source_key(s, sun(89.8)));
+  const MsSource below = build_ms_source(v, ms_source_key(s, sun(90.2)));
+  const MsSource shadow = build_ms_source(v, ms_source_key(s, sun(100.0)));  // the dip at the top (10.5 km) is 3.3 degrees
+  const double a = total(above), b = total(below);
+  EXPECT_GT(a, 0.0);
+  EXPECT_GT(b, 0.0) << "the cloud under a sun 0.2 degrees below its horizon takes light";
+  EXPECT_GT(b / a, 0.7);
+  EXPECT_LT(b / a, 1.4);
+  EXPECT_EQ(total(shadow), 0.0);
+  // Node by node at 3 km: the middle column, where the sun sets locally between the two suns,
+  // keeps its light across; the west of the bubble (the sun 0.6 degrees below its horizon under
+  // the lower sun, the dip at 3 km 1.8) takes light; the sunlit east side more than the far side.
+  const VolumeGrid& g = bubble.grid;
+  const int k = 10;
+  const double mid_above = above.i0[g.index(20, 20, k)], mid_below = below.i0[g.index(20, 20, k)];
+  EXPECT_GT(mid_above, 0.0);
+  EXPECT_GT(mid_below, 0.7 * mid_above);
+  EXPECT_LT(mid_below, 1.4 * mid_above);
+  EXPECT_GT(below.i0[g.index(16, 20, k)], 0.0f);
+  EXPECT_GT(below.i0[g.index(25, 20, k)], below.i0[g.index(15, 20, k)]);
+  for (float x : below.i1) ASSERT_TRUE(std::isfinite(x));
 }
 
 // Lit from the side: under a low sun the node on a cloud's sunlit side, below its top, keeps most
