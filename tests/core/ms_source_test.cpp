@@ -401,6 +401,10 @@ TEST(TwoStream, ASunJustBelowTheHorizonStillLightsTheCloud) {
   EXPECT_GT(below.i0[g.index(16, 20, k)], 0.0f);
   EXPECT_GT(below.i0[g.index(25, 20, k)], below.i0[g.index(15, 20, k)]);
   for (float x : below.i1) ASSERT_TRUE(std::isfinite(x));
+  // A direction that is not one gives no beam, not NaN.
+  std::vector<float> scaled(g.points(), 1e-3f);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (float x : sun_beam_field(g, scaled, glm::dvec3(nan, 0.0, 1.0), g.alt_m.count - 1)) ASSERT_TRUE(std::isfinite(x) && x >= 0.0f && x <= 1.0f);
 }
 
 // Lit from the side: under a low sun the node on a cloud's sunlit side, below its top, keeps most
