@@ -223,6 +223,11 @@ std::vector<Config> make_configs(const bench::StandardScene& sc, const core::Mar
     c.description = "the default preset with the octave sum at 8 octaves, gate on";
     c.march.medium.ms_two_stream = false, c.march.quality.octaves = 8;
   });
+  add("two_stream_linear", [&](Config& c) {
+    c.kind = ConfigKind::Seed;
+    c.description = "the default preset with the two-stream source's diffuse light linear in angle (diffuse_shape linear)";
+    c.march.medium.ms_two_stream = true, c.march.medium.ms_slab = false;
+  });
   add("octave_sum_classic", [&](Config& c) {
     c.kind = ConfigKind::Seed;
     c.description = "the default preset with the classic octave sum (4 octaves, no gate)";
@@ -321,6 +326,7 @@ int cmd_bench(const std::vector<std::string>& args) {
     core::MarchSettings base = sc.march;
     base.medium.modelled = modelled;
     base.medium.ms_two_stream = core::scene_march_defaults().medium.ms_two_stream;  // the model the product renders with
+    base.medium.ms_slab = core::scene_march_defaults().medium.ms_slab;
     base.features.atmosphere = base.features.globe = false;
     base.medium.ambient = 0.0, base.medium.noise_amount = 0.0;
     // The reference samples pixel centres: accumulated configurations march them too, so their

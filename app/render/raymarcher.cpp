@@ -9,6 +9,7 @@
 #include "kernel/bindings.glsl"
 #include "kernel/march_stats.glsl"
 #include "kernel/ms_beam.glsl"
+#include "kernel/ms_slab.glsl"
 #include "kernel/detail_drift.hpp"
 #include "physics/physics.hpp"  // CV_DETAIL_COVERS (shaders/common/detail.glsl)
 #include "noise/blue_noise.hpp"
@@ -27,7 +28,10 @@ int loop_iterations_per_view_step(const core::MarchSettings& s, int sun_march_st
   const int air = std::max(s.quality.atmo_sun_steps, 0) + 2;
   const int octaves = 2 * (std::max(s.quality.octaves, 0) + 1);
   const int substeps = s.features.adaptive_steps ? 64 : 1;  // march_substeps divides a step at most 64 times
-  return substeps * (1 + sun + air + octaves);
+  // The slab-shaped diffuse light (ms_slab_in_scatter): its harmonics' recurrence (37) and the
+  // table's eight corners; the part lit from below, its Legendre recurrence (14) and four corners.
+  const int slab = s.medium.ms_two_stream && s.medium.ms_slab ? 37 + 8 + 14 + 4 + 4 + 8 : 0;
+  return substeps * (1 + sun + air + octaves + slab);
 }
 
 int view_steps_per_dispatch(const core::MarchSettings& s, int sun_march_steps) {
@@ -97,6 +101,7 @@ GpuRaymarcher::~GpuRaymarcher() {
   if (pyramid_buffer_) glDeleteBuffers(1, &pyramid_buffer_);
   if (stats_buffer_) glDeleteBuffers(1, &stats_buffer_);
   if (ms_beam_buffer_) glDeleteBuffers(1, &ms_beam_buffer_);
+  if (ms_slab_buffer_) glDeleteBuffers(1, &ms_slab_buffer_);
   if (params_buffer_) glDeleteBuffers(1, &params_buffer_);
 }
 
@@ -233,16 +238,23 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
       bool built = true;
       const std::shared_ptr<const core::MsSource> ms = core::ms_source_for(v, key, &built);  // built ahead by the viewer's prefetcher, or now
       const core::MsSource& src = *ms;
-      // Two RG32F textures: (I0, I1 up) and, where the columns exchange light, (I1 east, I1 north).
+      // Two RG32F textures: (I0, I1 up) and, where the columns exchange light, (I1 east, I1 north);
+      // the first RGBA32F with the higher-order source's depths (tau above, tau below).
       const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
+      const bool rgba = !src.tau_above.empty();
+      if (ms_[0] && rgba != ms_rgba_) {
+        glDeleteTextures(1, &ms_[0]);
+        ms_[0] = 0;
+      }
       for (int t = 0; t < 2; ++t) {
         if (ms_[t] || (t == 1 && src.i1e.empty())) continue;
         glCreateTextures(GL_TEXTURE_3D, 1, &ms_[t]);
-        glTextureStorage3D(ms_[t], 1, GL_RG32F, n.x, n.y, n.z);
+        glTextureStorage3D(ms_[t], 1, t == 0 && rgba ? GL_RGBA32F : GL_RG32F, n.x, n.y, n.z);
       }
+      ms_rgba_ = rgba;
       glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
       const std::vector<float> moments = core::ms_moments_texels(src);
-      glTextureSubImage3D(ms_[0], 0, 0, 0, 0, n.x, n.y, n.z, GL_RG, GL_FLOAT, moments.data());
+      glTextureSubImage3D(ms_[0], 0, 0, 0, 0, n.x, n.y, n.z, rgba ? GL_RGBA : GL_RG, GL_FLOAT, moments.data());
       ms_lateral_ = !src.i1e.empty();
       if (ms_lateral_) {
         const std::vector<float> horizontal = core::ms_horizontal_texels(src);
@@ -272,6 +284,20 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
       ms_beam_uploaded_ = peaks.beam;
     }
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_MS_BEAM, ms_beam_buffer_);
+  }
+  // The higher-order source's slab tables (core::ms_slab_tables): always bound too, for the same reason.
+  {
+    const std::shared_ptr<const std::vector<float>> tables = core::ms_slab_on(s) ? core::ms_slab_tables(s) : nullptr;
+    if (!ms_slab_buffer_) {
+      glCreateBuffers(1, &ms_slab_buffer_);
+      glNamedBufferStorage(ms_slab_buffer_, static_cast<GLsizeiptr>(sizeof(float) * CV_MS_SLAB_TOTAL), nullptr, GL_DYNAMIC_STORAGE_BIT);
+    }
+    if (tables && tables != ms_slab_uploaded_) {
+      glNamedBufferSubData(ms_slab_buffer_, 0, static_cast<GLsizeiptr>(sizeof(float) * tables->size()), tables->data());
+      check_gl("uploading the slab tables");
+      ms_slab_uploaded_ = tables;
+    }
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CV_SSBO_MS_SLAB, ms_slab_buffer_);
   }
   if (s.medium.modelled && params.u_has_fraction && fraction_volume_ != &v) {  // the cover, only when the modelled cloud reads it
     if (!fraction_) {

@@ -199,7 +199,8 @@ class GpuRaymarcher {
   std::size_t path_pixels_ = 0;
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
-  GLuint ms_[2] = {0, 0};           // the two-stream source (RG32F x2), built for ms_key_ on ms_volume_
+  GLuint ms_[2] = {0, 0};           // the two-stream source (RG32F x2; the first RGBA32F with the slab's depths), built for ms_key_ on ms_volume_
+  bool ms_rgba_ = false;            // ms_[0] holds four channels (the higher-order source's depths)
   bool ms_lateral_ = false;         // ms_[1] holds the source's horizontal moment
   GLuint fraction_ = 0;             // the modelled cloud's cover (R32F 3-D), uploaded for fraction_volume_ when used
   const core::PreparedVolume* fraction_volume_ = nullptr;
@@ -219,6 +220,8 @@ class GpuRaymarcher {
   std::size_t ms_count_[2] = {0, 0};  // sources built here, taken prebuilt
   GLuint ms_beam_buffer_ = 0;         // the droplets' beam table (CV_SSBO_MS_BEAM)
   std::shared_ptr<const core::MsBeamTable> ms_beam_uploaded_;  // the table it holds
+  GLuint ms_slab_buffer_ = 0;         // the higher-order source's slab tables (CV_SSBO_MS_SLAB)
+  std::shared_ptr<const std::vector<float>> ms_slab_uploaded_;  // the tables it holds
   GLuint column_tau_ = 0;           // the column maps (RGBA32F): optical depth (the octave gate), ground, cloud type
   core::MediumMask column_mask_;    // the mask column_tau_'s depths were made for (none: the prepared map)
   GLuint jitter_mask_ = 0;          // the blue-noise mask (R32F), uploaded at construction

@@ -11,6 +11,7 @@
 #include "kernel/march_params.hpp"
 #include "kernel/march_stats.glsl"
 #include "kernel/ms_beam.glsl"
+#include "kernel/ms_slab.glsl"
 #include "physics/physics.hpp"
 
 namespace cv::kernel {
@@ -31,6 +32,7 @@ struct sampler2D {
 inline glm::dvec4 texelFetch(const sampler3D& t, glm::ivec3 p, int) {
   const std::size_t i = (static_cast<std::size_t>(p.z) * t.size.y + p.y) * t.size.x + p.x;
   if (t.channels == 2) return glm::dvec4(t.texels[2 * i], t.texels[2 * i + 1], 0.0, 1.0);
+  if (t.channels == 4) return glm::dvec4(t.texels[4 * i], t.texels[4 * i + 1], t.texels[4 * i + 2], t.texels[4 * i + 3]);
   return glm::dvec4(t.texels[i], 0.0, 0.0, 1.0);
 }
 inline glm::dvec4 texelFetch(const sampler2D& t, glm::ivec2 p, int) {
@@ -67,11 +69,13 @@ struct MarchKernel : MarchParams {
   sampler2D u_jitter_mask, u_ground, u_depth, u_opaque, u_tl_distance, u_tl_color, u_detail_table, u_detail_shift;
   const glm::vec2* u_min_max = nullptr;
   const float* u_ms_beam_table = nullptr;  // the droplets' beam table (ms_beam_table), read by the two-stream march with the Mie phase
+  const float* u_ms_slab_table = nullptr;  // the higher-order source's slab table (ms_slab_table), liquid then ice, read with u_ms_slab
   // The program switches (compile-time constants on the GPU).
   bool kSkipEmpty = true, kAdaptive = false, kAtmosphere = false, kGlobe = false, kNoise = false, kTwoStream = false,
        kTranslucent = false, kLayerMask = true,  // the CPU pays nothing for a uniform branch: the mask follows u_mask_band
        kTint = true,                             // and the tint follows u_tint
-       kModelled = false;
+       kModelled = false,
+       kSlab = false;  // the two-stream's diffuse light shaped by the slab tables (u_ms_slab_table)
 
 #include "kernel/march.glsl"
 

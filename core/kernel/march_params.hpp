@@ -126,10 +126,11 @@ struct MarchVariant {
   bool layer_mask = false;  // a height band masks the medium (layer_bottom_m / layer_top_m set)
   bool tint = false;        // false colour by liquid and ice (tint_liquid / tint_ice set)
   bool modelled = false;    // the modelled cloud (cloud_model "modelled")
+  bool slab = false;        // with two_stream: the diffuse light shaped by the slab tables (diffuse_shape "slab")
   static MarchVariant of(const core::MarchSettings& s);
   // A small integer naming the variant (a bit per switch), for caches of compiled programs.
   unsigned key() const;
-  static constexpr unsigned kCount = 1024;
+  static constexpr unsigned kCount = 2048;
   std::vector<std::pair<std::string, std::string>> defines() const;
 };
 

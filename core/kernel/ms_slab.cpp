@@ -13,6 +13,10 @@
 
 #include <Eigen/Dense>
 
+#include "io/parallel.hpp"
+#include "kernel/ms_slab.glsl"
+#include "kernel/ms_source.hpp"
+
 namespace cv::core {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
@@ -211,8 +215,14 @@ MsSlab::MsSlab(std::vector<double> chi, double omega, int streams, int modes) : 
 }
 
 MsSlabField MsSlab::solve(double tau, double mu0) const {
-  if (!(tau >= 0.0) || !std::isfinite(tau)) throw std::invalid_argument("MsSlab::solve: optical depth " + std::to_string(tau) + " is not >= 0");
   if (!(mu0 > 0.0 && mu0 <= 1.0)) throw std::invalid_argument("MsSlab::solve: mu0 " + std::to_string(mu0) + " outside (0, 1]");
+  return solve_any(tau, mu0, false);
+}
+
+MsSlabField MsSlab::solve_lit_from_below(double tau) const { return solve_any(tau, 1.0, true); }
+
+MsSlabField MsSlab::solve_any(double tau, double mu0, bool from_below) const {
+  if (!(tau >= 0.0) || !std::isfinite(tau)) throw std::invalid_argument("MsSlab::solve: optical depth " + std::to_string(tau) + " is not >= 0");
   const int n = n_;
   // A sun whose 1 / mu0 meets an eigenvalue makes the beam's particular solution singular: it is
   // moved by a relative 1e-7 (Stamnes and co. do the same in DISORT), far below any figure here.
@@ -225,6 +235,7 @@ MsSlabField MsSlab::solve(double tau, double mu0) const {
   f.slab_ = this;
   f.tau_ = tau;
   f.mu0_ = mu0;
+  f.beam_ = !from_below;
   const double c = 1.0 - omega_ * (chi_.size() > 1 ? chi_[1] : 0.0);
   for (const Mode& md : modes_) {
     const int m = md.m;
@@ -248,11 +259,11 @@ MsSlabField MsSlab::solve(double tau, double mu0) const {
         qm += ((l + m) % 2 ? -t : t);
       }
       const double scale = omega_ * (m == 0 ? 1.0 : 2.0) / mu_[static_cast<std::size_t>(i)];
-      rhs(i) = -qp * scale;
-      rhs(n + i) = qm * scale;
+      rhs(i) = from_below ? 0.0 : -qp * scale;
+      rhs(n + i) = from_below ? 0.0 : qm * scale;
       qmax = std::max({qmax, std::abs(qp), std::abs(qm)});
     }
-    if (qmax == 0.0) {  // no light in this mode (an overhead sun's modes m >= 1)
+    if (from_below ? m > 0 : qmax == 0.0) {  // no light in this mode (an overhead sun's modes m >= 1; light from below has m = 0 alone)
       f.sol_.push_back(std::move(ms));
       continue;
     }
@@ -268,12 +279,13 @@ MsSlabField MsSlab::solve(double tau, double mu0) const {
         big(n + i, n + j) -= a;
       }
     }
-    const Eigen::VectorXd z = big.fullPivLu().solve(rhs);
+    const Eigen::VectorXd z = from_below ? Eigen::VectorXd::Zero(2 * n) : Eigen::VectorXd(big.fullPivLu().solve(rhs));
     for (int i = 0; i < n; ++i) {
       ms.zp[static_cast<std::size_t>(i)] = z(i);
       ms.zm[static_cast<std::size_t>(i)] = z(n + i);
     }
-    // The boundaries: no diffuse light comes down at the top, none up from the black ground.
+    // The boundaries: no diffuse light comes down at the top, none up from the black ground (or
+    // radiance 1 up from it, lit from below).
     Eigen::MatrixXd bc(2 * n, 2 * n);
     Eigen::VectorXd r(2 * n);
     const double beam_bottom = std::exp(-tau / mu0);
@@ -294,7 +306,7 @@ MsSlabField MsSlab::solve(double tau, double mu0) const {
         bc(n + i, n + j) = md.gp[ij];
       }
       r(i) = -ms.zp[static_cast<std::size_t>(i)];
-      r(n + i) = -ms.zm[static_cast<std::size_t>(i)] * beam_bottom;
+      r(n + i) = from_below ? 1.0 : -ms.zm[static_cast<std::size_t>(i)] * beam_bottom;
     }
     const Eigen::VectorXd x = bc.fullPivLu().solve(r);
     for (int j = 0; j < n; ++j) {
@@ -366,9 +378,16 @@ double MsSlabField::in_scatter(double t, double mu, double phi, int l_max) const
 
 double MsSlabField::net_flux(double t) const {
   const MsSlab& s = *slab_;
-  double f = mu0_ * std::exp(-std::clamp(t, 0.0, tau_) / mu0_);
+  double f = beam_ ? mu0_ * std::exp(-std::clamp(t, 0.0, tau_) / mu0_) : 0.0;
   for (int i = 0; i < s.n_; ++i)
     f += 2.0 * kPi * s.w_[static_cast<std::size_t>(i)] * s.mu_[static_cast<std::size_t>(i)] * (radiance(0, i, t) - radiance(0, s.n_ + i, t));
+  return f;
+}
+
+double MsSlabField::up_flux(double t) const {
+  const MsSlab& s = *slab_;
+  double f = 0.0;
+  for (int i = 0; i < s.n_; ++i) f += 2.0 * kPi * s.w_[static_cast<std::size_t>(i)] * s.mu_[static_cast<std::size_t>(i)] * radiance(0, s.n_ + i, t);
   return f;
 }
 
@@ -384,6 +403,103 @@ double MsSlabField::transmitted_diffuse_flux() const {
   double f = 0.0;
   for (int i = 0; i < s.n_; ++i) f += 2.0 * kPi * s.w_[static_cast<std::size_t>(i)] * s.mu_[static_cast<std::size_t>(i)] * radiance(0, i, tau_);
   return f / mu0_;
+}
+
+MsSlabTwoStream ms_slab_two_stream(double t, double b, double mu0, double g, double ground) {
+  // A column of three nodes whose two layers hold the optical depths t and b (each layer's depth
+  // is the mean of its ends' extinction, dz 1).
+  t = std::max(std::isfinite(t) ? t : 0.0, 0.0);
+  b = std::max(std::isfinite(b) ? b : 0.0, 0.0);
+  const double s1 = std::min(t, b), gc = std::clamp(g, -0.999, 0.999);
+  const double sigma[3] = {2.0 * b - s1, s1, 2.0 * t - s1}, gs[3] = {gc, gc, gc};
+  const TwoStreamColumn c = two_stream_column(sigma, gs, 3, 1.0, mu0, ground);
+  return {c.i0[1], std::clamp(ground, 0.0, 1.0) * c.transmitted * mu0 / kPi};
+}
+
+double ms_slab_two_stream_i0(double t, double b, double mu0, double g) { return ms_slab_two_stream(t, b, mu0, g, 0.0).i0; }
+
+std::vector<double> ms_phase_moments(const std::function<double(double)>& phase, int l_max) {
+  std::vector<double> chi(static_cast<std::size_t>(std::max(l_max, 0) + 1), 0.0);
+  constexpr int kNodes = 40001;
+  std::vector<double> prev = legendre_all(l_max, 1.0), cur;
+  double prev_mu = 1.0, prev_p = phase(1.0);
+  if (!std::isfinite(prev_p)) prev_p = 0.0;
+  for (int i = 1; i < kNodes; ++i) {
+    const double mu = i == kNodes - 1 ? -1.0 : 1.0 - 1e-12 * std::pow(2e12, static_cast<double>(i) / (kNodes - 1));
+    double p = phase(mu);
+    if (!std::isfinite(p)) p = 0.0;
+    cur = legendre_all(l_max, mu);
+    for (std::size_t l = 0; l < chi.size(); ++l) chi[l] += kPi * (p * cur[l] + prev_p * prev[l]) * (prev_mu - mu);
+    prev.swap(cur);
+    prev_mu = mu;
+    prev_p = p;
+  }
+  return chi;
+}
+
+double ms_slab_share(const std::function<double(double)>& phase, double spike_weight) {
+  const std::vector<double> chi = ms_phase_moments(phase, CV_MS_SLAB_L + 1);
+  const double chi8 = chi[0] > 0.0 ? chi[CV_MS_SLAB_L + 1] / chi[0] : 0.0;
+  return std::clamp(std::max(chi8, spike_weight / 0.98), 0.0, 0.99);
+}
+
+MsSlabTable ms_slab_table(const std::function<double(double)>& phase, double f, double g_two_stream, int streams) {
+  MsSlabTable out;
+  out.f = std::clamp(f, 0.0, 0.99);
+  out.cut = ms_peak(phase, out.f).cut;
+  out.chi = ms_clipped_moments(phase, out.cut, 2 * streams - 2);
+  const MsSlab slab(out.chi, 1.0, streams, CV_MS_SLAB_L + 1);
+  constexpr int nd = CV_MS_SLAB_DEPTHS;
+  out.values.assign(static_cast<std::size_t>(CV_MS_SLAB_PHASE_SIZE), 0.0f);
+  // The depth of a grid index: t = T0 u / (1 - u); the half-space row at 1e4 (its light is the
+  // half-space's to rounding); the thinnest at 1e-3, whose shape the thin limit's is.
+  auto depth = [](int i) {
+    const double u = static_cast<double>(i) / (nd - 1);
+    return i == nd - 1 ? 1.0e4 : std::max(CV_MS_SLAB_T0 * u / (1.0 - u), 5.0e-4);
+  };
+  const std::size_t cells = static_cast<std::size_t>(CV_MS_SLAB_SUNS * nd * nd);
+  parallel_ranges(cells, 8, [&](std::size_t b0, std::size_t e0, unsigned) {
+    for (std::size_t cell = b0; cell < e0; ++cell) {
+      const int iu = static_cast<int>(cell % nd), iv = static_cast<int>((cell / nd) % nd), is = static_cast<int>(cell / (nd * nd));
+      const double mu0 = CV_MS_SLAB_MU0_LO + (1.0 - CV_MS_SLAB_MU0_LO) * is / (CV_MS_SLAB_SUNS - 1);
+      const double t = depth(iu), b = depth(iv);
+      const MsSlabField field = slab.solve((1.0 - out.f) * (t + b), mu0);
+      const std::vector<double> psi = field.moments((1.0 - out.f) * t, CV_MS_SLAB_L0);
+      float* dst = out.values.data() + cell * static_cast<std::size_t>(CV_MS_SLAB_STRIDE);
+      std::size_t k = 0;  // the table's order: m = 0 to degree L0, then m >= 1 to degree L
+      for (int m = 0; m <= CV_MS_SLAB_L; ++m) {
+        for (int l = m; l <= (m == 0 ? CV_MS_SLAB_L0 : CV_MS_SLAB_L); ++l, ++k) {
+          const double v = (2 * l + 1) * 0.5 * out.chi[static_cast<std::size_t>(l)] * psi[static_cast<std::size_t>(l * (l + 1) / 2 + m)];
+          dst[k] = std::isfinite(v) ? static_cast<float>(v) : 0.0f;
+        }
+      }
+      const double down = field.net_flux((1.0 - out.f) * t) - mu0 * std::exp(-(1.0 - out.f) * t / mu0) + field.up_flux((1.0 - out.f) * t);
+      dst[CV_MS_SLAB_FLUX_DOWN] = std::isfinite(down) ? static_cast<float>(std::max(down, 0.0)) : 0.0f;
+      dst[CV_MS_SLAB_TWO_STREAM_I0] = static_cast<float>(ms_slab_two_stream_i0(t, b, mu0, g_two_stream));
+    }
+  });
+  // Lit from below: per (b, t) cell (no sun).
+  out.below.assign(static_cast<std::size_t>(CV_MS_SLAB_BELOW_SIZE), 0.0f);
+  parallel_ranges(static_cast<std::size_t>(nd * nd), 8, [&](std::size_t b0, std::size_t e0, unsigned) {
+    for (std::size_t cell = b0; cell < e0; ++cell) {
+      const int iu = static_cast<int>(cell % nd), iv = static_cast<int>(cell / nd);
+      const double t = depth(iu), b = depth(iv);
+      const MsSlabField field = slab.solve_lit_from_below((1.0 - out.f) * (t + b));
+      const std::vector<double> psi = field.moments((1.0 - out.f) * t, CV_MS_SLAB_BELOW_L);
+      float* dst = out.below.data() + cell * static_cast<std::size_t>(CV_MS_SLAB_BELOW_STRIDE);
+      for (int l = 0; l <= CV_MS_SLAB_BELOW_L; ++l) {
+        const double v = (2 * l + 1) * 0.5 * out.chi[static_cast<std::size_t>(l)] * psi[static_cast<std::size_t>(l * (l + 1) / 2)];
+        dst[l] = std::isfinite(v) ? static_cast<float>(v) : 0.0f;
+      }
+      const double down = field.net_flux((1.0 - out.f) * t) + field.up_flux((1.0 - out.f) * t);
+      dst[CV_MS_SLAB_BELOW_FLUX_DOWN] = std::isfinite(down) ? static_cast<float>(std::max(down, 0.0)) : 0.0f;
+      // The two-stream's I0 per unit of the ground's radiance: linear in it, so from one ground.
+      const MsSlabTwoStream lit = ms_slab_two_stream(t, b, 0.5, g_two_stream, 0.5), dark = ms_slab_two_stream(t, b, 0.5, g_two_stream, 0.0);
+      const double per = lit.ground_radiance > 0.0 ? (lit.i0 - dark.i0) / lit.ground_radiance : 0.0;
+      dst[CV_MS_SLAB_BELOW_TWO_STREAM_I0] = std::isfinite(per) ? static_cast<float>(std::max(per, 0.0)) : 0.0f;
+    }
+  });
+  return out;
 }
 
 }  // namespace cv::core

@@ -20,6 +20,7 @@
 #pragma once
 
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace cv::core {
@@ -35,6 +36,17 @@ std::vector<double> ms_slab_legendre(int m, int l_max, double mu);
 std::vector<double> ms_clipped_moments(const std::function<double(double)>& phase, double cut, int l_max,
                                        double* share_cut = nullptr);
 
+// The Legendre moments chi_0 .. chi_l_max of a phase function over the sphere, by the trapezoid on
+// cosines packed geometrically toward the forward direction (1 - mu from 1e-12 to 2), so a droplet's
+// forward lobe narrower than a degree is resolved.
+std::vector<double> ms_phase_moments(const std::function<double(double)>& phase, int l_max);
+
+// The share f the higher-order source truncates from a phase (docs/physics.md, "The higher-order
+// source"): delta-M's with eight moments, f = chi_8; for a droplets' Mie fit whose narrow HG lobe
+// (weight spike_weight, kept apart by the beam's table) would not fit within it, enough to hold the
+// lobe: f = max(chi_8, spike_weight / 0.98). Henyey-Greenstein: g^8.
+double ms_slab_share(const std::function<double(double)>& phase, double spike_weight = 0.0);
+
 class MsSlabField;
 
 // The eigen-solutions of one homogeneous medium (phase moments, single-scattering albedo) for
@@ -47,6 +59,9 @@ class MsSlab {
 
   // The slab of optical depth tau (>= 0) under a sun at cosine mu0 (0 < mu0 <= 1).
   MsSlabField solve(double tau, double mu0) const;
+  // The slab lit from below by isotropic radiance 1 going up at its bottom (a Lambertian ground's
+  // light), nothing from above: the azimuthal mean alone.
+  MsSlabField solve_lit_from_below(double tau) const;
 
   int streams() const { return n_; }
   int modes() const { return static_cast<int>(modes_.size()); }
@@ -66,6 +81,7 @@ class MsSlab {
 
  private:
   friend class MsSlabField;
+  MsSlabField solve_any(double tau, double mu0, bool from_below) const;
   std::vector<double> chi_;
   double omega_;
   int n_;
@@ -89,6 +105,8 @@ class MsSlabField {
   // Net downward flux (diffuse and direct) per unit irradiance normal to the beam: constant in t
   // on a conservative slab.
   double net_flux(double t) const;
+  // The upward diffuse flux at depth t per unit irradiance normal to the beam.
+  double up_flux(double t) const;
   // Upward diffuse flux at the top and downward diffuse flux at the bottom, over mu0.
   double reflected_flux() const;
   double transmitted_diffuse_flux() const;
@@ -99,11 +117,39 @@ class MsSlabField {
   friend class MsSlab;
   const MsSlab* slab_ = nullptr;
   double tau_ = 0.0, mu0_ = 1.0;
+  bool beam_ = true;  // lit by the sun's beam from above; else from below (solve_lit_from_below)
   struct ModeSolution {
     std::vector<double> a, b;   // coefficients of the solutions decaying from the top and from the bottom
     std::vector<double> zp, zm;  // the beam's particular solution, down and up halves
   };
   std::vector<ModeSolution> sol_;
 };
+
+// The slab table of one phase (shaders/kernel/ms_slab.glsl for its layout; docs/physics.md, "The
+// higher-order source"): for a conservative homogeneous slab with the optical depth t above a point
+// and b below it, under a sun at mu0, the moments psi_lm of the diffuse radiance of the problem
+// truncated at the share f (ms_slab_share; the phase cut flat there, its moments chi'_l) by discrete
+// ordinates, times (2l + 1) / 2 chi'_l, per unit irradiance; the diffuse flux going down; and the
+// two-stream's I0 there for a phase of mean cosine g_two_stream (ms_slab_two_stream_i0). The march
+// weighs it by its node's slab factor (the source's I0 over that I0, which carries the 3-D light). Made in parallel; about a third of a second per phase on two cores.
+struct MsSlabTable {
+  std::vector<float> values;  // CV_MS_SLAB_PHASE_SIZE
+  std::vector<float> below;   // CV_MS_SLAB_BELOW_SIZE: the slab lit from below
+  double f = 0.0;             // the share truncated
+  double cut = 0.0;           // the phase's cut (1/sr) that leaves f above it
+  std::vector<double> chi;    // the cut phase's moments to 2 streams - 2
+};
+// The mean diffuse radiance I0 that the delta-scaled two-stream (two_stream_column, its default
+// closure) gives at a point of a conservative homogeneous slab over a black ground with the optical
+// depth t above it and b below, under a sun at mu0, for a phase of mean cosine g.
+double ms_slab_two_stream_i0(double t, double b, double mu0, double g);
+// The same over a Lambertian ground of albedo `ground`: I0 there and the ground's radiance (its
+// albedo times the flux that reaches it, over pi), per unit irradiance.
+struct MsSlabTwoStream {
+  double i0 = 0.0, ground_radiance = 0.0;
+};
+MsSlabTwoStream ms_slab_two_stream(double t, double b, double mu0, double g, double ground);
+
+MsSlabTable ms_slab_table(const std::function<double(double)>& phase, double f, double g_two_stream, int streams = 16);
 
 }  // namespace cv::core

@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <utility>
 
@@ -13,7 +15,9 @@
 #include "geo/geodesy.hpp"
 #include "io/parallel.hpp"
 #include "kernel/ms_beam.glsl"
+#include "kernel/ms_slab.glsl"
 #include "kernel/ms_lateral.hpp"
+#include "kernel/ms_slab.hpp"
 #include "physics/physics.hpp"
 #include "volume/sampler.hpp"
 
@@ -146,6 +150,7 @@ MsSourceKey ms_source_key(const MarchSettings& s, const glm::dvec3& to_sun, cons
   k.ice_g = s.medium.ice_g;
   k.ground_albedo = s.features.globe ? (s.medium.ground_albedo.x + s.medium.ground_albedo.y + s.medium.ground_albedo.z) / 3.0 : 0.0;
   k.mask = medium_mask(s);
+  k.slab = ms_slab_on(s);
   if (s.features.globe && ground && ground->width > 0 && ground->height > 0 &&
       ground->rgba.size() == 4 * static_cast<std::size_t>(ground->width) * static_cast<std::size_t>(ground->height)) {
     k.ground = ground;
@@ -462,6 +467,7 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
   // reads its own beam before it writes its i0 and i1; a column left out is zeroed.
   out.i0.assign(grid.points(), 0.0f);
   out.i1.assign(grid.points(), 0.0f);
+  if (key.slab) out.tau_above.assign(grid.points(), 0.0f), out.tau_below.assign(grid.points(), 0.0f), out.sigma.assign(grid.points(), 0.0f);
   float* scaled = out.i0.data();
   float* beam = out.i1.data();
   // The scaled extinction, and the highest level with cloud (the beam is whole above the level
@@ -568,7 +574,8 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
     out.lateral_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tl).count();
   }
   parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
-    std::vector<double> sigma(static_cast<std::size_t>(nz)), g(static_cast<std::size_t>(nz)), col_beam(static_cast<std::size_t>(nz));
+    std::vector<double> sigma(static_cast<std::size_t>(nz)), g(static_cast<std::size_t>(nz)), col_beam(static_cast<std::size_t>(nz)),
+        col_above(static_cast<std::size_t>(nz));
     for (std::size_t jj = jb; jj < je; ++jj) {
       const int j = static_cast<int>(jj);
       for (int i = 0; i < nx; ++i) {
@@ -611,6 +618,30 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
           out.i0[grid.index(i, j, k)] = static_cast<float>(tc.i0[K]);
           out.i1[grid.index(i, j, k)] = static_cast<float>(below ? -tc.i1[K] : tc.i1[K]);
         }
+        if (key.slab) {
+          // Where each node stands in the slab the march reads (docs/physics.md, "The higher-order
+          // source"): below it the column's optical depth under it (the trapezoid between levels,
+          // from the sun's side: a column solved upside down has its "below" above); above it the
+          // depth at which the slab's beam is the node's own 3-D beam, -mu0 ln(beam) / (1 - g^2)
+          // (mu0 as the table reads it), at most the column's: in a horizontally uniform cloud the
+          // depth from the top, on a cloud's sunlit side near 0 (its light there is the newly
+          // scattered beam's), in a shadow deep.
+          double total = 0.0;
+          std::vector<double>& above = col_above;
+          for (int k = nz - 1; k >= 0; --k) {
+            if (k < nz - 1) total += 0.5 * (sigma[static_cast<std::size_t>(k)] + sigma[static_cast<std::size_t>(k + 1)]) * grid.alt_m.step;
+            above[static_cast<std::size_t>(k)] = total;
+          }
+          const double mu0c = std::max(std::abs(mu0), double(CV_MS_SLAB_MU0_LO));
+          for (int k = 0; k < nz; ++k) {
+            const std::size_t a = grid.index(i, j, k);
+            const std::size_t K = static_cast<std::size_t>(below ? nz - 1 - k : k);
+            const double gk = g[K], e = std::clamp(double(col_beam[K]), 1e-300, 1.0);
+            out.tau_above[a] = static_cast<float>(std::min(-mu0c * std::log(e) / (1.0 - gk * gk), total));
+            out.tau_below[a] = static_cast<float>(std::max(total - above[K], 0.0));
+            out.sigma[a] = static_cast<float>(sigma[K]);
+          }
+        }
       }
     }
   });
@@ -632,7 +663,8 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
     // edge) instead of 0. Other levels keep 0: the ground beside a cloud takes no diffuse light from
     // under it.
     const bool wrap = grid.wraps_lon();
-    std::vector<float>* fields[4] = {&out.i0, &out.i1, &out.i1e, &out.i1n};
+    std::vector<float>* fields[7] = {&out.i0, &out.i1, &out.i1e, &out.i1n, &out.tau_above, &out.tau_below, &out.sigma};
+    const int nf = key.slab ? 7 : 4;
     parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
       std::vector<glm::ivec2> near;
       for (std::size_t jj = jb; jj < je; ++jj) {
@@ -653,7 +685,7 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
           }
           for (int k = 0; k < nz && !near.empty(); ++k) {
             const std::size_t off = static_cast<std::size_t>(k) * layer;
-            double sum[4] = {0.0, 0.0, 0.0, 0.0};
+            double sum[7] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
             int count = 0;
             for (const glm::ivec2 c : near) {
               bool fringe = false;
@@ -664,10 +696,45 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
               }
               if (!fringe) continue;
               ++count;
-              for (int f = 0; f < 4; ++f) sum[f] += (*fields[f])[grid.column(c.x, c.y) + off];
+              for (int f = 0; f < nf; ++f) sum[f] += (*fields[f])[grid.column(c.x, c.y) + off];
             }
             if (count == 0) continue;
-            for (int f = 0; f < 4; ++f) (*fields[f])[grid.column(i, j) + off] = static_cast<float>(sum[f] / count);
+            for (int f = 0; f < nf; ++f) (*fields[f])[grid.column(i, j) + off] = static_cast<float>(sum[f] / count);
+          }
+        }
+      }
+    });
+  }
+  if (key.slab) {
+    // The higher-order source's light per node against the homogeneous slab's with the node's
+    // depths above and below it, over its column's ground, under its column's sun (as the march
+    // reads the table: mu0 at least CV_MS_SLAB_MU0_LO; a column under a sun below its horizon has
+    // no ground light): the difference from the slab's two-stream I0 (ms_slab_two_stream), and the
+    // ground's albedo, with which the march finds the slab's ground radiance from the tables.
+    // The march takes the slab's light (from the sun, and from the ground at that radiance) scaled
+    // down where the node holds less (a shaded column, an edge losing light), and adds what it
+    // holds beyond as isotropic light (from neighbouring columns): the slab's shape belongs to the
+    // light that came through the column. A difference interpolates between nodes without
+    // amplifying anything (a ratio carried a thin column's ground light, times the slab's light
+    // over its I0, into its thick neighbours).
+    out.slab_excess.assign(out.i0.size(), 0.0f);
+    out.slab_ground.assign(out.i0.size(), 0.0f);
+    parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
+      for (std::size_t jj = jb; jj < je; ++jj) {
+        const int j = static_cast<int>(jj);
+        for (int i = 0; i < nx; ++i) {
+          const double mu_true = glm::dot(geo::sphere_enu(grid.lat_deg.at(j), grid.lon_deg.at(i)).up, to_sun);
+          const double mu0 = std::max(std::abs(mu_true), double(CV_MS_SLAB_MU0_LO));
+          const double ground = mu_true > 0.0 ? ground_at(i, j) : 0.0;
+          for (int k = 0; k < nz; ++k) {
+            const std::size_t a = grid.index(i, j, k);
+            if (!(out.i0[a] > 0.0f)) continue;
+            double sl, si;
+            shown_at(i, j, k, sl, si);
+            const double g = sl + si > 0.0 ? (sl * key.liquid_g + si * key.ice_g) / (sl + si) : key.liquid_g;
+            const MsSlabTwoStream ref = ms_slab_two_stream(out.tau_above[a], out.tau_below[a], mu0, g, ground);
+            out.slab_excess[a] = static_cast<float>(double(out.i0[a]) - ref.i0);
+            out.slab_ground[a] = static_cast<float>(ground);
           }
         }
       }
@@ -689,7 +756,16 @@ std::vector<float> interleave(const std::vector<float>& a, const std::vector<flo
 }
 }  // namespace
 
-std::vector<float> ms_moments_texels(const MsSource& s) { return interleave(s.i0, s.i1); }
+std::vector<float> ms_moments_texels(const MsSource& s) {
+  if (s.tau_above.empty() || s.tau_above.size() != s.i0.size() || s.slab_excess.size() != s.i0.size() ||
+      s.slab_ground.size() != s.i0.size() || s.sigma.size() != s.i0.size())
+    return interleave(s.i0, s.i1);
+  std::vector<float> out(4 * s.i0.size());
+  parallel_ranges(s.i0.size(), 65536, [&](std::size_t lo, std::size_t hi, unsigned) {
+    for (std::size_t i = lo; i < hi; ++i) out[4 * i] = s.slab_excess[i], out[4 * i + 1] = s.sigma[i], out[4 * i + 2] = s.tau_above[i], out[4 * i + 3] = s.slab_ground[i];
+  });
+  return out;
+}
 std::vector<float> ms_horizontal_texels(const MsSource& s) { return interleave(s.i1e, s.i1n); }
 
 std::shared_ptr<const MsSource> ms_source_for(const PreparedVolume& v, const MsSourceKey& key, bool* built) {
@@ -770,25 +846,62 @@ std::shared_ptr<const MsBeamTable> droplet_beam_table(double d_um, double cut, d
 }
 }  // namespace
 
+bool ms_slab_on(const MarchSettings& s) { return s.medium.ms_two_stream && s.medium.ms_slab; }
+
 MsPeaks ms_peaks(const MarchSettings& s) {
   struct Memo {
     double droplet_um = -1.0, ice_g = -2.0;
-    bool liquid_hg = false;
+    bool liquid_hg = false, slab = false;
     MsPeaks peaks;
   };
   thread_local Memo memo;
   const double d = s.medium.droplet_diameter_um, ice_g = s.medium.ice_g;
-  const bool hg = s.medium.liquid_phase_hg;
-  if (memo.droplet_um == d && memo.ice_g == ice_g && memo.liquid_hg == hg) return memo.peaks;
+  const bool hg = s.medium.liquid_phase_hg, slab = ms_slab_on(s);
+  if (memo.droplet_um == d && memo.ice_g == ice_g && memo.liquid_hg == hg && memo.slab == slab) return memo.peaks;
   const physics::f64::MieParams mie = physics::f64::mie_params(d);
   const double gl = physics::f64::mie_mean_cosine(mie);
+  // The share truncated: g^2, or the higher-order source's (chi_8; for droplets at least their
+  // fit's narrow lobe, which the beam's table keeps apart).
+  const bool lobe_apart = !hg && 1.0 - mie.w_d < gl * gl;  // as droplet_beam_table decides at g^2
+  const double fl = slab ? ms_slab_share(hg ? std::function<double(double)>([gl](double m) { return physics::f64::phase_hg(m, gl); })
+                                            : std::function<double(double)>([&mie](double m) { return physics::f64::phase_mie(m, mie); }),
+                                         lobe_apart ? 1.0 - mie.w_d : 0.0)
+                         : gl * gl;
+  const double fi = slab ? std::pow(ice_g, 8) : ice_g * ice_g;
   MsPeaks out;
-  out.liquid = hg ? ms_peak([gl](double m) { return physics::f64::phase_hg(m, gl); }, gl * gl)
-                  : ms_peak([&mie](double m) { return physics::f64::phase_mie(m, mie); }, gl * gl);
-  out.ice = ms_peak([ice_g](double m) { return physics::f64::phase_hg(m, ice_g); }, ice_g * ice_g);
-  out.beam = hg ? nullptr : droplet_beam_table(d, out.liquid.cut, gl * gl);
-  memo = Memo{d, ice_g, hg, out};
+  out.f_liquid = fl;
+  out.f_ice = fi;
+  out.liquid = hg ? ms_peak([gl](double m) { return physics::f64::phase_hg(m, gl); }, fl)
+                  : ms_peak([&mie](double m) { return physics::f64::phase_mie(m, mie); }, fl);
+  out.ice = ms_peak([ice_g](double m) { return physics::f64::phase_hg(m, ice_g); }, fi);
+  out.beam = hg ? nullptr : droplet_beam_table(d, out.liquid.cut, fl);
+  memo = Memo{d, ice_g, hg, slab, out};
   return out;
+}
+
+std::shared_ptr<const std::vector<float>> ms_slab_tables(const MarchSettings& s) {
+  struct Memo {
+    double droplet_um = -1.0, ice_g = -2.0;
+    bool liquid_hg = false;
+    std::shared_ptr<const std::vector<float>> tables;
+  };
+  thread_local Memo memo;
+  const double d = s.medium.droplet_diameter_um, ice_g = s.medium.ice_g;
+  const bool hg = s.medium.liquid_phase_hg;
+  if (memo.tables && memo.droplet_um == d && memo.ice_g == ice_g && memo.liquid_hg == hg) return memo.tables;
+  const physics::f64::MieParams mie = physics::f64::mie_params(d);
+  const double gl = physics::f64::mie_mean_cosine(mie);
+  MarchSettings slab_settings = s;
+  const MsPeaks peaks = ms_peaks(slab_settings);
+  const MsSlabTable liquid = hg ? ms_slab_table([gl](double m) { return physics::f64::phase_hg(m, gl); }, peaks.f_liquid, gl)
+                                : ms_slab_table([&mie](double m) { return physics::f64::phase_mie(m, mie); }, peaks.f_liquid, gl);
+  const MsSlabTable ice = ms_slab_table([ice_g](double m) { return physics::f64::phase_hg(m, ice_g); }, peaks.f_ice, ice_g);
+  auto both = std::make_shared<std::vector<float>>(liquid.values);  // the layout of CV_MS_SLAB_TOTAL
+  both->insert(both->end(), ice.values.begin(), ice.values.end());
+  both->insert(both->end(), liquid.below.begin(), liquid.below.end());
+  both->insert(both->end(), ice.below.begin(), ice.below.end());
+  memo = Memo{d, ice_g, hg, both};
+  return memo.tables;
 }
 
 namespace {

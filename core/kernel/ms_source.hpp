@@ -66,6 +66,12 @@ struct MsSource {
   // empty where the columns were left independent (MsSourceKey::lateral off, or a grid beyond
   // kLateralMaxNodes).
   std::vector<float> i1e, i1n;
+  // For the higher-order source (MsSourceKey::slab; empty otherwise): the optical depth (true, of
+  // what the march shows) above each node in its column and below it, the extinction the column was
+  // solved with, and the node's light against the homogeneous slab's with its depths over its
+  // column's ground (ms_slab_two_stream): I0 - I0_slab, and that ground's albedo (0 under a sun
+  // below the column's horizon).
+  std::vector<float> tau_above, tau_below, sigma, slab_excess, slab_ground;
   double build_ms = 0.0;        // wall time to build it
   int lateral_iterations = -1;  // the 3-D diffusion's conjugate-gradient iterations (-1: the columns left on their own)
   std::string columns_alone;    // with -1: why the columns were left on their own (ms_columns_alone_why)
@@ -73,7 +79,8 @@ struct MsSource {
 };
 
 // The kernel's two textures of the source, two channels per node: (I0, I1 up) and (I1 east, I1
-// north); the second is empty where the source has no horizontal moment.
+// north); the second is empty where the source has no horizontal moment. With the depths of the
+// higher-order source the first has four: (I0 - I0_slab, extinction, tau above, ground albedo).
 std::vector<float> ms_moments_texels(const MsSource& s);
 std::vector<float> ms_horizontal_texels(const MsSource& s);
 
@@ -97,11 +104,12 @@ struct MsSourceKey {
   // Light between the columns (the 3-D diffusion's ratio and horizontal flux); off, every column on
   // its own as before the fortieth session (kept for comparison).
   bool lateral = true;
+  bool slab = false;  // the higher-order source: each node's optical depths above and below too
   bool operator==(const MsSourceKey& o) const {
     const bool same_ground = (ground == nullptr) == (o.ground == nullptr) &&
                              (ground_id != 0 || o.ground_id != 0 ? ground_id == o.ground_id : ground == o.ground);
     return to_sun == o.to_sun && liquid_g == o.liquid_g && ice_g == o.ice_g && ground_albedo == o.ground_albedo && mask == o.mask &&
-           same_ground && lateral == o.lateral;
+           same_ground && lateral == o.lateral && slab == o.slab;
   }
 };
 
@@ -162,9 +170,16 @@ inline double ms_peak_cut(const std::function<double(double)>& phase, double f) 
 struct MsBeamTable;
 struct MsPeaks {
   MsPeak liquid, ice;
+  double f_liquid = 0.0, f_ice = 0.0;  // the shares truncated: g^2, or the higher-order source's (ms_slab_share)
   std::shared_ptr<const MsBeamTable> beam;  // the droplets' beam phase table (ms_beam_table; none with liquid_phase_hg)
 };
 MsPeaks ms_peaks(const MarchSettings& s);
+
+// The higher-order source (u_ms_slab; docs/physics.md, "The higher-order source"): whether the
+// settings ask for it, and its slab tables, liquid then ice (ms_slab_table; made once per phase
+// and remembered for the last settings asked).
+bool ms_slab_on(const MarchSettings& s);
+std::shared_ptr<const std::vector<float>> ms_slab_tables(const MarchSettings& s);
 
 // The beam phase table (docs/physics.md, "The droplets' beam spread by the true peak kernel"). A
 // phase p = smooth + s HG(spike_g) (spike_c = 1 - spike_g kept apart for precision; s = 0: no lobe

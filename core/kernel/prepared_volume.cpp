@@ -141,6 +141,8 @@ kernel::MarchParams march_params(const PreparedVolume& v, const Camera& cam, con
     p.u_ms_peak_g_liquid = peaks.liquid.g;
     p.u_ms_peak_g_ice = peaks.ice.g;
     p.u_ms_beam_a_liquid = peaks.beam ? peaks.beam->spike_share : 0.0;
+    p.u_ms_f_liquid = peaks.f_liquid;
+    p.u_ms_f_ice = peaks.f_ice;
   }
   if (s.medium.noise_amount > 0.0) {
     const NoiseAnchor a = noise_anchor(grid_centre_ecef(grid), s.medium.noise_scale_m);

@@ -49,12 +49,14 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
     ms = ms_source_for(v, ms_source_key(s, k.u_to_sun, ground_map));
     ms_moments = ms_moments_texels(*ms);
     ms_horizontal = ms_horizontal_texels(*ms);
-    k.u_ms_moments = {ms_moments.data(), n, 2};
+    k.u_ms_moments = {ms_moments.data(), n, ms->tau_above.empty() ? 2 : 4};
     k.u_ms_lateral = !ms_horizontal.empty();
     k.u_ms_horizontal = k.u_ms_lateral ? kernel::sampler3D{ms_horizontal.data(), n, 2} : k.u_ms_moments;
   }
   const MsPeaks peaks = s.medium.ms_two_stream ? ms_peaks(s) : MsPeaks{};  // holds the droplets' beam table
   if (peaks.beam) k.u_ms_beam_table = peaks.beam->values.data();
+  const std::shared_ptr<const std::vector<float>> slab_tables = ms_slab_on(s) ? ms_slab_tables(s) : nullptr;
+  if (slab_tables) k.u_ms_slab_table = slab_tables->data();
   const BlueNoiseMask& mask = step_jitter_mask();
   k.u_jitter_mask = {mask.values.data(), {mask.n, mask.n}, 1};
   if (ground_map) k.u_ground = {ground_map->rgba.data(), {ground_map->width, ground_map->height}, 4};
@@ -89,6 +91,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   k.kTwoStream = s.medium.ms_two_stream;
   k.kTranslucent = k.u_tl_count > 0;
   k.kModelled = s.medium.modelled;
+  k.kSlab = ms_slab_on(s);
 
   ReferenceImage img;
   img.width = cam.width;

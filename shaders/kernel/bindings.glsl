@@ -30,3 +30,4 @@
 #define CV_SSBO_PATH_STATE 7
 #define CV_SSBO_PATH_BRANCHES 2
 #define CV_SSBO_MS_BEAM 1
+#define CV_SSBO_MS_SLAB 0

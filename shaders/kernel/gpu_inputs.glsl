@@ -51,6 +51,9 @@ layout(std430, binding = CV_SSBO_PYRAMID) readonly buffer Pyramid { vec2 u_min_m
 // The droplets' beam phase table (core/kernel/ms_source ms_beam_table), CV_MS_BEAM_ROWS x CV_MS_BEAM_ANGLES.
 #include "../kernel/ms_beam.glsl"
 layout(std430, binding = CV_SSBO_MS_BEAM) readonly buffer MsBeam { float u_ms_beam_table[]; };
+// The higher-order source's slab table (core/kernel/ms_slab ms_slab_table), liquid then ice.
+#include "../kernel/ms_slab.glsl"
+layout(std430, binding = CV_SSBO_MS_SLAB) readonly buffer MsSlab { float u_ms_slab_table[]; };
 // Per-frame counters (MarchStats), each as (low, high) 32-bit words.
 layout(std430, binding = CV_SSBO_STATS) buffer Stats { uint u_stats[]; };
 uint g_stats[CV_STAT_COUNT] = uint[CV_STAT_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u);
@@ -88,6 +91,9 @@ uint g_stats[CV_STAT_COUNT] = uint[CV_STAT_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u
 #ifndef CV_MODELLED
 #define CV_MODELLED 0
 #endif
+#ifndef CV_MS_SLAB_SHAPE
+#define CV_MS_SLAB_SHAPE 1
+#endif
 const bool kSkipEmpty = CV_SKIP_EMPTY != 0;
 const bool kAdaptive = CV_ADAPTIVE != 0;
 const bool kAtmosphere = CV_ATMOSPHERE != 0;
@@ -98,3 +104,4 @@ const bool kTranslucent = CV_TRANSLUCENT != 0;  // translucent geometry composit
 const bool kLayerMask = CV_LAYER_MASK != 0;     // a height band masks the medium (u_mask_band)
 const bool kTint = CV_TINT != 0;                // false colour by liquid and ice (u_tint)
 const bool kModelled = CV_MODELLED != 0;        // the modelled cloud: sub-grid detail keeping each cell's means
+const bool kSlab = kTwoStream && CV_MS_SLAB_SHAPE != 0;  // the two-stream's diffuse light shaped by the slab tables

@@ -77,6 +77,8 @@ CV_PARAM(real, u_ms_peak_ice)        // the same for the ice's Henyey-Greenstein
 CV_PARAM(real, u_ms_peak_g_liquid)   // two-stream, liquid_phase_hg: the mean cosine of the liquid phase's peak above the cut (ms_peak)
 CV_PARAM(real, u_ms_peak_g_ice)      // the same for ice
 CV_PARAM(real, u_ms_beam_a_liquid)   // two-stream, Mie droplets: the fit's HG lobe's share of the peak kernel (ms_beam_table)
+CV_PARAM(real, u_ms_f_liquid)        // two-stream: the share of the liquid phase taken as no scattering (g^2; the higher-order source's ms_slab_share)
+CV_PARAM(real, u_ms_f_ice)           // the same for ice
 CV_PARAM(ivec4, u_level_nodes)       // grid nodes per brick side, finest level first
 CV_PARAM(ivec4, u_level_offset)      // first brick of each level in u_min_max
 CV_PARAM_ARRAY(ivec4, u_bricks, 4)   // bricks per axis (xyz), finest level first

@@ -1,12 +1,13 @@
 // Benchmark (not a test): the multiple-scattering models against the Monte Carlo reference on the
 // standard scenes, clouds only, with the CPU kernel (the GPU runs the same kernel). For each scene:
-// the reference's mean luminance and its noise, then per model the image-mean bias and the
-// noise-corrected relative RMSE (app/bench/metrics image_error), and the two-stream source's build
-// time. usage: bench_ms_model [--size WxH] [--spp N] [--max-bounces N] [--rows] [SCENE...]
+// the reference's mean luminance and its noise, then per model (the octave sum, the two-stream
+// source with its diffuse light linear in angle, and shaped by the slab tables) the image-mean bias
+// and the noise-corrected relative RMSE (app/bench/metrics image_error), and the source's build time
+// (with the slab's depths and shares, as the default builds it). usage: bench_ms_model [--size WxH] [--spp N] [--max-bounces N] [--rows] [SCENE...]
 // --max-bounces 1 compares single scattering alone (the Monte Carlo cut at one event against the
-// octave sum with one octave; the two-stream column then shows its single-scattering term with the
-// forward peak's light kept in the beam, and its diffuse term); --rows prints each image row's mean
-// luminance (top row first) for the reference and both models, to see where in a view they differ.
+// octave sum with one octave; the two-stream columns then show their single-scattering term with the
+// forward peak's light kept in the beam, and their diffuse term); --rows prints each image row's mean
+// luminance (top row first) for the reference and the models, to see where in a view they differ.
 // --reference-dir DIR keeps the references in DIR with their sums (app/bench/reference_cache, the
 // files `cloudviewer bench --out DIR` keeps): a later run reads them, and a larger --spp extends them.
 // --ground-albedo A draws the globe under the clouds (still no air and no sky light) as a Lambertian
@@ -42,7 +43,7 @@ int main(int argc, char** argv) {
                              "  octave sum and two-stream source against the Monte Carlo reference, clouds only\n"
                              "  --max-bounces N  cut the reference's paths at N scattering events (1: single scattering,\n"
                              "                   against one octave)\n"
-                             "  --rows           print each image row's mean luminance: reference, octaves, two-stream\n"
+                             "  --rows           print each image row's mean luminance: reference, octaves, linear, slab\n"
                              "  --reference-dir DIR  read the references from DIR and save them there with their sums\n"
                              "                   (as `cloudviewer bench --out DIR`): a larger --spp extends a saved one\n"
                              "  --ground-albedo A  a Lambertian ground of albedo A under the clouds (no air), in both\n",
@@ -65,8 +66,8 @@ int main(int argc, char** argv) {
     for (const auto& n : cv::bench::standard_scene_names()) if (n != "clear_sky") scenes.push_back(n);
   }
   using clock = std::chrono::steady_clock;
-  std::printf("%-14s %10s %7s | %-18s | %-18s | %s\n", "scene", "MC lum", "noise", "octaves: bias rmse",
-              "two-stream: bias rmse", "source ms");
+  std::printf("%-14s %10s %7s | %-18s | %-18s | %-18s | %s\n", "scene", "MC lum", "noise", "octaves: bias rmse",
+              "linear: bias rmse", "slab: bias rmse", "source ms");
   for (const std::string& name : scenes) {
     cv::bench::StandardScene sc;
     try {
@@ -105,9 +106,12 @@ int main(int argc, char** argv) {
     }
     std::printf("%-14s %10.4g %6.1f%% |", name.c_str(), lum / ref.size(), 100.0 * std::sqrt(nvar) / lum);
     std::vector<std::vector<glm::dvec3>> images;
-    for (bool two : {false, true}) {
+    // The octave sum, the two-stream source with its diffuse light linear in angle, and shaped by
+    // the slab tables.
+    for (int model : {0, 1, 2}) {
       cv::core::MarchSettings mm = m;
-      mm.medium.ms_two_stream = two;
+      mm.medium.ms_two_stream = model > 0;
+      mm.medium.ms_slab = model == 2;
       const cv::core::ReferenceImage r = cv::core::render_reference(sc.grid, ext, sc.camera, sc.sun, mm);
       const cv::bench::ImageError e = cv::bench::image_error(r.radiance, ref, var);
       std::printf(" %+7.1f%% %7.1f%% |", 100.0 * e.rel_bias, 100.0 * e.rel_rmse);
@@ -128,13 +132,15 @@ int main(int argc, char** argv) {
     if (rows) {
       auto lum = [](const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; };
       for (int y = 0; y < h; ++y) {
-        double a = 0.0, b = 0.0, c = 0.0;
+        double a = 0.0, m3[3] = {0.0, 0.0, 0.0};
         for (int x = 0; x < w; ++x) {
           const std::size_t i = static_cast<std::size_t>(y) * w + x;
-          a += lum(ref[i]), b += lum(images[0][i]), c += lum(images[1][i]);
+          a += lum(ref[i]);
+          for (int k = 0; k < 3; ++k) m3[k] += lum(images[static_cast<std::size_t>(k)][i]);
         }
-        std::printf("  row %3d: reference %10.4g  octaves %10.4g (%+6.1f%%)  two-stream %10.4g (%+6.1f%%)\n", y, a / w, b / w,
-                    a > 0.0 ? 100.0 * (b / a - 1.0) : 0.0, c / w, a > 0.0 ? 100.0 * (c / a - 1.0) : 0.0);
+        auto rel = [&](double v) { return a > 0.0 ? 100.0 * (v / a - 1.0) : 0.0; };
+        std::printf("  row %3d: reference %10.4g  octaves %10.4g (%+6.1f%%)  linear %10.4g (%+6.1f%%)  slab %10.4g (%+6.1f%%)\n", y, a / w,
+                    m3[0] / w, rel(m3[0]), m3[1] / w, rel(m3[1]), m3[2] / w, rel(m3[2]));
       }
     }
     std::fflush(stdout);

@@ -68,7 +68,8 @@ int main(int argc, char** argv) {
   std::vector<SlabPhase> which;
   if (phases == "hg" || phases == "both") which.push_back(SlabPhase::HG085);
   if (phases == "mie" || phases == "both") which.push_back(SlabPhase::Mie);
-  std::printf("| phase | tau | sun zenith | solver I/E at nadir | octaves (%d, gate) | two-stream |\n|---|---|---|---|---|---|\n", octaves);
+  std::printf("| phase | tau | sun zenith | solver I/E at nadir | octaves (%d, gate) | two-stream linear | two-stream slab |\n|---|---|---|---|---|---|---|\n",
+              octaves);
   for (SlabPhase ph : which) {
     const slabcheck::PhaseFunction phase =
         ph == SlabPhase::HG085 ? slabcheck::henyey_greenstein_phase(0.85) : slabcheck::approximate_mie_phase(20.0);
@@ -93,12 +94,14 @@ int main(int argc, char** argv) {
       for (double z : zeniths) {
         const double mu0 = std::cos(z * kPi / 180.0);
         const double ref = sol.nadir_radiance_over_ground(mu0, ground);
-        cv::core::MarchSettings two = m;
-        two.medium.ms_two_stream = true;
+        cv::core::MarchSettings two = m, slab = m;
+        two.medium.ms_two_stream = slab.medium.ms_two_stream = true;
+        two.medium.ms_slab = false;
+        slab.medium.ms_slab = true;
         const cv::core::AlbedoMap* on = mapped ? &map : nullptr;
-        const double a = march_nadir_radiance(s, m, z, on), b = march_nadir_radiance(s, two, z, on);
-        std::printf("| %s | %g | %g | %.5f | %+.1f %% | %+.1f %% |\n", phase_name(ph), tau, z, ref, 100.0 * (a / ref - 1.0),
-                    100.0 * (b / ref - 1.0));
+        const double a = march_nadir_radiance(s, m, z, on), b = march_nadir_radiance(s, two, z, on), c = march_nadir_radiance(s, slab, z, on);
+        std::printf("| %s | %g | %g | %.5f | %+.1f %% | %+.1f %% | %+.1f %% |\n", phase_name(ph), tau, z, ref, 100.0 * (a / ref - 1.0),
+                    100.0 * (b / ref - 1.0), 100.0 * (c / ref - 1.0));
         std::fflush(stdout);
       }
     }

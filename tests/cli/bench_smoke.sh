@@ -13,7 +13,7 @@ export XDG_CACHE_HOME
 header='scene,config,kind,view_step_m,sun_steps,octaves,accumulate,resolution_scale,liquid_phase,adaptive_steps,wall_ms,gpu_ms,rel_rmse,rel_rmse_raw,ref_noise_floor,rel_rmse_resolution,rel_bias,worst_pixel,psnr_db,pareto,ref_spp,ref_mean_rel_stderr,error_image,path_spp,path_rel_stderr'
 test "$(head -n 1 "$dir/results.csv")" = "$header" || { echo "bad header: $(head -n 1 "$dir/results.csv")"; exit 1; }
 rows=$(tail -n +2 "$dir/results.csv" | grep -c '^stratocumulus,')
-test "$rows" -eq 22 || { echo "expected 22 rows, found $rows"; exit 1; }
+test "$rows" -eq 23 || { echo "expected 23 rows, found $rows"; exit 1; }
 for n in 1 4; do
   awk -F, -v n=$n '$2 == "path_" n "spp" && $3 == "path_tracer" && $20 == 0 && $24 == n { f = 1 } END { exit !f }' "$dir/results.csv" \
     || { echo "no path tracer row at $n spp (kind path_tracer, off the front)"; exit 1; }
@@ -24,7 +24,7 @@ done
 awk -F, '$2 == "path_1spp" { a = $13 } $2 == "path_4spp" { b = $13 } END { exit !(b < 0.8 * a) }' "$dir/results.csv" \
   || { echo "the path tracer's error did not fall from 1 to 4 spp"; exit 1; }
 if grep -q '"name": "path_' "$dir/quality_front.json"; then echo "a path tracer row is in the quality front"; exit 1; fi
-for c in low default high costa2023 haggstrom2018 fordsung2024; do
+for c in low default high two_stream_linear costa2023 haggstrom2018 fordsung2024; do
   grep -q "^stratocumulus,$c," "$dir/results.csv" || { echo "no row for $c"; exit 1; }
 done
 test "$(awk -F, 'NR > 1 && $20 == 1' "$dir/results.csv" | wc -l)" -ge 1 || { echo "no configuration on the Pareto front"; exit 1; }
@@ -47,15 +47,15 @@ test "$(awk -F, 'NR == 2 { print $21 }' "$dir/results.csv")" = 33 || { echo "res
 # --timing-only: frame times without a reference (no error, no front, no plots); the path tracer
 # with its own noise estimate.
 "$exe" bench stratocumulus --size 24x14 --repeats 1 --path-spp 2 --timing-only --out "$dir/timing" --no-cache > "$dir/run4.txt"
-test "$(tail -n +2 "$dir/timing/results.csv" | grep -c '^stratocumulus,')" -eq 21 || { echo "timing only: expected 21 rows"; exit 1; }
+test "$(tail -n +2 "$dir/timing/results.csv" | grep -c '^stratocumulus,')" -eq 22 || { echo "timing only: expected 22 rows"; exit 1; }
 test ! -e "$dir/timing/quality_front.json" && test ! -e "$dir/timing/stratocumulus_pareto.png" || { echo "timing only wrote a front or a plot"; exit 1; }
 awk -F, '$2 == "default" && $13 == "nan" && $11 > 0 { f = 1 } END { exit !f }' "$dir/timing/results.csv" || { echo "timing only: the default row has an error or no time"; exit 1; }
 awk -F, '$2 == "path_2spp" && $25 > 0 && $25 < 1e300 { f = 1 } END { exit !f }' "$dir/timing/results.csv" || { echo "timing only: no noise estimate of the path tracer"; exit 1; }
 # --cloud-model both: each scene also as <scene>+modelled, against a reference of the modelled
 # density (its own cached file), its rows in the CSV and its scene in the front.
 "$exe" bench stratocumulus --size 24x14 --reference-spp 32 --repeats 1 --path-spp 1 --cloud-model both --out "$dir/models" --no-cache > "$dir/run5.txt"
-test "$(tail -n +2 "$dir/models/results.csv" | grep -c '^stratocumulus+modelled,')" -eq 21 || { echo "modelled: expected 21 rows"; exit 1; }
-test "$(tail -n +2 "$dir/models/results.csv" | grep -c '^stratocumulus,')" -eq 21 || { echo "both: expected 21 data rows"; exit 1; }
+test "$(tail -n +2 "$dir/models/results.csv" | grep -c '^stratocumulus+modelled,')" -eq 22 || { echo "modelled: expected 22 rows"; exit 1; }
+test "$(tail -n +2 "$dir/models/results.csv" | grep -c '^stratocumulus,')" -eq 22 || { echo "both: expected 22 data rows"; exit 1; }
 test "$(ls "$dir/models"/ref_stratocumulus+modelled_24x14_*.cvref | wc -l)" -eq 1 || { echo "no reference of the modelled cloud"; exit 1; }
 test "$(ls "$dir/models"/ref_stratocumulus_24x14_*.cvref | wc -l)" -eq 1 || { echo "no reference of the data mode"; exit 1; }
 grep -q '"scene": "stratocumulus+modelled"' "$dir/models/quality_front.json" || { echo "the modelled scene is not in the front"; exit 1; }

@@ -5,9 +5,11 @@
 // comparison with the tests' independent adding-doubling solver is in slab_check_test.cpp.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <vector>
 
+#include "kernel/ms_slab.glsl"
 #include "kernel/ms_slab.hpp"
 #include "kernel/ms_source.hpp"
 #include "physics/physics.hpp"
@@ -150,6 +152,68 @@ TEST(MsSlab, TheMomentsConvergeInTheNumberOfStreams) {
       }
     }
   }
+}
+
+// The table the march reads (ms_slab_table): at its grid's cells the moments times (2l + 1) / 2
+// chi'_l of a discrete-ordinates slab solved here on its own, the diffuse flux going down, and the
+// two-stream's I0 of the same slab; the three-node column gives the homogeneous column's I0 at any
+// depth; the share is g^8 for HG and holds the droplets' lobe.
+TEST(MsSlab, TheTableHoldsTheSlabsLightAtItsCells) {
+  const double g = 0.85;
+  auto hg = [g](double mu) { return physics::f64::phase_hg(mu, g); };
+  const double f = ms_slab_share(hg);
+  EXPECT_NEAR(f, std::pow(g, 8), 1e-5);
+  const MsSlabTable table = ms_slab_table(hg, f, g);
+  ASSERT_EQ(table.values.size(), static_cast<std::size_t>(CV_MS_SLAB_PHASE_SIZE));
+  for (float v : table.values) ASSERT_TRUE(std::isfinite(v));
+  const MsSlab slab(table.chi, 1.0, 16, CV_MS_SLAB_L + 1);
+  constexpr int nd = CV_MS_SLAB_DEPTHS;
+  for (const auto& c : {std::array<int, 3>{0, 3, 5}, {4, 7, 1}, {9, 0, 12}, {6, 10, 10}}) {
+    const int is = c[0], iv = c[1], iu = c[2];
+    auto depth = [](int i) { const double u = double(i) / (nd - 1); return std::max(CV_MS_SLAB_T0 * u / (1.0 - u), 5.0e-4); };
+    const double mu0 = CV_MS_SLAB_MU0_LO + (1.0 - CV_MS_SLAB_MU0_LO) * is / (CV_MS_SLAB_SUNS - 1);
+    const double t = depth(iu), b = depth(iv);
+    const MsSlabField fld = slab.solve((1.0 - f) * (t + b), mu0);
+    const std::vector<double> psi = fld.moments((1.0 - f) * t, CV_MS_SLAB_L0);
+    const float* cell = table.values.data() + static_cast<std::size_t>(((is * nd + iv) * nd + iu) * CV_MS_SLAB_STRIDE);
+    int k = 0;
+    for (int m = 0; m <= CV_MS_SLAB_L; ++m) {
+      for (int l = m; l <= (m == 0 ? CV_MS_SLAB_L0 : CV_MS_SLAB_L); ++l, ++k) {
+        const double want = (2 * l + 1) * 0.5 * table.chi[static_cast<std::size_t>(l)] * psi[static_cast<std::size_t>(l * (l + 1) / 2 + m)];
+        EXPECT_NEAR(cell[k], want, 1e-5 * std::abs(psi[0]) + 1e-7) << "cell " << is << " " << iv << " " << iu << " l " << l << " m " << m;
+      }
+    }
+    ASSERT_EQ(k, CV_MS_SLAB_MOMENTS);
+    // The diffuse flux going down: 2 pi sum w mu I^0 over the downward nodes.
+    double down = 0.0;
+    for (int i = 0; i < slab.streams(); ++i)
+      down += 2.0 * 3.14159265358979 * slab.weights()[static_cast<std::size_t>(i)] * slab.nodes()[static_cast<std::size_t>(i)] * fld.radiance(0, i, (1.0 - f) * t);
+    EXPECT_NEAR(cell[CV_MS_SLAB_FLUX_DOWN], down, 1e-5 * down + 1e-7);
+    EXPECT_NEAR(cell[CV_MS_SLAB_TWO_STREAM_I0], ms_slab_two_stream_i0(t, b, mu0, g), 1e-6);
+  }
+  // The three-node column against a homogeneous column of 401 nodes at its nodes.
+  for (double tau : {0.3, 4.0, 60.0}) {
+    for (double mu0 : {0.2, 0.9}) {
+      const int n = 401;
+      std::vector<double> sig(n, tau / (n - 1)), gg(n, g);
+      const TwoStreamColumn col = two_stream_column(sig.data(), gg.data(), n, 1.0, mu0, 0.0);
+      for (int k : {0, 37, 200, 399, 400}) {
+        const double t = tau * (n - 1 - k) / (n - 1);  // node k from the bottom
+        EXPECT_NEAR(ms_slab_two_stream_i0(t, tau - t, mu0, g), col.i0[static_cast<std::size_t>(k)], 1e-9 + 1e-7 * col.i0[static_cast<std::size_t>(k)])
+            << "tau " << tau << " mu0 " << mu0 << " node " << k;
+      }
+    }
+  }
+  // The droplets at 20 um: at least delta-M's chi_8 and the fit's lobe.
+  const physics::f64::MieParams mie = physics::f64::mie_params(20.0);
+  auto mie_phase = [&mie](double mu) { return physics::f64::phase_mie(mu, mie); };
+  const double chi8 = ms_phase_moments(mie_phase, 8)[8];
+  const double fm = ms_slab_share(mie_phase, 1.0 - mie.w_d);
+  EXPECT_GE(fm, chi8 - 1e-9);
+  EXPECT_GE(fm, (1.0 - mie.w_d) / 0.98 - 1e-9);
+  EXPECT_LT(fm, 0.6);
+  EXPECT_NEAR(ms_phase_moments(mie_phase, 1)[0], 1.0, 1e-4);
+  EXPECT_NEAR(ms_phase_moments(mie_phase, 1)[1], physics::f64::mie_mean_cosine(mie), 1e-3);
 }
 
 TEST(MsSlab, ExtremesGiveFiniteLight) {

@@ -14,6 +14,8 @@
 
 #include "geo/geodesy.hpp"
 #include "kernel/march_kernel.hpp"
+#include "kernel/ms_slab.glsl"
+#include "kernel/ms_slab.hpp"
 #include "kernel/ms_source.hpp"
 #include "physics/physics.hpp"
 #include "settings/march_settings.hpp"
@@ -483,6 +485,93 @@ TEST(TwoStream, AHiddenLayerHoldsAndPassesNoDiffuseLight) {
       ASSERT_EQ(got.i1[i], ref->i1[i]) << i << (m == &no_ice ? " ice hidden" : " band");
     }
   }
+}
+
+// The higher-order source's fields (diffuse_shape "slab", the default): each node's light against
+// the homogeneous slab's with its depths over its column's ground, I0 - I0_slab, exactly, and the
+// ground's albedo (no ground, and a ground of albedo 0.3); in a horizontally uniform layer under a high sun the node stands where the slab's
+// beam is its own (the depth from the top) and holds the slab's light; nothing is NaN; and the
+// linear shape builds none of these fields.
+TEST(TwoStream, TheSlabShapesFieldsMeasureEachNodeAgainstItsSlab) {
+  const cv::test::BubbleScene bubble(true);
+  const glm::dvec3 to_sun = glm::normalize(glm::dvec3(1.3, 0.2, 1.0));  // high over (0, 0), whose up is +x
+  MarchSettings s;
+  s.medium.ms_two_stream = true;
+  s.features.globe = false;  // no ground
+  ASSERT_TRUE(ms_slab_on(s));
+  const PreparedVolume v = prepare_volume(bubble.grid, bubble.data);
+  const VolumeGrid& g = bubble.grid;
+  int checked = 0, more = 0, less = 0;
+  for (double albedo : {0.0, 0.3}) {
+    MarchSettings sg = s;
+    sg.features.globe = albedo > 0.0;
+    sg.medium.ground_texture = "none";
+    sg.medium.ground_albedo = glm::dvec3(albedo);
+    const MsSourceKey key = ms_source_key(sg, to_sun);
+    ASSERT_NEAR(key.ground_albedo, albedo, 1e-12);
+    const MsSource src = build_ms_source(v, key);
+    ASSERT_EQ(src.slab_excess.size(), src.i0.size());
+    ASSERT_EQ(src.slab_ground.size(), src.i0.size());
+    ASSERT_EQ(ms_moments_texels(src).size(), 4 * src.i0.size());
+    for (int j = 0; j < g.lat_deg.count; ++j) {
+      for (int i = 0; i < g.lon_deg.count; ++i) {
+        const double mu0 = std::max(std::abs(glm::dot(geo::sphere_enu(g.lat_deg.at(j), g.lon_deg.at(i)).up, to_sun)), double(CV_MS_SLAB_MU0_LO));
+        for (int k = 0; k < g.alt_m.count; ++k) {
+          const std::size_t a = g.index(i, j, k);
+          ASSERT_TRUE(std::isfinite(src.slab_excess[a]) && std::isfinite(src.slab_ground[a]) && std::isfinite(src.tau_above[a]) &&
+                      std::isfinite(src.tau_below[a]));
+          if (!(src.i0[a] > 0.0f)) {
+            ASSERT_EQ(src.slab_excess[a], 0.0f);
+            continue;
+          }
+          const double sl = bubble.data[Field::ExtinctionLiquid][a], si = bubble.data[Field::ExtinctionIce][a];
+          const double gn = sl + si > 0.0 ? (sl * key.liquid_g + si * key.ice_g) / (sl + si) : key.liquid_g;
+          const MsSlabTwoStream ref = ms_slab_two_stream(src.tau_above[a], src.tau_below[a], mu0, gn, albedo);
+          const double d0 = double(src.i0[a]) - ref.i0;
+          EXPECT_NEAR(src.slab_excess[a], d0, 1e-5 * src.i0[a] + 1e-12) << i << " " << j << " " << k;
+          EXPECT_NEAR(src.slab_ground[a], albedo, 1e-7) << i << " " << j << " " << k;
+          more += d0 > 0.0;
+          less += d0 < 0.0;
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 2000);
+  EXPECT_GT(more, 0);  // a bubble has both: the light through its sides and the edges losing light
+  EXPECT_GT(less, 0);
+
+  // A layer uniform across the grid, nodes 1.5-3 km (with the linear ramps to the clear nodes 250 m
+  // beyond, optical depth 17.5); the sun 30 degrees from the zenith.
+  TimeStepData layer;
+  layer[Field::ExtinctionLiquid].assign(g.points(), 0.0f);
+  for (int k = 0; k < g.alt_m.count; ++k) {
+    const double z = g.alt_m.at(k);
+    if (z < 1500.0 || z > 3000.0) continue;
+    for (int j = 0; j < g.lat_deg.count; ++j)
+      for (int i = 0; i < g.lon_deg.count; ++i) layer[Field::ExtinctionLiquid][g.index(i, j, k)] = 0.01f;
+  }
+  const double z30 = 30.0 * 3.14159265358979 / 180.0;
+  const glm::dvec3 sun30 = std::cos(z30) * glm::dvec3(1.0, 0.0, 0.0) + std::sin(z30) * glm::dvec3(0.0, 0.0, 1.0);  // over (0, 0)
+  const MsSource uni = build_ms_source(prepare_volume(g, layer), ms_source_key(s, sun30));
+  ASSERT_EQ(uni.slab_excess.size(), uni.i0.size());
+  const int ic = 20, jc = 20;
+  for (int k = 0; k < g.alt_m.count; ++k) {
+    const double z = g.alt_m.at(k);
+    if (z < 1500.0 || z > 3000.0) continue;
+    const std::size_t a = g.index(ic, jc, k);
+    const double depth = 1.25 + 0.01 * (3000.0 - z);  // the trapezoid is exact for the linear profile
+    EXPECT_NEAR(uni.tau_above[a], depth, 0.02 * depth + 0.05) << "level " << k;
+    EXPECT_NEAR(uni.tau_above[a] + uni.tau_below[a], 17.5, 0.01) << "level " << k;
+    EXPECT_LT(std::abs(uni.slab_excess[a]), 0.03 * uni.i0[a]) << "level " << k;
+  }
+
+  // The linear shape builds none of the slab's fields.
+  MarchSettings linear = s;
+  linear.medium.ms_slab = false;
+  const MsSource lin = build_ms_source(v, ms_source_key(linear, to_sun));
+  EXPECT_TRUE(lin.slab_excess.empty() && lin.tau_above.empty());
+  EXPECT_EQ(ms_moments_texels(lin).size(), 2 * lin.i0.size());
 }
 
 // The octave gate's column depths (u_column_tau) with a mask are those of the medium the march

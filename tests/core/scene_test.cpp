@@ -198,7 +198,7 @@ TEST(SceneJson, OutOfRangeValuesAreRefused) {
 
 TEST(SceneJson, UnknownKeysAreNamedSoTyposAreCaught) {
   EXPECT_EQ(error_of(R"({"version": 1, "render": {"march": {"sun_step": 8}}})"),
-            "scene.json: render.march.sun_step: unknown key, expected one of view_step_m, sun_steps, octaves, multiple_scattering, octave_a, "
+            "scene.json: render.march.sun_step: unknown key, expected one of view_step_m, sun_steps, octaves, multiple_scattering, diffuse_shape, octave_a, "
             "octave_b, octave_c, octave_gate, droplet_diameter_um, liquid_phase, ice_g, frame, blue_noise, anti_alias, noise_amount, noise_scale_m, "
             "cloud_model, detail_amount, detail_scale_m, atmosphere, globe, ambient, sky_steps, atmo_sun_steps, ground_albedo, ground_texture, ground_model, ocean_wind_m_s, layer_bottom_m, layer_top_m, "
             "layer_reference, tint_liquid, tint_ice, hide_liquid, hide_ice, skip_empty, adaptive_steps, "
