@@ -28,9 +28,9 @@ int loop_iterations_per_view_step(const core::MarchSettings& s, int sun_march_st
   const int air = std::max(s.quality.atmo_sun_steps, 0) + 2;
   const int octaves = 2 * (std::max(s.quality.octaves, 0) + 1);
   const int substeps = s.features.adaptive_steps ? 64 : 1;  // march_substeps divides a step at most 64 times
-  // The slab-shaped diffuse light (ms_slab_in_scatter): its harmonics' recurrence (37) and the
-  // table's eight corners; the part lit from below, its Legendre recurrence (14) and four corners.
-  const int slab = s.medium.ms_two_stream && s.medium.ms_slab ? 37 + 8 + 14 + 4 + 4 + 8 : 0;
+  // The slab-shaped diffuse light (ms_slab_in_scatter): its harmonics' recurrence (37 iterations)
+  // and the table's eight corners (the rest is written out).
+  const int slab = s.medium.ms_two_stream && s.medium.ms_slab ? 37 + 8 + 3 : 0;
   return substeps * (1 + sun + air + octaves + slab);
 }
 

@@ -411,18 +411,17 @@ CV_FN real ms_slab_entry(int phase, real t, real b, real mu0, int k) {
   real wu = fu - real(u0);
   real wv = fv - real(v0);
   real ws = fs - real(s0);
-  real sum = real(0.0);
-  for (int corner = 0; corner < 8; ++corner) {
-    int du = corner & 1;
-    int dv = (corner >> 1) & 1;
-    int ds = corner >> 2;
-    real w = (du == 1 ? wu : real(1.0) - wu) * (dv == 1 ? wv : real(1.0) - wv) * (ds == 1 ? ws : real(1.0) - ws);
-    sum += w * ms_slab_table_at(phase * CV_MS_SLAB_PHASE_SIZE + (((s0 + ds) * CV_MS_SLAB_DEPTHS + v0 + dv) * CV_MS_SLAB_DEPTHS + u0 + du) * CV_MS_SLAB_STRIDE + k);
-  }
-  return sum;
+  // The eight corners written out (no loop: llvmpipe counts loop iterations, see below).
+  int c = phase * CV_MS_SLAB_PHASE_SIZE + ((s0 * CV_MS_SLAB_DEPTHS + v0) * CV_MS_SLAB_DEPTHS + u0) * CV_MS_SLAB_STRIDE + k;
+  int du = CV_MS_SLAB_STRIDE;
+  int dv = CV_MS_SLAB_DEPTHS * CV_MS_SLAB_STRIDE;
+  int ds = CV_MS_SLAB_DEPTHS * CV_MS_SLAB_DEPTHS * CV_MS_SLAB_STRIDE;
+  real lo = mix(mix(ms_slab_table_at(c), ms_slab_table_at(c + du), wu), mix(ms_slab_table_at(c + dv), ms_slab_table_at(c + dv + du), wu), wv);
+  real hi = mix(mix(ms_slab_table_at(c + ds), ms_slab_table_at(c + ds + du), wu), mix(ms_slab_table_at(c + ds + dv), ms_slab_table_at(c + ds + dv + du), wu), wv);
+  return mix(lo, hi, ws);
 }
-// The slab lit from below (a ground's light; the table's second part): entry k, and the light it
-// scatters toward cosine mu, per unit of the ground's radiance, bilinear in the depths.
+// The slab lit from below (a ground's light; the table's second part): its cell, and entry k,
+// bilinear in the depths.
 CV_FN void ms_slab_below_cell(real t, real b, CV_OUT(int) u0, CV_OUT(int) v0, CV_OUT(real) wu, CV_OUT(real) wv) {
   real fu = clamp(t / (t + real(CV_MS_SLAB_T0)), real(0.0), real(1.0)) * real(CV_MS_SLAB_DEPTHS - 1);
   real fv = clamp(b / (b + real(CV_MS_SLAB_T0)), real(0.0), real(1.0)) * real(CV_MS_SLAB_DEPTHS - 1);
@@ -443,30 +442,6 @@ CV_FN real ms_slab_below_entry(int phase, real t, real b, int k) {
   return mix(mix(ms_slab_table_at(ms_slab_below_base(phase, v0, u0) + k), ms_slab_table_at(ms_slab_below_base(phase, v0, u0 + 1) + k), wu),
              mix(ms_slab_table_at(ms_slab_below_base(phase, v0 + 1, u0) + k), ms_slab_table_at(ms_slab_below_base(phase, v0 + 1, u0 + 1) + k), wu), wv);
 }
-#if CV_MS_SLAB_BELOW_L != 15
-#error "ms_slab_below_in_scatter writes out 16 products"
-#endif
-CV_FN real ms_slab_below_in_scatter(int phase, real t, real b, real mu) {
-  real p[CV_MS_SLAB_BELOW_L + 1];
-  p[0] = real(1.0);
-  p[1] = mu;
-  for (int l = 2; l <= CV_MS_SLAB_BELOW_L; ++l) p[l] = (real(2 * l - 1) * mu * p[l - 1] - real(l - 1) * p[l - 2]) / real(l);
-  int u0;
-  int v0;
-  real wu;
-  real wv;
-  ms_slab_below_cell(t, b, u0, v0, wu, wv);
-  real sum = real(0.0);
-  for (int corner = 0; corner < 4; ++corner) {
-    int du = corner & 1;
-    int dv = corner >> 1;
-    real w = (du == 1 ? wu : real(1.0) - wu) * (dv == 1 ? wv : real(1.0) - wv);
-    int bb = ms_slab_below_base(phase, v0 + dv, u0 + du);
-    sum += w * (CV_MS_SLAB_DOT4(bb, p, 0) + CV_MS_SLAB_DOT4(bb, p, 4) + CV_MS_SLAB_DOT4(bb, p, 8) + CV_MS_SLAB_DOT4(bb, p, 12));
-  }
-  return sum;
-}
-
 // The radiance of the ground of albedo A under the slab of total optical depth T (its phase's share
 // f truncated) as the tables have it: the flux that reaches it, the scaled beam and the diffuse
 // light, with what the slab sends back down of the ground's own light (s = its downward flux at the
@@ -478,7 +453,10 @@ CV_FN real ms_slab_ground_radiance(int phase, real T, real mu0, real f, real A) 
   return A * e / (CV_PI * max(real(1.0) - A * s, real(1e-6)));
 }
 
-CV_FN real ms_slab_in_scatter(int phase, real t, real b, real mu0, real mu, real cos_phi) {
+#if CV_MS_SLAB_BELOW_L != CV_MS_SLAB_L0
+#error "the light from below takes the azimuthal mean's harmonics of ms_slab_in_scatter"
+#endif
+CV_FN real ms_slab_in_scatter(int phase, real t, real b, real mu0, real mu, real cos_phi, real ground_l) {
   // Lambda_l^m(mu) cos(m phi) in the table's order (m = 0 to degree L0, then m >= 1 to degree L).
   real y[CV_MS_SLAB_MOMENTS];
   real s = sqrt(max(real(1.0) - mu * mu, real(0.0)));
@@ -527,6 +505,24 @@ CV_FN real ms_slab_in_scatter(int phase, real t, real b, real mu0, real mu, real
                 CV_MS_SLAB_DOT4(b, y, 16) + CV_MS_SLAB_DOT4(b, y, 20) + CV_MS_SLAB_DOT4(b, y, 24) + CV_MS_SLAB_DOT4(b, y, 28) +
                 CV_MS_SLAB_DOT4(b, y, 32) + CV_MS_SLAB_DOT4(b, y, 36) + CV_MS_SLAB_DOT4(b, y, 40);
     sum += w * dotp;
+  }
+  // The light from the ground (the table's part lit from below), per unit of its radiance: the
+  // azimuthal mean's harmonics are y's first CV_MS_SLAB_L0 + 1 (cos 0 = 1), bilinear in the depths.
+  if (ground_l > real(0.0)) {
+    int gu0;
+    int gv0;
+    real gwu;
+    real gwv;
+    ms_slab_below_cell(t, b, gu0, gv0, gwu, gwv);
+    int b00 = ms_slab_below_base(phase, gv0, gu0);
+    int b01 = ms_slab_below_base(phase, gv0, gu0 + 1);
+    int b10 = ms_slab_below_base(phase, gv0 + 1, gu0);
+    int b11 = ms_slab_below_base(phase, gv0 + 1, gu0 + 1);
+    real l00 = CV_MS_SLAB_DOT4(b00, y, 0) + CV_MS_SLAB_DOT4(b00, y, 4) + CV_MS_SLAB_DOT4(b00, y, 8) + CV_MS_SLAB_DOT4(b00, y, 12);
+    real l01 = CV_MS_SLAB_DOT4(b01, y, 0) + CV_MS_SLAB_DOT4(b01, y, 4) + CV_MS_SLAB_DOT4(b01, y, 8) + CV_MS_SLAB_DOT4(b01, y, 12);
+    real l10 = CV_MS_SLAB_DOT4(b10, y, 0) + CV_MS_SLAB_DOT4(b10, y, 4) + CV_MS_SLAB_DOT4(b10, y, 8) + CV_MS_SLAB_DOT4(b10, y, 12);
+    real l11 = CV_MS_SLAB_DOT4(b11, y, 0) + CV_MS_SLAB_DOT4(b11, y, 4) + CV_MS_SLAB_DOT4(b11, y, 8) + CV_MS_SLAB_DOT4(b11, y, 12);
+    sum += ground_l * mix(mix(l00, l01, gwu), mix(l10, l11, gwu), gwv);
   }
   return sum;
 }
@@ -824,8 +820,7 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
       real i0_slab = ms_slab_entry(phase, src.y, src.z, mu0_slab, CV_MS_SLAB_TWO_STREAM_I0) +
                      ground_l * ms_slab_below_entry(phase, src.y, src.z, CV_MS_SLAB_BELOW_TWO_STREAM_I0);
       real keep = src.x < real(0.0) ? clamp(real(1.0) + src.x / max(i0_slab, real(1e-30)), real(0.0), real(1.0)) : real(1.0);
-      real slab_light = ms_slab_in_scatter(phase, src.y, src.z, mu0_slab, mu_out, cos_phi) +
-                        ground_l * ms_slab_below_in_scatter(phase, src.y, src.z, mu_out);
+      real slab_light = ms_slab_in_scatter(phase, src.y, src.z, mu0_slab, mu_out, cos_phi, ground_l);
       real j = (s_liquid + s_ice) * (keep * slab_light + max(src.x, real(0.0)));
       if (lit) scaled_source += sun_air * max(j, real(0.0));
     } else {
