@@ -76,27 +76,20 @@ CV_FN real4 fetch_cell(sampler3D tex, real3 f) {
 // The trilinear value at f (the shape's sums are left to the compiler to drop).
 CV_FN real fetch(sampler3D tex, real3 f) { return fetch_cell(tex, f).x; }
 
-// The trilinear value of a four-channel texture at f, as fetch.
+// A node of a texture of up to four channels (0 beside a regional grid), and the bilinear value
+// over the level z of the cell between a and b (cell_at's corners and weights).
 CV_FN real4 node4(sampler3D tex, int x, int y, int z) {
   ivec3 n = ivec3(u_grid_count);
   if (x < 0 || x >= n.x || y < 0 || y >= n.y) return real4(0.0);
   return real4(texelFetch(tex, ivec3(x, y, z), 0));
 }
-CV_FN real4 fetch4(sampler3D tex, real3 f) {
-  ivec3 a;
-  ivec3 b;
-  real3 w;
-  cell_at(f, a, b, w);
-  real4 lo = mix(mix(node4(tex, a.x, a.y, a.z), node4(tex, b.x, a.y, a.z), w.x), mix(node4(tex, a.x, b.y, a.z), node4(tex, b.x, b.y, a.z), w.x), w.y);
-  real4 hi = mix(mix(node4(tex, a.x, a.y, b.z), node4(tex, b.x, a.y, b.z), w.x), mix(node4(tex, a.x, b.y, b.z), node4(tex, b.x, b.y, b.z), w.x), w.y);
-  return mix(lo, hi, w.z);
+CV_FN real4 level4(sampler3D tex, ivec3 a, ivec3 b, real3 w, int z) {
+  return mix(mix(node4(tex, a.x, a.y, z), node4(tex, b.x, a.y, z), w.x), mix(node4(tex, a.x, b.y, z), node4(tex, b.x, b.y, z), w.x), w.y);
 }
 
 // The trilinear value of a two-channel texture (red, green) at f, as fetch.
 CV_FN real2 node2(sampler3D tex, int x, int y, int z) {
-  ivec3 n = ivec3(u_grid_count);
-  if (x < 0 || x >= n.x || y < 0 || y >= n.y) return real2(0.0);
-  real4 t = real4(texelFetch(tex, ivec3(x, y, z), 0));
+  real4 t = node4(tex, x, y, z);
   return real2(t.x, t.y);
 }
 CV_FN real2 fetch2(sampler3D tex, real3 f) {
@@ -378,10 +371,8 @@ CV_FN real4 ms_slab_source_at(real3 p, real alt_m) {
   ivec3 b;
   real3 w;
   cell_at(f, a, b, w);
-  real4 lo = mix(mix(node4(u_ms_moments, a.x, a.y, a.z), node4(u_ms_moments, b.x, a.y, a.z), w.x),
-                 mix(node4(u_ms_moments, a.x, b.y, a.z), node4(u_ms_moments, b.x, b.y, a.z), w.x), w.y);
-  real4 hi = mix(mix(node4(u_ms_moments, a.x, a.y, b.z), node4(u_ms_moments, b.x, a.y, b.z), w.x),
-                 mix(node4(u_ms_moments, a.x, b.y, b.z), node4(u_ms_moments, b.x, b.y, b.z), w.x), w.y);
+  real4 lo = level4(u_ms_moments, a, b, w, a.z);
+  real4 hi = level4(u_ms_moments, a, b, w, b.z);
   real xi = real(1.0) - w.z;  // from the upper node down, in level spacings
   real dz = abs(u_grid_step.z);
   real t = hi.z + dz * xi * (hi.y + real(0.5) * (lo.y - hi.y) * xi);
@@ -400,35 +391,39 @@ CV_FN real ms_slab_table_at(int i) { return real(u_ms_slab_table[i]); }
 #error "ms_slab_in_scatter writes out 44 products"
 #endif
 #define CV_MS_SLAB_DOT4(B, Y, I) (ms_slab_table_at(B + I) * Y[I] + ms_slab_table_at(B + I + 1) * Y[I + 1] + ms_slab_table_at(B + I + 2) * Y[I + 2] + ms_slab_table_at(B + I + 3) * Y[I + 3])
-// One entry k of the slab table of `phase`, trilinear as ms_slab_in_scatter reads it.
-CV_FN real ms_slab_entry(int phase, real t, real b, real mu0, int k) {
+// The table cell of depths t above and b below under a sun at mu0 (its lower corner) and the
+// weights toward the next, in u = t / (t + T0), v and mu0.
+CV_FN void ms_slab_cell(real t, real b, real mu0, CV_OUT(ivec3) c0, CV_OUT(real3) w) {
   real fu = clamp(t / (t + real(CV_MS_SLAB_T0)), real(0.0), real(1.0)) * real(CV_MS_SLAB_DEPTHS - 1);
   real fv = clamp(b / (b + real(CV_MS_SLAB_T0)), real(0.0), real(1.0)) * real(CV_MS_SLAB_DEPTHS - 1);
   real fs = clamp((mu0 - real(CV_MS_SLAB_MU0_LO)) / (real(1.0) - real(CV_MS_SLAB_MU0_LO)), real(0.0), real(1.0)) * real(CV_MS_SLAB_SUNS - 1);
-  int u0 = clamp(int(fu), 0, CV_MS_SLAB_DEPTHS - 2);
-  int v0 = clamp(int(fv), 0, CV_MS_SLAB_DEPTHS - 2);
-  int s0 = clamp(int(fs), 0, CV_MS_SLAB_SUNS - 2);
-  real wu = fu - real(u0);
-  real wv = fv - real(v0);
-  real ws = fs - real(s0);
+  c0 = ivec3(clamp(int(fu), 0, CV_MS_SLAB_DEPTHS - 2), clamp(int(fv), 0, CV_MS_SLAB_DEPTHS - 2), clamp(int(fs), 0, CV_MS_SLAB_SUNS - 2));
+  w = real3(fu - real(c0.x), fv - real(c0.y), fs - real(c0.z));
+}
+// One entry k of the slab table of `phase`, trilinear as ms_slab_in_scatter reads it.
+CV_FN real ms_slab_entry(int phase, real t, real b, real mu0, int k) {
+  ivec3 cell;
+  real3 wc;
+  ms_slab_cell(t, b, mu0, cell, wc);
   // The eight corners written out (no loop: llvmpipe counts loop iterations, see below).
-  int c = phase * CV_MS_SLAB_PHASE_SIZE + ((s0 * CV_MS_SLAB_DEPTHS + v0) * CV_MS_SLAB_DEPTHS + u0) * CV_MS_SLAB_STRIDE + k;
+  int c = phase * CV_MS_SLAB_PHASE_SIZE + ((cell.z * CV_MS_SLAB_DEPTHS + cell.y) * CV_MS_SLAB_DEPTHS + cell.x) * CV_MS_SLAB_STRIDE + k;
   int du = CV_MS_SLAB_STRIDE;
   int dv = CV_MS_SLAB_DEPTHS * CV_MS_SLAB_STRIDE;
   int ds = CV_MS_SLAB_DEPTHS * CV_MS_SLAB_DEPTHS * CV_MS_SLAB_STRIDE;
-  real lo = mix(mix(ms_slab_table_at(c), ms_slab_table_at(c + du), wu), mix(ms_slab_table_at(c + dv), ms_slab_table_at(c + dv + du), wu), wv);
-  real hi = mix(mix(ms_slab_table_at(c + ds), ms_slab_table_at(c + ds + du), wu), mix(ms_slab_table_at(c + ds + dv), ms_slab_table_at(c + ds + dv + du), wu), wv);
-  return mix(lo, hi, ws);
+  real lo = mix(mix(ms_slab_table_at(c), ms_slab_table_at(c + du), wc.x), mix(ms_slab_table_at(c + dv), ms_slab_table_at(c + dv + du), wc.x), wc.y);
+  real hi = mix(mix(ms_slab_table_at(c + ds), ms_slab_table_at(c + ds + du), wc.x), mix(ms_slab_table_at(c + ds + dv), ms_slab_table_at(c + ds + dv + du), wc.x), wc.y);
+  return mix(lo, hi, wc.z);
 }
 // The slab lit from below (a ground's light; the table's second part): its cell, and entry k,
 // bilinear in the depths.
 CV_FN void ms_slab_below_cell(real t, real b, CV_OUT(int) u0, CV_OUT(int) v0, CV_OUT(real) wu, CV_OUT(real) wv) {
-  real fu = clamp(t / (t + real(CV_MS_SLAB_T0)), real(0.0), real(1.0)) * real(CV_MS_SLAB_DEPTHS - 1);
-  real fv = clamp(b / (b + real(CV_MS_SLAB_T0)), real(0.0), real(1.0)) * real(CV_MS_SLAB_DEPTHS - 1);
-  u0 = clamp(int(fu), 0, CV_MS_SLAB_DEPTHS - 2);
-  v0 = clamp(int(fv), 0, CV_MS_SLAB_DEPTHS - 2);
-  wu = fu - real(u0);
-  wv = fv - real(v0);
+  ivec3 cell;
+  real3 wc;
+  ms_slab_cell(t, b, real(1.0), cell, wc);
+  u0 = cell.x;
+  v0 = cell.y;
+  wu = wc.x;
+  wv = wc.y;
 }
 CV_FN int ms_slab_below_base(int phase, int v, int u) {
   return CV_MS_SLAB_BELOW_OFFSET + phase * CV_MS_SLAB_BELOW_SIZE + (v * CV_MS_SLAB_DEPTHS + u) * CV_MS_SLAB_BELOW_STRIDE;
@@ -483,22 +478,16 @@ CV_FN real ms_slab_in_scatter(int phase, real t, real b, real mu0, real mu, real
       bb = c;
     }
   }
-  real fu = clamp(t / (t + real(CV_MS_SLAB_T0)), real(0.0), real(1.0)) * real(CV_MS_SLAB_DEPTHS - 1);
-  real fv = clamp(b / (b + real(CV_MS_SLAB_T0)), real(0.0), real(1.0)) * real(CV_MS_SLAB_DEPTHS - 1);
-  real fs = clamp((mu0 - real(CV_MS_SLAB_MU0_LO)) / (real(1.0) - real(CV_MS_SLAB_MU0_LO)), real(0.0), real(1.0)) * real(CV_MS_SLAB_SUNS - 1);
-  int u0 = clamp(int(fu), 0, CV_MS_SLAB_DEPTHS - 2);
-  int v0 = clamp(int(fv), 0, CV_MS_SLAB_DEPTHS - 2);
-  int s0 = clamp(int(fs), 0, CV_MS_SLAB_SUNS - 2);
-  real wu = fu - real(u0);
-  real wv = fv - real(v0);
-  real ws = fs - real(s0);
+  ivec3 cell;
+  real3 wc;
+  ms_slab_cell(t, b, mu0, cell, wc);
   real sum = real(0.0);
   for (int corner = 0; corner < 8; ++corner) {
     int du = corner & 1;
     int dv = (corner >> 1) & 1;
     int ds = corner >> 2;
-    real w = (du == 1 ? wu : real(1.0) - wu) * (dv == 1 ? wv : real(1.0) - wv) * (ds == 1 ? ws : real(1.0) - ws);
-    int b = phase * CV_MS_SLAB_PHASE_SIZE + (((s0 + ds) * CV_MS_SLAB_DEPTHS + v0 + dv) * CV_MS_SLAB_DEPTHS + u0 + du) * CV_MS_SLAB_STRIDE;
+    real w = (du == 1 ? wc.x : real(1.0) - wc.x) * (dv == 1 ? wc.y : real(1.0) - wc.y) * (ds == 1 ? wc.z : real(1.0) - wc.z);
+    int b = phase * CV_MS_SLAB_PHASE_SIZE + (((cell.z + ds) * CV_MS_SLAB_DEPTHS + cell.y + dv) * CV_MS_SLAB_DEPTHS + cell.x + du) * CV_MS_SLAB_STRIDE;
     // The 44 products written out: llvmpipe counts every loop iteration against its budget
     // (loop_iterations_per_view_step), and an inner loop here cost 352 a sample.
     real dotp = CV_MS_SLAB_DOT4(b, y, 0) + CV_MS_SLAB_DOT4(b, y, 4) + CV_MS_SLAB_DOT4(b, y, 8) + CV_MS_SLAB_DOT4(b, y, 12) +
