@@ -241,7 +241,7 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
       // Two RG32F textures: (I0, I1 up) and, where the columns exchange light, (I1 east, I1 north);
       // the first RGBA32F with the higher-order source's depths (tau above, tau below).
       const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
-      const bool rgba = !src.tau_above.empty();
+      const bool rgba = core::ms_moments_channels(src) == 4;
       if (ms_[0] && rgba != ms_rgba_) {
         glDeleteTextures(1, &ms_[0]);
         ms_[0] = 0;

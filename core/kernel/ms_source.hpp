@@ -82,6 +82,8 @@ struct MsSource {
 // north); the second is empty where the source has no horizontal moment. With the depths of the
 // higher-order source the first has four: (I0 - I0_slab, extinction, tau above, ground albedo).
 std::vector<float> ms_moments_texels(const MsSource& s);
+// The first texture's channels: 4 with the slab's fields (all of them, each node), else 2.
+int ms_moments_channels(const MsSource& s);
 std::vector<float> ms_horizontal_texels(const MsSource& s);
 
 // The largest grid whose columns exchange light (the 3-D diffusion holds about 80 bytes per node

@@ -49,7 +49,7 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
     ms = ms_source_for(v, ms_source_key(s, k.u_to_sun, ground_map));
     ms_moments = ms_moments_texels(*ms);
     ms_horizontal = ms_horizontal_texels(*ms);
-    k.u_ms_moments = {ms_moments.data(), n, ms->tau_above.empty() ? 2 : 4};
+    k.u_ms_moments = {ms_moments.data(), n, ms_moments_channels(*ms)};
     k.u_ms_lateral = !ms_horizontal.empty();
     k.u_ms_horizontal = k.u_ms_lateral ? kernel::sampler3D{ms_horizontal.data(), n, 2} : k.u_ms_moments;
   }

@@ -566,6 +566,13 @@ TEST(TwoStream, TheSlabShapesFieldsMeasureEachNodeAgainstItsSlab) {
     EXPECT_LT(std::abs(uni.slab_excess[a]), 0.03 * uni.i0[a]) << "level " << k;
   }
 
+  // A volume with no cloud at all still has all four fields (zero), as the textures take them.
+  TimeStepData none;
+  none[Field::ExtinctionLiquid].assign(g.points(), 0.0f);
+  const MsSource empty = build_ms_source(prepare_volume(g, none), ms_source_key(s, sun30));
+  EXPECT_EQ(ms_moments_channels(empty), 4);
+  for (float x : ms_moments_texels(empty)) ASSERT_EQ(x, 0.0f);
+
   // The linear shape builds none of the slab's fields.
   MarchSettings linear = s;
   linear.medium.ms_slab = false;
