@@ -897,7 +897,8 @@ std::shared_ptr<const std::vector<float>> ms_slab_tables(const MarchSettings& s)
   if (memo.tables && memo.droplet_um == d && memo.ice_g == ice_g && memo.liquid_hg == hg) return memo.tables;
   const physics::f64::MieParams mie = physics::f64::mie_params(d);
   const double gl = physics::f64::mie_mean_cosine(mie);
-  MarchSettings slab_settings = s;
+  MarchSettings slab_settings = s;  // the shares the tables are made for, whatever s's shape
+  slab_settings.medium.ms_two_stream = slab_settings.medium.ms_slab = true;
   const MsPeaks peaks = ms_peaks(slab_settings);
   const MsSlabTable liquid = hg ? ms_slab_table([gl](double m) { return physics::f64::phase_hg(m, gl); }, peaks.f_liquid, gl)
                                 : ms_slab_table([&mie](double m) { return physics::f64::phase_mie(m, mie); }, peaks.f_liquid, gl);

@@ -448,6 +448,16 @@ CV_FN real ms_slab_ground_radiance(int phase, real T, real mu0, real f, real A) 
   return A * e / (CV_PI * max(real(1.0) - A * s, real(1e-6)));
 }
 
+// How much of its slab's light a point keeps (core/kernel/ms_source): src = (d0, t, b, A) as
+// ms_slab_source_at reads it. Its ground's radiance in ground_l; keep = 1 + d0 / I0_slab where the
+// source holds less than the slab (d0 < 0), else 1.
+CV_FN real ms_slab_keep(int phase, real4 src, real mu0, real f, CV_OUT(real) ground_l) {
+  ground_l = ms_slab_ground_radiance(phase, src.y + src.z, mu0, f, src.w);
+  real i0_slab = ms_slab_entry(phase, src.y, src.z, mu0, CV_MS_SLAB_TWO_STREAM_I0) +
+                 ground_l * ms_slab_below_entry(phase, src.y, src.z, CV_MS_SLAB_BELOW_TWO_STREAM_I0);
+  return src.x < real(0.0) ? clamp(real(1.0) + src.x / max(i0_slab, real(1e-30)), real(0.0), real(1.0)) : real(1.0);
+}
+
 #if CV_MS_SLAB_BELOW_L != CV_MS_SLAB_L0
 #error "the light from below takes the azimuthal mean's harmonics of ms_slab_in_scatter"
 #endif
@@ -788,8 +798,8 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
     }
     sigma_ms = sl * (real(1.0) - f_liquid) + si * (real(1.0) - f_ice);
     if (kSlab) {
-      // The higher-order source: the slab table's light toward the camera times the nodes' factor
-      // (the light travels along -d; mu to the downward vertical, phi from the beam's azimuth).
+      // The higher-order source: the slab tables' light toward the camera (the light travels along
+      // -d; mu to the downward vertical, phi from the beam's azimuth).
       real4 src = ms_slab_source_at(p, alt_p);
       real mu_out = dot(d, up_p);
       real3 out_h = -d + mu_out * up_p;
@@ -805,10 +815,8 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
       real s_liquid = sl * (real(1.0) - f_liquid);
       real s_ice = si * (real(1.0) - f_ice);
       int phase = s_liquid >= s_ice ? 0 : 1;
-      real ground_l = ms_slab_ground_radiance(phase, src.y + src.z, mu0_slab, phase == 0 ? f_liquid : f_ice, src.w);
-      real i0_slab = ms_slab_entry(phase, src.y, src.z, mu0_slab, CV_MS_SLAB_TWO_STREAM_I0) +
-                     ground_l * ms_slab_below_entry(phase, src.y, src.z, CV_MS_SLAB_BELOW_TWO_STREAM_I0);
-      real keep = src.x < real(0.0) ? clamp(real(1.0) + src.x / max(i0_slab, real(1e-30)), real(0.0), real(1.0)) : real(1.0);
+      real ground_l;
+      real keep = ms_slab_keep(phase, src, mu0_slab, phase == 0 ? f_liquid : f_ice, ground_l);
       real slab_light = ms_slab_in_scatter(phase, src.y, src.z, mu0_slab, mu_out, cos_phi, ground_l);
       real j = (s_liquid + s_ice) * (keep * slab_light + max(src.x, real(0.0)));
       if (lit) scaled_source += sun_air * max(j, real(0.0));
@@ -1246,10 +1254,8 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, real behind_t, 
         // optical depth 2 5.5 % too bright).
         real4 src = ms_slab_source_at(pg, u_grid_start.z);
         real mu0g = max(mu_sg, real(CV_MS_SLAB_MU0_LO));
-        real ground_l = ms_slab_ground_radiance(0, src.y + src.z, mu0g, u_ms_f_liquid, src.w);
-        real i0_slab = ms_slab_entry(0, src.y, src.z, mu0g, CV_MS_SLAB_TWO_STREAM_I0) +
-                       ground_l * ms_slab_below_entry(0, src.y, src.z, CV_MS_SLAB_BELOW_TWO_STREAM_I0);
-        real keep = src.x < real(0.0) ? clamp(real(1.0) + src.x / max(i0_slab, real(1e-30)), real(0.0), real(1.0)) : real(1.0);
+        real ground_l;
+        real keep = ms_slab_keep(0, src, mu0g, u_ms_f_liquid, ground_l);
         down = keep * (ms_slab_entry(0, src.y, src.z, mu0g, CV_MS_SLAB_FLUX_DOWN) +
                        ground_l * ms_slab_below_entry(0, src.y, src.z, CV_MS_SLAB_BELOW_FLUX_DOWN));
       }
