@@ -843,7 +843,9 @@ int cmd_render(const std::vector<std::string>& args) {
   const core::MarchSettings& march = frame.march;
   const int mw = frame.march_camera.width, mh = frame.march_camera.height;
   const std::string model =
-      march.medium.ms_two_stream ? std::string("two-stream multiple scattering") : std::to_string(march.quality.octaves) + " octaves";
+      march.medium.ms_two_stream
+          ? std::string("two-stream multiple scattering, ") + (march.medium.ms_slab ? "slab-shaped" : "linear") + " diffuse light"
+          : std::to_string(march.quality.octaves) + " octaves";
   // Between two steps the report names both (the medium is interpolated), else the step.
   const std::string when = instant.between() ? "between time steps " + std::to_string(instant.step0) + " and " + std::to_string(instant.step1)
                                              : "time step " + std::to_string(instant.step0);

@@ -334,6 +334,18 @@ CV_FN void medium_in(real3 p, real3 g, real alt_m, CV_OUT(real) sl, CV_OUT(real)
   if (kNoise && sl + si > real(0.0)) erode_at(p, sl, si);
 }
 
+// The light between the columns (u_ms_lateral; else 0): the source's first moment's east and north
+// parts at p, grid coordinates f (the local frame from p; at the axis, longitude 0's).
+CV_FN real3 ms_horizontal_in(real3 p, real3 f) {
+  if (!u_ms_lateral) return real3(0.0);
+  real3 up = normalize(p);
+  real rho = length(real2(p.x, p.y));
+  real3 east = rho > real(0.0) ? real3(-p.y / rho, p.x / rho, real(0.0)) : real3(0.0, 1.0, 0.0);
+  real3 north = cross(up, east);
+  real2 h = fetch2(u_ms_horizontal, f);
+  return h.x * east + h.y * north;
+}
+
 // The two-stream source's moments (per unit irradiance) at p, altitude alt_m (core/kernel/ms_source).
 CV_FN void ms_source_at(real3 p, real alt_m, CV_OUT(real) i0, CV_OUT(real3) i1) {
   i0 = real(0.0);
@@ -342,18 +354,8 @@ CV_FN void ms_source_at(real3 p, real alt_m, CV_OUT(real) i0, CV_OUT(real3) i1) 
   real3 f;
   if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
   real2 m = fetch2(u_ms_moments, f);
-  real3 up = normalize(p);
   i0 = m.x;
-  i1 = m.y * up;
-  if (u_ms_lateral) {
-    // The light between the columns: the first moment's east and north parts (the local frame
-    // from p; at the axis, longitude 0's).
-    real rho = length(real2(p.x, p.y));
-    real3 east = rho > real(0.0) ? real3(-p.y / rho, p.x / rho, real(0.0)) : real3(0.0, 1.0, 0.0);
-    real3 north = cross(up, east);
-    real2 h = fetch2(u_ms_horizontal, f);
-    i1 += h.x * east + h.y * north;
-  }
+  i1 = m.y * normalize(p) + ms_horizontal_in(p, f);
 }
 
 // The higher-order source at p (kSlab): the source's light against the slab's, d0 = I0 - I0_slab,
@@ -362,11 +364,14 @@ CV_FN void ms_source_at(real3 p, real alt_m, CV_OUT(real) i0, CV_OUT(real3) i1) 
 // extinction, depth above, A);
 // between two levels the extinction is linear, so the depth above grows quadratically from the
 // upper node down (a linear blend of the nodes' depths put the samples in a cloud's top layer as
-// deep as its middle), and the depth below is the column's (u_column_tau) less it.
-CV_FN real4 ms_slab_source_at(real3 p, real alt_m) {
+// deep as its middle), and the depth below is the column's (u_column_tau) less it. The light
+// between the columns in i1h (ms_horizontal_in).
+CV_FN real4 ms_slab_source_at(real3 p, real alt_m, CV_OUT(real3) i1h) {
+  i1h = real3(0.0);
   real3 g = ecef_to_sphere(p, u_r0);
   real3 f;
   if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return real4(0.0);
+  i1h = ms_horizontal_in(p, f);
   ivec3 a;
   ivec3 b;
   real3 w;
@@ -800,7 +805,8 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
     if (kSlab) {
       // The higher-order source: the slab tables' light toward the camera (the light travels along
       // -d; mu to the downward vertical, phi from the beam's azimuth).
-      real4 src = ms_slab_source_at(p, alt_p);
+      real3 i1h;
+      real4 src = ms_slab_source_at(p, alt_p, i1h);
       real mu_out = dot(d, up_p);
       real3 out_h = -d + mu_out * up_p;
       real3 beam_h = -u_to_sun + mu_sun * up_p;
@@ -819,6 +825,10 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
       real keep = ms_slab_keep(phase, src, mu0_slab, phase == 0 ? f_liquid : f_ice, ground_l);
       real slab_light = ms_slab_in_scatter(phase, src.y, src.z, mu0_slab, mu_out, cos_phi, ground_l);
       real j = (s_liquid + s_ice) * (keep * slab_light + max(src.x, real(0.0)));
+      // The light between the columns (the source's horizontal first moment; the slab has none
+      // across its sun's azimuth and none from its neighbours) scattered by the truncated phase, as
+      // the linear shape scatters it: sigma' g' I1 . (-d), sigma' g' = sigma (g - f) per phase.
+      j -= (sl * max(g_liquid - f_liquid, real(0.0)) + si * max(g_ice - f_ice, real(0.0))) * dot(i1h, d);
       if (lit) scaled_source += sun_air * max(j, real(0.0));
     } else {
       real first = sl * g_liquid * (real(1.0) - g_liquid) + si * g_ice * (real(1.0) - g_ice);
@@ -1252,7 +1262,8 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, real behind_t, 
         // What the source holds beyond the slab is left out here: at the foot it is mostly the
         // ground's light going up (counted as isotropic it made a bright ground under a cloud of
         // optical depth 2 5.5 % too bright).
-        real4 src = ms_slab_source_at(pg, u_grid_start.z);
+        real3 i1h;
+        real4 src = ms_slab_source_at(pg, u_grid_start.z, i1h);
         real mu0g = max(mu_sg, real(CV_MS_SLAB_MU0_LO));
         real ground_l;
         real keep = ms_slab_keep(0, src, mu0g, u_ms_f_liquid, ground_l);
