@@ -174,7 +174,7 @@ void GpuRaymarcher::upload(std::shared_ptr<const core::PreparedVolume> volume) {
     if (t) glDeleteTextures(1, &t);
     t = 0;
   }
-  ms_lateral_ = false;
+  ms_lateral_ = ms_second_ = false;
   ms_volume_ = nullptr;
   // The modelled cloud's cover: uploaded again when a march needs it, into a texture of this grid's size.
   if (fraction_) glDeleteTextures(1, &fraction_);
@@ -239,26 +239,31 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
       const std::shared_ptr<const core::MsSource> ms = core::ms_source_for(v, key, &built);  // built ahead by the viewer's prefetcher, or now
       const core::MsSource& src = *ms;
       // Two RG32F textures: (I0, I1 up) and, where the columns exchange light, (I1 east, I1 north);
-      // the first RGBA32F with the higher-order source's depths (tau above, tau below).
+      // both RGBA32F with the higher-order source's fields (core::ms_moments_texels), the second
+      // then always made.
       const glm::ivec3 n(grid.lon_deg.count, grid.lat_deg.count, grid.alt_m.count);
       const bool rgba = core::ms_moments_channels(src) == 4;
-      if (ms_[0] && rgba != ms_rgba_) {
-        glDeleteTextures(1, &ms_[0]);
-        ms_[0] = 0;
+      if (rgba != ms_rgba_) {
+        for (GLuint& tex : ms_) {
+          if (tex) glDeleteTextures(1, &tex);
+          tex = 0;
+        }
       }
+      const bool second = rgba || !src.i1e.empty();
       for (int t = 0; t < 2; ++t) {
-        if (ms_[t] || (t == 1 && src.i1e.empty())) continue;
+        if (ms_[t] || (t == 1 && !second)) continue;
         glCreateTextures(GL_TEXTURE_3D, 1, &ms_[t]);
-        glTextureStorage3D(ms_[t], 1, t == 0 && rgba ? GL_RGBA32F : GL_RG32F, n.x, n.y, n.z);
+        glTextureStorage3D(ms_[t], 1, rgba ? GL_RGBA32F : GL_RG32F, n.x, n.y, n.z);
       }
       ms_rgba_ = rgba;
       glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
       const std::vector<float> moments = core::ms_moments_texels(src);
       glTextureSubImage3D(ms_[0], 0, 0, 0, 0, n.x, n.y, n.z, rgba ? GL_RGBA : GL_RG, GL_FLOAT, moments.data());
       ms_lateral_ = !src.i1e.empty();
-      if (ms_lateral_) {
+      ms_second_ = second;
+      if (second) {
         const std::vector<float> horizontal = core::ms_horizontal_texels(src);
-        glTextureSubImage3D(ms_[1], 0, 0, 0, 0, n.x, n.y, n.z, GL_RG, GL_FLOAT, horizontal.data());
+        glTextureSubImage3D(ms_[1], 0, 0, 0, 0, n.x, n.y, n.z, rgba ? GL_RGBA : GL_RG, GL_FLOAT, horizontal.data());
       }
       check_gl("uploading the two-stream source");
       ms_volume_ = &v, ms_key_ = key, ms_build_ms_ = src.build_ms, ms_built_here_ = built;
@@ -365,7 +370,7 @@ kernel::MarchParams GpuRaymarcher::bind_inputs(const core::Camera& cam, const co
   glBindTextureUnit(CV_TEX_JITTER_MASK, jitter_mask_);
   glBindTextureUnit(CV_TEX_COLUMN_TAU, column_tau_);
   glBindTextureUnit(CV_TEX_MS_MOMENTS, ms_[0]);
-  glBindTextureUnit(CV_TEX_MS_HORIZONTAL, ms_lateral_ ? ms_[1] : ms_[0]);  // unread without the light between columns
+  glBindTextureUnit(CV_TEX_MS_HORIZONTAL, ms_second_ ? ms_[1] : ms_[0]);  // unread without the light between columns or the slab
   glBindTextureUnit(CV_TEX_FRACTION, fraction_);
   glBindTextureUnit(CV_TEX_DETAIL_TABLE, detail_table_);
   glBindTextureUnit(CV_TEX_DETAIL_SHIFT, detail_shift_);

@@ -199,9 +199,10 @@ class GpuRaymarcher {
   std::size_t path_pixels_ = 0;
   GLuint textures_[2] = {0, 0};
   GLuint noise_textures_[2] = {0, 0};
-  GLuint ms_[2] = {0, 0};           // the two-stream source (RG32F x2; the first RGBA32F with the slab's depths), built for ms_key_ on ms_volume_
-  bool ms_rgba_ = false;            // ms_[0] holds four channels (the higher-order source's depths)
+  GLuint ms_[2] = {0, 0};           // the two-stream source (RG32F x2; RGBA32F x2 with the slab's fields), built for ms_key_ on ms_volume_
+  bool ms_rgba_ = false;            // both hold four channels (the higher-order source's fields)
   bool ms_lateral_ = false;         // ms_[1] holds the source's horizontal moment
+  bool ms_second_ = false;          // ms_[1] is made (the horizontal moment, or the slab's fields)
   GLuint fraction_ = 0;             // the modelled cloud's cover (R32F 3-D), uploaded for fraction_volume_ when used
   const core::PreparedVolume* fraction_volume_ = nullptr;
   GLuint detail_shift_ = 0;         // the modelled cloud's displacement per level (RG32F, detail_shift_levels_ x 1)

@@ -715,11 +715,14 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
     // no ground light): the difference from the slab's two-stream I0 (ms_slab_two_stream), and the
     // ground's albedo, with which the march finds the slab's ground radiance from the tables.
     // The march takes the slab's light (from the sun, and from the ground at that radiance) scaled
-    // down where the node holds less (a shaded column, an edge losing light), and adds what it
+    // down where the sample holds less (a shaded column, an edge losing light), and adds what it
     // holds beyond as isotropic light (from neighbouring columns): the slab's shape belongs to the
-    // light that came through the column. A difference interpolates between nodes without
-    // amplifying anything (a ratio carried a thin column's ground light, times the slab's light
-    // over its I0, into its thick neighbours).
+    // light that came through the column. Where the medium's column at the sample holds the
+    // nodes' slab it reads this difference (a difference interpolates between nodes without
+    // amplifying anything: a ratio carried a thin column's ground light, times the slab's light
+    // over its I0, into its thick neighbours; and it follows the slab between two nodes, where
+    // the nodes' light, linear, does not); in a cloud's fringe, its own I0 against its column's
+    // slab (march.glsl ms_slab_source_at, ms_slab_keep).
     out.slab_excess.assign(out.i0.size(), 0.0f);
     out.slab_ground.assign(out.i0.size(), 0.0f);
     parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
@@ -761,18 +764,33 @@ std::vector<float> interleave(const std::vector<float>& a, const std::vector<flo
 
 int ms_moments_channels(const MsSource& s) {
   const std::size_t n = s.i0.size();
-  return !s.tau_above.empty() && s.tau_above.size() == n && s.slab_excess.size() == n && s.slab_ground.size() == n && s.sigma.size() == n ? 4 : 2;
+  return !s.tau_above.empty() && s.tau_above.size() == n && s.tau_below.size() == n && s.slab_excess.size() == n &&
+                 s.slab_ground.size() == n && s.sigma.size() == n
+             ? 4
+             : 2;
 }
 
 std::vector<float> ms_moments_texels(const MsSource& s) {
   if (ms_moments_channels(s) != 4) return interleave(s.i0, s.i1);
   std::vector<float> out(4 * s.i0.size());
   parallel_ranges(s.i0.size(), 65536, [&](std::size_t lo, std::size_t hi, unsigned) {
-    for (std::size_t i = lo; i < hi; ++i) out[4 * i] = s.slab_excess[i], out[4 * i + 1] = s.sigma[i], out[4 * i + 2] = s.tau_above[i], out[4 * i + 3] = s.slab_ground[i];
+    for (std::size_t i = lo; i < hi; ++i) out[4 * i] = s.i0[i], out[4 * i + 1] = s.sigma[i], out[4 * i + 2] = s.tau_above[i], out[4 * i + 3] = s.slab_ground[i];
   });
   return out;
 }
-std::vector<float> ms_horizontal_texels(const MsSource& s) { return interleave(s.i1e, s.i1n); }
+int ms_horizontal_channels(const MsSource& s) { return ms_moments_channels(s); }
+std::vector<float> ms_horizontal_texels(const MsSource& s) {
+  if (ms_horizontal_channels(s) != 4) return interleave(s.i1e, s.i1n);
+  const bool lateral = s.i1e.size() == s.i0.size() && s.i1n.size() == s.i0.size();
+  std::vector<float> out(4 * s.i0.size());
+  parallel_ranges(s.i0.size(), 65536, [&](std::size_t lo, std::size_t hi, unsigned) {
+    for (std::size_t i = lo; i < hi; ++i) {
+      out[4 * i] = lateral ? s.i1e[i] : 0.0f, out[4 * i + 1] = lateral ? s.i1n[i] : 0.0f;
+      out[4 * i + 2] = s.tau_below[i], out[4 * i + 3] = s.slab_excess[i];
+    }
+  });
+  return out;
+}
 
 std::shared_ptr<const MsSource> ms_source_for(const PreparedVolume& v, const MsSourceKey& key, bool* built) {
   const bool ahead = v.ms_prebuilt && v.ms_prebuilt->key == key;

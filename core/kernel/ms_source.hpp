@@ -79,11 +79,14 @@ struct MsSource {
 };
 
 // The kernel's two textures of the source, two channels per node: (I0, I1 up) and (I1 east, I1
-// north); the second is empty where the source has no horizontal moment. With the depths of the
-// higher-order source the first has four: (I0 - I0_slab, extinction, tau above, ground albedo).
+// north); the second is empty where the source has no horizontal moment. With the higher-order
+// source's fields both have four: (I0, extinction, tau above, ground albedo) and (I1 east, I1
+// north, tau below, I0 - I0_slab), the second then always made (its horizontal moment 0 where the
+// columns stay on their own).
 std::vector<float> ms_moments_texels(const MsSource& s);
-// The first texture's channels: 4 with the slab's fields (all of them, each node), else 2.
+// The textures' channels: 4 with the slab's fields (all of them, each node), else 2.
 int ms_moments_channels(const MsSource& s);
+int ms_horizontal_channels(const MsSource& s);
 std::vector<float> ms_horizontal_texels(const MsSource& s);
 
 // The largest grid whose columns exchange light (the 3-D diffusion holds about 80 bytes per node

@@ -44,14 +44,14 @@ ReferenceImage render_reference(const PreparedVolume& v, const Camera& cam, cons
   k.u_column_tau = {(hidden.any() ? masked_columns : v.column_maps).data(), {v.columns.nx, v.columns.ny, int(kColumnMapLayers)},
                     int(kColumnMapChannels)};
   std::shared_ptr<const MsSource> ms;  // the two-stream source, as the GPU's (core/kernel/ms_source)
-  std::vector<float> ms_moments, ms_horizontal;  // its textures, two channels per node
+  std::vector<float> ms_moments, ms_horizontal;  // its textures, two or four channels per node
   if (s.medium.ms_two_stream) {
     ms = ms_source_for(v, ms_source_key(s, k.u_to_sun, ground_map));
     ms_moments = ms_moments_texels(*ms);
     ms_horizontal = ms_horizontal_texels(*ms);
     k.u_ms_moments = {ms_moments.data(), n, ms_moments_channels(*ms)};
-    k.u_ms_lateral = !ms_horizontal.empty();
-    k.u_ms_horizontal = k.u_ms_lateral ? kernel::sampler3D{ms_horizontal.data(), n, 2} : k.u_ms_moments;
+    k.u_ms_lateral = !ms->i1e.empty();
+    k.u_ms_horizontal = !ms_horizontal.empty() ? kernel::sampler3D{ms_horizontal.data(), n, ms_horizontal_channels(*ms)} : k.u_ms_moments;
   }
   const MsPeaks peaks = s.medium.ms_two_stream ? ms_peaks(s) : MsPeaks{};  // holds the droplets' beam table
   if (peaks.beam) k.u_ms_beam_table = peaks.beam->values.data();

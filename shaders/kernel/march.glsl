@@ -335,14 +335,14 @@ CV_FN void medium_in(real3 p, real3 g, real alt_m, CV_OUT(real) sl, CV_OUT(real)
 }
 
 // The light between the columns (u_ms_lateral; else 0): the source's first moment's east and north
-// parts at p, grid coordinates f (the local frame from p; at the axis, longitude 0's).
-CV_FN real3 ms_horizontal_in(real3 p, real3 f) {
+// parts h (the second texture's first two channels) as a vector at p (the local frame from p; at
+// the axis, longitude 0's).
+CV_FN real3 ms_horizontal_vector(real3 p, real2 h) {
   if (!u_ms_lateral) return real3(0.0);
   real3 up = normalize(p);
   real rho = length(real2(p.x, p.y));
   real3 east = rho > real(0.0) ? real3(-p.y / rho, p.x / rho, real(0.0)) : real3(0.0, 1.0, 0.0);
   real3 north = cross(up, east);
-  real2 h = fetch2(u_ms_horizontal, f);
   return h.x * east + h.y * north;
 }
 
@@ -355,35 +355,48 @@ CV_FN void ms_source_at(real3 p, real alt_m, CV_OUT(real) i0, CV_OUT(real3) i1) 
   if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return;
   real2 m = fetch2(u_ms_moments, f);
   i0 = m.x;
-  i1 = m.y * normalize(p) + ms_horizontal_in(p, f);
+  i1 = m.y * normalize(p) + (u_ms_lateral ? ms_horizontal_vector(p, fetch2(u_ms_horizontal, f)) : real3(0.0));
 }
 
-// The higher-order source at p (kSlab): the source's light against the slab's, d0 = I0 - I0_slab,
-// and the column's ground albedo A (trilinear like ms_source_at; core/kernel/ms_source), and the
-// optical depths above and below p in its column (t, b): (d0, t, b, A). The nodes hold (d0,
-// extinction, depth above, A);
-// between two levels the extinction is linear, so the depth above grows quadratically from the
-// upper node down (a linear blend of the nodes' depths put the samples in a cloud's top layer as
-// deep as its middle), and the depth below is the column's (u_column_tau) less it. The light
-// between the columns in i1h (ms_horizontal_in).
-CV_FN real4 ms_slab_source_at(real3 p, real alt_m, CV_OUT(real3) i1h) {
+// The higher-order source at p (kSlab; core/kernel/ms_source): the nodes hold (I0, extinction,
+// depth above, ground albedo) and (I1 east, I1 north, depth below, d0 = I0 - I0_slab against the
+// slab of the node's depths). Between two levels the extinction is linear, so the depth above t
+// grows quadratically from the upper node down and the depth below from the lower node up (a
+// linear blend of the nodes' depths put the samples in a cloud's top layer as deep as its middle).
+// Returns (I0, t, b, A) and, in d0 and share, how the sample is measured against its slab
+// (ms_slab_keep): where the medium's column at p (the column map) holds the nodes' slab, t + b,
+// the nodes' difference d0 (interpolated: a slab's light between two nodes follows the slab, which
+// the nodes' light, linear between them, does not: thick slabs up to 5.5 % bright); where it holds
+// less (share = column / (t + b) < 1: the fringe the interpolation spreads around a cloud, a cell
+// wide, whose nodes carry the cloud's depths), the slab of the column's own depth, b = column - t,
+// and the source's own light there. The light between the columns in i1h (ms_horizontal_vector).
+CV_FN real4 ms_slab_source_at(real3 p, real alt_m, CV_OUT(real3) i1h, CV_OUT(real) d0, CV_OUT(real) share) {
   i1h = real3(0.0);
+  d0 = real(0.0);
+  share = real(1.0);
   real3 g = ecef_to_sphere(p, u_r0);
   real3 f;
   if (!volume_coords(g.x / CV_KDEG, g.y / CV_KDEG, alt_m, u_grid_start, u_grid_step, u_grid_count, u_wraps, u_global_lat, f)) return real4(0.0);
-  i1h = ms_horizontal_in(p, f);
   ivec3 a;
   ivec3 b;
   real3 w;
   cell_at(f, a, b, w);
   real4 lo = level4(u_ms_moments, a, b, w, a.z);
   real4 hi = level4(u_ms_moments, a, b, w, b.z);
-  real xi = real(1.0) - w.z;  // from the upper node down, in level spacings
+  real4 lo2 = level4(u_ms_horizontal, a, b, w, a.z);
+  real4 hi2 = level4(u_ms_horizontal, a, b, w, b.z);
   real dz = abs(u_grid_step.z);
+  real xi = real(1.0) - w.z;  // from the upper node down, in level spacings
   real t = hi.z + dz * xi * (hi.y + real(0.5) * (lo.y - hi.y) * xi);
   t = clamp(t, hi.z, max(lo.z, hi.z));
-  real total = max(column_map(real3(f.x, f.y, real(0.0))).x, lo.z);
-  return real4(mix(lo.x, hi.x, w.z), t, max(total - t, real(0.0)), mix(lo.w, hi.w, w.z));
+  real bn = lo2.z + dz * w.z * (lo.y + real(0.5) * (hi.y - lo.y) * w.z);
+  bn = clamp(bn, lo2.z, max(lo2.z, hi2.z));
+  real column = column_map(real3(f.x, f.y, real(0.0))).x;
+  real bc = max(max(column, lo.z) - t, real(0.0));
+  share = clamp(column / max(t + bn, real(1e-6)), real(0.0), real(1.0));
+  d0 = mix(lo2.w, hi2.w, w.z);
+  i1h = ms_horizontal_vector(p, real2(mix(lo2.x, hi2.x, w.z), mix(lo2.y, hi2.y, w.z)));
+  return real4(mix(lo.x, hi.x, w.z), t, mix(bc, bn, share), mix(lo.w, hi.w, w.z));
 }
 
 // The diffuse light that the higher-order source scatters toward a direction of travel at cosine mu
@@ -453,14 +466,24 @@ CV_FN real ms_slab_ground_radiance(int phase, real T, real mu0, real f, real A) 
   return A * e / (CV_PI * max(real(1.0) - A * s, real(1e-6)));
 }
 
-// How much of its slab's light a point keeps (core/kernel/ms_source): src = (d0, t, b, A) as
-// ms_slab_source_at reads it. Its ground's radiance in ground_l; keep = 1 + d0 / I0_slab where the
-// source holds less than the slab (d0 < 0), else 1.
-CV_FN real ms_slab_keep(int phase, real4 src, real mu0, real f, CV_OUT(real) ground_l) {
+// How much of its slab's light a point keeps: src = (I0, t, b, A), d0 and share as
+// ms_slab_source_at gives them. Its light against the slab's two-stream I0 at its depths over its
+// ground, d = share d0 + (1 - share) (I0 - I0_slab); the ground's radiance in ground_l, what it
+// holds beyond the slab in extra (max(d, 0), isotropic), and keep = 1 + d / I0_dom where it holds
+// less: I0_dom the slab's own mean radiance (its discrete-ordinates light, the table's first
+// moment). (The two-stream's I0 is the g^2-truncated problem's; the slab's table holds the lighter
+// truncation's diffuse light, which includes what the 3-D beam carries between the two: measured
+// against the two-stream's I0, a node losing light lost that part too, and a small cumulus's
+// shaded parts went dark.)
+CV_FN real ms_slab_keep(int phase, real4 src, real d0, real share, real mu0, real f, CV_OUT(real) ground_l, CV_OUT(real) extra) {
   ground_l = ms_slab_ground_radiance(phase, src.y + src.z, mu0, f, src.w);
   real i0_slab = ms_slab_entry(phase, src.y, src.z, mu0, CV_MS_SLAB_TWO_STREAM_I0) +
                  ground_l * ms_slab_below_entry(phase, src.y, src.z, CV_MS_SLAB_BELOW_TWO_STREAM_I0);
-  return src.x < real(0.0) ? clamp(real(1.0) + src.x / max(i0_slab, real(1e-30)), real(0.0), real(1.0)) : real(1.0);
+  real d = mix(src.x - i0_slab, d0, share);
+  extra = max(d, real(0.0));
+  if (!(d < real(0.0))) return real(1.0);
+  real i0_dom = ms_slab_entry(phase, src.y, src.z, mu0, 0) + ground_l * ms_slab_below_entry(phase, src.y, src.z, 0);
+  return clamp(real(1.0) + d / max(i0_dom, real(1e-30)), real(0.0), real(1.0));
 }
 
 #if CV_MS_SLAB_BELOW_L != CV_MS_SLAB_L0
@@ -806,7 +829,9 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
       // The higher-order source: the slab tables' light toward the camera (the light travels along
       // -d; mu to the downward vertical, phi from the beam's azimuth).
       real3 i1h;
-      real4 src = ms_slab_source_at(p, alt_p, i1h);
+      real d0;
+      real share;
+      real4 src = ms_slab_source_at(p, alt_p, i1h, d0, share);
       real mu_out = dot(d, up_p);
       real3 out_h = -d + mu_out * up_p;
       real3 beam_h = -u_to_sun + mu_sun * up_p;
@@ -822,9 +847,10 @@ CV_FN void march_sample(real3 p, real alt_p, real t, real ds, real t_entry, real
       real s_ice = si * (real(1.0) - f_ice);
       int phase = s_liquid >= s_ice ? 0 : 1;
       real ground_l;
-      real keep = ms_slab_keep(phase, src, mu0_slab, phase == 0 ? f_liquid : f_ice, ground_l);
+      real extra;
+      real keep = ms_slab_keep(phase, src, d0, share, mu0_slab, phase == 0 ? f_liquid : f_ice, ground_l, extra);
       real slab_light = ms_slab_in_scatter(phase, src.y, src.z, mu0_slab, mu_out, cos_phi, ground_l);
-      real j = (s_liquid + s_ice) * (keep * slab_light + max(src.x, real(0.0)));
+      real j = (s_liquid + s_ice) * (keep * slab_light + extra);
       // The light between the columns (the source's horizontal first moment; the slab has none
       // across its sun's azimuth and none from its neighbours) scattered by the truncated phase, as
       // the linear shape scatters it: sigma' g' I1 . (-d), sigma' g' = sigma (g - f) per phase.
@@ -1263,10 +1289,13 @@ CV_FN real4 sky_and_ground(real3 d, real3 cloud_l, real cloud_t, real behind_t, 
         // ground's light going up (counted as isotropic it made a bright ground under a cloud of
         // optical depth 2 5.5 % too bright).
         real3 i1h;
-        real4 src = ms_slab_source_at(pg, u_grid_start.z, i1h);
+        real d0;
+        real share;
+        real4 src = ms_slab_source_at(pg, u_grid_start.z, i1h, d0, share);
         real mu0g = max(mu_sg, real(CV_MS_SLAB_MU0_LO));
         real ground_l;
-        real keep = ms_slab_keep(0, src, mu0g, u_ms_f_liquid, ground_l);
+        real extra;
+        real keep = ms_slab_keep(0, src, d0, share, mu0g, u_ms_f_liquid, ground_l, extra);
         down = keep * (ms_slab_entry(0, src.y, src.z, mu0g, CV_MS_SLAB_FLUX_DOWN) +
                        ground_l * ms_slab_below_entry(0, src.y, src.z, CV_MS_SLAB_BELOW_FLUX_DOWN));
       }
