@@ -352,11 +352,7 @@ int cmd_bench(const std::vector<std::string>& args) {
       ref.spp = static_cast<int>(img.spp);
       ref.mean_rel_stderr = img.mean_relative_standard_error();
       ref_rgb = img.radiance();
-      ref_var.assign(ref_rgb.size(), 0.0);
-      for (std::size_t i = 0; i < ref_var.size(); ++i) {
-        const double se = img.luminance_standard_error(i);
-        ref_var[i] = std::isfinite(se) ? se * se : 0.0;
-      }
+      ref_var = img.luminance_variance();
       refs.push_back(ref);
     }
     fs::create_directories(fs::path(a.out) / name);

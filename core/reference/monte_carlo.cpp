@@ -59,6 +59,25 @@ double MonteCarloImage::luminance_standard_error(std::size_t i) const {
   return std::sqrt(std::max(lum_sq[i] - n * m * m, 0.0) / (n - 1.0) / n);
 }
 
+std::vector<double> MonteCarloImage::luminance_variance() const {
+  std::vector<double> var(lum_sum.size(), 0.0);
+  for (std::size_t i = 0; i < var.size(); ++i) {
+    const double se = luminance_standard_error(i);
+    var[i] = std::isfinite(se) ? se * se : 0.0;
+  }
+  return var;
+}
+
+double MonteCarloImage::image_mean_relative_error() const {
+  double lum = 0.0, var = 0.0;
+  for (std::size_t i = 0; i < lum_sum.size(); ++i) {
+    const double se = luminance_standard_error(i);
+    lum += luminance(i);
+    var += std::isfinite(se) ? se * se : 0.0;
+  }
+  return lum > 0.0 ? std::sqrt(var) / lum : 0.0;
+}
+
 double MonteCarloImage::mean_relative_standard_error(double floor_fraction) const {
   double top = 0.0;
   for (std::size_t i = 0; i < lum_sum.size(); ++i) top = std::max(top, luminance(i));

@@ -76,6 +76,12 @@ struct MonteCarloImage {
   // least `floor_fraction` of the image's largest (dark pixels have no meaningful relative error).
   double mean_relative_standard_error(double floor_fraction = 0.05) const;
   std::vector<glm::dvec3> radiance() const;  // the means
+  // Each pixel's luminance variance of the mean (the squared standard error; 0 where it is not
+  // finite, as before the second sample), as image_error takes it.
+  std::vector<double> luminance_variance() const;
+  // The image-mean luminance's relative standard error: sqrt(sum of the variances) / sum of the
+  // means (0 for a black image).
+  double image_mean_relative_error() const;
 };
 
 class MonteCarloRenderer {

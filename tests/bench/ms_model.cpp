@@ -96,15 +96,10 @@ int main(int argc, char** argv) {
         ref_dir.empty() ? cv::core::render_monte_carlo(sc.grid, ext, sc.camera, sc.sun, m, mc, spp)
                         : cv::bench::extend_reference(ref_dir, name, sc, ext, m, mc, spp, 0.0, nullptr, stderr).img;
     const std::vector<glm::dvec3> ref = img.radiance();
-    std::vector<double> var(ref.size());
-    double lum = 0.0, nvar = 0.0;
-    for (std::size_t i = 0; i < ref.size(); ++i) {
-      const double se = img.luminance_standard_error(i);
-      var[i] = std::isfinite(se) ? se * se : 0.0;
-      lum += img.luminance(i);
-      nvar += var[i];
-    }
-    std::printf("%-14s %10.4g %6.1f%% |", name.c_str(), lum / ref.size(), 100.0 * std::sqrt(nvar) / lum);
+    const std::vector<double> var = img.luminance_variance();
+    double lum = 0.0;
+    for (std::size_t i = 0; i < ref.size(); ++i) lum += img.luminance(i);
+    std::printf("%-14s %10.4g %6.1f%% |", name.c_str(), lum / ref.size(), 100.0 * img.image_mean_relative_error());
     std::vector<std::vector<glm::dvec3>> images;
     // The octave sum, the two-stream source with its diffuse light linear in angle, and shaped by
     // the slab tables.

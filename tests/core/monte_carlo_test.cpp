@@ -511,3 +511,36 @@ TEST(MonteCarlo, TheViewRaySeesTheAirInFrontOfTheGroundAsTheMarchDoes) {
 }
 
 }  // namespace cv::core
+
+namespace cv::core {
+// The image's variances and its mean's relative error, as the benches and tests take them: each
+// pixel's squared standard error (0 before a second sample, where it is not finite), and
+// sqrt(sum var) / sum mean.
+TEST(MonteCarlo, TheImagesVarianceAndItsMeansErrorFollowThePixels) {
+  MonteCarloImage img;
+  img.width = 3, img.height = 1, img.spp = 4;
+  img.sum.assign(3, glm::dvec3(0.0));
+  img.sum_sq.assign(3, glm::dvec3(0.0));
+  img.lum_sum = {2.0, 0.0, 6.0};
+  img.lum_sq = {1.5, 0.0, 10.0};
+  const std::vector<double> var = img.luminance_variance();
+  ASSERT_EQ(var.size(), 3u);
+  double lum = 0.0, v = 0.0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double se = img.luminance_standard_error(i);
+    ASSERT_TRUE(std::isfinite(se));
+    EXPECT_DOUBLE_EQ(var[i], se * se);
+    lum += img.luminance(i), v += se * se;
+  }
+  EXPECT_GT(var[0], 0.0);
+  EXPECT_EQ(var[1], 0.0);
+  EXPECT_DOUBLE_EQ(img.image_mean_relative_error(), std::sqrt(v) / lum);
+  img.spp = 1;  // one sample: no variance estimate
+  for (double x : img.luminance_variance()) EXPECT_EQ(x, 0.0);
+  MonteCarloImage black;
+  black.width = 1, black.height = 1, black.spp = 2;
+  black.sum.assign(1, glm::dvec3(0.0)), black.sum_sq.assign(1, glm::dvec3(0.0));
+  black.lum_sum = {0.0}, black.lum_sq = {0.0};
+  EXPECT_EQ(black.image_mean_relative_error(), 0.0);
+}
+}  // namespace cv::core
