@@ -7,7 +7,9 @@
 //
 //   J(mu, phi) = omega sum_m cos(m phi) sum_{l >= m} (2 l + 1) / 2 chi_l Lambda_l^m(mu) psi_lm(tau),
 //
-// follows from the moments psi_lm(tau) = int Lambda_l^m(mu') I^m(tau, mu') dmu' (l <= 7: 36 numbers).
+// follows from the moments psi_lm(tau) = int Lambda_l^m(mu') I^m(tau, mu') dmu' (to any degree; the
+// march's tables keep degree 15 in the azimuthal mean and 7 for m = 1..7: 44 numbers,
+// shaders/kernel/ms_slab.glsl).
 //
 // Conventions: tau is the optical depth from the top, down; mu the cosine of a direction of travel to
 // the downward vertical (mu > 0 travels down, into the slab); phi the azimuth of the direction of
