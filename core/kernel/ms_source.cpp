@@ -576,7 +576,7 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
   }
   parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
     std::vector<double> sigma(static_cast<std::size_t>(nz)), g(static_cast<std::size_t>(nz)), col_beam(static_cast<std::size_t>(nz)),
-        col_above(static_cast<std::size_t>(nz));
+        col_scaled(static_cast<std::size_t>(nz));
     for (std::size_t jj = jb; jj < je; ++jj) {
       const int j = static_cast<int>(jj);
       for (int i = 0; i < nx; ++i) {
@@ -625,23 +625,43 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
           // -mu0 ln(beam) / (1 - g^2) (mu0 as the table reads it), at most the column's optical
           // depth (the trapezoid between levels): in a horizontally uniform cloud the depth from the
           // top, on a cloud's sunlit side near 0 (its light there is the newly scattered beam's), in
-          // a shadow deep; below it the column's depth under it. (The slab a node is measured against
-          // here thus holds t + b; the march reads the table at the column's depth less t below.
-          // Measured against that slab instead, the cumulus field went from -16 to -60 % and the
-          // towering cell from -3 to -19 %: BENCHMARKS.)
-          double total = 0.0;
-          std::vector<double>& above = col_above;  // the depth from the column's top
+          // a shadow deep; below it the column's depth under it in the node's own phase, by
+          // similarity: sum (1 - g_k^2) dtau_k / (1 - g^2), so that ice over water reads an ice slab
+          // that reflects as the water under it does (the raw depth made ice of the water, and the
+          // orbit's tropical columns 7 % bright; a clear node takes the g of its column's nearest
+          // cloudy node). (The slab a node is measured against here thus holds t + b; the march reads
+          // the table at the column's depth less t below. Measured against that slab instead, the
+          // cumulus field went from -16 to -60 % and the towering cell from -3 to -19 %: BENCHMARKS.)
+          double total = 0.0, total_scaled = 0.0;
+          std::vector<double>& above_scaled = col_scaled;  // the depth from the column's top in (1 - g^2) dtau
           for (int k = nz - 1; k >= 0; --k) {
-            if (k < nz - 1) total += 0.5 * (sigma[static_cast<std::size_t>(k)] + sigma[static_cast<std::size_t>(k + 1)]) * grid.alt_m.step;
-            above[static_cast<std::size_t>(k)] = total;
+            const std::size_t K = static_cast<std::size_t>(k);
+            if (k < nz - 1) {
+              total += 0.5 * (sigma[K] + sigma[K + 1]) * grid.alt_m.step;
+              total_scaled += 0.5 * (sigma[K] * (1.0 - g[K] * g[K]) + sigma[K + 1] * (1.0 - g[K + 1] * g[K + 1])) * grid.alt_m.step;
+            }
+            above_scaled[K] = total_scaled;
           }
           const double mu0c = std::max(std::abs(mu0), double(CV_MS_SLAB_MU0_LO));
           for (int k = 0; k < nz; ++k) {
             const std::size_t a = grid.index(i, j, k);
             const std::size_t K = static_cast<std::size_t>(below ? nz - 1 - k : k);
             const double gk = g[K], e = std::clamp(double(col_beam[K]), 1e-300, 1.0);
+            double gb = gk;  // the phase the node's depth below is counted in
+            for (int dk = 1; !(sigma[K] > 0.0) && dk < nz; ++dk) {
+              const int k1 = static_cast<int>(K) - dk, k2 = static_cast<int>(K) + dk;
+              if (k1 >= 0 && sigma[static_cast<std::size_t>(k1)] > 0.0) {
+                gb = g[static_cast<std::size_t>(k1)];
+                break;
+              }
+              if (k2 < nz && sigma[static_cast<std::size_t>(k2)] > 0.0) {
+                gb = g[static_cast<std::size_t>(k2)];
+                break;
+              }
+              if (k1 < 0 && k2 >= nz) break;
+            }
             out.tau_above[a] = static_cast<float>(std::min(-mu0c * std::log(e) / (1.0 - gk * gk), total));
-            out.tau_below[a] = static_cast<float>(std::max(total - above[K], 0.0));
+            out.tau_below[a] = static_cast<float>(std::max(total_scaled - above_scaled[K], 0.0) / (1.0 - gb * gb));
             out.sigma[a] = static_cast<float>(sigma[K]);
           }
         }

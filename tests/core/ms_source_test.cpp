@@ -585,6 +585,38 @@ TEST(TwoStream, TheSlabShapesFieldsMeasureEachNodeAgainstItsSlab) {
     EXPECT_LT(std::abs(uni.slab_excess[a]), 0.03 * uni.i0[a]) << "level " << k;
   }
 
+  // Ice over the layer (nodes 3.5-5 km, 0.002 /m): an ice node's depth below counts the water in
+  // ice's terms by similarity, (1 - g_water^2) tau_water / (1 - g_ice^2), and its own ice below as
+  // it is; the water's nodes keep their raw depth below (only water under them).
+  TimeStepData iced = layer;
+  iced[Field::ExtinctionIce].assign(g.points(), 0.0f);
+  for (int k = 0; k < g.alt_m.count; ++k) {
+    const double z = g.alt_m.at(k);
+    if (z < 3500.0 || z > 5000.0) continue;
+    for (int j = 0; j < g.lat_deg.count; ++j)
+      for (int i = 0; i < g.lon_deg.count; ++i) iced[Field::ExtinctionIce][g.index(i, j, k)] = 0.002f;
+  }
+  const MsSourceKey iced_key = ms_source_key(s, sun30);
+  ASSERT_LT(iced_key.ice_g, iced_key.liquid_g);
+  const MsSource ice_over = build_ms_source(prepare_volume(g, iced), iced_key);
+  const double water_as_ice = 17.5 * (1.0 - iced_key.liquid_g * iced_key.liquid_g) / (1.0 - iced_key.ice_g * iced_key.ice_g);
+  int ice_nodes = 0, water_nodes = 0;
+  for (int k = 0; k < g.alt_m.count; ++k) {
+    const double z = g.alt_m.at(k);
+    const std::size_t a = g.index(ic, jc, k);
+    if (z >= 3500.0 && z <= 5000.0) {
+      const double b = water_as_ice + 0.25 + 0.002 * (z - 3500.0);
+      EXPECT_NEAR(ice_over.tau_below[a], b, 1e-3 * b) << "level " << k;
+      ++ice_nodes;
+    } else if (z >= 1500.0 && z <= 3000.0) {
+      const double b = 1.25 + 0.01 * (z - 1500.0);
+      EXPECT_NEAR(ice_over.tau_below[a], b, 1e-3 * b) << "level " << k;
+      ++water_nodes;
+    }
+  }
+  EXPECT_GE(ice_nodes, 4);
+  EXPECT_GE(water_nodes, 4);
+
   // A volume with no cloud at all still has all four fields (zero), as the textures take them.
   TimeStepData none;
   none[Field::ExtinctionLiquid].assign(g.points(), 0.0f);
