@@ -305,6 +305,45 @@ TEST(Lateral, TheSourceTakesTheLightBetweenItsColumns) {
   EXPECT_TRUE(ms_horizontal_texels(columns).empty());
 }
 
+// The fringe's light falls with the columns' spacing against the cloud's height: a block of cloud
+// 1-3 km up (its levels' span and a level: 2.25 km high), 5 x 5 columns. On columns 1.1 km apart
+// the clear column east of it takes its cloudy neighbours' mean at each level (the side's light
+// reaches it whole); on columns 111 km apart (a global model's), about H / dx of it (a fringe 50
+// cloud heights wide is its own thin column's: there, 2 to 3 % of the edge's light).
+TEST(Lateral, TheFringesLightFallsWithTheColumnsSpacing) {
+  for (const double step : {0.01, 1.0}) {
+    VolumeGrid g;
+    g.lon_deg = {-10.0 * step, step, 21};
+    g.lat_deg = {-10.0 * step, step, 21};
+    g.alt_m = {500.0, 250.0, 17};
+    TimeStepData d;
+    d[Field::ExtinctionLiquid].assign(g.points(), 0.0f);
+    for (int k = 0; k < g.alt_m.count; ++k)
+      for (int j = 8; j <= 12; ++j)
+        for (int i = 8; i <= 12; ++i)
+          if (g.alt_m.at(k) >= 1000.0 && g.alt_m.at(k) <= 3000.0) d[Field::ExtinctionLiquid][g.index(i, j, k)] = 0.02f;
+    MarchSettings s;
+    const glm::dvec3 to_sun = glm::normalize(glm::dvec3(1.0, 0.1, 0.2));  // over (0, 0), whose up is +x
+    const MsSourceKey key = ms_source_key(s, to_sun);
+    ASSERT_TRUE(key.lateral);
+    const MsSource src = build_ms_source(prepare_volume(g, d), key);
+    int levels = 0;
+    for (int k = 2; k <= 10; ++k) {  // 1-3 km
+      const double mean = (src.i0[g.index(12, 9, k)] + src.i0[g.index(12, 10, k)] + src.i0[g.index(12, 11, k)]) / 3.0;
+      ASSERT_GT(mean, 0.0) << "level " << k;
+      const double ratio = src.i0[g.index(13, 10, k)] / mean;
+      if (step < 0.1) {
+        EXPECT_NEAR(ratio, 1.0, 1e-5) << "level " << k;
+      } else {
+        EXPECT_GT(ratio, 0.01) << "level " << k;
+        EXPECT_LT(ratio, 0.03) << "level " << k;
+      }
+      ++levels;
+    }
+    EXPECT_EQ(levels, 9);
+  }
+}
+
 // What `render` says when the columns stay on their own: the reason, not a budget the grid is within.
 TEST(Lateral, SaysWhyTheColumnsStayOnTheirOwn) {
   MsSourceKey key;
