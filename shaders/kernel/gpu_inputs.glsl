@@ -54,6 +54,8 @@ layout(std430, binding = CV_SSBO_MS_BEAM) readonly buffer MsBeam { float u_ms_be
 // The higher-order source's slab table (core/kernel/ms_slab ms_slab_table), liquid then ice.
 #include "../kernel/ms_slab.glsl"
 layout(std430, binding = CV_SSBO_MS_SLAB) readonly buffer MsSlab { float u_ms_slab_table[]; };
+// The same buffer four numbers at a time (its cells start on four: ms_slab.glsl).
+layout(std430, binding = CV_SSBO_MS_SLAB) readonly buffer MsSlab4 { vec4 u_ms_slab_table4[]; };
 // Per-frame counters (MarchStats), each as (low, high) 32-bit words.
 layout(std430, binding = CV_SSBO_STATS) buffer Stats { uint u_stats[]; };
 uint g_stats[CV_STAT_COUNT] = uint[CV_STAT_COUNT](0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u);

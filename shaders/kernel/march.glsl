@@ -405,10 +405,20 @@ CV_FN real4 ms_slab_source_at(real3 p, real alt_m, CV_OUT(real3) i1h, CV_OUT(rea
 // of phase `phase` (0 liquid, 1 ice) trilinear in the depths above and below (t, b) and the sun's
 // cosine mu0 (docs/physics.md, "The higher-order source").
 CV_FN real ms_slab_table_at(int i) { return real(u_ms_slab_table[i]); }
+#ifdef __cplusplus
+CV_FN real4 ms_slab_table4_at(int i) {
+  return real4(real(u_ms_slab_table[i]), real(u_ms_slab_table[i + 1]), real(u_ms_slab_table[i + 2]), real(u_ms_slab_table[i + 3]));
+}
+#else
+CV_FN real4 ms_slab_table4_at(int i) { return real4(u_ms_slab_table4[i >> 2]); }
+#endif
 #if CV_MS_SLAB_MOMENTS != 44
 #error "ms_slab_in_scatter writes out 44 products"
 #endif
-#define CV_MS_SLAB_DOT4(B, Y, I) (ms_slab_table_at(B + I) * Y[I] + ms_slab_table_at(B + I + 1) * Y[I + 1] + ms_slab_table_at(B + I + 2) * Y[I + 2] + ms_slab_table_at(B + I + 3) * Y[I + 3])
+#if CV_MS_SLAB_STRIDE % 4 != 0 || CV_MS_SLAB_BELOW_STRIDE % 4 != 0
+#error "the slab table's cells are read four numbers at a time"
+#endif
+#define CV_MS_SLAB_DOT4(B, Y, I) dot(ms_slab_table4_at(B + I), real4(Y[I], Y[I + 1], Y[I + 2], Y[I + 3]))
 // The table cell of depths t above and b below under a sun at mu0 (its lower corner) and the
 // weights toward the next, in u = t / (t + T0), v and mu0.
 CV_FN void ms_slab_cell(real t, real b, real mu0, CV_OUT(ivec3) c0, CV_OUT(real3) w) {
@@ -526,8 +536,8 @@ CV_FN real ms_slab_in_scatter(int phase, real t, real b, real mu0, real mu, real
     int ds = corner >> 2;
     real w = (du == 1 ? wc.x : real(1.0) - wc.x) * (dv == 1 ? wc.y : real(1.0) - wc.y) * (ds == 1 ? wc.z : real(1.0) - wc.z);
     int b = phase * CV_MS_SLAB_PHASE_SIZE + (((cell.z + ds) * CV_MS_SLAB_DEPTHS + cell.y + dv) * CV_MS_SLAB_DEPTHS + cell.x + du) * CV_MS_SLAB_STRIDE;
-    // The 44 products written out: llvmpipe counts every loop iteration against its budget
-    // (loop_iterations_per_view_step), and an inner loop here cost 352 a sample.
+    // The 44 products written out, four at a time: llvmpipe counts every loop iteration against
+    // its budget (loop_iterations_per_view_step), and an inner loop here cost 352 a sample.
     real dotp = CV_MS_SLAB_DOT4(b, y, 0) + CV_MS_SLAB_DOT4(b, y, 4) + CV_MS_SLAB_DOT4(b, y, 8) + CV_MS_SLAB_DOT4(b, y, 12) +
                 CV_MS_SLAB_DOT4(b, y, 16) + CV_MS_SLAB_DOT4(b, y, 20) + CV_MS_SLAB_DOT4(b, y, 24) + CV_MS_SLAB_DOT4(b, y, 28) +
                 CV_MS_SLAB_DOT4(b, y, 32) + CV_MS_SLAB_DOT4(b, y, 36) + CV_MS_SLAB_DOT4(b, y, 40);

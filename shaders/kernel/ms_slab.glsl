@@ -20,7 +20,9 @@
 // (ms_slab_two_stream_i0), against which the source's I0 is measured.
 #define CV_MS_SLAB_FLUX_DOWN CV_MS_SLAB_MOMENTS
 #define CV_MS_SLAB_TWO_STREAM_I0 (CV_MS_SLAB_MOMENTS + 1)
-#define CV_MS_SLAB_STRIDE (CV_MS_SLAB_MOMENTS + 2)
+// (two numbers of padding: a cell starts on four numbers, which the march reads as one vec4, 11
+// reads instead of 44 a corner: on llvmpipe the slab shape's frame 2.0 -> 1.7x the octave sum's)
+#define CV_MS_SLAB_STRIDE (CV_MS_SLAB_MOMENTS + 4)
 #define CV_MS_SLAB_PHASE_SIZE (CV_MS_SLAB_SUNS * CV_MS_SLAB_DEPTHS * CV_MS_SLAB_DEPTHS * CV_MS_SLAB_STRIDE)
 // After both phases' blocks, per phase the slab lit from below by isotropic radiance 1 (a ground's
 // light; no sun, so no mu0): per (b, t) cell the azimuthal mean's moments to degree CV_MS_SLAB_BELOW_L
@@ -29,7 +31,7 @@
 #define CV_MS_SLAB_BELOW_L 15
 #define CV_MS_SLAB_BELOW_FLUX_DOWN (CV_MS_SLAB_BELOW_L + 1)
 #define CV_MS_SLAB_BELOW_TWO_STREAM_I0 (CV_MS_SLAB_BELOW_L + 2)
-#define CV_MS_SLAB_BELOW_STRIDE (CV_MS_SLAB_BELOW_L + 3)
+#define CV_MS_SLAB_BELOW_STRIDE (CV_MS_SLAB_BELOW_L + 5)  // (two of padding, as above)
 #define CV_MS_SLAB_BELOW_SIZE (CV_MS_SLAB_DEPTHS * CV_MS_SLAB_DEPTHS * CV_MS_SLAB_BELOW_STRIDE)
 #define CV_MS_SLAB_BELOW_OFFSET (2 * CV_MS_SLAB_PHASE_SIZE)
 #define CV_MS_SLAB_TOTAL (2 * (CV_MS_SLAB_PHASE_SIZE + CV_MS_SLAB_BELOW_SIZE))
