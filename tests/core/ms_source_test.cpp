@@ -562,14 +562,18 @@ TEST(TwoStream, TheSlabShapesFieldsMeasureEachNodeAgainstItsSlab) {
 
   // A layer uniform across the grid, nodes 1.5-3 km (with the linear ramps to the clear nodes 250 m
   // beyond, optical depth 17.5); the sun 30 degrees from the zenith.
+  // The nodes from z_lo to z_hi m of `field`, all columns, at `value` /m (the rest 0).
+  auto fill_layer = [&g](TimeStepData& d, Field field, double z_lo, double z_hi, float value) {
+    d[field].assign(g.points(), 0.0f);
+    for (int k = 0; k < g.alt_m.count; ++k) {
+      const double z = g.alt_m.at(k);
+      if (z < z_lo || z > z_hi) continue;
+      for (int j = 0; j < g.lat_deg.count; ++j)
+        for (int i = 0; i < g.lon_deg.count; ++i) d[field][g.index(i, j, k)] = value;
+    }
+  };
   TimeStepData layer;
-  layer[Field::ExtinctionLiquid].assign(g.points(), 0.0f);
-  for (int k = 0; k < g.alt_m.count; ++k) {
-    const double z = g.alt_m.at(k);
-    if (z < 1500.0 || z > 3000.0) continue;
-    for (int j = 0; j < g.lat_deg.count; ++j)
-      for (int i = 0; i < g.lon_deg.count; ++i) layer[Field::ExtinctionLiquid][g.index(i, j, k)] = 0.01f;
-  }
+  fill_layer(layer, Field::ExtinctionLiquid, 1500.0, 3000.0, 0.01f);
   const double z30 = 30.0 * 3.14159265358979 / 180.0;
   const glm::dvec3 sun30 = std::cos(z30) * glm::dvec3(1.0, 0.0, 0.0) + std::sin(z30) * glm::dvec3(0.0, 0.0, 1.0);  // over (0, 0)
   const MsSource uni = build_ms_source(prepare_volume(g, layer), ms_source_key(s, sun30));
@@ -589,13 +593,7 @@ TEST(TwoStream, TheSlabShapesFieldsMeasureEachNodeAgainstItsSlab) {
   // ice's terms by similarity, (1 - g_water^2) tau_water / (1 - g_ice^2), and its own ice below as
   // it is; the water's nodes keep their raw depth below (only water under them).
   TimeStepData iced = layer;
-  iced[Field::ExtinctionIce].assign(g.points(), 0.0f);
-  for (int k = 0; k < g.alt_m.count; ++k) {
-    const double z = g.alt_m.at(k);
-    if (z < 3500.0 || z > 5000.0) continue;
-    for (int j = 0; j < g.lat_deg.count; ++j)
-      for (int i = 0; i < g.lon_deg.count; ++i) iced[Field::ExtinctionIce][g.index(i, j, k)] = 0.002f;
-  }
+  fill_layer(iced, Field::ExtinctionIce, 3500.0, 5000.0, 0.002f);
   const MsSourceKey iced_key = ms_source_key(s, sun30);
   ASSERT_LT(iced_key.ice_g, iced_key.liquid_g);
   const MsSource ice_over = build_ms_source(prepare_volume(g, iced), iced_key);
