@@ -7,7 +7,7 @@
 // Greenstein phases of the source's own g (the source knows no more of the phase than g). Photons
 // enter through the grid's top (uniform in area, weighted by the sun's cosine there), so a sun low
 // enough to light the grid through its sides is not measured; clouds only (no ground, no air).
-// usage: bench_fluence [--photons N] [--levels] [--columns] [SCENE...]
+// usage: bench_fluence [--photons N] [--levels] [--columns] [--box F] [SCENE...]
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -57,18 +57,26 @@ glm::dvec3 scatter_hg(const glm::dvec3& d, double g, Rng& rng) {
 
 int main(int argc, char** argv) {
   int photons = 400000;
+  std::vector<double> boxes{1.0};
   bool levels = false, by_column = false;
   std::vector<std::string> scenes;
   namespace ba = cv::bench_args;
   const int code = ba::parse("bench_fluence",
-                             "usage: bench_fluence [--photons N] [--levels] [--columns] [SCENE...]\n"
+                             "usage: bench_fluence [--photons N] [--levels] [--columns] [--box F] [SCENE...]\n"
                              "  the two-stream source's fluence per node (its scaled beam plus 4 pi I0) against a Monte\n"
                              "  Carlo's (collision estimator, Henyey-Greenstein phases of the source's g), clouds only\n"
                              "  --photons N  photons per scene (default 400000)\n"
                              "  --levels     print each level's sums, not only the scene's\n"
-                             "  --columns    and the sums over columns in bins of their optical depth\n",
-                             argc, argv, {ba::integer("--photons", photons), ba::flag("--levels", levels), ba::flag("--columns", by_column)}, &scenes);
+                             "  --columns    and the sums over columns in bins of their optical depth\n"
+                             "  --box F      count the collisions within F of a cell around each node (0 < F <= 1, default 1):\n"
+                             "               a smaller box measures nearer the node where the light curves across a cell\n",
+                             argc, argv, {ba::integer("--photons", photons), ba::flag("--levels", levels), ba::flag("--columns", by_column), ba::numbers("--box", boxes)}, &scenes);
   if (code >= 0) return code;
+  if (boxes.size() != 1 || !(boxes[0] > 0.0 && boxes[0] <= 1.0)) {
+    std::fprintf(stderr, "bench_fluence: --box: expected one fraction of a cell in (0, 1]\n");
+    return 2;
+  }
+  const double box = boxes[0];
   if (photons < 1000) {
     std::fprintf(stderr, "bench_fluence: --photons: found %d, expected at least 1000\n", photons);
     return 2;
@@ -180,7 +188,7 @@ int main(int argc, char** argv) {
             }
             const std::size_t a = g.index(std::clamp(static_cast<int>(std::lround(fi)) % nx, 0, nx - 1), std::clamp(static_cast<int>(std::lround(fj)), 0, ny - 1),
                                           std::clamp(static_cast<int>(std::lround(fk)), 0, nz - 1));
-            tally[a] += w;
+            if (std::abs(fi - std::round(fi)) <= 0.5 * box && std::abs(fj - std::round(fj)) <= 0.5 * box && std::abs(fk - std::round(fk)) <= 0.5 * box) tally[a] += w;
             double sl, si;
             medium(fi, fj, fk, sl, si);
             if (rng.uniform() * majorant >= sl + si) continue;  // a null collision
@@ -208,7 +216,7 @@ int main(int argc, char** argv) {
           if (!(s > 0.0)) continue;
           double mc = 0.0;
           for (const auto& tl : tallies) mc += tl[a];
-          mc /= majorant * vol * ((!wraps && (i == 0 || i == nx - 1)) ? 0.5 : 1.0);
+          mc /= majorant * vol * box * box * box * ((!wraps && (i == 0 || i == nx - 1)) ? 0.5 : 1.0);
           const double model = double(beam[a]) + 4.0 * kPi * double(src.i0[a]);
           lv[0] += mc, lv[1] += model, lv[2] += s * mc, lv[3] += s * model;
         }
@@ -247,7 +255,7 @@ int main(int argc, char** argv) {
                                ((!wraps && (i == 0 || i == nx - 1)) ? 0.5 : 1.0);
             double mc = 0.0;
             for (const auto& tl : tallies) mc += tl[a];
-            mc /= majorant * vol;
+            mc /= majorant * vol * box * box * box;
             const double model = double(beam[a]) + 4.0 * kPi * double(src.i0[a]);
             bins[b][0] += mc, bins[b][1] += model, bins[b][2] += s * mc, bins[b][3] += s * model;
           }
