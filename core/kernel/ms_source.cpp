@@ -577,6 +577,7 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
   parallel_ranges(static_cast<std::size_t>(ny), 8, [&](std::size_t jb, std::size_t je, unsigned) {
     std::vector<double> sigma(static_cast<std::size_t>(nz)), g(static_cast<std::size_t>(nz)), col_beam(static_cast<std::size_t>(nz)),
         col_scaled(static_cast<std::size_t>(nz));
+    std::vector<int> cloudy_below(static_cast<std::size_t>(nz)), cloudy_above(static_cast<std::size_t>(nz));
     for (std::size_t jj = jb; jj < je; ++jj) {
       const int j = static_cast<int>(jj);
       for (int i = 0; i < nx; ++i) {
@@ -642,23 +643,28 @@ MsSource build_ms_source(const PreparedVolume& v, const MsSourceKey& key) {
             }
             above_scaled[K] = total_scaled;
           }
+          // Each level's nearest cloudy level at or below it and at or above it (-1: none).
+          for (int k = 0, last = -1; k < nz; ++k) {
+            if (sigma[static_cast<std::size_t>(k)] > 0.0) last = k;
+            cloudy_below[static_cast<std::size_t>(k)] = last;
+          }
+          for (int k = nz - 1, last = -1; k >= 0; --k) {
+            if (sigma[static_cast<std::size_t>(k)] > 0.0) last = k;
+            cloudy_above[static_cast<std::size_t>(k)] = last;
+          }
           const double mu0c = std::max(std::abs(mu0), double(CV_MS_SLAB_MU0_LO));
           for (int k = 0; k < nz; ++k) {
             const std::size_t a = grid.index(i, j, k);
             const std::size_t K = static_cast<std::size_t>(below ? nz - 1 - k : k);
             const double gk = g[K], e = std::clamp(double(col_beam[K]), 1e-300, 1.0);
             double gb = gk;  // the phase the node's depth below is counted in
-            for (int dk = 1; !(sigma[K] > 0.0) && dk < nz; ++dk) {
-              const int k1 = static_cast<int>(K) - dk, k2 = static_cast<int>(K) + dk;
-              if (k1 >= 0 && sigma[static_cast<std::size_t>(k1)] > 0.0) {
-                gb = g[static_cast<std::size_t>(k1)];
-                break;
+            if (!(sigma[K] > 0.0)) {
+              const int kb = cloudy_below[K], ka = cloudy_above[K], kk = static_cast<int>(K);
+              if (kb >= 0 && (ka < 0 || kk - kb <= ka - kk)) {
+                gb = g[static_cast<std::size_t>(kb)];
+              } else if (ka >= 0) {
+                gb = g[static_cast<std::size_t>(ka)];
               }
-              if (k2 < nz && sigma[static_cast<std::size_t>(k2)] > 0.0) {
-                gb = g[static_cast<std::size_t>(k2)];
-                break;
-              }
-              if (k1 < 0 && k2 >= nz) break;
             }
             out.tau_above[a] = static_cast<float>(std::min(-mu0c * std::log(e) / (1.0 - gk * gk), total));
             out.tau_below[a] = static_cast<float>(std::max(total_scaled - above_scaled[K], 0.0) / (1.0 - gb * gb));
