@@ -598,7 +598,7 @@ TEST(TwoStream, TheSlabShapesFieldsMeasureEachNodeAgainstItsSlab) {
   ASSERT_LT(iced_key.ice_g, iced_key.liquid_g);
   const MsSource ice_over = build_ms_source(prepare_volume(g, iced), iced_key);
   const double water_as_ice = 17.5 * (1.0 - iced_key.liquid_g * iced_key.liquid_g) / (1.0 - iced_key.ice_g * iced_key.ice_g);
-  int ice_nodes = 0, water_nodes = 0;
+  int ice_nodes = 0, water_nodes = 0, clear_nodes = 0;
   for (int k = 0; k < g.alt_m.count; ++k) {
     const double z = g.alt_m.at(k);
     const std::size_t a = g.index(ic, jc, k);
@@ -610,8 +610,17 @@ TEST(TwoStream, TheSlabShapesFieldsMeasureEachNodeAgainstItsSlab) {
       const double b = 1.25 + 0.01 * (z - 1500.0);
       EXPECT_NEAR(ice_over.tau_below[a], b, 1e-3 * b) << "level " << k;
       ++water_nodes;
+    } else if (z == 3250.0) {
+      // A clear node counts in its nearest cloudy node's phase, the one below at a tie: the water.
+      EXPECT_NEAR(ice_over.tau_below[a], 17.5, 1e-3 * 17.5) << "level " << k;
+      ++clear_nodes;
+    } else if (z == 5250.0) {
+      // Above the ice's top: the ice's (0.002 /m over 1.5 km and its two ramps, 3.5).
+      EXPECT_NEAR(ice_over.tau_below[a], water_as_ice + 3.5, 1e-3 * (water_as_ice + 3.5)) << "level " << k;
+      ++clear_nodes;
     }
   }
+  EXPECT_EQ(clear_nodes, 2);
   EXPECT_GE(ice_nodes, 4);
   EXPECT_GE(water_nodes, 4);
 
